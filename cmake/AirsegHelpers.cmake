@@ -1,0 +1,40 @@
+# Shared compile settings for every airseg target.
+add_library(airseg_options INTERFACE)
+target_compile_features(airseg_options INTERFACE cxx_std_20)
+target_include_directories(airseg_options INTERFACE ${PROJECT_SOURCE_DIR} ${PROJECT_BINARY_DIR}/generated)
+target_compile_options(airseg_options INTERFACE -Wall -Wextra -Wpedantic)
+if(AIRSEG_WERROR)
+  target_compile_options(airseg_options INTERFACE -Werror)
+endif()
+# Boost.Asio is header-only here; keep its deprecated API out so the code stays portable to newer Boost.
+target_compile_definitions(airseg_options INTERFACE BOOST_ASIO_NO_DEPRECATED BOOST_ASIO_NO_TS_EXECUTORS
+                                                    AIRSEG_VERSION="${PROJECT_VERSION}")
+if(AIRSEG_SANITIZE)
+  target_compile_options(airseg_options INTERFACE -fsanitize=${AIRSEG_SANITIZE} -fno-omit-frame-pointer)
+  target_link_options(airseg_options INTERFACE -fsanitize=${AIRSEG_SANITIZE})
+endif()
+
+# airseg_add_library(NAME SOURCES... [LIBS ...])
+function(airseg_add_library name)
+  cmake_parse_arguments(A "" "" "SOURCES;LIBS" ${ARGN})
+  add_library(${name} STATIC ${A_SOURCES})
+  target_link_libraries(${name} PUBLIC airseg_options ${A_LIBS})
+endfunction()
+
+# airseg_add_test(NAME SOURCES... [LIBS ...] [LABELS ...] [TIMEOUT seconds])
+# One GoogleTest executable whose cases ctest discovers one by one.
+function(airseg_add_test name)
+  cmake_parse_arguments(A "" "TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  if(NOT AIRSEG_BUILD_TESTS)
+    return()
+  endif()
+  if(NOT A_TIMEOUT)
+    set(A_TIMEOUT 60)
+  endif()
+  add_executable(${name} ${A_SOURCES})
+  target_link_libraries(${name} PRIVATE airseg_options GTest::gtest GTest::gtest_main GTest::gmock ${A_LIBS})
+  target_compile_definitions(${name} PRIVATE AIRSEG_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+                                             AIRSEG_BINARY_DIR="${PROJECT_BINARY_DIR}")
+  gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60
+                       PROPERTIES TIMEOUT ${A_TIMEOUT} LABELS "${A_LABELS}")
+endfunction()
