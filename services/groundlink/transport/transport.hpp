@@ -1,0 +1,241 @@
+#pragma once
+// The ground-link transport core: a sans-IO protocol engine for one end of the air↔ground serial link.
+// Byte layouts, state machines, timers and every parameter are described in docs/ground-link.md.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <ostream>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "services/common/time.hpp"
+
+namespace airseg::groundlink {
+
+inline constexpr std::size_t kMaxPaths = 2;
+inline constexpr std::size_t kMaxPriorities = 8;
+inline constexpr std::size_t kKeyBytes = 32;
+inline constexpr std::size_t kMaxFragments = 255;
+/// Largest Safe window: the selective-acknowledgement bitmap covers this many segments.
+inline constexpr std::size_t kMaxSafeWindow = 128;
+
+/// How the core spreads traffic over its paths (serial radio pairs).
+enum class PathMode : std::uint8_t {
+    single,     ///< one path carries both directions
+    split,      ///< each end transmits on its own path (split_tx_path); falls back to the other when it goes
+                ///< silent
+    redundant,  ///< every frame goes on every live path; the receiver drops the duplicates
+};
+
+enum class MessageClass : std::uint8_t {
+    safe,  ///< exactly once, in order per priority channel, retransmitted until acknowledged
+    fast,  ///< best effort, freshest value wins per topic, never retransmitted
+};
+
+/// Every field has its YAML key (under `groundlink.transport`) next to it. Durations are std::chrono
+/// durations.
+struct TransportConfig {
+    double link_rate_bytes_per_s = 5760.0;  ///< link_rate: bytes/s the core may write to each path (pacing)
+    std::size_t paths = 1;                  ///< paths: 1 or 2 serial radio pairs
+    PathMode path_mode = PathMode::single;  ///< path_mode: single | split | redundant
+    std::size_t split_tx_path = 0;  ///< split_tx_path: this end's transmit path in split mode (peer: other)
+    /// half_duplex: bytes received on a path consume that path's pacing budget too (radios share air time).
+    bool half_duplex = true;
+
+    std::size_t max_frame_payload = 1024;  ///< max_frame_payload: chunk bytes per frame on a clean link
+    std::size_t min_frame_payload = 48;    ///< min_frame_payload: floor of the adaptive frame size
+    bool adaptive_frame_size = true;  ///< adaptive_frame_size: shrink frames as the peer measures corruption
+    /// latency_frame_payload: frame ceiling while traffic above the lowest priority is active, so one frame
+    /// of bulk never holds an urgent message back by more than this many bytes of air time.
+    std::size_t latency_frame_payload = 192;
+    Duration latency_hold =
+        std::chrono::seconds(2);  ///< latency_hold: how long that ceiling stays after such traffic
+
+    std::size_t priorities = 4;  ///< priorities: levels 0 (highest: control) .. priorities-1 (bulk)
+    /// min_share: fraction of the link each priority gets when it has traffic, even under higher-priority
+    /// load.
+    std::array<double, kMaxPriorities> min_share{0.0, 0.05, 0.05, 0.05, 0.05, 0.05, 0.05, 0.05};
+
+    std::size_t safe_window = 64;  ///< safe_window: Safe segments in flight per channel (≤ 128)
+    std::size_t safe_queue_bytes =
+        256 * 1024;  ///< safe_queue_bytes: queued + in-flight Safe bytes per channel
+    std::size_t max_message_size = 64 * 1024;  ///< max_message_size: largest message either class accepts
+    double retransmit_share = 0.3;  ///< retransmit_share: link share retransmissions may take from others
+    Duration ack_delay = std::chrono::milliseconds(100);  ///< ack_delay: longest wait before acknowledging
+    std::size_t ack_every = 4;  ///< ack_every: acknowledge at once after this many segments
+    Duration rto_initial = std::chrono::milliseconds(1000);  ///< rto_initial: before any round-trip sample
+    Duration rto_min = std::chrono::milliseconds(250);       ///< rto_min
+    Duration rto_max = std::chrono::milliseconds(2000);      ///< rto_max: cap of the exponential backoff
+
+    std::size_t fast_queue_cap = 16;  ///< fast_queue_cap: per priority, oldest dropped
+    Duration fast_reassembly_timeout = std::chrono::milliseconds(1000);  ///< fast_reassembly_timeout
+
+    Duration keepalive_interval =
+        std::chrono::milliseconds(500);                        ///< keepalive_interval: idle path probe period
+    Duration hello_interval = std::chrono::milliseconds(500);  ///< hello_interval: handshake retry period
+    Duration link_down_after = std::chrono::seconds(3);        ///< link_down_after: silence that marks down
+    std::size_t link_up_frames = 2;  ///< link_up_frames: valid frames needed to mark a path/link up again
+
+    std::size_t delivery_queue_cap = 1024;  ///< delivery_queue_cap: messages waiting for poll_message()
+
+    /// key: pre-shared 32-byte key (from key_file, read by the adapter). Without it frames carry no MAC and
+    /// LinkStats::authenticated is false.
+    std::optional<std::array<std::uint8_t, kKeyBytes>> key;
+    /// Random per process start, supplied by the adapter (the core never reads randomness). Must not be 0.
+    std::uint64_t boot_nonce = 1;
+
+    /// Every problem, each naming the field; empty when the configuration is usable.
+    [[nodiscard]] std::vector<std::string> validate() const;
+};
+
+enum class SendResult : std::uint8_t {
+    accepted,
+    replaced,        ///< Fast: an unsent message of the same topic was replaced by this one
+    dropped_oldest,  ///< Fast: accepted; the queue was full and its oldest message was dropped
+    queue_full,      ///< Safe: refused, the channel's queue is full; retry after messages are acknowledged
+    too_large,       ///< refused: larger than max_message_size
+    bad_priority,    ///< refused: priority >= TransportConfig::priorities
+};
+std::ostream& operator<<(std::ostream& os, SendResult r);
+
+struct Delivered {
+    MessageClass cls = MessageClass::safe;
+    std::uint8_t priority = 0;  ///< for Safe: the channel
+    std::uint16_t topic = 0;    ///< Fast only (0 for Safe)
+    std::vector<std::uint8_t> bytes;
+};
+
+struct TransportEvent {
+    enum class Kind : std::uint8_t {
+        session_established,  ///< a session with the peer is up (first time, or after either end restarted)
+        peer_restarted,       ///< the peer came back with a new boot nonce; stream state was reset
+        link_up,
+        link_down,
+        path_up,        ///< `path` hears valid frames again
+        path_down,      ///< `path` went silent
+        safe_given_up,  ///< `count` Safe messages in flight were discarded because the peer restarted
+    };
+    Kind kind = Kind::link_up;
+    std::size_t path = 0;
+    std::uint64_t count = 0;
+};
+std::ostream& operator<<(std::ostream& os, TransportEvent::Kind k);
+
+/// Counters of one class in one direction (tx: what this end sent, rx: what it received).
+struct ClassStats {
+    std::uint64_t messages = 0;         ///< tx: accepted by send_*; rx: delivered
+    std::uint64_t bytes = 0;            ///< message bytes (goodput numerator)
+    std::uint64_t segments = 0;         ///< data chunks sent / received
+    std::uint64_t retransmissions = 0;  ///< tx Safe: segments sent again
+    std::uint64_t drops = 0;     ///< tx Fast: dropped by the cap; rx: duplicates, incomplete reassemblies
+    std::uint64_t replaced = 0;  ///< tx Fast: replaced by a fresher value of the same topic
+    std::uint64_t queue_depth =
+        0;  ///< tx: messages waiting (snapshot); rx: messages waiting for poll_message
+};
+
+struct PathStats {
+    std::uint64_t frames_sent = 0;
+    std::uint64_t bytes_sent = 0;
+    std::uint64_t frames_received = 0;  ///< valid frames
+    std::uint64_t bytes_received = 0;   ///< every byte handed in
+    bool alive = false;                 ///< this end hears valid frames on the path
+    bool peer_hears = false;            ///< the peer's latest report says it hears this end on the path
+};
+
+struct LinkStats {
+    bool authenticated = false;  ///< frames carry a MAC (a key is configured)
+    bool session = false;
+    bool link_up = false;
+    double srtt_ms = 0.0;  ///< smoothed round-trip time (0 before the first sample)
+    double rttvar_ms = 0.0;
+    double rto_ms = 0.0;
+    std::uint64_t rtt_samples = 0;
+    std::size_t frame_payload = 0;           ///< current ceiling of chunk bytes per frame
+    std::size_t peer_suggested_payload = 0;  ///< from the peer's corruption measurement (0: none yet)
+    double frame_loss = 0.0;  ///< fraction of sent Safe segments declared lost (moving average)
+
+    std::uint64_t frames_sent = 0;
+    std::uint64_t frames_received = 0;  ///< valid, authenticated, not replayed
+    std::uint64_t bytes_sent = 0;
+    std::uint64_t bytes_received = 0;
+    std::uint64_t framing_errors = 0;  ///< COBS errors, oversize or runt frames
+    std::uint64_t crc_errors = 0;      ///< includes unkeyed frames of a stale session
+    std::uint64_t mac_failures = 0;    ///< CRC fine, MAC wrong: forged, stale session or wrong key
+    std::uint64_t replays = 0;    ///< authentic frames already seen or too old (redundant copies included)
+    std::uint64_t malformed = 0;  ///< authentic frames whose content does not parse
+    std::uint64_t hellos_sent = 0;
+    std::uint64_t hellos_received = 0;
+    std::uint64_t peer_restarts = 0;
+    std::uint64_t acks_sent = 0;  ///< ACK chunks
+    std::uint64_t acks_received = 0;
+    std::uint64_t safe_given_up = 0;
+    std::uint64_t events_dropped = 0;
+    std::uint64_t deliveries_refused = 0;  ///< Safe segments not accepted because the delivery queue was full
+
+    ClassStats tx_safe, tx_fast, rx_safe, rx_fast;
+    std::array<PathStats, kMaxPaths> path{};
+};
+
+/// One end of the ground link.
+///
+/// Contract (sans-IO, after quinn-proto): the core never reads a clock, never touches a file descriptor, a
+/// thread or randomness. Every call takes `now`, which must never go backwards.
+///
+///   inputs   send_safe / send_fast (application), handle_bytes(path, bytes) (raw bytes read from a port, any
+///            chunking), handle_timeout(now)
+///   outputs  poll_transmit(path) (one whole encoded frame, ready to write), poll_message(), poll_event(),
+///            poll_timeout() (the single earliest deadline), stats()
+///
+/// Driver loop, after every input: for each path call poll_transmit(path, now) until it returns nullopt and
+/// write each frame to that path's port at once; drain poll_message() and poll_event(); (re)arm one timer at
+/// poll_timeout() and call handle_timeout(now) when it fires, then loop again. poll_transmit enforces the
+/// pacing: it returns nothing until the path's byte-time budget (link_rate) allows the next frame, so the
+/// bytes written to a path by time t never exceed link_rate × elapsed + one frame. poll_timeout() then
+/// includes the moment the budget frees up. Protocol errors never throw: they are counted in stats().
+class Transport {
+  public:
+    /// The configuration must be valid (see TransportConfig::validate); an invalid one throws
+    /// std::invalid_argument listing the problems.
+    Transport(TransportConfig config, TimePoint now);
+    ~Transport();
+    Transport(Transport&&) noexcept;
+    Transport& operator=(Transport&&) noexcept;
+    Transport(const Transport&) = delete;
+    Transport& operator=(const Transport&) = delete;
+
+    // ---- application side
+    /// Queue a Safe message on channel `priority`. Messages of one channel arrive exactly once, in order.
+    SendResult send_safe(std::uint8_t priority, std::span<const std::uint8_t> msg, TimePoint now);
+    /// Queue a Fast message: replaces an unsent message of the same (priority, topic); the per-priority queue
+    /// keeps at most fast_queue_cap messages and drops the oldest.
+    SendResult send_fast(std::uint8_t priority, std::uint16_t topic, std::span<const std::uint8_t> msg,
+                         TimePoint now);
+    std::optional<Delivered> poll_message();
+    std::optional<TransportEvent> poll_event();
+
+    // ---- wire side
+    void handle_bytes(std::size_t path, std::span<const std::uint8_t> bytes, TimePoint now);
+    /// The next frame (COBS-encoded, delimited) to write to `path` now, or nullopt when there is nothing to
+    /// send or the pacing budget does not allow it yet.
+    std::optional<std::vector<std::uint8_t>> poll_transmit(std::size_t path, TimePoint now);
+    [[nodiscard]] TimePoint poll_timeout() const;
+    void handle_timeout(TimePoint now);
+
+    // ---- observation
+    [[nodiscard]] const LinkStats& stats() const;
+    [[nodiscard]] bool link_up() const;
+    [[nodiscard]] bool session_established() const;
+    [[nodiscard]] const TransportConfig& config() const;
+    /// Safe messages of `priority` queued or in flight (not yet acknowledged).
+    [[nodiscard]] std::size_t safe_pending(std::uint8_t priority) const;
+
+    class Impl;
+
+  private:
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace airseg::groundlink
