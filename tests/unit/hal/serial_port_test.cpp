@@ -1,0 +1,263 @@
+#include "hal/serial_port.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+
+#include "tests/unit/hal/run_until.hpp"
+
+namespace airseg::hal {
+namespace {
+
+using test::drain;
+using test::pattern_bytes;
+using test::run_until;
+using test::run_until_idle;
+using test::TestPty;
+
+struct Received {
+    std::vector<std::uint8_t> bytes;
+    std::vector<std::pair<std::error_code, std::string>> errors;
+};
+
+class SerialPortTest : public ::testing::Test {
+  protected:
+    void SetUp() override { ASSERT_TRUE(pty_.ok()) << "openpty failed"; }
+
+    SerialConfig config_for(const TestPty& pty, unsigned baud = 115200) {
+        SerialConfig c;
+        c.path = pty.slave_path();
+        c.baud = baud;
+        return c;
+    }
+
+    void open_and_read(SerialPort& port, const SerialConfig& config) {
+        auto result = port.open(config);
+        ASSERT_TRUE(result.ok()) << result.message;
+        port.start_reading(
+            [this](std::span<const std::uint8_t> b) {
+                received_.bytes.insert(received_.bytes.end(), b.begin(), b.end());
+            },
+            [this](std::error_code ec, const std::string& what) { received_.errors.emplace_back(ec, what); });
+    }
+
+    boost::asio::io_context io_;
+    TestPty pty_;
+    Received received_;
+};
+
+TEST(SerialConfigTest, RejectsNonStandardBaudNamingIt) {
+    SerialConfig c;
+    c.path = "/dev/ttyS9";
+    c.baud = 12345;
+    const auto errors = SerialConfig::validate(c);
+    ASSERT_EQ(errors.size(), 1u);
+    EXPECT_NE(errors[0].find("12345"), std::string::npos) << errors[0];
+    EXPECT_NE(errors[0].find("/dev/ttyS9"), std::string::npos) << errors[0];
+    EXPECT_NE(errors[0].find("921600"), std::string::npos)
+        << "should list the supported rates: " << errors[0];
+}
+
+TEST(SerialConfigTest, AcceptsEveryStandardBaud) {
+    for (unsigned baud : {9600u, 19200u, 38400u, 57600u, 115200u, 230400u, 460800u, 500000u, 921600u}) {
+        SerialConfig c;
+        c.path = "/dev/ttyS0";
+        c.baud = baud;
+        EXPECT_TRUE(SerialConfig::validate(c).empty()) << baud;
+    }
+}
+
+TEST(SerialConfigTest, RejectsEmptyPathAndHandDrivenRtsUnderFlowControl) {
+    SerialConfig c;
+    c.rtscts = true;
+    c.rts_on_open = true;
+    EXPECT_EQ(SerialConfig::validate(c).size(), 2u);
+}
+
+TEST_F(SerialPortTest, InvalidBaudIsRejectedWithMessage) {
+    SerialPort port(io_.get_executor());
+    auto c = config_for(pty_);
+    c.baud = 14400;
+    const auto result = port.open(c);
+    EXPECT_EQ(result.error, make_error_code(HalError::InvalidConfig));
+    EXPECT_NE(result.message.find("14400"), std::string::npos) << result.message;
+    EXPECT_FALSE(port.is_open());
+}
+
+TEST_F(SerialPortTest, NonexistentPathErrorNamesThePath) {
+    SerialPort port(io_.get_executor());
+    SerialConfig c;
+    c.path = "/nonexistent/ttyAIRSEG0";
+    const auto result = port.open(c);
+    EXPECT_EQ(result.error, std::error_code(ENOENT, std::system_category()));
+    EXPECT_NE(result.message.find("/nonexistent/ttyAIRSEG0"), std::string::npos) << result.message;
+    EXPECT_FALSE(port.is_open());
+}
+
+TEST_F(SerialPortTest, RegularFileIsNotATerminal) {
+    char name[] = "/tmp/airseg-hal-notatty-XXXXXX";
+    const int fd = ::mkstemp(name);
+    ASSERT_GE(fd, 0);
+    ::close(fd);
+    SerialPort port(io_.get_executor());
+    SerialConfig c;
+    c.path = name;
+    const auto result = port.open(c);
+    ::unlink(name);
+    EXPECT_EQ(result.error, make_error_code(HalError::NotATerminal)) << result.message;
+    EXPECT_NE(result.message.find(name), std::string::npos) << result.message;
+}
+
+class SerialPortBaudTest : public SerialPortTest, public ::testing::WithParamInterface<unsigned> {};
+
+TEST_P(SerialPortBaudTest, BytesFlowBothWays) {
+    SerialPort port(io_.get_executor());
+    open_and_read(port, config_for(pty_, GetParam()));
+
+    const auto down = pattern_bytes(300, 1);
+    ASSERT_TRUE(test::write_all(pty_.master(), down));
+    ASSERT_TRUE(run_until(io_, [&] { return received_.bytes.size() >= down.size(); }));
+    EXPECT_EQ(received_.bytes, down);
+
+    const auto up = pattern_bytes(500, 2);
+    EXPECT_EQ(port.write(up), WriteResult::Queued);
+    std::vector<std::uint8_t> at_master;
+    ASSERT_TRUE(run_until(io_, [&] {
+        drain(pty_.master(), at_master);
+        return at_master.size() >= up.size();
+    }));
+    EXPECT_EQ(at_master, up);
+    EXPECT_TRUE(received_.errors.empty());
+}
+
+INSTANTIATE_TEST_SUITE_P(StandardRates, SerialPortBaudTest, ::testing::Values(57600u, 115200u));
+
+TEST_F(SerialPortTest, LargeWritesArriveInOrder) {
+    SerialPort port(io_.get_executor());
+    open_and_read(port, config_for(pty_));
+
+    // Far more than a pty buffers, so most writes wait in the queue while the test drains the master.
+    std::vector<std::uint8_t> expected;
+    for (std::uint32_t i = 0; i < 64; ++i) {
+        auto chunk = pattern_bytes(4096 + i, i);
+        expected.insert(expected.end(), chunk.begin(), chunk.end());
+        ASSERT_EQ(port.write(std::move(chunk)), WriteResult::Queued);
+    }
+    EXPECT_GT(port.queued_bytes(), 0u);
+    std::vector<std::uint8_t> at_master;
+    ASSERT_TRUE(run_until(io_,
+                          [&] {
+                              drain(pty_.master(), at_master);
+                              return at_master.size() >= expected.size() && port.queued_bytes() == 0;
+                          }))
+        << "received " << at_master.size() << " of " << expected.size();
+    EXPECT_EQ(at_master, expected);
+}
+
+TEST_F(SerialPortTest, WriteQueueIsBounded) {
+    SerialPort port(io_.get_executor());
+    auto c = config_for(pty_);
+    c.max_queued_bytes = 1000;
+    open_and_read(port, c);
+    EXPECT_EQ(port.write(std::vector<std::uint8_t>(800, 0x55)), WriteResult::Queued);
+    EXPECT_EQ(port.write(std::vector<std::uint8_t>(300, 0x55)), WriteResult::QueueFull);
+    EXPECT_EQ(port.queued_bytes(), 800u);
+    ASSERT_TRUE(run_until(io_, [&] { return port.queued_bytes() == 0; }));
+    EXPECT_EQ(port.write(std::vector<std::uint8_t>(300, 0x55)), WriteResult::Queued);
+}
+
+TEST_F(SerialPortTest, WriteOnClosedPortIsRefused) {
+    SerialPort port(io_.get_executor());
+    EXPECT_EQ(port.write({1, 2, 3}), WriteResult::NotOpen);
+}
+
+TEST_F(SerialPortTest, ModemLinesOnPtyWarnButOpen) {
+    SerialPort port(io_.get_executor());
+    auto c = config_for(pty_);
+    c.dtr_on_open = true;
+    c.low_latency = true;
+    const auto result = port.open(c);
+    ASSERT_TRUE(result.ok()) << result.message;
+    ASSERT_EQ(result.warnings.size(), 2u);
+    EXPECT_NE(result.warnings[0].find("DTR"), std::string::npos) << result.warnings[0];
+    EXPECT_NE(result.warnings[1].find("low-latency"), std::string::npos) << result.warnings[1];
+    EXPECT_TRUE(port.set_dtr(false)) << "a pty has no modem lines";
+    EXPECT_TRUE(port.is_open());
+}
+
+TEST_F(SerialPortTest, PeerCloseIsReportedOnceAsUnplugged) {
+    SerialPort port(io_.get_executor());
+    open_and_read(port, config_for(pty_));
+    pty_.close_master();
+    ASSERT_TRUE(run_until(io_, [&] { return !received_.errors.empty(); }));
+    run_until_idle(io_);
+    ASSERT_EQ(received_.errors.size(), 1u);
+    EXPECT_EQ(received_.errors[0].first, make_error_code(HalError::Unplugged));
+    EXPECT_NE(received_.errors[0].second.find(pty_.slave_path()), std::string::npos)
+        << received_.errors[0].second;
+    EXPECT_FALSE(port.is_open());
+}
+
+TEST_F(SerialPortTest, UnplugWithWritesPendingIsStillReportedOnce) {
+    SerialPort port(io_.get_executor());
+    open_and_read(port, config_for(pty_));
+    for (int i = 0; i < 16; ++i) {
+        ASSERT_EQ(port.write(pattern_bytes(16384, static_cast<std::uint32_t>(i))), WriteResult::Queued);
+    }
+    ASSERT_GT(port.queued_bytes(), 0u) << "256 KiB cannot all fit in a pty buffer";
+    pty_.close_master();
+    ASSERT_TRUE(run_until(io_, [&] { return !received_.errors.empty(); }));
+    run_until_idle(io_);
+    ASSERT_EQ(received_.errors.size(), 1u);
+    EXPECT_EQ(received_.errors[0].first, make_error_code(HalError::Unplugged));
+    EXPECT_EQ(port.queued_bytes(), 0u);
+}
+
+TEST_F(SerialPortTest, ReopenAfterUnplugWorks) {
+    SerialPort port(io_.get_executor());
+    open_and_read(port, config_for(pty_));
+    pty_.close_master();
+    ASSERT_TRUE(run_until(io_, [&] { return !received_.errors.empty(); }));
+
+    TestPty replugged;
+    ASSERT_TRUE(replugged.ok());
+    open_and_read(port, config_for(replugged));
+    const auto down = pattern_bytes(100, 7);
+    ASSERT_TRUE(test::write_all(replugged.master(), down));
+    ASSERT_TRUE(run_until(io_, [&] { return received_.bytes.size() >= down.size(); }));
+    EXPECT_EQ(received_.bytes, down);
+    EXPECT_EQ(port.write({0xFE, 0x01}), WriteResult::Queued);
+    std::vector<std::uint8_t> at_master;
+    ASSERT_TRUE(run_until(io_, [&] {
+        drain(replugged.master(), at_master);
+        return at_master.size() >= 2;
+    }));
+    EXPECT_EQ(at_master, (std::vector<std::uint8_t>{0xFE, 0x01}));
+    EXPECT_EQ(received_.errors.size(), 1u);
+}
+
+TEST_F(SerialPortTest, CloseIsNotAnErrorEvent) {
+    SerialPort port(io_.get_executor());
+    open_and_read(port, config_for(pty_));
+    EXPECT_EQ(port.write(pattern_bytes(100000, 3)), WriteResult::Queued);
+    port.close();
+    run_until_idle(io_);
+    EXPECT_TRUE(received_.errors.empty());
+    EXPECT_FALSE(port.is_open());
+    EXPECT_EQ(port.queued_bytes(), 0u);
+}
+
+TEST_F(SerialPortTest, DestroyingThePortWithOperationsPendingIsSafe) {
+    {
+        SerialPort port(io_.get_executor());
+        open_and_read(port, config_for(pty_));
+        EXPECT_EQ(port.write(pattern_bytes(100000, 4)), WriteResult::Queued);
+    }
+    run_until_idle(io_);
+    EXPECT_TRUE(received_.errors.empty());
+}
+
+}  // namespace
+}  // namespace airseg::hal
