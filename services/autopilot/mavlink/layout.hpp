@@ -1,0 +1,110 @@
+#pragma once
+// Derives a message's wire layout and CRC_EXTRA from its declaration, at compile time, by the rules of the
+// MAVLink specification (the same ones pymavlink's generator applies):
+//  - base fields (those before <extensions/>) are sorted by element size, largest first; the sort is stable,
+//    so fields of equal size keep their XML order; arrays sort by their element size;
+//  - extension fields follow in XML order, unsorted;
+//  - CRC_EXTRA is the X.25 CRC of "NAME " followed, for each base field in wire order, by "type " and
+//    "name " and, for an array, one byte holding its length; the 16-bit result is folded to 8 bits as
+//    (crc & 0xFF) ^ (crc >> 8). Extension fields never enter CRC_EXTRA.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+#include "services/autopilot/mavlink/crc.hpp"
+#include "services/autopilot/mavlink/field.hpp"
+#include "services/autopilot/mavlink/frame.hpp"
+
+namespace airseg::mavlink {
+
+template <std::size_t N>
+struct MessageLayout {
+    std::array<FieldInfo, N> wire{};               // fields in wire order
+    std::array<std::uint8_t, N> offset_by_decl{};  // byte offset of the i-th declared field
+    std::uint8_t crc_extra = 0;
+    std::uint8_t base_length = 0;  // bytes of the base fields: the MAVLink 1 payload length
+    std::uint8_t length = 0;       // bytes of all fields, extensions included
+};
+
+/// Number of real fields in a declaration (the extensions marker is not a field).
+constexpr std::size_t field_count(std::span<const FieldDecl> decls) {
+    std::size_t n = 0;
+    for (const FieldDecl& d : decls) {
+        n += d.is_extensions_marker ? 0 : 1;
+    }
+    return n;
+}
+
+constexpr std::uint8_t crc_extra_of(std::string_view message_name, std::span<const FieldInfo> wire_fields) {
+    Crc16 crc;
+    crc.add(message_name);
+    crc.add(" ");
+    for (const FieldInfo& f : wire_fields) {
+        if (f.extension) {
+            continue;
+        }
+        crc.add(type_name(f.type));
+        crc.add(" ");
+        crc.add(f.name);
+        crc.add(" ");
+        if (f.array_length != 0) {
+            crc.add(f.array_length);
+        }
+    }
+    return static_cast<std::uint8_t>((crc.value() & 0xFF) ^ (crc.value() >> 8));
+}
+
+template <std::size_t N>
+constexpr MessageLayout<N> make_layout(std::string_view message_name, std::span<const FieldDecl> decls) {
+    struct Entry {
+        FieldInfo info;
+        std::size_t decl_index = 0;
+    };
+    std::array<Entry, N> entries{};
+    std::size_t count = 0;
+    std::size_t base_count = 0;
+    bool in_extensions = false;
+    for (const FieldDecl& d : decls) {
+        if (d.is_extensions_marker) {
+            in_extensions = true;
+            continue;
+        }
+        entries[count] = Entry{FieldInfo{d.name, d.type, d.array_length, 0, in_extensions}, count};
+        ++count;
+        base_count += in_extensions ? 0 : 1;
+    }
+    if (count != N) {
+        throw "declaration does not hold the expected number of fields";
+    }
+    // Stable insertion sort of the base fields, largest element size first.
+    for (std::size_t i = 1; i < base_count; ++i) {
+        Entry moving = entries[i];
+        std::size_t j = i;
+        while (j > 0 && type_size(entries[j - 1].info.type) < type_size(moving.info.type)) {
+            entries[j] = entries[j - 1];
+            --j;
+        }
+        entries[j] = moving;
+    }
+    MessageLayout<N> layout{};
+    std::size_t offset = 0;
+    for (std::size_t i = 0; i < N; ++i) {
+        entries[i].info.offset = static_cast<std::uint8_t>(offset);
+        offset += entries[i].info.size();
+        if (offset > kMaxPayload) {
+            throw "message payload longer than 255 bytes";
+        }
+        if (i + 1 == base_count) {
+            layout.base_length = static_cast<std::uint8_t>(offset);
+        }
+        layout.wire[i] = entries[i].info;
+        layout.offset_by_decl[entries[i].decl_index] = entries[i].info.offset;
+    }
+    layout.length = static_cast<std::uint8_t>(offset);
+    layout.crc_extra = crc_extra_of(message_name, layout.wire);
+    return layout;
+}
+
+}  // namespace airseg::mavlink

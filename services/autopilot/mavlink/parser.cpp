@@ -1,0 +1,255 @@
+#include "services/autopilot/mavlink/parser.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+#include "services/autopilot/mavlink/crc.hpp"
+#include "services/autopilot/mavlink/wire.hpp"
+
+namespace airseg::mavlink {
+namespace {
+
+bool is_magic(std::uint8_t b) {
+    return b == kMagicV1 || b == kMagicV2;
+}
+
+std::size_t header_length(std::uint8_t magic) {
+    return magic == kMagicV1 ? kHeaderLengthV1 : kHeaderLengthV2;
+}
+
+// Header fields of the candidate at the start of a buffer that holds at least its header.
+struct Header {
+    Version version;
+    std::uint8_t payload_length;
+    std::uint8_t incompat_flags;
+    std::uint8_t compat_flags;
+    std::uint8_t seq;
+    std::uint8_t sysid;
+    std::uint8_t compid;
+    std::uint32_t msgid;
+    std::size_t header_length;
+
+    std::size_t frame_length() const {
+        const bool is_signed = version == Version::V2 && (incompat_flags & kIncompatSigned) != 0;
+        return header_length + payload_length + kChecksumLength + (is_signed ? kSignatureLength : 0);
+    }
+};
+
+Header read_header(const std::uint8_t* p) {
+    if (p[0] == kMagicV1) {
+        return Header{Version::V1, p[1], 0, 0, p[2], p[3], p[4], p[5], kHeaderLengthV1};
+    }
+    const std::uint32_t msgid = p[7] | (std::uint32_t{p[8]} << 8) | (std::uint32_t{p[9]} << 16);
+    return Header{Version::V2, p[1], p[2], p[3], p[4], p[5], p[6], msgid, kHeaderLengthV2};
+}
+
+}  // namespace
+
+const LinkStats* Parser::link(std::uint8_t sysid, std::uint8_t compid) const {
+    for (const LinkStats& l : links()) {
+        if (l.sysid == sysid && l.compid == compid) {
+            return &l;
+        }
+    }
+    return nullptr;
+}
+
+void Parser::push(std::span<const std::uint8_t> bytes, Sink sink) {
+    std::size_t pos = 0;
+    while (true) {
+        if (len_ == 0) {
+            // Fast path between frames: skip noise in place, without copying it.
+            const auto* start = bytes.data() + pos;
+            const auto* end = bytes.data() + bytes.size();
+            const auto* magic = std::find_if(start, end, is_magic);
+            discard(static_cast<std::size_t>(magic - start));
+            pos = static_cast<std::size_t>(magic - bytes.data());
+            if (pos == bytes.size()) {
+                return;
+            }
+            buf_[0] = bytes[pos++];
+            len_ = 1;
+        }
+        if (is_magic(buf_[0])) {
+            const std::size_t need = required_length();
+            if (len_ < need) {
+                const std::size_t n = std::min(need - len_, bytes.size() - pos);
+                std::memcpy(buf_.data() + len_, bytes.data() + pos, n);
+                len_ += n;
+                pos += n;
+                if (len_ < need && pos == bytes.size()) {
+                    return;
+                }
+                continue;  // the header may now be complete: the required length can grow
+            }
+        }
+        step(sink, false);
+    }
+}
+
+void Parser::finish(Sink sink) {
+    while (len_ > 0) {
+        step(sink, true);
+    }
+}
+
+// Bytes needed before the candidate at buf_[0] can be judged: its header, then the whole frame, plus one
+// byte of look-ahead for a message id whose checksum cannot be verified.
+std::size_t Parser::required_length() const {
+    const std::size_t header = header_length(buf_[0]);
+    if (len_ < header) {
+        return header;
+    }
+    const Header h = read_header(buf_.data());
+    return h.frame_length() + (find_message(h.msgid) == nullptr ? 1 : 0);
+}
+
+void Parser::step(Sink sink, bool at_end) {
+    if (!is_magic(buf_[0])) {
+        const auto magic =
+            std::find_if(buf_.begin(), buf_.begin() + static_cast<std::ptrdiff_t>(len_), is_magic);
+        const auto n = static_cast<std::size_t>(magic - buf_.begin());
+        discard(n);
+        drop_front(n);
+        return;
+    }
+    const std::size_t need = required_length();
+    if (len_ >= need) {
+        process_candidate(sink, read_header(buf_.data()).frame_length());
+        return;
+    }
+    if (!at_end) {
+        return;
+    }
+    // The stream ended inside this candidate.
+    if (len_ >= header_length(buf_[0])) {
+        const Header h = read_header(buf_.data());
+        if (find_message(h.msgid) == nullptr && len_ == h.frame_length()) {
+            // An unverifiable frame that ends exactly where the stream ends: nothing contradicts it.
+            accept(sink, h.frame_length(), nullptr);
+            return;
+        }
+    }
+    mark_damaged(len_, DamageKind::Truncated);
+    discard(1);
+    drop_front(1);
+}
+
+void Parser::process_candidate(Sink sink, std::size_t frame_length) {
+    const Header h = read_header(buf_.data());
+    const MessageInfo* info = find_message(h.msgid);
+    bool valid = false;
+    if (info != nullptr) {
+        Crc16 crc;
+        crc.add(std::span<const std::uint8_t>(buf_.data() + 1, h.header_length - 1 + h.payload_length));
+        crc.add(info->crc_extra);
+        valid = crc.value() == wire::get<std::uint16_t>(buf_.data() + h.header_length + h.payload_length);
+    } else {
+        valid = is_magic(buf_[frame_length]);
+    }
+    if (!valid) {
+        mark_damaged(frame_length, DamageKind::BadChecksum);
+        discard(1);
+        drop_front(1);
+        return;
+    }
+    accept(sink, frame_length, info);
+}
+
+// A frame that passed its checks (or, for an unknown id, was not contradicted by the bytes after it).
+void Parser::accept(Sink sink, std::size_t frame_length, const MessageInfo* info) {
+    const Header h = read_header(buf_.data());
+    resolve_damage_by_good_frame();
+    track_sequence(h.sysid, h.compid, h.seq);
+    if ((h.incompat_flags & ~kIncompatSigned) != 0) {
+        ++stats_.incompat_rejected;
+        drop_front(frame_length);
+        return;
+    }
+    deliver(sink, frame_length, info);
+}
+
+void Parser::deliver(Sink sink, std::size_t frame_length, const MessageInfo* info) {
+    const Header h = read_header(buf_.data());
+    frame_.version = h.version;
+    frame_.incompat_flags = h.incompat_flags;
+    frame_.compat_flags = h.compat_flags;
+    frame_.seq = h.seq;
+    frame_.sysid = h.sysid;
+    frame_.compid = h.compid;
+    frame_.msgid = h.msgid;
+    frame_.wire_length = h.payload_length;
+    frame_.payload_length = info != nullptr ? std::max(h.payload_length, info->length) : h.payload_length;
+    frame_.is_signed = (h.incompat_flags & kIncompatSigned) != 0;
+    frame_.checksum_verified = info != nullptr;
+    std::memcpy(frame_.payload.data(), buf_.data() + h.header_length, h.payload_length);
+    std::fill(frame_.payload.begin() + h.payload_length, frame_.payload.end(), std::uint8_t{0});
+    if (info != nullptr) {
+        ++stats_.frames_ok;
+    } else {
+        ++stats_.unknown_msgid;
+    }
+    if (frame_.is_signed) {
+        ++stats_.signed_frames;
+    }
+    drop_front(frame_length);
+    sink(frame_);
+}
+
+void Parser::track_sequence(std::uint8_t sysid, std::uint8_t compid, std::uint8_t seq) {
+    ++frames_seen_;
+    for (std::size_t i = 0; i < link_count_; ++i) {
+        LinkStats& l = links_[i];
+        if (l.sysid == sysid && l.compid == compid) {
+            const auto gap = static_cast<std::uint8_t>(seq - l.last_seq - 1);
+            l.lost += gap;
+            stats_.seq_lost += gap;
+            l.last_seq = seq;
+            ++l.received;
+            link_last_heard_[i] = frames_seen_;
+            return;
+        }
+    }
+    std::size_t slot = link_count_;
+    if (link_count_ < kMaxLinks) {
+        ++link_count_;
+    } else {
+        slot = static_cast<std::size_t>(std::min_element(link_last_heard_.begin(), link_last_heard_.end()) -
+                                        link_last_heard_.begin());
+    }
+    links_[slot] = LinkStats{sysid, compid, seq, 1, 0};
+    link_last_heard_[slot] = frames_seen_;
+}
+
+void Parser::mark_damaged(std::size_t span, DamageKind kind) {
+    if (damaged_left_ == 0) {
+        damaged_left_ = span;
+        damage_kind_ = kind;
+    }
+}
+
+void Parser::resolve_damage_by_good_frame() {
+    if (damaged_left_ > 0) {
+        ++stats_.truncated;
+        damaged_left_ = 0;
+    }
+}
+
+// Accounts for n bytes thrown away: inside a damaged frame they are part of it, outside they are noise.
+void Parser::discard(std::size_t n) {
+    const std::size_t in_damaged = std::min(n, damaged_left_);
+    stats_.garbage_bytes += n - in_damaged;
+    if (in_damaged > 0) {
+        damaged_left_ -= in_damaged;
+        if (damaged_left_ == 0) {
+            ++(damage_kind_ == DamageKind::Truncated ? stats_.truncated : stats_.bad_checksum);
+        }
+    }
+}
+
+void Parser::drop_front(std::size_t n) {
+    std::memmove(buf_.data(), buf_.data() + n, len_ - n);
+    len_ -= n;
+}
+
+}  // namespace airseg::mavlink

@@ -1,0 +1,118 @@
+#pragma once
+// Sans-IO MAVLink v1/v2 stream parser.
+//
+// Contract: the caller feeds bytes in any chunking with push(bytes, on_frame); on_frame(const Frame&) is
+// called, synchronously and in stream order, for each frame found (the Frame reference is valid only during
+// the call). finish(on_frame) tells the parser the stream has ended. The parser owns one fixed buffer of
+// kMaxFrameLength + 1 bytes and never allocates after construction; it never reads a clock.
+//
+// What it accepts and how it recovers:
+//  - A frame with a known message id is delivered only when its checksum (with the message's CRC_EXTRA)
+//    matches. A MAVLink 2 payload shorter than the message is zero-extended (payload_view() has the full
+//    length); a longer one (fields of a newer definition) is delivered as received.
+//  - MAVLink 2 frames with an incompatibility flag other than "signed" are dropped (incompat_rejected), as
+//  the
+//    specification requires; compatibility flags are ignored. Signed frames are delivered with is_signed set;
+//    their 13-byte signature is skipped, not verified (signed_frames).
+//  - A message id without a known CRC_EXTRA cannot be verified. Such a frame is delivered with
+//    checksum_verified == false (unknown_msgid) only when the byte right after it starts another frame (or
+//    the stream ends there); otherwise its start byte is treated as noise. This keeps a stray 0xFD/0xFE in
+//    line noise from swallowing good frames behind it.
+//  - After a bad checksum the parser rescans from the byte after the failed start byte, so a good frame that
+//    begins inside a damaged or cut-short one is still found. Each damaged stretch is counted once: as
+//    `truncated` when a good frame began inside it (or the stream ended inside a frame), else as
+//    `bad_checksum`. Bytes outside any frame candidate count as `garbage_bytes`.
+//  - Sequence numbers are tracked per (sysid, compid); a gap of n counts n lost frames (seq_lost), the same
+//    rule as the reference C library, so a repeated or reordered frame counts as a large gap.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <type_traits>
+#include <utility>
+
+#include "services/autopilot/mavlink/frame.hpp"
+#include "services/autopilot/mavlink/message_table.hpp"
+
+namespace airseg::mavlink {
+
+struct ParserStats {
+    std::uint64_t frames_ok = 0;          // verified frames delivered
+    std::uint64_t garbage_bytes = 0;      // bytes skipped outside any frame candidate
+    std::uint64_t bad_checksum = 0;       // damaged frames (checksum mismatch)
+    std::uint64_t truncated = 0;          // frames cut short by a new frame or by the end of the stream
+    std::uint64_t unknown_msgid = 0;      // unverifiable frames delivered (no CRC_EXTRA for their id)
+    std::uint64_t incompat_rejected = 0;  // MAVLink 2 frames with unknown incompatibility flags, dropped
+    std::uint64_t signed_frames = 0;      // signed frames delivered (signature skipped)
+    std::uint64_t seq_lost = 0;           // frames missing according to sequence gaps, all links
+};
+
+struct LinkStats {
+    std::uint8_t sysid = 0;
+    std::uint8_t compid = 0;
+    std::uint8_t last_seq = 0;
+    std::uint64_t received = 0;
+    std::uint64_t lost = 0;
+};
+
+class Parser {
+  public:
+    /// Links whose sequence numbers are tracked at once; beyond that the least recently heard is forgotten.
+    static constexpr std::size_t kMaxLinks = 32;
+
+    template <class OnFrame>
+    void push(std::span<const std::uint8_t> bytes, OnFrame&& on_frame) {
+        push(bytes, Sink(on_frame));
+    }
+    template <class OnFrame>
+    void finish(OnFrame&& on_frame) {
+        finish(Sink(on_frame));
+    }
+
+    const ParserStats& stats() const { return stats_; }
+    /// Sequence statistics of one sender, or nullptr if it has not been heard (or was forgotten).
+    const LinkStats* link(std::uint8_t sysid, std::uint8_t compid) const;
+    std::span<const LinkStats> links() const { return std::span(links_).first(link_count_); }
+
+  private:
+    // A non-owning reference to the caller's callable: the parsing code stays out of the header.
+    class Sink {
+      public:
+        template <class F>
+        explicit Sink(F& f)
+            : object_(&f),
+              call_([](void* o, const Frame& fr) { (*static_cast<std::remove_reference_t<F>*>(o))(fr); }) {}
+        void operator()(const Frame& f) const { call_(object_, f); }
+
+      private:
+        void* object_;
+        void (*call_)(void*, const Frame&);
+    };
+    enum class DamageKind : std::uint8_t { BadChecksum, Truncated };
+
+    void push(std::span<const std::uint8_t> bytes, Sink sink);
+    void finish(Sink sink);
+    void step(Sink sink, bool at_end);
+    std::size_t required_length() const;
+    void process_candidate(Sink sink, std::size_t frame_length);
+    void accept(Sink sink, std::size_t frame_length, const MessageInfo* info);
+    void deliver(Sink sink, std::size_t frame_length, const MessageInfo* info);
+    void track_sequence(std::uint8_t sysid, std::uint8_t compid, std::uint8_t seq);
+    void mark_damaged(std::size_t span, DamageKind kind);
+    void discard(std::size_t n);
+    void drop_front(std::size_t n);
+    void resolve_damage_by_good_frame();
+
+    std::array<std::uint8_t, kMaxFrameLength + 1> buf_{};  // one frame candidate, plus one byte of look-ahead
+    std::size_t len_ = 0;
+    std::size_t damaged_left_ = 0;
+    DamageKind damage_kind_ = DamageKind::BadChecksum;
+    Frame frame_{};
+    ParserStats stats_{};
+    std::array<LinkStats, kMaxLinks> links_{};
+    std::array<std::uint64_t, kMaxLinks> link_last_heard_{};
+    std::size_t link_count_ = 0;
+    std::uint64_t frames_seen_ = 0;
+};
+
+}  // namespace airseg::mavlink
