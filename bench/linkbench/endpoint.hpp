@@ -1,0 +1,56 @@
+#pragma once
+// What the link benchmark needs from one end of a link protocol: the common ground of the seed's MAREA serial
+// transport and airseg's ground-link transport core, both sans-IO.
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "services/common/time.hpp"
+
+namespace airseg::linkbench {
+
+struct BenchMessage {
+    bool safe = false;
+    std::vector<std::uint8_t> bytes;
+};
+
+/// How a scenario wires the ends: one radio pair for both directions, or two pairs with each end transmitting
+/// on its own pair (the seed's "serialduo", the transport's split mode).
+enum class LinkMode : std::uint8_t { single, dual };
+
+struct EndpointSetup {
+    std::uint32_t baud = 57600;
+    LinkMode mode = LinkMode::single;
+    bool is_a = true;  ///< end A transmits on path 0 in dual mode, end B on path 1
+    TimePoint now{};
+};
+
+class BenchEndpoint {
+  public:
+    virtual ~BenchEndpoint() = default;
+
+    /// False when the protocol refuses the message for now (queue full); the workload retries later.
+    virtual bool send_safe(std::span<const std::uint8_t> msg, TimePoint now) = 0;
+    /// `stream` tells independent Fast streams apart (a topic, where the protocol has them).
+    virtual void send_fast(std::uint16_t stream, std::span<const std::uint8_t> msg, TimePoint now) = 0;
+    virtual void handle_bytes(std::size_t path, std::span<const std::uint8_t> bytes, TimePoint now) = 0;
+    virtual void handle_timeout(TimePoint now) = 0;
+    /// One whole frame to write to `path`, or nullopt.
+    virtual std::optional<std::vector<std::uint8_t>> poll_transmit(std::size_t path, TimePoint now) = 0;
+    virtual std::optional<BenchMessage> poll_message() = 0;
+    virtual TimePoint poll_timeout() const = 0;
+    /// Safe messages accepted and not yet acknowledged.
+    virtual std::size_t safe_backlog() const = 0;
+};
+
+/// The seed's protocol (bench/linkbench/seed_protocol.hpp).
+std::unique_ptr<BenchEndpoint> make_seed_endpoint(const EndpointSetup& setup);
+
+/// airseg's transport core, or nullptr when the benchmark was built without it.
+std::unique_ptr<BenchEndpoint> make_transport_endpoint(const EndpointSetup& setup);
+
+}  // namespace airseg::linkbench

@@ -1,0 +1,169 @@
+#include "bench/linkbench/report.hpp"
+
+#include <cmath>
+#include <functional>
+#include <iomanip>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+namespace airseg::linkbench {
+
+namespace {
+
+std::string fig(const ScenarioResult& r, double v, int precision) {
+    if (!r.ran) {
+        return "-";
+    }
+    if (std::isnan(v)) {
+        return "n/a";
+    }
+    std::ostringstream os;
+    os << std::fixed << std::setprecision(precision) << v;
+    return os.str();
+}
+
+std::string pair(const Row& row, double ScenarioResult::*field, int precision) {
+    return fig(row.ours, row.ours.*field, precision) + " / " + fig(row.seed, row.seed.*field, precision);
+}
+
+const Row* find(const std::vector<Row>& rows, std::uint32_t baud, LinkMode mode,
+                const std::string& impairment) {
+    for (const Row& r : rows) {
+        if (r.scenario.baud == baud && r.scenario.mode == mode && r.scenario.impairment == impairment) {
+            return &r;
+        }
+    }
+    return nullptr;
+}
+
+nlohmann::json number(double v) {
+    return std::isnan(v) ? nlohmann::json(nullptr) : nlohmann::json(v);
+}
+
+std::string where(const Row& r) {
+    return std::to_string(r.scenario.baud) + " " + to_string(r.scenario.mode) + " " + r.scenario.impairment;
+}
+
+}  // namespace
+
+const char* to_string(LinkMode m) {
+    return m == LinkMode::single ? "single" : "dual";
+}
+
+void print_table(std::ostream& os, const std::vector<Row>& rows) {
+    os << "figures are ours / seed; goodput = intact Safe payload as % of one line's rate (baud/10 B/s)\n";
+    os << std::left << std::setw(7) << "baud" << std::setw(8) << "mode" << std::setw(15) << "impairment"
+       << std::right << std::setw(17) << "goodput %" << std::setw(19) << "fast p50 ms" << std::setw(19)
+       << "fast p99 ms" << std::setw(17) << "fast deliv %" << std::setw(15) << "max stall s" << '\n';
+    for (const Row& r : rows) {
+        os << std::left << std::setw(7) << r.scenario.baud << std::setw(8) << to_string(r.scenario.mode)
+           << std::setw(15) << r.scenario.impairment << std::right << std::setw(17)
+           << pair(r, &ScenarioResult::goodput_pct, 1) << std::setw(19)
+           << pair(r, &ScenarioResult::fast_p50_ms, 0) << std::setw(19)
+           << pair(r, &ScenarioResult::fast_p99_ms, 0) << std::setw(17)
+           << pair(r, &ScenarioResult::fast_delivery_pct, 0) << std::setw(15)
+           << pair(r, &ScenarioResult::max_stall_s, 1) << '\n';
+    }
+}
+
+std::vector<TargetCheck> check_targets(const std::vector<Row>& rows) {
+    std::vector<TargetCheck> checks;
+    auto add = [&](const std::string& name, const Row* row,
+                   const std::function<bool(const ScenarioResult&)>& ok, double ScenarioResult::*shown) {
+        if (row == nullptr) {
+            return;
+        }
+        TargetCheck c;
+        c.name = name + " [" + where(*row) + "]";
+        c.evaluated = row->ours.ran;
+        c.pass = row->ours.ran && ok(row->ours);
+        c.seed_pass = row->seed.ran && ok(row->seed);
+        c.detail =
+            "ours " + fig(row->ours, row->ours.*shown, 1) + ", seed " + fig(row->seed, row->seed.*shown, 1);
+        checks.push_back(std::move(c));
+    };
+    for (std::uint32_t baud : {57600U, 115200U}) {
+        for (LinkMode mode : {LinkMode::single, LinkMode::dual}) {
+            add(
+                "clean goodput >= 95 %", find(rows, baud, mode, "clean"),
+                [](const ScenarioResult& r) { return r.goodput_pct >= 95.0; }, &ScenarioResult::goodput_pct);
+            add(
+                "corruption 1e-4 goodput >= 85 %", find(rows, baud, mode, "corrupt=1e-4"),
+                [](const ScenarioResult& r) { return r.goodput_pct >= 85.0; }, &ScenarioResult::goodput_pct);
+            add(
+                "corruption 1e-3 goodput >= 65 %", find(rows, baud, mode, "corrupt=1e-3"),
+                [](const ScenarioResult& r) { return r.goodput_pct >= 65.0; }, &ScenarioResult::goodput_pct);
+            add(
+                "30 % frame loss: Safe delivered, stall <= 5 s", find(rows, baud, mode, "frameloss=30%"),
+                [](const ScenarioResult& r) { return r.safe_messages > 0 && r.max_stall_s <= 5.0; },
+                &ScenarioResult::max_stall_s);
+            if (baud == 57600) {
+                add(
+                    "Fast p99 <= 150 ms under saturating bulk", find(rows, baud, mode, "clean"),
+                    [](const ScenarioResult& r) {
+                        return !std::isnan(r.fast_p99_ms) && r.fast_p99_ms <= 150.0;
+                    },
+                    &ScenarioResult::fast_p99_ms);
+            }
+        }
+        const Row* single = find(rows, baud, LinkMode::single, "bidir");
+        const Row* dual = find(rows, baud, LinkMode::dual, "bidir");
+        if (single != nullptr && dual != nullptr) {
+            auto ratio = [](const ScenarioResult& d, const ScenarioResult& s) {
+                return s.goodput_pct > 0.0 ? d.goodput_pct / s.goodput_pct : 0.0;
+            };
+            TargetCheck c;
+            c.name = "dual split >= 1.9 x single, both directions saturated [" + std::to_string(baud) + "]";
+            c.evaluated = single->ours.ran && dual->ours.ran;
+            c.pass = c.evaluated && ratio(dual->ours, single->ours) >= 1.9;
+            c.seed_pass = ratio(dual->seed, single->seed) >= 1.9;
+            std::ostringstream d;
+            d << std::fixed << std::setprecision(2) << "ours ";
+            if (c.evaluated) {
+                d << ratio(dual->ours, single->ours);
+            } else {
+                d << '-';
+            }
+            d << ", seed " << ratio(dual->seed, single->seed);
+            c.detail = d.str();
+            checks.push_back(std::move(c));
+        }
+    }
+    return checks;
+}
+
+void print_targets(std::ostream& os, const std::vector<TargetCheck>& checks) {
+    os << "\ntargets (ours; the seed's verdict in brackets)\n";
+    for (const auto& c : checks) {
+        os << (c.evaluated ? (c.pass ? "PASS " : "FAIL ") : "n/a  ") << "(" << (c.seed_pass ? "pass" : "fail")
+           << ")  " << c.name << ": " << c.detail << '\n';
+    }
+}
+
+void print_json(std::ostream& os, const std::vector<Row>& rows) {
+    for (const Row& r : rows) {
+        nlohmann::json j;
+        j["baud"] = r.scenario.baud;
+        j["mode"] = to_string(r.scenario.mode);
+        j["impairment"] = r.scenario.impairment;
+        j["duration_s"] = std::chrono::duration<double>(r.scenario.duration).count();
+        auto put = [&j](const std::string& prefix, const ScenarioResult& x) {
+            if (!x.ran) {
+                j[prefix + "goodput_pct"] = nullptr;
+                return;
+            }
+            j[prefix + "goodput_pct"] = x.goodput_pct;
+            j[prefix + "fast_p50_ms"] = number(x.fast_p50_ms);
+            j[prefix + "fast_p99_ms"] = number(x.fast_p99_ms);
+            j[prefix + "fast_delivery_pct"] = x.fast_delivery_pct;
+            j[prefix + "max_stall_s"] = x.max_stall_s;
+            j[prefix + "safe_messages"] = x.safe_messages;
+            j[prefix + "damaged_deliveries"] = x.damaged_deliveries;
+        };
+        put("", r.ours);
+        put("seed_", r.seed);
+        os << j.dump() << '\n';
+    }
+}
+
+}  // namespace airseg::linkbench

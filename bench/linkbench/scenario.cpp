@@ -1,0 +1,236 @@
+#include "bench/linkbench/scenario.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <vector>
+
+#include "tools/linksim/radio_model.hpp"
+
+namespace airseg::linkbench {
+
+namespace {
+
+using linksim::Side;
+
+constexpr std::size_t kSafeSize = 1024;
+constexpr std::size_t kFastSize = 32;
+constexpr Duration kFastPeriod = std::chrono::milliseconds(100);
+constexpr std::uint16_t kFastStreams = 8;
+constexpr std::size_t kBulkBacklog = 24;  // Safe messages the application keeps offered
+constexpr Duration kStep = std::chrono::milliseconds(1);
+
+// Message content: a 4-byte id (little-endian) then bytes derived from it, so damage is detectable.
+std::vector<std::uint8_t> make_payload(std::uint32_t id, std::size_t size, std::uint8_t salt) {
+    std::vector<std::uint8_t> p(size);
+    for (std::size_t i = 0; i < size; ++i) {
+        p[i] = i < 4 ? static_cast<std::uint8_t>(id >> (8 * i))
+                     : static_cast<std::uint8_t>(id * 31 + i * 7 + salt);
+    }
+    return p;
+}
+
+std::optional<std::uint32_t> check_payload(const std::vector<std::uint8_t>& p, std::size_t size,
+                                           std::uint8_t salt) {
+    if (p.size() != size) {
+        return std::nullopt;
+    }
+    const std::uint32_t id = static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 |
+                             static_cast<std::uint32_t>(p[2]) << 16 | static_cast<std::uint32_t>(p[3]) << 24;
+    return p == make_payload(id, size, salt) ? std::optional(id) : std::nullopt;
+}
+
+constexpr std::uint8_t kSaltSafeAB = 1;
+constexpr std::uint8_t kSaltSafeBA = 2;
+constexpr std::uint8_t kSaltFast = 3;
+
+double percentile(std::vector<double> v, double q) {
+    if (v.empty()) {
+        return std::numeric_limits<double>::quiet_NaN();
+    }
+    std::sort(v.begin(), v.end());
+    const auto i = static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size()))) - 1;
+    return v[std::min(i, v.size() - 1)];
+}
+
+double ms(Duration d) {
+    return std::chrono::duration<double, std::milli>(d).count();
+}
+
+// A frame the protocol handed over, being written to the host UART as a blocking write would.
+struct PendingWrite {
+    std::vector<std::uint8_t> bytes;
+    std::size_t written = 0;
+    bool empty() const { return written >= bytes.size(); }
+};
+
+}  // namespace
+
+linksim::RadioConfig bench_radio(const Scenario& s, std::uint64_t seed) {
+    linksim::RadioConfig c;
+    c.baud = s.baud;
+    c.duplex = linksim::Duplex::Half;
+    c.turnaround = std::chrono::milliseconds(1);
+    c.max_air_packet = 252;
+    c.radio_buffer = 2048;
+    c.host_buffer = 4096;
+    c.seed = seed;
+    for (auto& d : c.impairment) {
+        d.byte_corruption = s.byte_corruption;
+        d.frame_loss = s.frame_loss;
+        if (s.outage) {
+            d.outages.push_back(*s.outage);
+        }
+    }
+    return c;
+}
+
+ScenarioResult run_scenario(const Scenario& s, const EndpointFactory& make) {
+    ScenarioResult result;
+    const TimePoint t0{};
+    const TimePoint end = t0 + s.duration;
+    const std::size_t paths = s.mode == LinkMode::dual ? 2 : 1;
+
+    std::vector<linksim::RadioModel> pairs;
+    for (std::size_t p = 0; p < paths; ++p) {
+        pairs.emplace_back(bench_radio(s, 1000 + p), t0);
+    }
+    std::array<std::unique_ptr<BenchEndpoint>, 2> ends{make({s.baud, s.mode, true, t0}),
+                                                       make({s.baud, s.mode, false, t0})};
+    if (!ends[0] || !ends[1]) {
+        return result;
+    }
+    std::array<std::array<PendingWrite, 2>, 2> pending{};  // [side][path]
+
+    std::array<std::uint32_t, 2> next_safe_id{0, 0};
+    std::array<std::vector<bool>, 2> safe_seen;  // by receiving side
+    std::array<std::uint64_t, 2> safe_bytes{0, 0};
+    TimePoint last_ab_delivery = t0;
+    Duration max_stall{0};
+
+    std::uint32_t next_fast_id = 0;
+    TimePoint next_fast = t0;
+    std::map<std::uint32_t, TimePoint> fast_sent;
+    std::vector<double> fast_latency;
+    std::uint64_t fast_counted = 0;
+    std::uint64_t fast_delivered_counted = 0;
+    const TimePoint fast_count_until = end - std::chrono::seconds(2);
+
+    auto on_message = [&](Side to, const BenchMessage& m, TimePoint now) {
+        if (!m.safe) {
+            auto id = check_payload(m.bytes, kFastSize, kSaltFast);
+            if (!id) {
+                ++result.damaged_deliveries;
+                return;
+            }
+            auto it = fast_sent.find(*id);
+            if (it != fast_sent.end()) {
+                fast_latency.push_back(ms(now - it->second));
+                if (it->second <= fast_count_until) {
+                    ++fast_delivered_counted;
+                }
+                fast_sent.erase(it);
+            }
+            return;
+        }
+        const std::uint8_t salt = to == Side::B ? kSaltSafeAB : kSaltSafeBA;
+        auto id = check_payload(m.bytes, kSafeSize, salt);
+        if (!id) {
+            ++result.damaged_deliveries;
+            return;
+        }
+        auto& seen = safe_seen[linksim::index(to)];
+        if (*id >= seen.size()) {
+            seen.resize(*id + 1, false);
+        }
+        if (seen[*id]) {
+            return;
+        }
+        seen[*id] = true;
+        safe_bytes[linksim::index(to)] += m.bytes.size();
+        ++result.safe_messages;
+        if (to == Side::B) {
+            max_stall = std::max(max_stall, now - last_ab_delivery);
+            last_ab_delivery = now;
+        }
+    };
+
+    for (TimePoint now = t0; now <= end;) {
+        for (std::size_t p = 0; p < paths; ++p) {
+            for (Side side : {Side::A, Side::B}) {
+                auto bytes = pairs[p].poll_output(side, now);
+                if (!bytes.empty()) {
+                    ends[linksim::index(side)]->handle_bytes(p, bytes, now);
+                }
+            }
+        }
+        for (Side side : {Side::A, Side::B}) {
+            auto& e = *ends[linksim::index(side)];
+            if (e.poll_timeout() <= now) {
+                e.handle_timeout(now);
+            }
+            while (auto m = e.poll_message()) {
+                on_message(side, *m, now);
+            }
+        }
+        // Workload: Fast telemetry A→B at 10 Hz, bulk Safe kept offered.
+        while (next_fast <= now) {
+            const auto payload = make_payload(next_fast_id, kFastSize, kSaltFast);
+            ends[0]->send_fast(static_cast<std::uint16_t>(next_fast_id % kFastStreams), payload, now);
+            fast_sent[next_fast_id] = now;
+            if (now <= fast_count_until) {
+                ++fast_counted;
+            }
+            ++next_fast_id;
+            next_fast += kFastPeriod;
+        }
+        for (Side side : {Side::A, Side::B}) {
+            if (side == Side::B && !s.bidirectional) {
+                break;
+            }
+            auto& e = *ends[linksim::index(side)];
+            const std::uint8_t salt = side == Side::A ? kSaltSafeAB : kSaltSafeBA;
+            auto& id = next_safe_id[linksim::index(side)];
+            while (e.safe_backlog() < kBulkBacklog && e.send_safe(make_payload(id, kSafeSize, salt), now)) {
+                ++id;
+            }
+        }
+        for (Side side : {Side::A, Side::B}) {
+            for (std::size_t p = 0; p < paths; ++p) {
+                auto& w = pending[linksim::index(side)][p];
+                while (true) {
+                    if (w.empty()) {
+                        auto frame = ends[linksim::index(side)]->poll_transmit(p, now);
+                        if (!frame) {
+                            break;
+                        }
+                        w = PendingWrite{std::move(*frame), 0};
+                    }
+                    w.written += pairs[p].push(side, std::span(w.bytes).subspan(w.written), now);
+                    if (!w.empty()) {
+                        break;  // UART buffer full: the write blocks until it drains
+                    }
+                }
+            }
+        }
+        TimePoint next = std::min({now + kStep, next_fast, ends[0]->poll_timeout(), ends[1]->poll_timeout()});
+        now = std::max(next, now + std::chrono::microseconds(10));
+    }
+    max_stall = std::max(max_stall, end - last_ab_delivery);
+
+    const double line = s.baud / 10.0;
+    const double seconds = std::chrono::duration<double>(s.duration).count();
+    result.ran = true;
+    result.goodput_pct = 100.0 * static_cast<double>(safe_bytes[0] + safe_bytes[1]) / (line * seconds);
+    result.fast_p50_ms = percentile(fast_latency, 0.50);
+    result.fast_p99_ms = percentile(fast_latency, 0.99);
+    result.fast_delivery_pct = fast_counted == 0 ? 0.0
+                                                 : 100.0 * static_cast<double>(fast_delivered_counted) /
+                                                       static_cast<double>(fast_counted);
+    result.max_stall_s = std::chrono::duration<double>(max_stall).count();
+    return result;
+}
+
+}  // namespace airseg::linkbench
