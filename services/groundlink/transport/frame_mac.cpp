@@ -1,0 +1,51 @@
+#include "services/groundlink/transport/frame_mac.hpp"
+
+#include <sodium.h>
+
+#include <stdexcept>
+#include <vector>
+
+#include "services/groundlink/transport/byte_io.hpp"
+
+namespace airseg::groundlink {
+
+FrameMac::FrameMac(const std::array<std::uint8_t, kKeyBytes>& key) : key_(key) {
+    if (sodium_init() < 0) {
+        throw std::runtime_error("groundlink: libsodium failed to initialise");
+    }
+}
+
+FrameMac::~FrameMac() {
+    sodium_memzero(key_.data(), key_.size());
+}
+
+MacTag FrameMac::tag(const MacContext& ctx, std::span<const std::uint8_t> frame) const {
+    std::vector<std::uint8_t> prefix;
+    prefix.reserve(24);
+    wire::put_u64(prefix, ctx.sender_nonce);
+    wire::put_u64(prefix, ctx.receiver_nonce);
+    wire::put_u64(prefix, ctx.frame_number);
+
+    crypto_generichash_state st;
+    std::array<std::uint8_t, crypto_generichash_BYTES_MIN> full{};
+    crypto_generichash_init(&st, key_.data(), key_.size(), full.size());
+    crypto_generichash_update(&st, prefix.data(), prefix.size());
+    crypto_generichash_update(&st, frame.data(), frame.size());
+    crypto_generichash_final(&st, full.data(), full.size());
+    MacTag out{};
+    for (std::size_t i = 0; i < out.size(); ++i) {
+        out[i] = full[i];
+    }
+    return out;
+}
+
+bool FrameMac::verify(const MacContext& ctx, std::span<const std::uint8_t> frame,
+                      std::span<const std::uint8_t> received) const {
+    if (received.size() != kMacTagBytes) {
+        return false;
+    }
+    const MacTag expected = tag(ctx, frame);
+    return sodium_memcmp(expected.data(), received.data(), kMacTagBytes) == 0;
+}
+
+}  // namespace airseg::groundlink

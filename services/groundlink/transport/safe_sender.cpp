@@ -1,0 +1,190 @@
+#include "services/groundlink/transport/safe_sender.hpp"
+
+#include <algorithm>
+
+namespace airseg::groundlink {
+
+SendResult SafeSender::enqueue(std::span<const std::uint8_t> msg) {
+    if (msg.size() > max_message_) {
+        return SendResult::too_large;
+    }
+    if (bytes_held_ + msg.size() > queue_bytes_) {
+        return SendResult::queue_full;
+    }
+    queue_.emplace_back(msg.begin(), msg.end());
+    bytes_held_ += msg.size();
+    return SendResult::accepted;
+}
+
+bool SafeSender::can_send_new() const {
+    return !queue_.empty() && next_ - una_ < window_;
+}
+
+std::size_t SafeSender::lost_size() const {
+    for (const auto& s : inflight_) {
+        if (s.lost) {
+            return s.data.size();
+        }
+    }
+    return 0;
+}
+
+SafeSender::Segment SafeSender::take_lost(TimePoint now) {
+    for (std::size_t i = 0; i < inflight_.size(); ++i) {
+        InFlight& s = inflight_[i];
+        if (!s.lost) {
+            continue;
+        }
+        s.lost = false;
+        --lost_count_;
+        ++s.transmissions;
+        s.last_sent = now;
+        return Segment{static_cast<std::uint16_t>(una_ + i), s.end, s.data, true};
+    }
+    return Segment{};
+}
+
+std::optional<SafeSender::Segment> SafeSender::take_new(std::size_t max_data, bool force, TimePoint now) {
+    if (!can_send_new()) {
+        return std::nullopt;
+    }
+    const auto& msg = queue_.front();
+    const std::size_t remaining = msg.size() - cut_offset_;
+    const std::size_t fragments_left = kMaxFragments - cut_fragments_;
+    const std::size_t min_size = (remaining + fragments_left - 1) / fragments_left;
+    std::size_t size = std::min(remaining, max_data);
+    if (size < min_size || (size == 0 && remaining > 0)) {
+        if (!force) {
+            return std::nullopt;
+        }
+        size = std::min(remaining, std::max<std::size_t>(min_size, 1));
+    }
+    InFlight s;
+    s.data.assign(msg.begin() + static_cast<std::ptrdiff_t>(cut_offset_),
+                  msg.begin() + static_cast<std::ptrdiff_t>(cut_offset_ + size));
+    s.end = size == remaining;
+    s.transmissions = 1;
+    s.last_sent = now;
+    cut_offset_ += size;
+    ++cut_fragments_;
+    if (s.end) {
+        queue_.pop_front();
+        cut_offset_ = 0;
+        cut_fragments_ = 0;
+        ++inflight_messages_;
+    }
+    Segment out{static_cast<std::uint16_t>(next_), s.end, s.data, false};
+    inflight_.push_back(std::move(s));
+    ++next_;
+    return out;
+}
+
+void SafeSender::mark_acked(InFlight& s, AckResult& r, TimePoint now, TimePoint& newest_acked_send) {
+    if (s.acked) {
+        return;
+    }
+    s.acked = true;
+    if (s.lost) {
+        s.lost = false;
+        --lost_count_;
+    }
+    ++r.newly_acked;
+    if (s.last_sent > newest_acked_send) {
+        newest_acked_send = s.last_sent;
+        // Karn: only a segment sent once gives an unambiguous sample.
+        r.rtt_sample = s.transmissions == 1 ? std::optional<Duration>(now - s.last_sent) : std::nullopt;
+    }
+}
+
+void SafeSender::pop_acked_front() {
+    while (!inflight_.empty() && inflight_.front().acked) {
+        bytes_held_ -= inflight_.front().data.size();
+        if (inflight_.front().end) {
+            --inflight_messages_;
+        }
+        inflight_.pop_front();
+        ++una_;
+    }
+}
+
+SafeSender::AckResult SafeSender::on_ack(const frame::AckChunk& ack, TimePoint now) {
+    AckResult r;
+    const std::uint64_t span = next_ - una_;
+    const auto delta = static_cast<std::uint16_t>(ack.next_expected - static_cast<std::uint16_t>(una_));
+    if (delta > span) {
+        return r;  // older than what is already acknowledged, or not ours
+    }
+    const std::uint64_t cum = una_ + delta;
+    TimePoint newest{};
+    for (std::uint64_t seq = una_; seq < cum; ++seq) {
+        mark_acked(inflight_[static_cast<std::size_t>(seq - una_)], r, now, newest);
+    }
+    for (std::size_t bit = 0; bit < ack.bitmap.size() * 8; ++bit) {
+        if (((ack.bitmap[bit / 8] >> (bit % 8)) & 1U) == 0) {
+            continue;
+        }
+        const std::uint64_t seq = cum + 1 + bit;
+        if (seq >= next_) {
+            break;
+        }
+        mark_acked(inflight_[static_cast<std::size_t>(seq - una_)], r, now, newest);
+    }
+    if (r.newly_acked > 0) {
+        for (auto& s : inflight_) {
+            if (!s.acked && !s.lost && s.last_sent < newest) {
+                s.lost = true;
+                ++lost_count_;
+                ++r.newly_lost;
+            }
+        }
+    }
+    const std::uint64_t before = una_;
+    pop_acked_front();
+    r.progress = una_ != before;
+    return r;
+}
+
+std::size_t SafeSender::on_timeout(TimePoint now, Duration rto) {
+    std::size_t n = 0;
+    for (auto& s : inflight_) {
+        if (!s.acked && !s.lost && s.last_sent + rto <= now) {
+            s.lost = true;
+            ++lost_count_;
+            ++n;
+        }
+    }
+    return n;
+}
+
+TimePoint SafeSender::next_timeout(Duration rto) const {
+    TimePoint t = kNever;
+    for (const auto& s : inflight_) {
+        if (!s.acked && !s.lost) {
+            t = std::min(t, s.last_sent + rto);
+        }
+    }
+    return t;
+}
+
+std::size_t SafeSender::reset() {
+    // Bytes leave bytes_held_ when their segment is acknowledged at the front of the window; everything still
+    // in inflight_ and the uncut rest of a partly sent message are released here.
+    std::size_t given_up = inflight_messages_;
+    if (cut_fragments_ > 0) {
+        bytes_held_ -= queue_.front().size() - cut_offset_;
+        queue_.pop_front();
+        ++given_up;
+    }
+    for (const auto& s : inflight_) {
+        bytes_held_ -= s.data.size();
+    }
+    inflight_.clear();
+    inflight_messages_ = 0;
+    cut_offset_ = 0;
+    cut_fragments_ = 0;
+    una_ = next_ = 0;
+    lost_count_ = 0;
+    return given_up;
+}
+
+}  // namespace airseg::groundlink

@@ -1,0 +1,249 @@
+#include "services/groundlink/transport/transport.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "services/groundlink/transport/transport_impl.hpp"
+
+namespace airseg::groundlink {
+namespace {
+
+TransportConfig checked(TransportConfig c) {
+    const auto problems = c.validate();
+    if (!problems.empty()) {
+        std::string all = "groundlink: invalid transport configuration:";
+        for (const auto& p : problems) {
+            all += "\n  " + p;
+        }
+        throw std::invalid_argument(all);
+    }
+    return c;
+}
+
+}  // namespace
+
+Transport::Impl::Impl(TransportConfig config, TimePoint now)
+    : cfg(checked(std::move(config))),
+      now_(now),
+      reassembly(cfg.fast_reassembly_timeout, cfg.max_message_size),
+      rtt(cfg.rto_initial, cfg.rto_min, cfg.rto_max, cfg.ack_delay) {
+    if (cfg.key) {
+        mac = std::make_unique<FrameMac>(*cfg.key);
+    }
+    stats.authenticated = mac != nullptr;
+    candidate = cfg.boot_nonce;
+    const std::size_t max_encoded = cobs_max_encoded(cfg.max_frame_payload + 256);
+    for (std::size_t p = 0; p < cfg.paths; ++p) {
+        paths.emplace_back(max_encoded);
+        paths.back().next_free = now;
+        paths.back().next_hello = now;
+        paths.back().last_sent = now;
+        paths.back().last_hello = now - cfg.hello_interval;
+    }
+    for (std::size_t l = 0; l < cfg.priorities; ++l) {
+        senders.emplace_back(cfg.safe_window, cfg.safe_queue_bytes, cfg.max_message_size);
+        receivers.emplace_back(cfg.safe_window, cfg.max_message_size);
+        fast.emplace_back(cfg.fast_queue_cap);
+    }
+    acks.resize(cfg.priorities);
+    backoff.resize(cfg.priorities, 0);
+    last_report_time = now;
+    refresh(now);
+}
+
+SendResult Transport::Impl::send_safe(std::uint8_t priority, std::span<const std::uint8_t> msg,
+                                      TimePoint now) {
+    now_ = std::max(now_, now);
+    if (priority >= cfg.priorities) {
+        return SendResult::bad_priority;
+    }
+    const SendResult r = senders[priority].enqueue(msg);
+    if (r == SendResult::accepted) {
+        ++stats.tx_safe.messages;
+        stats.tx_safe.bytes += msg.size();
+        if (priority + 1U < cfg.priorities) {
+            mark_urgent(now_);
+        }
+    }
+    refresh(now_);
+    return r;
+}
+
+SendResult Transport::Impl::send_fast(std::uint8_t priority, std::uint16_t topic,
+                                      std::span<const std::uint8_t> msg, TimePoint now) {
+    now_ = std::max(now_, now);
+    if (priority >= cfg.priorities) {
+        return SendResult::bad_priority;
+    }
+    if (msg.size() > cfg.max_message_size) {
+        return SendResult::too_large;
+    }
+    const SendResult r = fast[priority].push(topic, msg);
+    ++stats.tx_fast.messages;
+    stats.tx_fast.bytes += msg.size();
+    if (r == SendResult::replaced) {
+        ++stats.tx_fast.replaced;
+    } else if (r == SendResult::dropped_oldest) {
+        ++stats.tx_fast.drops;
+    }
+    mark_urgent(now_);
+    refresh(now_);
+    return r;
+}
+
+void Transport::Impl::handle_timeout(TimePoint now) {
+    now_ = std::max(now_, now);
+    for (std::size_t l = 0; l < senders.size(); ++l) {
+        const std::size_t lost = senders[l].on_timeout(now_, rtt.rto(backoff[l]));
+        if (lost > 0) {
+            backoff[l] = std::min(backoff[l] + 1, kMaxBackoff);
+            lost_window += static_cast<double>(lost);
+        }
+    }
+    stats.rx_fast.drops += reassembly.expire(now_);
+    for (std::size_t p = 0; p < paths.size(); ++p) {
+        Path& ps = paths[p];
+        if (ps.alive && ps.last_heard + cfg.link_down_after <= now_) {
+            ps.alive = false;
+            ps.streak = 0;
+            push_event(TransportEvent::Kind::path_down, p);
+        }
+    }
+    update_link_state();
+    refresh(now_);
+}
+
+void Transport::Impl::push_event(TransportEvent::Kind kind, std::size_t path, std::uint64_t count) {
+    if (events.size() >= kEventCap) {
+        events.pop_front();
+        ++stats.events_dropped;
+    }
+    events.push_back(TransportEvent{kind, path, count});
+}
+
+void Transport::Impl::update_link_state() {
+    const bool any_alive = std::any_of(paths.begin(), paths.end(), [](const Path& p) { return p.alive; });
+    const bool up = confirmed && any_alive;
+    if (up != link) {
+        link = up;
+        push_event(up ? TransportEvent::Kind::link_up : TransportEvent::Kind::link_down);
+    }
+}
+
+void Transport::Impl::refresh(TimePoint now) {
+    now_ = std::max(now_, now);
+    TimePoint tx = kNever;
+    for (std::size_t p = 0; p < paths.size(); ++p) {
+        const TimePoint due = content_due(p);
+        if (due != kNever) {
+            tx = std::min(tx, std::max(due, paths[p].next_free));
+        }
+    }
+    timers[static_cast<std::size_t>(Timer::transmit)] = tx;
+    TimePoint rto = kNever;
+    for (std::size_t l = 0; l < senders.size(); ++l) {
+        rto = std::min(rto, senders[l].next_timeout(rtt.rto(backoff[l])));
+    }
+    timers[static_cast<std::size_t>(Timer::retransmit)] = rto;
+    timers[static_cast<std::size_t>(Timer::reassembly)] = reassembly.next_deadline();
+    TimePoint live = kNever;
+    for (const Path& ps : paths) {
+        if (ps.alive) {
+            live = std::min(live, ps.last_heard + cfg.link_down_after);
+        }
+    }
+    if (peer_mask_known && peer_mask_time + cfg.link_down_after > now_) {
+        live = std::min(live, peer_mask_time + cfg.link_down_after);  // path selection changes then
+    }
+    timers[static_cast<std::size_t>(Timer::liveness)] = live;
+
+    // Snapshots for stats().
+    stats.session = established;
+    stats.link_up = link;
+    stats.srtt_ms = std::chrono::duration<double, std::milli>(rtt.srtt()).count();
+    stats.rttvar_ms = std::chrono::duration<double, std::milli>(rtt.rttvar()).count();
+    stats.rto_ms = std::chrono::duration<double, std::milli>(rtt.rto()).count();
+    stats.rtt_samples = rtt.samples();
+    stats.frame_payload = payload_cap();
+    stats.peer_suggested_payload = peer_suggested;
+    stats.frame_loss = sent_window > 0 ? std::min(1.0, lost_window / sent_window) : 0.0;
+    std::uint64_t safe_depth = 0;
+    std::uint64_t fast_depth = 0;
+    for (std::size_t l = 0; l < senders.size(); ++l) {
+        safe_depth += senders[l].pending_messages();
+        fast_depth += fast[l].size();
+    }
+    stats.tx_safe.queue_depth = safe_depth;
+    stats.tx_fast.queue_depth = fast_depth;
+    const auto safe_waiting = static_cast<std::uint64_t>(
+        std::count_if(deliveries.begin(), deliveries.end(),
+                      [](const Delivered& d) { return d.cls == MessageClass::safe; }));
+    stats.rx_safe.queue_depth = safe_waiting;
+    stats.rx_fast.queue_depth = deliveries.size() - safe_waiting;
+    for (std::size_t p = 0; p < paths.size(); ++p) {
+        stats.path[p].alive = paths[p].alive;
+        stats.path[p].peer_hears = peer_mask_fresh() && ((peer_mask >> p) & 1U) != 0;
+    }
+}
+
+// ---- public forwarding
+
+Transport::Transport(TransportConfig config, TimePoint now)
+    : impl_(std::make_unique<Impl>(std::move(config), now)) {}
+Transport::~Transport() = default;
+Transport::Transport(Transport&&) noexcept = default;
+Transport& Transport::operator=(Transport&&) noexcept = default;
+
+SendResult Transport::send_safe(std::uint8_t priority, std::span<const std::uint8_t> msg, TimePoint now) {
+    return impl_->send_safe(priority, msg, now);
+}
+SendResult Transport::send_fast(std::uint8_t priority, std::uint16_t topic, std::span<const std::uint8_t> msg,
+                                TimePoint now) {
+    return impl_->send_fast(priority, topic, msg, now);
+}
+std::optional<Delivered> Transport::poll_message() {
+    if (impl_->deliveries.empty()) {
+        return std::nullopt;
+    }
+    Delivered d = std::move(impl_->deliveries.front());
+    impl_->deliveries.pop_front();
+    (d.cls == MessageClass::safe ? impl_->stats.rx_safe : impl_->stats.rx_fast).queue_depth -= 1;
+    return d;
+}
+std::optional<TransportEvent> Transport::poll_event() {
+    if (impl_->events.empty()) {
+        return std::nullopt;
+    }
+    TransportEvent e = impl_->events.front();
+    impl_->events.pop_front();
+    return e;
+}
+void Transport::handle_bytes(std::size_t path, std::span<const std::uint8_t> bytes, TimePoint now) {
+    impl_->handle_bytes(path, bytes, now);
+}
+std::optional<std::vector<std::uint8_t>> Transport::poll_transmit(std::size_t path, TimePoint now) {
+    return impl_->poll_transmit(path, now);
+}
+TimePoint Transport::poll_timeout() const {
+    return *std::min_element(impl_->timers.begin(), impl_->timers.end());
+}
+void Transport::handle_timeout(TimePoint now) {
+    impl_->handle_timeout(now);
+}
+const LinkStats& Transport::stats() const {
+    return impl_->stats;
+}
+bool Transport::link_up() const {
+    return impl_->link;
+}
+bool Transport::session_established() const {
+    return impl_->established && impl_->confirmed;
+}
+const TransportConfig& Transport::config() const {
+    return impl_->cfg;
+}
+std::size_t Transport::safe_pending(std::uint8_t priority) const {
+    return priority < impl_->senders.size() ? impl_->senders[priority].pending_messages() : 0;
+}
+
+}  // namespace airseg::groundlink

@@ -1,0 +1,144 @@
+#pragma once
+// Internal state of Transport (see transport.hpp for the contract). Split over transport.cpp (public calls,
+// timers, link state), transport_rx.cpp (frames in, handshake) and transport_tx.cpp (scheduler, frames out).
+#include <array>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "services/groundlink/transport/cobs.hpp"
+#include "services/groundlink/transport/corruption_meter.hpp"
+#include "services/groundlink/transport/fast_queue.hpp"
+#include "services/groundlink/transport/fast_reassembly.hpp"
+#include "services/groundlink/transport/frame.hpp"
+#include "services/groundlink/transport/frame_mac.hpp"
+#include "services/groundlink/transport/replay_window.hpp"
+#include "services/groundlink/transport/rtt_estimator.hpp"
+#include "services/groundlink/transport/safe_receiver.hpp"
+#include "services/groundlink/transport/safe_sender.hpp"
+#include "services/groundlink/transport/transport.hpp"
+
+namespace airseg::groundlink {
+
+/// The core's deadlines; poll_timeout() is the earliest of them.
+enum class Timer : std::uint8_t { transmit, retransmit, reassembly, liveness, count };
+
+class Transport::Impl {
+  public:
+    static constexpr std::size_t kEventCap = 64;
+    static constexpr std::size_t kMirrorCap = 4;
+    static constexpr unsigned kMaxBackoff = 10;
+
+    Impl(TransportConfig config, TimePoint now);
+
+    // transport.cpp
+    SendResult send_safe(std::uint8_t priority, std::span<const std::uint8_t> msg, TimePoint now);
+    SendResult send_fast(std::uint8_t priority, std::uint16_t topic, std::span<const std::uint8_t> msg,
+                         TimePoint now);
+    void handle_timeout(TimePoint now);
+    void push_event(TransportEvent::Kind kind, std::size_t path = 0, std::uint64_t count = 0);
+    void update_link_state();
+    void refresh(TimePoint now);
+
+    // transport_rx.cpp
+    void handle_bytes(std::size_t path, std::span<const std::uint8_t> bytes, TimePoint now);
+    void on_plain_frame(std::size_t path, std::span<const std::uint8_t> plain, TimePoint now);
+    void on_hello(std::size_t path, const frame::Hello& h, TimePoint now);
+    void on_data_frame(std::size_t path, std::span<const std::uint8_t> frame, TimePoint now);
+    void on_authentic(std::size_t path, std::uint8_t peer_heard_mask, TimePoint now);
+    void on_safe(const frame::SafeChunk& c, TimePoint now);
+    void on_fast(const frame::FastChunk& c, TimePoint now);
+    void on_ack(const frame::AckChunk& a, TimePoint now);
+    void accept_session(std::uint64_t peer, TimePoint now);
+    void queue_hello_reply(const frame::Hello& h);
+    std::uint64_t fresh_nonce();
+
+    // transport_tx.cpp
+    std::optional<std::vector<std::uint8_t>> poll_transmit(std::size_t path, TimePoint now);
+    [[nodiscard]] bool carries_data(std::size_t path) const;
+    [[nodiscard]] bool keeps_alive(std::size_t path) const;
+    [[nodiscard]] bool peer_mask_fresh() const;
+    [[nodiscard]] std::uint8_t heard_mask() const;
+    [[nodiscard]] bool data_ready() const;
+    [[nodiscard]] TimePoint ack_due() const;
+    [[nodiscard]] TimePoint content_due(std::size_t path) const;
+    [[nodiscard]] std::size_t payload_cap() const;
+    [[nodiscard]] bool level_ready(std::size_t level, bool retx_ok) const;
+    std::optional<std::vector<std::uint8_t>> build_hello(std::size_t path, TimePoint now);
+    std::optional<std::vector<std::uint8_t>> build_data(std::size_t path, TimePoint now);
+    bool add_data_chunk(std::vector<frame::Chunk>& chunks, std::vector<std::vector<std::uint8_t>>& storage,
+                        std::size_t& room, bool first, TimePoint now);
+    void account_sent(std::size_t path, std::size_t bytes, TimePoint now);
+    void mark_urgent(TimePoint now) { urgent_until = now + cfg.latency_hold; }
+
+    TransportConfig cfg;
+    std::unique_ptr<FrameMac> mac;
+    LinkStats stats;
+    TimePoint now_;
+
+    // Session (handshake in docs/ground-link.md, "Sessions").
+    std::uint64_t nonce_counter = 0;
+    std::uint64_t candidate = 0;  // offered in the next handshake
+    bool established = false;
+    bool confirmed = false;  // the peer is known to hold the same session
+    std::uint64_t my_nonce = 0;
+    std::uint64_t peer_nonce = 0;
+    std::uint64_t last_seen_peer = 0;
+    std::optional<frame::Hello> hello_reply;
+    std::uint8_t hello_reply_paths = 0;
+    std::uint64_t next_frame_number = 0;
+    ReplayWindow rx_window;
+
+    struct Path {
+        explicit Path(std::size_t max_encoded) : deframer(max_encoded) {}
+        CobsDeframer deframer;
+        TimePoint next_free{};  // pacing: the path's byte-time budget allows the next frame from here
+        TimePoint last_sent{};
+        TimePoint next_hello{};
+        TimePoint last_hello{};
+        TimePoint last_heard{};
+        std::size_t streak = 0;
+        bool alive = false;
+        std::deque<std::vector<std::uint8_t>> mirror;  // redundant mode: frames built for another path
+    };
+    std::vector<Path> paths;
+    std::uint8_t peer_mask = 0;
+    TimePoint peer_mask_time{};
+    bool peer_mask_known = false;
+    bool link = false;
+
+    struct AckState {
+        bool needed = false;
+        bool immediate = false;
+        std::size_t unacked = 0;
+        TimePoint first{};
+    };
+    std::vector<SafeSender> senders;
+    std::vector<SafeReceiver> receivers;
+    std::vector<AckState> acks;
+    std::vector<unsigned> backoff;
+    std::vector<FastQueue> fast;
+    FastReassembly reassembly;
+    RttEstimator rtt;
+
+    // Scheduler.
+    std::array<double, kMaxPriorities> share_credit{};
+    double retx_credit = 0.0;
+    std::array<bool, kMaxPriorities> fast_turn{};
+    TimePoint urgent_until{};
+    double sent_window = 0.0;
+    double lost_window = 0.0;
+
+    // Frame size adaptation.
+    CorruptionMeter meter;
+    std::size_t last_reported = 0;
+    TimePoint last_report_time{};
+    std::size_t peer_suggested = 0;
+
+    std::deque<Delivered> deliveries;
+    std::deque<TransportEvent> events;
+    std::array<TimePoint, static_cast<std::size_t>(Timer::count)> timers{};
+};
+
+}  // namespace airseg::groundlink

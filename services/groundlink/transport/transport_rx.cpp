@@ -1,0 +1,296 @@
+// Frames in: deframing, CRC, authentication, replay window, handshake, chunk dispatch.
+#include <algorithm>
+
+#include "services/groundlink/transport/transport_impl.hpp"
+
+namespace airseg::groundlink {
+
+void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_t> bytes, TimePoint now) {
+    now_ = std::max(now_, now);
+    if (path >= paths.size() || bytes.empty()) {
+        return;
+    }
+    Path& ps = paths[path];
+    stats.bytes_received += bytes.size();
+    stats.path[path].bytes_received += bytes.size();
+    meter.on_bytes(bytes.size());
+    if (cfg.half_duplex) {
+        // The peer's bytes occupied the shared air just now; they count against this end's budget on the
+        // path.
+        const auto air = std::chrono::duration_cast<Duration>(
+            std::chrono::duration<double>(static_cast<double>(bytes.size()) / cfg.link_rate_bytes_per_s));
+        ps.next_free = std::max(ps.next_free, now_ - air) + air;
+    }
+    ps.deframer.feed(
+        bytes, [&](std::vector<std::uint8_t>&& plain) { on_plain_frame(path, plain, now_); },
+        [&] {
+            ++stats.framing_errors;
+            meter.on_bad_frame();
+        });
+    update_link_state();
+    refresh(now_);
+}
+
+void Transport::Impl::on_plain_frame(std::size_t path, std::span<const std::uint8_t> plain, TimePoint now) {
+    const bool keyed = mac != nullptr;
+    const auto kind = frame::kind_of(plain);
+    const std::size_t tag_bytes = keyed ? kMacTagBytes : 0;
+    if (!kind) {
+        ++stats.crc_errors;
+        meter.on_bad_frame();
+        return;
+    }
+    MacContext ctx{};
+    if (*kind == frame::Kind::data) {
+        ctx = MacContext{peer_nonce, my_nonce, 0};
+    }
+    const auto body = frame::check_crc(plain, keyed, ctx);
+    if (!body || body->size() < tag_bytes + 1) {
+        ++stats.crc_errors;
+        if (keyed || established || *kind == frame::Kind::hello) {
+            meter.on_bad_frame();
+        }
+        return;
+    }
+    const auto frame_bytes = body->first(body->size() - tag_bytes);
+    const auto tag = body->subspan(body->size() - tag_bytes);
+    if (*kind == frame::Kind::hello) {
+        if (keyed && !mac->verify(ctx, frame_bytes, tag)) {
+            ++stats.mac_failures;
+            return;
+        }
+        const auto hello = frame::decode_hello(frame_bytes);
+        if (!hello) {
+            ++stats.malformed;
+            return;
+        }
+        on_hello(path, *hello, now);
+        return;
+    }
+    if (!established) {
+        ++stats.mac_failures;  // no session to authenticate it against
+        return;
+    }
+    const auto truncated = frame::frame_number_of(frame_bytes);
+    if (!truncated) {
+        ++stats.malformed;
+        return;
+    }
+    const std::uint64_t number = rx_window.reconstruct(*truncated);
+    ctx.frame_number = number;
+    if (keyed && !mac->verify(ctx, frame_bytes, tag)) {
+        ++stats.mac_failures;
+        return;
+    }
+    if (rx_window.check(number) != ReplayWindow::Check::fresh) {
+        ++stats.replays;
+        return;
+    }
+    rx_window.accept(number);
+    on_authentic(path, frame::heard_mask_of(frame_bytes), now);
+    if (!confirmed) {
+        confirmed = true;
+    }
+    on_data_frame(path, frame_bytes, now);
+}
+
+void Transport::Impl::on_authentic(std::size_t path, std::uint8_t peer_heard_mask, TimePoint now) {
+    Path& ps = paths[path];
+    if (!ps.alive) {
+        if (ps.streak > 0 && now - ps.last_heard > cfg.link_down_after) {
+            ps.streak = 0;
+        }
+        if (++ps.streak >= cfg.link_up_frames) {
+            ps.alive = true;
+            push_event(TransportEvent::Kind::path_up, path);
+        }
+    }
+    ps.last_heard = now;
+    ++stats.frames_received;
+    ++stats.path[path].frames_received;
+    peer_mask = peer_heard_mask;
+    peer_mask_time = now;
+    peer_mask_known = true;
+}
+
+void Transport::Impl::on_data_frame(std::size_t path, std::span<const std::uint8_t> frame_bytes,
+                                    TimePoint now) {
+    (void)path;
+    const auto chunks = frame::decode_chunks(frame_bytes);
+    if (!chunks) {
+        ++stats.malformed;
+        return;
+    }
+    for (const auto& c : *chunks) {
+        if (const auto* s = std::get_if<frame::SafeChunk>(&c)) {
+            on_safe(*s, now);
+        } else if (const auto* f = std::get_if<frame::FastChunk>(&c)) {
+            on_fast(*f, now);
+        } else if (const auto* a = std::get_if<frame::AckChunk>(&c)) {
+            on_ack(*a, now);
+        } else if (const auto* r = std::get_if<frame::ReportChunk>(&c)) {
+            peer_suggested = r->suggested_payload;
+        }
+    }
+}
+
+void Transport::Impl::on_safe(const frame::SafeChunk& c, TimePoint now) {
+    if (c.channel >= receivers.size()) {
+        ++stats.malformed;
+        return;
+    }
+    ++stats.rx_safe.segments;
+    AckState& ack = acks[c.channel];
+    if (deliveries.size() >= cfg.delivery_queue_cap) {
+        ++stats.deliveries_refused;  // not acknowledged: the sender retries once the application catches up
+        return;
+    }
+    SafeReceiver& rx = receivers[c.channel];
+    const auto result = rx.on_segment(c);
+    if (!ack.needed) {
+        ack.first = now;
+    }
+    ack.needed = true;
+    switch (result) {
+        case SafeReceiver::Accept::fresh:
+            ++ack.unacked;
+            if (rx.has_gap() || ack.unacked >= cfg.ack_every) {
+                ack.immediate = true;
+            }
+            break;
+        case SafeReceiver::Accept::duplicate:
+            ++stats.rx_safe.drops;
+            ack.immediate = true;
+            break;
+        case SafeReceiver::Accept::out_of_window:
+            ack.immediate = true;
+            break;
+    }
+    while (auto m = rx.pop_message()) {
+        ++stats.rx_safe.messages;
+        stats.rx_safe.bytes += m->size();
+        deliveries.push_back(Delivered{MessageClass::safe, c.channel, 0, std::move(*m)});
+    }
+}
+
+void Transport::Impl::on_fast(const frame::FastChunk& c, TimePoint now) {
+    if (c.priority >= fast.size()) {
+        ++stats.malformed;
+        return;
+    }
+    ++stats.rx_fast.segments;
+    std::optional<std::vector<std::uint8_t>> whole;
+    if (!c.fragmented) {
+        whole.emplace(c.data.begin(), c.data.end());
+    } else {
+        const auto before = reassembly.dropped();
+        whole = reassembly.add(c, now);
+        stats.rx_fast.drops += reassembly.dropped() - before;
+    }
+    if (!whole) {
+        return;
+    }
+    if (deliveries.size() >= cfg.delivery_queue_cap) {
+        ++stats.rx_fast.drops;
+        return;
+    }
+    ++stats.rx_fast.messages;
+    stats.rx_fast.bytes += whole->size();
+    deliveries.push_back(Delivered{MessageClass::fast, c.priority, c.topic, std::move(*whole)});
+}
+
+void Transport::Impl::on_ack(const frame::AckChunk& a, TimePoint now) {
+    if (a.channel >= senders.size()) {
+        ++stats.malformed;
+        return;
+    }
+    ++stats.acks_received;
+    const auto r = senders[a.channel].on_ack(a, now);
+    if (r.rtt_sample) {
+        rtt.sample(*r.rtt_sample);
+    }
+    if (r.progress) {
+        backoff[a.channel] = 0;
+    }
+    lost_window += static_cast<double>(r.newly_lost);
+}
+
+// ---- handshake (docs/ground-link.md, "Sessions")
+
+std::uint64_t Transport::Impl::fresh_nonce() {
+    std::uint64_t v = 0;
+    do {
+        ++nonce_counter;
+        v = cfg.boot_nonce + nonce_counter * 0x9E3779B97F4A7C15ULL;
+    } while (v == 0);
+    return v;
+}
+
+void Transport::Impl::queue_hello_reply(const frame::Hello& h) {
+    hello_reply = h;
+    hello_reply_paths = static_cast<std::uint8_t>((1U << paths.size()) - 1U);
+}
+
+void Transport::Impl::on_hello(std::size_t path, const frame::Hello& h, TimePoint now) {
+    ++stats.hellos_received;
+    if (established && h.sender_nonce == peer_nonce && h.echo_nonce == my_nonce) {
+        on_authentic(path, h.heard_mask, now);
+        if (h.established) {
+            confirmed = true;
+        } else {
+            queue_hello_reply(frame::Hello{0, my_nonce, peer_nonce, true});
+        }
+        return;
+    }
+    if (h.echo_nonce != 0 && h.echo_nonce == candidate) {
+        // The sender echoed the nonce this end offered most recently: it is live, not a recording.
+        accept_session(h.sender_nonce, now);
+        on_authentic(path, h.heard_mask, now);
+        if (h.established) {
+            confirmed = true;
+        }
+        queue_hello_reply(frame::Hello{0, my_nonce, peer_nonce, true});
+        return;
+    }
+    if (!established || h.echo_nonce == 0) {
+        // A peer that does not know this end (it started, or it is a replay): challenge it with a fresh
+        // nonce; the session changes only if the answer echoes it.
+        last_seen_peer = h.sender_nonce;
+        queue_hello_reply(frame::Hello{0, candidate, h.sender_nonce, false});
+    }
+}
+
+void Transport::Impl::accept_session(std::uint64_t peer, TimePoint now) {
+    const bool had_session = established;
+    established = true;
+    confirmed = false;
+    my_nonce = candidate;
+    peer_nonce = peer;
+    last_seen_peer = peer;
+    candidate = fresh_nonce();
+    rx_window.reset();
+    next_frame_number = 0;
+    std::size_t given_up = 0;
+    for (std::size_t l = 0; l < senders.size(); ++l) {
+        given_up += senders[l].reset();
+        receivers[l].reset();
+        acks[l] = AckState{};
+        backoff[l] = 0;
+    }
+    reassembly.reset();
+    for (Path& ps : paths) {
+        ps.mirror.clear();
+        ps.last_sent = now;
+    }
+    if (had_session) {
+        ++stats.peer_restarts;
+        push_event(TransportEvent::Kind::peer_restarted);
+        if (given_up > 0) {
+            stats.safe_given_up += given_up;
+            push_event(TransportEvent::Kind::safe_given_up, 0, given_up);
+        }
+    }
+    push_event(TransportEvent::Kind::session_established);
+}
+
+}  // namespace airseg::groundlink

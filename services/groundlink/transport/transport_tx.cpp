@@ -1,0 +1,341 @@
+// Frames out: path selection, pacing, handshake frames and the scheduler that fills data frames.
+#include <algorithm>
+#include <cmath>
+
+#include "services/groundlink/transport/transport_impl.hpp"
+
+namespace airseg::groundlink {
+namespace {
+
+constexpr std::size_t kMinUsefulSafe = 16;  // do not top up a frame with a Safe sliver smaller than this
+constexpr std::size_t kMaxDataChunks = 64;
+
+}  // namespace
+
+bool Transport::Impl::peer_mask_fresh() const {
+    return peer_mask_known && now_ - peer_mask_time < cfg.link_down_after;
+}
+
+std::uint8_t Transport::Impl::heard_mask() const {
+    std::uint8_t m = 0;
+    for (std::size_t p = 0; p < paths.size(); ++p) {
+        if (paths[p].alive) {
+            m = static_cast<std::uint8_t>(m | (1U << p));
+        }
+    }
+    return m;
+}
+
+bool Transport::Impl::carries_data(std::size_t path) const {
+    const auto bit = static_cast<std::uint8_t>(1U << path);
+    switch (cfg.path_mode) {
+        case PathMode::single:
+            return path == 0;
+        case PathMode::split: {
+            const std::size_t primary = cfg.split_tx_path;
+            const bool fallback = peer_mask_fresh() && ((peer_mask >> primary) & 1U) == 0;
+            return fallback ? path != primary : path == primary;
+        }
+        case PathMode::redundant:
+            // A path the peer reports silent stops carrying data while another one works.
+            return !peer_mask_fresh() || (peer_mask & bit) != 0 || (peer_mask & 0x03U & ~bit) == 0;
+    }
+    return false;
+}
+
+bool Transport::Impl::keeps_alive(std::size_t path) const {
+    switch (cfg.path_mode) {
+        case PathMode::single:
+            return path == 0;
+        case PathMode::split:
+            return path == cfg.split_tx_path || carries_data(path);
+        case PathMode::redundant:
+            return true;
+    }
+    return false;
+}
+
+std::size_t Transport::Impl::payload_cap() const {
+    std::size_t cap = cfg.max_frame_payload;
+    if (cfg.adaptive_frame_size && peer_suggested > 0) {
+        cap = std::clamp(peer_suggested, cfg.min_frame_payload, cfg.max_frame_payload);
+    }
+    if (now_ < urgent_until) {
+        cap = std::min(cap, cfg.latency_frame_payload);
+    }
+    return std::max(cap, cfg.min_frame_payload);
+}
+
+bool Transport::Impl::level_ready(std::size_t level, bool retx_ok) const {
+    return !fast[level].empty() || (retx_ok && senders[level].has_lost()) || senders[level].can_send_new();
+}
+
+bool Transport::Impl::data_ready() const {
+    for (std::size_t l = 0; l < senders.size(); ++l) {
+        if (level_ready(l, true)) {
+            return true;
+        }
+    }
+    return false;
+}
+
+TimePoint Transport::Impl::ack_due() const {
+    TimePoint t = kNever;
+    for (const AckState& a : acks) {
+        if (a.needed) {
+            t = std::min(t, a.immediate ? now_ : a.first + cfg.ack_delay);
+        }
+    }
+    return t;
+}
+
+TimePoint Transport::Impl::content_due(std::size_t path) const {
+    const Path& ps = paths[path];
+    TimePoint t = kNever;
+    if (hello_reply && ((hello_reply_paths >> path) & 1U) != 0) {
+        t = std::min(t, ps.last_hello + cfg.hello_interval / 4);
+    }
+    if (!confirmed) {
+        return std::min(t, ps.next_hello);
+    }
+    if (carries_data(path)) {
+        if (!ps.mirror.empty() || data_ready()) {
+            return std::min(t, now_);
+        }
+        t = std::min(t, ack_due());
+    }
+    if (keeps_alive(path)) {
+        t = std::min(t, ps.last_sent + cfg.keepalive_interval);
+    }
+    return t;
+}
+
+std::optional<std::vector<std::uint8_t>> Transport::Impl::poll_transmit(std::size_t path, TimePoint now) {
+    now_ = std::max(now_, now);
+    if (path >= paths.size() || now_ < paths[path].next_free) {
+        return std::nullopt;
+    }
+    auto out = build_hello(path, now_);
+    if (!out && confirmed) {
+        out = build_data(path, now_);
+    }
+    if (out) {
+        account_sent(path, out->size(), now_);
+    }
+    update_link_state();
+    refresh(now_);
+    return out;
+}
+
+void Transport::Impl::account_sent(std::size_t path, std::size_t bytes, TimePoint now) {
+    Path& ps = paths[path];
+    const auto air = std::chrono::duration_cast<Duration>(
+        std::chrono::duration<double>(static_cast<double>(bytes) / cfg.link_rate_bytes_per_s));
+    ps.next_free = std::max(ps.next_free, now) + air;
+    ps.last_sent = now;
+    ++stats.frames_sent;
+    stats.bytes_sent += bytes;
+    ++stats.path[path].frames_sent;
+    stats.path[path].bytes_sent += bytes;
+}
+
+std::optional<std::vector<std::uint8_t>> Transport::Impl::build_hello(std::size_t path, TimePoint now) {
+    Path& ps = paths[path];
+    const auto bit = static_cast<std::uint8_t>(1U << path);
+    frame::Hello h;
+    if (hello_reply && (hello_reply_paths & bit) != 0 && now >= ps.last_hello + cfg.hello_interval / 4) {
+        h = *hello_reply;
+        hello_reply_paths = static_cast<std::uint8_t>(hello_reply_paths & ~bit);
+        if (hello_reply_paths == 0) {
+            hello_reply.reset();
+        }
+    } else if (!confirmed && now >= ps.next_hello) {
+        h = established ? frame::Hello{0, my_nonce, peer_nonce, true}
+                        : frame::Hello{0, candidate, last_seen_peer, false};
+    } else {
+        return std::nullopt;
+    }
+    h.heard_mask = heard_mask();
+    ps.next_hello = now + cfg.hello_interval;
+    ps.last_hello = now;
+    ++stats.hellos_sent;
+    return frame::seal(frame::encode_hello(h), mac.get(), MacContext{});
+}
+
+bool Transport::Impl::add_data_chunk(std::vector<frame::Chunk>& chunks,
+                                     std::vector<std::vector<std::uint8_t>>& storage, std::size_t& room,
+                                     bool first, TimePoint now) {
+    const std::size_t levels = senders.size();
+    const bool any_fast =
+        std::any_of(fast.begin(), fast.end(), [](const FastQueue& q) { return !q.empty(); });
+    const bool retx_ok = retx_credit > 0.0 || !any_fast;
+
+    // Level order: a lower level that has earned its minimum share goes first, then strict priority.
+    std::vector<std::size_t> order;
+    for (std::size_t l = 1; l < levels; ++l) {
+        if (share_credit[l] > 0.0 && level_ready(l, retx_ok)) {
+            order.push_back(l);
+        }
+    }
+    for (std::size_t l = 0; l < levels; ++l) {
+        order.push_back(l);
+    }
+
+    for (const std::size_t l : order) {
+        if (!level_ready(l, retx_ok)) {
+            continue;
+        }
+        SafeSender& tx = senders[l];
+        const auto level = static_cast<std::uint8_t>(l);
+        std::size_t used = 0;
+        if (retx_ok && tx.has_lost() && (first || tx.lost_size() + frame::safe_chunk_overhead() <= room)) {
+            auto seg = tx.take_lost(now);
+            storage.push_back(std::move(seg.data));
+            chunks.emplace_back(frame::SafeChunk{level, seg.end, seg.seq, storage.back()});
+            used = frame::safe_chunk_overhead() + storage.back().size();
+            ++stats.tx_safe.retransmissions;
+            retx_credit -= static_cast<double>(used);
+        } else {
+            const bool fast_first = fast_turn[l] || !tx.can_send_new();
+            for (int attempt = 0; attempt < 2 && used == 0; ++attempt) {
+                const bool try_fast = (attempt == 0) == fast_first;
+                if (try_fast && !fast[l].empty()) {
+                    if (auto piece = fast[l].take(room, first)) {
+                        storage.push_back(std::move(piece->data));
+                        chunks.emplace_back(frame::FastChunk{level, piece->topic, piece->fragmented,
+                                                             piece->msg_id, piece->index, piece->count,
+                                                             storage.back()});
+                        used = frame::fast_chunk_overhead(piece->fragmented) + storage.back().size();
+                        ++stats.tx_fast.segments;
+                        fast_turn[l] = false;
+                        mark_urgent(now);
+                    }
+                } else if (!try_fast && tx.can_send_new()) {
+                    const std::size_t fit =
+                        room > frame::safe_chunk_overhead() ? room - frame::safe_chunk_overhead() : 0;
+                    if (!first && fit < kMinUsefulSafe) {
+                        continue;
+                    }
+                    if (auto seg = tx.take_new(fit, first, now)) {
+                        storage.push_back(std::move(seg->data));
+                        chunks.emplace_back(frame::SafeChunk{level, seg->end, seg->seq, storage.back()});
+                        used = frame::safe_chunk_overhead() + storage.back().size();
+                        fast_turn[l] = true;
+                        if (l + 1 < levels) {
+                            mark_urgent(now);
+                        }
+                    }
+                }
+            }
+            if (used == 0) {
+                continue;
+            }
+        }
+        if (std::holds_alternative<frame::SafeChunk>(chunks.back())) {
+            ++stats.tx_safe.segments;
+            sent_window += 1.0;
+            if (sent_window > 400.0) {  // loss estimate over roughly the last few hundred segments
+                sent_window /= 2;
+                lost_window /= 2;
+            }
+        }
+        share_credit[l] = std::max(share_credit[l] - static_cast<double>(used),
+                                   -4.0 * static_cast<double>(cfg.max_frame_payload));
+        room = room > used ? room - used : 0;
+        return true;
+    }
+    return false;
+}
+
+std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t path, TimePoint now) {
+    Path& ps = paths[path];
+    if (!ps.mirror.empty()) {
+        auto f = std::move(ps.mirror.front());
+        ps.mirror.pop_front();
+        return f;
+    }
+    const bool keepalive_due = keeps_alive(path) && now >= ps.last_sent + cfg.keepalive_interval;
+    if (!carries_data(path)) {
+        if (!keepalive_due) {
+            return std::nullopt;
+        }
+        // A probe: an empty frame, so the peer can report whether it hears this path.
+        auto plain = frame::encode_data(heard_mask(), static_cast<std::uint32_t>(next_frame_number), {});
+        const MacContext ctx{my_nonce, peer_nonce, next_frame_number++};
+        return frame::seal(std::move(plain), mac.get(), ctx);
+    }
+
+    std::vector<frame::Chunk> chunks;
+    std::vector<std::vector<std::uint8_t>> storage;
+    storage.reserve(kMaxDataChunks);  // chunk spans point into it: no reallocation while filling
+    std::size_t room = payload_cap();
+    const bool ack_is_due = ack_due() <= now;
+
+    std::vector<std::size_t> acked_channels;
+    for (std::size_t l = 0; l < acks.size(); ++l) {
+        if (acks[l].needed) {
+            chunks.emplace_back(receivers[l].make_ack(static_cast<std::uint8_t>(l)));
+            acked_channels.push_back(l);
+        }
+    }
+    if (const auto suggestion = meter.suggested_payload()) {
+        const auto s = std::min<std::size_t>(*suggestion, 0xFFFF);
+        const bool changed =
+            last_reported == 0 || std::abs(static_cast<double>(s) - static_cast<double>(last_reported)) >
+                                      0.1 * static_cast<double>(last_reported);
+        if (changed || now - last_report_time >= std::chrono::seconds(5)) {
+            chunks.emplace_back(frame::ReportChunk{static_cast<std::uint16_t>(s)});
+            last_reported = s;
+            last_report_time = now;
+        }
+    }
+    for (const auto& c : chunks) {
+        room = room > frame::encoded_size(c) ? room - frame::encoded_size(c) : 0;
+    }
+    std::size_t data_chunks = 0;
+    while (data_chunks < kMaxDataChunks && add_data_chunk(chunks, storage, room, data_chunks == 0, now)) {
+        ++data_chunks;
+        if (room <= frame::safe_chunk_overhead()) {
+            break;
+        }
+    }
+    if (data_chunks == 0 && !ack_is_due && !keepalive_due) {
+        return std::nullopt;  // only opportunistic content: wait for a frame worth sending
+    }
+    for (const std::size_t l : acked_channels) {
+        acks[l] = AckState{};
+        ++stats.acks_sent;
+    }
+
+    std::size_t payload = 0;
+    for (const auto& c : chunks) {
+        payload += frame::encoded_size(c);
+    }
+    // Credits for the scheduler: every ready level earns its minimum share, retransmissions their share.
+    const auto frame_bytes = static_cast<double>(payload + frame::frame_overhead(mac != nullptr));
+    const auto cap = static_cast<double>(cfg.max_frame_payload);
+    for (std::size_t l = 1; l < senders.size(); ++l) {
+        if (level_ready(l, true)) {
+            share_credit[l] = std::min(share_credit[l] + cfg.min_share[l] * frame_bytes, cap);
+        } else {
+            share_credit[l] = std::min(share_credit[l], 0.0);
+        }
+    }
+    retx_credit = std::min(retx_credit + cfg.retransmit_share * frame_bytes, cap);
+
+    auto plain = frame::encode_data(
+        heard_mask(), static_cast<std::uint32_t>(next_frame_number & frame::kFrameNumberMask), chunks);
+    const MacContext ctx{my_nonce, peer_nonce, next_frame_number++};
+    auto sealed = frame::seal(std::move(plain), mac.get(), ctx);
+    for (std::size_t q = 0; q < paths.size(); ++q) {
+        if (q != path && cfg.path_mode == PathMode::redundant && carries_data(q)) {
+            if (paths[q].mirror.size() >= kMirrorCap) {
+                paths[q].mirror.pop_front();
+            }
+            paths[q].mirror.push_back(sealed);
+        }
+    }
+    return sealed;
+}
+
+}  // namespace airseg::groundlink
