@@ -1,0 +1,296 @@
+#include "services/flightplan/expander.hpp"
+
+#include <algorithm>
+#include <limits>
+
+namespace airseg::flightplan {
+
+const char* to_string(WaypointAction action) {
+    switch (action) {
+        case WaypointAction::Go:
+            return "go";
+        case WaypointAction::HoldFor:
+            return "hold";
+        case WaypointAction::HoldUntilReleased:
+            return "hold-until-released";
+    }
+    return "?";
+}
+
+Expander::Expander(std::shared_ptr<const Plan> plan, bool enforce_no_fly)
+    : plan_(std::move(plan)), enforce_no_fly_(enforce_no_fly), body_count_(plan_->nodes.size()) {
+    for (std::uint32_t i = 0; i < plan_->nodes.size(); ++i) {
+        const Node& n = plan_->nodes[i];
+        if (n.kind != NodeKind::Repeat)
+            continue;
+        std::optional<std::uint64_t> sum = 0;
+        for (auto c : n.children) {
+            const auto& cc = plan_->nodes[c].count;
+            if (!cc) {
+                sum.reset();
+                break;
+            }
+            *sum += *cc;
+        }
+        body_count_[i] = sum;
+    }
+    reset_to_origin();
+}
+
+void Expander::reset_to_origin() {
+    stack_.clear();
+    leaf_ = kNoNode;
+    position_ = origin_.index;
+    speed_ = plan_->vehicle.cruise_speed;
+    // The first waypoint after a (re)start always carries the speed, so the autopilot gets it set.
+    speed_changed_ = true;
+    last_position_.reset();
+    error_.reset();
+    if (origin_.element == StreamOrigin::kStreamStart) {
+        if (plan_->main_list != kNoNode)
+            stack_.push_back({plan_->main_list, 0, 0});
+    } else {
+        place_at(origin_.element);
+    }
+}
+
+void Expander::place_at(std::uint32_t target) {
+    const auto& nodes = plan_->nodes;
+    stack_.clear();
+    if (nodes[target].kind == NodeKind::ElementList) {
+        stack_.push_back({target, 0, 0});
+        return;
+    }
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> chain;  // (ancestor, its child on the way to target)
+    std::uint32_t child = target;
+    for (std::uint32_t p = nodes[target].parent; p != kNoNode; p = nodes[p].parent) {
+        chain.emplace_back(p, child);
+        if (nodes[p].kind == NodeKind::ElementList)
+            break;
+        child = p;
+    }
+    std::reverse(chain.begin(), chain.end());
+    for (auto [ancestor, on_path] : chain) {
+        if (ancestor == plan_->blocks_list)
+            continue;  // a detached block ends the plan when it ends
+        const std::uint32_t next = nodes[on_path].index_in_parent + (on_path == target ? 0 : 1);
+        stack_.push_back({ancestor, next, 0});
+    }
+    if (nodes[target].parent == plan_->blocks_list)
+        stack_.push_back({target, 0, 0});
+}
+
+bool Expander::activate_next_leaf(std::uint64_t* skip_budget) {
+    const auto& nodes = plan_->nodes;
+    const std::size_t step_limit = 4 * nodes.size() + 64;
+    std::size_t steps = 0;
+    // Seeking: skip whole iterations of a goto-free repeat, keeping the last one to walk so that speed
+    // elements inside it still take effect.
+    auto fast_forward = [&](Frame& f) {
+        const auto& per = body_count_[f.node];
+        if (skip_budget == nullptr || !per || *per == 0)
+            return;
+        const auto& total = nodes[f.node].repeat_count;
+        const std::uint64_t left = total ? *total - f.iteration : std::numeric_limits<std::uint64_t>::max();
+        const std::uint64_t k = std::min(*skip_budget / *per, left);
+        if (k < 2)
+            return;
+        f.iteration += k - 1;
+        position_ += (k - 1) * *per;
+        *skip_budget -= (k - 1) * *per;
+        steps = 0;
+    };
+    while (!stack_.empty()) {
+        if (++steps > step_limit) {
+            error_ = "the plan loops without producing waypoints (goto cycle)";
+            stack_.clear();
+            return false;
+        }
+        Frame& f = stack_.back();
+        const Node& container = nodes[f.node];
+        if (f.next_child >= container.children.size()) {
+            if (container.kind == NodeKind::Repeat &&
+                (!container.repeat_count || f.iteration + 1 < *container.repeat_count)) {
+                ++f.iteration;
+                f.next_child = 0;
+                fast_forward(f);
+            } else {
+                stack_.pop_back();
+            }
+            continue;
+        }
+        const std::uint32_t id = container.children[f.next_child++];
+        const Node& n = nodes[id];
+        switch (n.kind) {
+            case NodeKind::Speed:
+                speed_ = n.speed.value_or(speed_);
+                speed_changed_ = true;
+                break;
+            case NodeKind::Repeat:
+            case NodeKind::Block:
+                stack_.push_back({id, 0, 0});
+                if (n.kind == NodeKind::Repeat)
+                    fast_forward(stack_.back());
+                break;
+            case NodeKind::Goto:
+                place_at(n.goto_target);
+                break;
+            case NodeKind::ElementList:
+                break;
+            case NodeKind::Waypoint:
+            case NodeKind::Hold:
+            case NodeKind::Scan:
+            case NodeKind::Orbit: {
+                const std::uint64_t count = n.count.value_or(0);
+                if (count == 0)
+                    break;
+                if (skip_budget != nullptr && *skip_budget >= count) {
+                    *skip_budget -= count;
+                    position_ += count;
+                    steps = 0;
+                    break;
+                }
+                activate_leaf(id, 0);
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
+void Expander::activate_leaf(std::uint32_t node, std::uint64_t offset) {
+    const Node& n = plan_->nodes[node];
+    leaf_ = node;
+    leaf_count_ = n.count.value_or(0);
+    leaf_offset_ = offset;
+    if (n.kind == NodeKind::Scan && n.scan) {
+        scan_line_ = 0;
+        scan_line_start_ = 0;
+        line_ = n.scan->line(0);
+        while (offset - scan_line_start_ >= line_.count && scan_line_ + 1 < n.scan->line_count()) {
+            scan_line_start_ += line_.count;
+            line_ = n.scan->line(++scan_line_);
+        }
+    }
+}
+
+Waypoint Expander::make_waypoint() {
+    const Node& n = plan_->nodes[leaf_];
+    Waypoint w;
+    w.index = position_;
+    w.element = leaf_;
+    w.origin = origin_;
+    w.alt = n.alt;
+    w.speed = n.speed.value_or(speed_);
+    w.speed_changed = speed_changed_;
+    w.arrival_radius = n.arrival_radius.value_or(plan_->vehicle.arrival_radius);
+    w.first_of_element = leaf_offset_ == 0;
+    w.last_of_element = leaf_offset_ + 1 == leaf_count_;
+    switch (n.kind) {
+        case NodeKind::Hold:
+            w.action = n.hold_seconds ? WaypointAction::HoldFor : WaypointAction::HoldUntilReleased;
+            w.hold_seconds = n.hold_seconds.value_or(0.0);
+            w.has_position = n.has_position;
+            w.position = n.geo;
+            w.local = n.pos;
+            return w;
+        case NodeKind::Waypoint:
+            w.position = n.geo;
+            w.local = n.pos;
+            return w;
+        case NodeKind::Orbit:
+            w.local = n.orbit->point(leaf_offset_);
+            break;
+        case NodeKind::Scan:
+            while (leaf_offset_ - scan_line_start_ >= line_.count) {
+                scan_line_start_ += line_.count;
+                line_ = n.scan->line(++scan_line_);
+            }
+            w.local = n.scan->point(scan_line_, line_, leaf_offset_ - scan_line_start_);
+            break;
+        default:
+            break;
+    }
+    w.position = plan_->frame.to_geo(w.local);
+    return w;
+}
+
+std::optional<Waypoint> Expander::next() {
+    if (error_)
+        return std::nullopt;
+    if (leaf_ == kNoNode || leaf_offset_ >= leaf_count_) {
+        leaf_ = kNoNode;
+        if (!activate_next_leaf(nullptr))
+            return std::nullopt;
+    }
+    Waypoint w = make_waypoint();
+    if (enforce_no_fly_ && w.has_position && last_position_) {
+        for (const auto& zone : plan_->no_fly) {
+            if (segment_violates_zone(*last_position_, w.local, zone.local, zone.buffer)) {
+                error_ = "the leg to waypoint " + std::to_string(w.index) + " (" + element_path(w.element) +
+                         ") enters no-fly zone '" + zone.name + "'";
+                leaf_ = kNoNode;
+                stack_.clear();
+                return std::nullopt;
+            }
+        }
+    }
+    if (w.has_position)
+        last_position_ = w.local;
+    ++leaf_offset_;
+    ++position_;
+    speed_changed_ = false;
+    return w;
+}
+
+bool Expander::seek(std::uint64_t index) {
+    if (index < origin_.index)
+        return false;
+    if (index < position_ || error_)
+        reset_to_origin();
+    std::uint64_t budget = index - position_;
+    last_position_.reset();
+    if (leaf_ != kNoNode && leaf_offset_ < leaf_count_) {
+        const std::uint64_t available = leaf_count_ - leaf_offset_;
+        if (budget < available) {
+            activate_leaf(leaf_, leaf_offset_ + budget);
+            position_ += budget;
+            return true;
+        }
+        budget -= available;
+        position_ += available;
+    }
+    leaf_ = kNoNode;
+    if (!activate_next_leaf(&budget))
+        return false;
+    activate_leaf(leaf_, budget);
+    position_ += budget;
+    return true;
+}
+
+bool Expander::jump_to(std::string_view element_name) {
+    const std::uint32_t node = plan_->find(element_name);
+    return node != kNoNode && jump_to_node(node);
+}
+
+bool Expander::jump_to_node(std::uint32_t node) {
+    if (node >= plan_->nodes.size())
+        return false;
+    origin_ = {node, position_};
+    reset_to_origin();
+    return true;
+}
+
+bool Expander::restore(StreamOrigin origin, std::uint64_t index) {
+    if (origin.element != StreamOrigin::kStreamStart && origin.element >= plan_->nodes.size())
+        return false;
+    origin_ = origin;
+    reset_to_origin();
+    return seek(index);
+}
+
+std::string Expander::element_path(std::uint32_t element) const {
+    return plan_->element_path(element);
+}
+
+}  // namespace airseg::flightplan

@@ -1,0 +1,129 @@
+#pragma once
+// The flight plan model: what the YAML loader produces and the expander walks. Elements form a tree of
+// nodes stored in one vector (parents before children); containers (the plan's element list, repeat,
+// block) hold child ids. Positions are kept both geographic and in the plan's local frame.
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "services/flightplan/geo.hpp"
+#include "services/flightplan/scan_pattern.hpp"
+
+namespace airseg::flightplan {
+
+inline constexpr std::uint32_t kNoNode = std::numeric_limits<std::uint32_t>::max();
+
+/// Where an element came from in its source file (1-based; 0 when unknown).
+struct SourceMark {
+    int line = 0;
+    int col = 0;
+};
+
+enum class NodeKind : std::uint8_t {
+    ElementList,  // the plan's main element list, or the list of detached named blocks
+    Waypoint,
+    Hold,
+    Scan,
+    Orbit,
+    Speed,
+    Repeat,
+    Block,
+    Goto,
+};
+const char* to_string(NodeKind kind);
+
+struct OrbitPattern {
+    Enu centre;
+    double radius = 0.0;
+    double turns = 1.0;
+    bool clockwise = true;
+    std::uint64_t points_per_turn = 8;
+    std::uint64_t count() const;
+    Enu point(std::uint64_t k) const;
+};
+
+struct Node {
+    NodeKind kind = NodeKind::ElementList;
+    std::uint32_t parent = kNoNode;
+    std::uint32_t index_in_parent = 0;
+    std::vector<std::uint32_t> children;  // ElementList, Repeat, Block
+    std::string name;                     // optional for every element; goto/reaction target
+    std::string path;                     // "plan.elements[2].repeat.elements[0]"
+    SourceMark mark;
+
+    // Waypoint / Hold (a hold without a position holds where the previous waypoint ends).
+    bool has_position = false;
+    LatLon geo;
+    Enu pos;
+    std::optional<double> alt;
+    std::optional<double> speed;           // Waypoint/Scan/Orbit: leg speed; Speed: the new speed
+    std::optional<double> arrival_radius;  // overrides the vehicle profile
+    std::optional<double> hold_seconds;    // Hold: empty = until released
+    std::optional<ScanPattern> scan;
+    std::optional<OrbitPattern> orbit;
+    std::optional<std::uint64_t> repeat_count;  // Repeat: empty = forever
+    std::string goto_target_name;
+    std::uint32_t goto_target = kNoNode;
+
+    // Derived: waypoints one execution of the node produces; empty when unbounded or when the subtree
+    // contains a goto (its count then depends on where the goto lands).
+    std::optional<std::uint64_t> count;
+};
+
+struct VehicleProfile {
+    std::string type = "rover";
+    double min_spacing = 4.0;     // metres between consecutive generated waypoints
+    double arrival_radius = 2.0;  // metres
+    double cruise_speed = 2.0;    // m/s
+    static std::optional<VehicleProfile> defaults_for(std::string_view type);
+};
+
+struct NoFlyZone {
+    std::string name;
+    std::vector<LatLon> polygon;
+    std::vector<Enu> local;
+    double buffer = 0.0;  // metres kept clear around the polygon
+    SourceMark mark;
+};
+
+enum class ReactionAction : std::uint8_t { Hold, ReturnHome, Continue, GotoBlock };
+const char* to_string(ReactionAction action);
+
+struct Reaction {
+    ReactionAction action = ReactionAction::Hold;
+    std::string target;  // GotoBlock: name of the element to go to
+    std::uint32_t target_node = kNoNode;
+};
+
+struct Reactions {
+    std::optional<Reaction> link_loss;
+    double link_loss_seconds = 30.0;
+    std::optional<Reaction> low_battery;
+    double low_battery_percent = 20.0;
+    std::optional<Reaction> geofence;
+};
+
+struct Plan {
+    std::string name;
+    std::string source_file;
+    VehicleProfile vehicle;
+    LocalFrame frame;
+    std::optional<LatLon> home;
+    std::vector<NoFlyZone> no_fly;
+    std::vector<LatLon> geofence;
+    std::vector<Enu> geofence_local;
+    Reactions reactions;
+
+    std::vector<Node> nodes;
+    std::uint32_t main_list = kNoNode;    // the plan's elements
+    std::uint32_t blocks_list = kNoNode;  // detached named blocks, reached only by goto or a reaction
+
+    /// The element with this name, or kNoNode.
+    std::uint32_t find(std::string_view name) const;
+    const std::string& element_path(std::uint32_t id) const;
+};
+
+}  // namespace airseg::flightplan

@@ -1,0 +1,34 @@
+#pragma once
+// YAML flight plan loader (format: docs/flight-plan.md). Every problem of a plan is reported at once, each
+// located as file:line:col plus the element path; a plan with any error is not returned, so a rejected
+// plan can change nothing downstream.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "services/flightplan/diagnostic.hpp"
+#include "services/flightplan/plan.hpp"
+
+namespace airseg::flightplan {
+
+struct LoadOptions {
+    /// Legs checked against no-fly zones at load time, per entry point (main list, each detached block).
+    /// Finite plans below this size are checked completely; see docs/flight-plan.md for infinite ones.
+    std::uint64_t leg_check_limit = 4'000'000;
+    /// Refuse plans whose finite element lists expand to more waypoints than this.
+    std::uint64_t max_finite_waypoints = 100'000'000;
+};
+
+struct LoadResult {
+    std::shared_ptr<const Plan> plan;  // null when errors is not empty
+    std::vector<Diagnostic> errors;
+    bool ok() const { return plan != nullptr; }
+};
+
+LoadResult load_plan_text(std::string_view text, const std::string& source_name,
+                          const LoadOptions& options = {});
+LoadResult load_plan_file(const std::string& path, const LoadOptions& options = {});
+
+}  // namespace airseg::flightplan

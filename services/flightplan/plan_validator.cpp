@@ -1,0 +1,62 @@
+#include "services/flightplan/plan_validator.hpp"
+
+#include <memory>
+#include <set>
+
+#include "services/flightplan/expander.hpp"
+
+namespace airseg::flightplan {
+
+namespace {
+constexpr std::size_t kMaxLegErrors = 50;
+
+bool point_violates(Enu p, const NoFlyZone& zone) {
+    return point_in_polygon(p, zone.local) || distance_to_boundary(p, zone.local) < zone.buffer;
+}
+}  // namespace
+
+void check_legs(const Plan& plan, std::uint64_t limit, std::vector<Diagnostic>& errors) {
+    // The expander shares ownership; this plan outlives the call, so an aliasing, non-owning pointer is fine.
+    std::shared_ptr<const Plan> view(std::shared_ptr<const Plan>{}, &plan);
+    std::vector<std::uint32_t> entries;
+    entries.push_back(kNoNode);
+    if (plan.blocks_list != kNoNode) {
+        for (auto b : plan.nodes[plan.blocks_list].children)
+            entries.push_back(b);
+    }
+    std::set<std::pair<std::uint32_t, std::size_t>> reported;  // (element, zone)
+    for (auto entry : entries) {
+        Expander stream(view, /*enforce_no_fly=*/false);
+        if (entry != kNoNode)
+            stream.jump_to_node(entry);
+        std::optional<Enu> last;
+        for (std::uint64_t n = 0; n < limit && !plan.no_fly.empty(); ++n) {
+            auto w = stream.next();
+            if (!w)
+                break;
+            if (!w->has_position)
+                continue;
+            for (std::size_t z = 0; z < plan.no_fly.size(); ++z) {
+                const auto& zone = plan.no_fly[z];
+                const bool bad = last ? segment_violates_zone(*last, w->local, zone.local, zone.buffer)
+                                      : point_violates(w->local, zone);
+                if (!bad || !reported.emplace(w->element, z).second)
+                    continue;
+                const Node& node = plan.nodes[w->element];
+                errors.push_back({plan.source_file, node.mark.line, node.mark.col, node.path,
+                                  "the leg to waypoint " + std::to_string(w->index) +
+                                      " crosses no-fly zone '" + zone.name + "' (buffer " +
+                                      std::to_string(zone.buffer) + " m)"});
+                if (errors.size() >= kMaxLegErrors)
+                    return;
+            }
+            last = w->local;
+        }
+        if (auto e = stream.error()) {
+            const Node& node = plan.nodes[entry == kNoNode ? plan.main_list : entry];
+            errors.push_back({plan.source_file, node.mark.line, node.mark.col, node.path, *e});
+        }
+    }
+}
+
+}  // namespace airseg::flightplan

@@ -1,0 +1,604 @@
+#include "services/flightplan/window_feeder.hpp"
+
+#include <algorithm>
+
+namespace airseg::flightplan {
+
+std::optional<std::string> FeederConfig::validate() const {
+    if (window < 3)
+        return "flightplan.window must be >= 3";
+    if (window > 250)
+        return "flightplan.window must be <= 250";
+    if (request_timeout <= Duration::zero())
+        return "flightplan.request_timeout must be > 0";
+    if (fault_backoff < Duration::zero())
+        return "flightplan.fault_backoff must be >= 0";
+    if (lost_reached_tolerance + 2 > window)
+        return "flightplan.lost_reached_tolerance must be <= window - 2";
+    return std::nullopt;
+}
+
+WindowFeeder::WindowFeeder(FeederConfig config) : config_(config), confirmed_(config.window + 2u) {}
+
+MissionItem WindowFeeder::Entry::item() const {
+    MissionItem m;
+    m.kind = stop ? MissionItem::Kind::Stop : MissionItem::Kind::Waypoint;
+    m.position = wp.position;
+    m.alt = wp.alt;
+    m.speed = wp.speed;
+    m.arrival_radius = wp.arrival_radius;
+    return m;
+}
+
+bool WindowFeeder::confirmed(const Entry& e) const {
+    return mission_ok_ && e.slot < confirmed_.size() && confirmed_[e.slot] == e.item();
+}
+
+void WindowFeeder::emit(FeederEvent::Kind kind, const Waypoint* wp, std::uint32_t generation,
+                        std::string path, std::string detail) {
+    FeederEvent e;
+    e.kind = kind;
+    e.generation = generation;
+    if (wp != nullptr) {
+        e.plan_index = wp->index;
+        e.element = wp->element;
+    }
+    e.element_path = std::move(path);
+    e.detail = std::move(detail);
+    events_.push_back(std::move(e));
+}
+
+// ---- plan inputs ---------------------------------------------------------------------------------------
+
+void WindowFeeder::replace_plan(PlanFeed feed, TimePoint now) {
+    stream_ = std::move(feed.stream);
+    plan_name_ = std::move(feed.name);
+    ++generation_;
+    stream_ended_ = false;
+    done_ = false;
+    reached_ = 0;
+    holds_.clear();
+    holding_ = false;
+    hold_until_.reset();
+    hold_wp_.reset();
+    cleared_ = false;
+    const bool keep_head = mission_ok_ && !queue_.empty() && !queue_[0].stop && !need_set_current_ &&
+                           ap_target_ == queue_[0].slot;
+    if (keep_head) {
+        queue_.resize(1);
+        refill(now);
+        check_done();
+    } else {
+        start_fresh(queue_.empty() ? std::uint16_t{1} : ring_next(queue_[0].slot), now);
+    }
+}
+
+void WindowFeeder::restore_plan(PlanFeed feed, std::uint64_t waypoints_reached, TimePoint now) {
+    replace_plan(std::move(feed), now);
+    reached_ = waypoints_reached;
+}
+
+bool WindowFeeder::skip_to(std::uint64_t index, TimePoint now) {
+    if (!stream_ || !stream_->seek(index))
+        return false;
+    restart(now);
+    return true;
+}
+
+bool WindowFeeder::jump_to(std::string_view element_name, TimePoint now) {
+    if (!stream_ || !stream_->jump_to(element_name))
+        return false;
+    restart(now);
+    return true;
+}
+
+void WindowFeeder::restart(TimePoint now) {
+    holds_.clear();
+    holding_ = false;
+    hold_until_.reset();
+    hold_wp_.reset();
+    stream_ended_ = false;
+    done_ = false;
+    // The new head goes in a slot the vehicle is not heading for; SetCurrent then points it there.
+    start_fresh(queue_.empty() ? std::uint16_t{1} : ring_next(queue_[0].slot), now);
+}
+
+void WindowFeeder::start_fresh(std::uint16_t first_slot, TimePoint now) {
+    queue_.clear();
+    fresh_slot_ = first_slot;
+    need_set_current_ = true;
+    refill(now);
+    if (!queue_.empty() && !queue_[0].stop && queue_[0].wp.first_of_element) {
+        emit(FeederEvent::Kind::ElementStarted, &queue_[0].wp, queue_[0].generation, queue_[0].element_path);
+    }
+    check_done();
+}
+
+void WindowFeeder::clear_plan() {
+    stream_.reset();
+    queue_.clear();
+    holds_.clear();
+    holding_ = false;
+    hold_until_.reset();
+    hold_wp_.reset();
+    plan_name_.clear();
+    done_ = false;
+    cleared_ = true;
+    ++generation_;
+}
+
+void WindowFeeder::pause() {
+    paused_ = true;
+}
+
+void WindowFeeder::resume() {
+    paused_ = false;
+    fault_ = false;
+}
+
+void WindowFeeder::release_hold(TimePoint now) {
+    if (!holding_)
+        return;
+    end_hold(now);
+    check_done();
+}
+
+// ---- window bookkeeping --------------------------------------------------------------------------------
+
+void WindowFeeder::refill(TimePoint now) {
+    while (stream_ && !stream_ended_ && queue_.size() < config_.window) {
+        auto w = stream_->next();
+        const std::uint16_t slot = queue_.empty() ? fresh_slot_ : ring_next(queue_.back().slot);
+        if (!w) {
+            stream_ended_ = true;
+            if (auto err = stream_->error()) {
+                emit(FeederEvent::Kind::PlanBlocked, nullptr, generation_, {}, *err);
+            }
+            if (!queue_.empty() && !queue_.back().stop) {
+                Entry stop = queue_.back();
+                stop.stop = true;
+                stop.holds_after.clear();
+                stop.slot = slot;
+                queue_.push_back(std::move(stop));
+            }
+            break;
+        }
+        if (!w->has_position) {
+            if (queue_.empty()) {
+                // Nothing to hold after: the vehicle holds where it is, now.
+                holds_.push_back(*w);
+                if (!holding_)
+                    begin_hold(now);
+            } else {
+                queue_.back().holds_after.push_back(*w);
+            }
+            continue;
+        }
+        Entry e;
+        e.wp = *w;
+        e.slot = slot;
+        e.generation = generation_;
+        e.element_path = stream_->element_path(w->element);
+        queue_.push_back(std::move(e));
+    }
+}
+
+void WindowFeeder::complete_through(std::size_t position, TimePoint now) {
+    for (std::size_t i = 0; i <= position && !queue_.empty(); ++i) {
+        Entry e = std::move(queue_.front());
+        queue_.pop_front();
+        emit(FeederEvent::Kind::WaypointReached, &e.wp, e.generation, e.element_path);
+        if (e.generation == generation_)
+            ++reached_;
+        if (e.wp.last_of_element) {
+            emit(FeederEvent::Kind::ElementFinished, &e.wp, e.generation, e.element_path);
+        }
+        const bool last = i == position;
+        if (last && e.wp.action != WaypointAction::Go)
+            holds_.push_back(e.wp);
+        for (auto& h : e.holds_after) {
+            if (last) {
+                holds_.push_back(h);
+            } else {
+                // Passed without a reached report: the hold cannot be held any more; report it done.
+                emit(FeederEvent::Kind::WaypointReached, &h, e.generation, stream_path(h));
+                if (e.generation == generation_)
+                    ++reached_;
+            }
+        }
+    }
+    if (!holds_.empty() && !holding_)
+        begin_hold(now);
+    refill(now);
+    if (!queue_.empty() && !queue_[0].stop && queue_[0].wp.first_of_element) {
+        emit(FeederEvent::Kind::ElementStarted, &queue_[0].wp, queue_[0].generation, queue_[0].element_path);
+    }
+    check_starvation();
+    check_done();
+}
+
+std::string WindowFeeder::stream_path(const Waypoint& wp) const {
+    return stream_ ? stream_->element_path(wp.element) : std::string{};
+}
+
+void WindowFeeder::begin_hold(TimePoint now) {
+    const Waypoint wp = holds_.front();
+    holding_ = true;
+    hold_wp_ = wp;
+    if (!wp.has_position) {
+        // A hold without a position has no reached report of its own: reaching it is starting it.
+        emit(FeederEvent::Kind::WaypointReached, &wp, generation_, stream_path(wp));
+        ++reached_;
+    }
+    if (wp.action == WaypointAction::HoldFor) {
+        hold_until_ =
+            now + std::chrono::duration_cast<Duration>(std::chrono::duration<double>(wp.hold_seconds));
+    } else {
+        hold_until_.reset();
+    }
+    emit(FeederEvent::Kind::HoldStarted, &wp, generation_, stream_path(wp));
+}
+
+void WindowFeeder::end_hold(TimePoint now) {
+    if (!holding_)
+        return;
+    emit(FeederEvent::Kind::HoldEnded, &*hold_wp_, generation_, stream_path(*hold_wp_));
+    holding_ = false;
+    hold_until_.reset();
+    hold_wp_.reset();
+    if (!holds_.empty())
+        holds_.pop_front();
+    if (!holds_.empty())
+        begin_hold(now);
+}
+
+void WindowFeeder::check_done() {
+    if (done_ || holding_ || !stream_)
+        return;
+    if ((queue_.empty() && stream_ended_) || (!queue_.empty() && queue_[0].stop)) {
+        done_ = true;
+        emit(FeederEvent::Kind::PlanDone, nullptr, generation_);
+    }
+}
+
+void WindowFeeder::check_starvation() {
+    if (!mission_ok_ || need_set_current_ || queue_.empty() || starving_)
+        return;
+    if (!confirmed(queue_[0])) {
+        starving_ = true;
+        ++counters_.starvation_holds;
+        emit(FeederEvent::Kind::WindowStarved, &queue_[0].wp, queue_[0].generation, queue_[0].element_path);
+    }
+}
+
+// ---- autopilot inputs ----------------------------------------------------------------------------------
+
+void WindowFeeder::on_reached(std::uint16_t slot, TimePoint now) {
+    if (slot == jump_slot())
+        return;
+    const std::size_t limit = std::min<std::size_t>(queue_.size(), config_.lost_reached_tolerance + 1);
+    for (std::size_t p = 0; p < limit; ++p) {
+        const Entry& e = queue_[p];
+        if (e.stop)
+            break;
+        if (e.slot == slot && confirmed(e)) {
+            ap_target_ = ring_next(slot);
+            current_mismatches_ = 0;
+            complete_through(p, now);
+            return;
+        }
+    }
+    ++counters_.ignored_reached;
+}
+
+void WindowFeeder::on_current(std::uint16_t slot, TimePoint now) {
+    if (queue_.empty() || !mission_ok_)
+        return;
+    if (slot == jump_slot())
+        slot = 1;
+    if (need_set_current_) {
+        ap_target_ = slot;
+        return;
+    }
+    if (slot == queue_[0].slot) {
+        ap_target_ = slot;
+        current_mismatches_ = 0;
+        return;
+    }
+    const std::size_t limit = std::min<std::size_t>(queue_.size(), config_.lost_reached_tolerance + 2);
+    for (std::size_t p = 1; p < limit; ++p) {
+        if (queue_[p - 1].stop)
+            break;
+        if (queue_[p].slot == slot && confirmed(queue_[p])) {
+            // The autopilot moved past entries whose reached reports were lost (or are still on the way).
+            ap_target_ = slot;
+            current_mismatches_ = 0;
+            complete_through(p - 1, now);
+            return;
+        }
+    }
+    // Anything else twice in a row: point the autopilot back at the head.
+    if (++current_mismatches_ >= 2) {
+        ap_target_ = slot;
+        need_set_current_ = true;
+        current_mismatches_ = 0;
+    }
+}
+
+void WindowFeeder::on_autopilot_rebooted(TimePoint) {
+    mission_ok_ = false;
+    std::fill(confirmed_.begin(), confirmed_.end(), std::nullopt);
+    ap_target_.reset();
+    mode_ = Mode::Unknown;
+    outstanding_.reset();
+    need_set_current_ = true;
+    starving_ = false;
+    if (!config_.resume_after_reboot && !queue_.empty() && !done_)
+        paused_ = true;
+}
+
+void WindowFeeder::on_request_result(std::uint32_t id, RequestResult result, TimePoint now) {
+    if (!outstanding_ || outstanding_->request.id != id)
+        return;  // stale: retried or reset since
+    const FeederRequest request = std::move(outstanding_->request);
+    outstanding_.reset();
+    if (result == RequestResult::Ok) {
+        consecutive_failures_ = 0;
+        request_succeeded(request);
+        return;
+    }
+    request_failed(now);
+}
+
+void WindowFeeder::request_failed(TimePoint now) {
+    // The reconciliation in poll_request() regenerates the same request: retrying needs no copy of it.
+    if (++consecutive_failures_ <= config_.retries) {
+        ++counters_.retries;
+        return;
+    }
+    consecutive_failures_ = 0;
+    ++counters_.failures;
+    fault_ = true;
+    retry_not_before_ = now + config_.fault_backoff;
+    emit(FeederEvent::Kind::RequestFailed, nullptr, generation_, {},
+         "autopilot request failed after retries");
+}
+
+void WindowFeeder::request_succeeded(const FeederRequest& request) {
+    if (const auto* up = std::get_if<UploadMission>(&request.op)) {
+        std::fill(confirmed_.begin(), confirmed_.end(), std::nullopt);
+        for (std::size_t i = 0; i < up->items.size() && i + 1 < confirmed_.size(); ++i)
+            confirmed_[i + 1] = up->items[i];
+        mission_ok_ = true;
+        need_set_current_ = true;
+        ap_target_.reset();
+    } else if (const auto* wr = std::get_if<WriteItems>(&request.op)) {
+        for (std::size_t i = 0; i < wr->items.size(); ++i) {
+            const std::size_t slot = wr->first_slot + i;
+            if (slot < confirmed_.size())
+                confirmed_[slot] = wr->items[i];
+        }
+    } else if (const auto* sc = std::get_if<SetCurrent>(&request.op)) {
+        ap_target_ = sc->slot;
+        if (!queue_.empty() && queue_[0].slot == sc->slot)
+            need_set_current_ = false;
+        current_mismatches_ = 0;
+    } else if (std::holds_alternative<HoldVehicle>(request.op)) {
+        mode_ = Mode::Hold;
+    } else if (std::holds_alternative<ResumeMission>(request.op)) {
+        mode_ = Mode::Auto;
+    }
+}
+
+void WindowFeeder::handle_timeout(TimePoint now) {
+    if (outstanding_ && now >= outstanding_->deadline) {
+        outstanding_.reset();
+        request_failed(now);
+    }
+    if (holding_ && hold_until_ && now >= *hold_until_) {
+        end_hold(now);
+        check_done();
+    }
+}
+
+// ---- outputs -------------------------------------------------------------------------------------------
+
+std::optional<WindowFeeder::Mode> WindowFeeder::desired_mode() const {
+    if (!stream_ && queue_.empty()) {
+        return cleared_ ? std::optional<Mode>(Mode::Hold) : std::nullopt;
+    }
+    if (paused_ || starving_ || fault_ || holding_)
+        return Mode::Hold;
+    if (done_ || queue_.empty())
+        return std::nullopt;  // parked on the Stop item
+    return Mode::Auto;
+}
+
+bool WindowFeeder::ready_for_auto() const {
+    return mission_ok_ && !need_set_current_ && !queue_.empty() && confirmed(queue_[0]) &&
+           (queue_.size() < 2 || confirmed(queue_[1]));
+}
+
+FeederRequest WindowFeeder::issue(decltype(FeederRequest::op) op, TimePoint now) {
+    FeederRequest r{next_request_id_++, std::move(op)};
+    outstanding_ = Outstanding{r, now + config_.request_timeout};
+    return r;
+}
+
+std::optional<FeederRequest> WindowFeeder::next_write(std::size_t from, std::size_t to, TimePoint now) {
+    to = std::min(to, queue_.size());
+    auto writable = [&](std::size_t i) {
+        // Never rewrite the item the vehicle is driving to, unless it is the head (then it is wrong anyway).
+        return !confirmed(queue_[i]) && (i == 0 || ap_target_ != queue_[i].slot);
+    };
+    for (std::size_t i = from; i < to; ++i) {
+        if (!writable(i))
+            continue;
+        WriteItems w;
+        w.first_slot = queue_[i].slot;
+        w.items.push_back(queue_[i].item());
+        for (std::size_t j = i + 1;
+             j < queue_.size() && queue_[j].slot == queue_[j - 1].slot + 1 && writable(j); ++j) {
+            w.items.push_back(queue_[j].item());
+        }
+        return issue(std::move(w), now);
+    }
+    return std::nullopt;
+}
+
+std::optional<FeederRequest> WindowFeeder::poll_request(TimePoint now) {
+    if (outstanding_)
+        return std::nullopt;
+    const auto want = desired_mode();
+    if (want == Mode::Hold && mode_ != Mode::Hold && now >= retry_not_before_)
+        return issue(HoldVehicle{}, now);
+    if (queue_.empty() || now < retry_not_before_)
+        return std::nullopt;
+    if (!mission_ok_) {
+        UploadMission up;
+        up.items.resize(config_.window);
+        for (std::uint16_t s = 1; s <= config_.window; ++s) {
+            // Slots the window does not use get a Stop at the last position: harmless if ever reached.
+            MissionItem filler = queue_.back().item();
+            filler.kind = MissionItem::Kind::Stop;
+            up.items[s - 1] = filler;
+        }
+        for (const auto& e : queue_)
+            up.items[e.slot - 1] = e.item();
+        MissionItem jump;
+        jump.kind = MissionItem::Kind::JumpTo;
+        jump.jump_slot = 1;
+        up.items.push_back(jump);
+        return issue(std::move(up), now);
+    }
+    if (auto w = next_write(0, 2, now))
+        return w;
+    if (need_set_current_ && confirmed(queue_[0]) && (queue_.size() < 2 || confirmed(queue_[1]))) {
+        return issue(SetCurrent{queue_[0].slot}, now);
+    }
+    if (auto w = next_write(2, queue_.size(), now))
+        return w;
+    if (ready_for_auto()) {
+        starving_ = false;
+        if (fault_ &&
+            std::all_of(queue_.begin(), queue_.end(), [&](const Entry& e) { return confirmed(e); })) {
+            fault_ = false;
+        }
+    }
+    if (desired_mode() == Mode::Auto && mode_ != Mode::Auto && ready_for_auto()) {
+        return issue(ResumeMission{}, now);
+    }
+    return std::nullopt;
+}
+
+TimePoint WindowFeeder::poll_timeout() const {
+    TimePoint t = kNever;
+    if (outstanding_)
+        t = std::min(t, outstanding_->deadline);
+    if (holding_ && hold_until_)
+        t = std::min(t, *hold_until_);
+    if (fault_ && retry_not_before_ != TimePoint::min())
+        t = std::min(t, retry_not_before_);
+    return t;
+}
+
+std::optional<FeederEvent> WindowFeeder::poll_event() {
+    if (events_.empty())
+        return std::nullopt;
+    FeederEvent e = std::move(events_.front());
+    events_.pop_front();
+    return e;
+}
+
+FeederProgress WindowFeeder::progress() const {
+    FeederProgress p = counters_;
+    p.plan_name = plan_name_;
+    p.generation = generation_;
+    p.waypoints_reached = reached_;
+    if (!stream_ && queue_.empty()) {
+        p.state = PlanState::None;
+    } else if (done_) {
+        p.state = PlanState::Done;
+    } else {
+        p.state = paused_ ? PlanState::Paused : PlanState::Running;
+    }
+    const Entry* first_of_plan = nullptr;
+    for (const auto& e : queue_) {
+        if (e.stop)
+            break;
+        if (e.generation != generation_)
+            continue;
+        if (first_of_plan == nullptr)
+            first_of_plan = &e;
+        if (confirmed(e))
+            ++p.window;
+    }
+    if (!queue_.empty() && !queue_[0].stop) {
+        p.next_waypoint = queue_[0].wp.index;
+        p.element = queue_[0].element_path;
+    }
+    if (holding_ && hold_wp_) {
+        p.element = stream_path(*hold_wp_);
+        p.resume_origin = hold_wp_->origin;
+        p.resume_index = hold_wp_->index;
+    } else if (first_of_plan != nullptr) {
+        p.resume_origin = first_of_plan->wp.origin;
+        p.resume_index = first_of_plan->wp.index;
+    }
+    return p;
+}
+
+// ---- printing ------------------------------------------------------------------------------------------
+
+const char* to_string(PlanState state) {
+    switch (state) {
+        case PlanState::None:
+            return "none";
+        case PlanState::Running:
+            return "running";
+        case PlanState::Paused:
+            return "paused";
+        case PlanState::Done:
+            return "done";
+    }
+    return "?";
+}
+
+const char* to_string(FeederEvent::Kind kind) {
+    switch (kind) {
+        case FeederEvent::Kind::ElementStarted:
+            return "element-started";
+        case FeederEvent::Kind::ElementFinished:
+            return "element-finished";
+        case FeederEvent::Kind::WaypointReached:
+            return "waypoint-reached";
+        case FeederEvent::Kind::HoldStarted:
+            return "hold-started";
+        case FeederEvent::Kind::HoldEnded:
+            return "hold-ended";
+        case FeederEvent::Kind::PlanDone:
+            return "plan-done";
+        case FeederEvent::Kind::PlanBlocked:
+            return "plan-blocked";
+        case FeederEvent::Kind::RequestFailed:
+            return "request-failed";
+        case FeederEvent::Kind::WindowStarved:
+            return "window-starved";
+    }
+    return "?";
+}
+
+std::ostream& operator<<(std::ostream& os, const FeederRequest& r) {
+    os << "#" << r.id << " ";
+    if (const auto* up = std::get_if<UploadMission>(&r.op))
+        return os << "upload(" << up->items.size() << " items)";
+    if (const auto* w = std::get_if<WriteItems>(&r.op))
+        return os << "write(slot " << w->first_slot << " x" << w->items.size() << ")";
+    if (const auto* s = std::get_if<SetCurrent>(&r.op))
+        return os << "set-current(" << s->slot << ")";
+    if (std::holds_alternative<HoldVehicle>(r.op))
+        return os << "hold";
+    return os << "resume";
+}
+
+}  // namespace airseg::flightplan

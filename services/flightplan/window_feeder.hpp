@@ -1,0 +1,154 @@
+#pragma once
+// WindowFeeder: keeps a rolling window of plan waypoints on the autopilot so that it never reaches the end
+// of its mission while the plan has more (the circular waypoint queue of APM:Rover navigation, made
+// robust). Sans-IO: no autopilot protocol, no clock, no thread.
+//
+// Mission layout (see docs/flight-plan.md): slot 0 home (the driver's), slots 1..K a ring of plan
+// waypoints, slot K+1 a JumpTo(1). The current target is the window's head; the ring holds the next K
+// entries in ring order. When the vehicle reaches slot s, slot s is rewritten with the entry K ahead, so the
+// successor of the current target, in mission order, is always the next plan waypoint. When the plan ends,
+// the slot after the last waypoint holds a Stop item at the last position, so the vehicle stays there.
+//
+// Contract (the driver, on the service's strand):
+//   inputs   replace_plan(), skip_to(), jump_to(), pause(), resume(), release_hold(),
+//            on_reached(slot), on_current(slot), on_request_result(id, result), on_autopilot_rebooted(),
+//            handle_timeout(now) when poll_timeout() is due;
+//   outputs  poll_request(now) after every input, until it returns nothing: at most one request is
+//            outstanding; each ends with exactly one on_request_result() (or a timeout);
+//            poll_event() until empty; progress() any time.
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "services/common/time.hpp"
+#include "services/flightplan/feeder_types.hpp"
+#include "services/flightplan/waypoint.hpp"
+
+namespace airseg::flightplan {
+
+struct FeederConfig {
+    std::uint16_t window = 5;                  // flightplan.window: K ring slots (>= 3)
+    std::uint32_t retries = 3;                 // flightplan.retries: extra attempts per request
+    Duration request_timeout = seconds(5);     // flightplan.request_timeout
+    Duration fault_backoff = seconds(5);       // pause before trying again after a request failed for good
+    std::uint32_t lost_reached_tolerance = 1;  // reached/current reports may skip this many entries
+    bool resume_after_reboot = true;           // flightplan.resume_after_reboot
+    /// Empty when valid, else what is wrong.
+    std::optional<std::string> validate() const;
+};
+
+struct PlanFeed {
+    std::unique_ptr<WaypointStream> stream;
+    std::string name;
+};
+
+class WindowFeeder {
+  public:
+    explicit WindowFeeder(FeederConfig config = {});
+
+    /// Start a plan, or replace the running one. The autopilot's current target is kept (the vehicle
+    /// carries on to it, then heads to the new plan's first waypoint without stopping); nothing is
+    /// cleared. A paused feeder stays paused.
+    void replace_plan(PlanFeed feed, TimePoint now);
+    /// Head for expanded waypoint `index` now. False (and nothing changes) if the stream has no such index.
+    bool skip_to(std::uint64_t index, TimePoint now);
+    /// Continue at the named element now (a reaction's lost-link path). False if there is no such element.
+    bool jump_to(std::string_view element_name, TimePoint now);
+    /// Resume a stream restored from persistence: like replace_plan, with the reached count carried over.
+    void restore_plan(PlanFeed feed, std::uint64_t waypoints_reached, TimePoint now);
+    /// Forget the plan: no more requests; the vehicle finishes its current target and then holds.
+    void clear_plan();
+    void pause();
+    void resume();
+    /// Ends a hold-until-released (or a timed hold early).
+    void release_hold(TimePoint now);
+
+    void on_reached(std::uint16_t slot, TimePoint now);
+    void on_current(std::uint16_t slot, TimePoint now);
+    void on_request_result(std::uint32_t id, RequestResult result, TimePoint now);
+    void on_autopilot_rebooted(TimePoint now);
+    void handle_timeout(TimePoint now);
+
+    std::optional<FeederRequest> poll_request(TimePoint now);
+    TimePoint poll_timeout() const;
+    std::optional<FeederEvent> poll_event();
+    FeederProgress progress() const;
+    const FeederConfig& config() const { return config_; }
+
+  private:
+    struct Entry {
+        Waypoint wp;
+        bool stop = false;
+        std::vector<Waypoint> holds_after;  // holds without a position, held when wp is reached
+        std::uint16_t slot = 1;
+        std::uint32_t generation = 0;
+        std::string element_path;
+        MissionItem item() const;
+    };
+    struct Outstanding {
+        FeederRequest request;
+        TimePoint deadline;
+        std::uint32_t attempt = 0;
+    };
+    enum class Mode : std::uint8_t { Unknown, Auto, Hold };
+
+    std::uint16_t ring_next(std::uint16_t slot) const { return slot >= config_.window ? 1 : slot + 1; }
+    std::uint16_t jump_slot() const { return static_cast<std::uint16_t>(config_.window + 1); }
+    bool confirmed(const Entry& e) const;
+    void start_fresh(std::uint16_t first_slot, TimePoint now);
+    void restart(TimePoint now);
+    void refill(TimePoint now);
+    void complete_through(std::size_t position, TimePoint now);
+    void begin_hold(TimePoint now);
+    void end_hold(TimePoint now);
+    void check_done();
+    std::string stream_path(const Waypoint& wp) const;
+    void request_failed(TimePoint now);
+    void check_starvation();
+    void emit(FeederEvent::Kind kind, const Waypoint* wp, std::uint32_t generation, std::string path = {},
+              std::string detail = {});
+    std::optional<Mode> desired_mode() const;
+    bool ready_for_auto() const;
+    std::optional<FeederRequest> next_write(std::size_t from, std::size_t to, TimePoint now);
+    FeederRequest issue(decltype(FeederRequest::op) op, TimePoint now);
+    void request_succeeded(const FeederRequest& request);
+
+    FeederConfig config_;
+    std::unique_ptr<WaypointStream> stream_;
+    std::string plan_name_;
+    std::uint32_t generation_ = 0;
+    bool stream_ended_ = false;
+    std::deque<Entry> queue_;       // queue_[0] is the current target
+    std::uint16_t fresh_slot_ = 1;  // slot of the first entry when the queue starts empty
+    bool done_ = false;
+    bool cleared_ = false;
+
+    // What the autopilot is known to hold.
+    bool mission_ok_ = false;
+    std::vector<std::optional<MissionItem>> confirmed_;  // by slot, 0..K+1
+    std::optional<std::uint16_t> ap_target_;             // the slot the autopilot is believed to head for
+    bool need_set_current_ = false;
+    Mode mode_ = Mode::Unknown;
+    std::uint32_t current_mismatches_ = 0;
+
+    bool paused_ = false;
+    bool starving_ = false;
+    bool fault_ = false;
+    TimePoint retry_not_before_ = TimePoint::min();
+    std::uint32_t consecutive_failures_ = 0;
+    std::deque<Waypoint> holds_;  // holds to run, front first (the one being held while holding_)
+    bool holding_ = false;
+    std::optional<TimePoint> hold_until_;  // empty while holding: until released
+    std::optional<Waypoint> hold_wp_;
+
+    std::optional<Outstanding> outstanding_;
+    std::uint32_t next_request_id_ = 1;
+    std::deque<FeederEvent> events_;
+    FeederProgress counters_;
+    std::uint64_t reached_ = 0;
+};
+
+}  // namespace airseg::flightplan

@@ -1,0 +1,257 @@
+#pragma once
+// A small simulated autopilot for WindowFeeder tests: mission slots (0 = home), a current target, reaches one
+// target per step while in auto, follows JumpTo items, parks on Stop items and falls into HOLD when it passes
+// the last slot (ArduPilot Rover behaviour at the end of a mission). Reboots lose the mission.
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <optional>
+#include <random>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "services/flightplan/window_feeder.hpp"
+
+namespace airseg::flightplan::test {
+
+class SimAutopilot {
+  public:
+    SimAutopilot() { reboot(); }
+
+    RequestResult apply(const FeederRequest& r) {
+        if (const auto* up = std::get_if<UploadMission>(&r.op)) {
+            slots_.assign(1, home());
+            for (const auto& item : up->items)
+                slots_.push_back(item);
+            if (current_ == 0 || current_ >= slots_.size())
+                current_ = 1;
+            return RequestResult::Ok;
+        }
+        if (const auto* w = std::get_if<WriteItems>(&r.op)) {
+            if (w->first_slot == 0 || w->first_slot + w->items.size() > slots_.size())
+                return RequestResult::Failed;
+            for (std::size_t i = 0; i < w->items.size(); ++i)
+                slots_[w->first_slot + i] = w->items[i];
+            ++writes_;
+            return RequestResult::Ok;
+        }
+        if (const auto* s = std::get_if<SetCurrent>(&r.op)) {
+            if (s->slot == 0 || s->slot >= slots_.size())
+                return RequestResult::Failed;
+            current_ = s->slot;
+            parked_ = false;
+            return RequestResult::Ok;
+        }
+        if (std::holds_alternative<HoldVehicle>(r.op)) {
+            auto_ = false;
+            ++hold_requests_;
+            return RequestResult::Ok;
+        }
+        auto_ = true;
+        return RequestResult::Ok;
+    }
+
+    /// Drives to the current target: returns the reached slot, if any.
+    std::optional<std::uint16_t> step() {
+        if (!auto_ || current_ == 0 || current_ >= slots_.size())
+            return std::nullopt;
+        const MissionItem& item = slots_[current_];
+        if (item.kind == MissionItem::Kind::Stop) {
+            parked_ = true;
+            return std::nullopt;
+        }
+        visited_.push_back(item.position);
+        const std::uint16_t reached = current_;
+        std::size_t next = current_ + 1u;
+        for (int guard = 0;
+             next < slots_.size() && slots_[next].kind == MissionItem::Kind::JumpTo && guard < 8; ++guard) {
+            next = slots_[next].jump_slot;
+        }
+        if (next >= slots_.size()) {
+            auto_ = false;  // mission complete: ArduPilot Rover goes HOLD
+            ++end_of_mission_holds_;
+        } else {
+            current_ = static_cast<std::uint16_t>(next);
+        }
+        return reached;
+    }
+
+    void reboot() {
+        slots_.assign(1, home());
+        current_ = 0;
+        auto_ = false;
+        parked_ = false;
+    }
+
+    std::uint16_t current() const { return current_; }
+    bool in_auto() const { return auto_; }
+    bool parked() const { return parked_; }
+    const std::vector<LatLon>& visited() const { return visited_; }
+    int end_of_mission_holds() const { return end_of_mission_holds_; }
+    int hold_requests() const { return hold_requests_; }
+    int writes() const { return writes_; }
+
+  private:
+    static MissionItem home() {
+        MissionItem h;
+        h.position = {0.0, 0.0};
+        return h;
+    }
+    std::vector<MissionItem> slots_;
+    std::uint16_t current_ = 0;
+    bool auto_ = false;
+    bool parked_ = false;
+    std::vector<LatLon> visited_;
+    int end_of_mission_holds_ = 0;
+    int hold_requests_ = 0;
+    int writes_ = 0;
+};
+
+/// A lazily generated straight-line plan of n waypoints; selected indices can carry hold actions.
+class SyntheticStream final : public WaypointStream {
+  public:
+    explicit SyntheticStream(std::uint64_t n, double base_lat = 41.0,
+                             std::map<std::uint64_t, Waypoint> overrides = {})
+        : n_(n), base_lat_(base_lat), overrides_(std::move(overrides)) {}
+
+    static LatLon position_of(double base_lat, std::uint64_t i) {
+        return {base_lat + static_cast<double>(i) * 1e-4, 2.0 + static_cast<double>(i % 7) * 1e-5};
+    }
+
+    std::optional<Waypoint> next() override {
+        if (pos_ >= n_)
+            return std::nullopt;
+        Waypoint w;
+        if (auto it = overrides_.find(pos_); it != overrides_.end())
+            w = it->second;
+        w.index = pos_;
+        w.element = 0;
+        if (w.has_position)
+            w.position = position_of(base_lat_, pos_);
+        w.speed = 2.0;
+        w.arrival_radius = 2.0;
+        w.first_of_element = pos_ == 0;
+        w.last_of_element = pos_ + 1 == n_;
+        ++pos_;
+        return w;
+    }
+    bool seek(std::uint64_t index) override {
+        if (index >= n_)
+            return false;
+        pos_ = index;
+        return true;
+    }
+    bool jump_to(std::string_view name) override {
+        if (name != "second-half")
+            return false;
+        pos_ = n_ / 2;
+        return true;
+    }
+    std::string element_path(std::uint32_t) const override { return "plan.elements[0]"; }
+    std::optional<std::string> error() const override { return std::nullopt; }
+
+  private:
+    std::uint64_t n_;
+    double base_lat_;
+    std::map<std::uint64_t, Waypoint> overrides_;
+    std::uint64_t pos_ = 0;
+};
+
+struct Impairments {
+    double duplicate_reached = 0.0;  // probability a reached report is delivered twice
+    double delay_reached = 0.0;      // probability a reached report arrives one step late
+    double drop_reached = 0.0;       // probability a reached report is lost
+    double fail_request = 0.0;       // probability a request fails
+    int requests_per_step = 2;       // link budget
+    bool report_current = true;      // MISSION_CURRENT every step
+};
+
+/// Drives a feeder against the simulated autopilot in simulated time, one second per step.
+class Harness {
+  public:
+    explicit Harness(FeederConfig config = {}, Impairments imp = {}, unsigned seed = 1)
+        : feeder(config), imp_(imp), rng_(seed) {}
+
+    void step() {
+        int budget = imp_.requests_per_step;
+        while (budget-- > 0) {
+            auto r = feeder.poll_request(now);
+            if (!r)
+                break;
+            const bool fail = chance(imp_.fail_request);
+            const RequestResult res = fail ? RequestResult::Failed : ap.apply(*r);
+            feeder.on_request_result(r->id, res, now);
+            drain();
+        }
+        std::vector<std::uint16_t> deliver(late_.begin(), late_.end());
+        late_.clear();
+        if (auto reached = ap.step()) {
+            if (chance(imp_.drop_reached)) {
+                // lost
+            } else if (chance(imp_.delay_reached)) {
+                late_.push_back(*reached);
+            } else {
+                deliver.insert(deliver.begin(), *reached);
+                if (chance(imp_.duplicate_reached))
+                    deliver.push_back(*reached);
+            }
+        }
+        for (auto s : deliver) {
+            feeder.on_reached(s, now);
+            drain();
+        }
+        if (imp_.report_current) {
+            feeder.on_current(ap.current(), now);
+            drain();
+        }
+        now += seconds(1);
+        if (feeder.poll_timeout() <= now)
+            feeder.handle_timeout(now);
+        drain();
+    }
+
+    /// Steps until the plan is done (or the limit); returns the steps taken.
+    int run_until_done(int limit) {
+        for (int i = 0; i < limit; ++i) {
+            if (feeder.progress().state == PlanState::Done)
+                return i;
+            step();
+        }
+        return limit;
+    }
+
+    void drain() {
+        while (auto e = feeder.poll_event()) {
+            if (e->kind == FeederEvent::Kind::WaypointReached)
+                reached.push_back(e->plan_index);
+            events.push_back(*e);
+        }
+    }
+
+    std::size_t count(FeederEvent::Kind kind) const {
+        std::size_t n = 0;
+        for (const auto& e : events)
+            n += e.kind == kind;
+        return n;
+    }
+
+    WindowFeeder feeder;
+    SimAutopilot ap;
+    TimePoint now{};
+    std::vector<std::uint64_t> reached;
+    std::vector<FeederEvent> events;
+
+  private:
+    bool chance(double p) { return p > 0.0 && std::uniform_real_distribution<double>(0.0, 1.0)(rng_) < p; }
+    Impairments imp_;
+    std::mt19937 rng_;
+    std::deque<std::uint16_t> late_;
+};
+
+inline PlanFeed synthetic(std::uint64_t n, double base_lat = 41.0,
+                          std::map<std::uint64_t, Waypoint> overrides = {}) {
+    return PlanFeed{std::make_unique<SyntheticStream>(n, base_lat, std::move(overrides)), "synthetic"};
+}
+
+}  // namespace airseg::flightplan::test

@@ -1,0 +1,276 @@
+// WindowFeeder against the simulated autopilot: ordering, starvation, impairments, reboot, replace, skip,
+// pause and holds, all in simulated time.
+#include <gtest/gtest.h>
+
+#include <numeric>
+
+#include "tests/unit/flightplan/sim_autopilot.hpp"
+
+namespace airseg::flightplan {
+namespace {
+
+using test::Harness;
+using test::Impairments;
+using test::SyntheticStream;
+
+std::vector<std::uint64_t> iota(std::uint64_t from, std::uint64_t to) {
+    std::vector<std::uint64_t> v(to - from);
+    std::iota(v.begin(), v.end(), from);
+    return v;
+}
+
+void expect_visited(const Harness& h, double base_lat, std::uint64_t from, std::uint64_t to,
+                    std::size_t at = 0) {
+    ASSERT_GE(h.ap.visited().size(), at + (to - from));
+    for (std::uint64_t i = from; i < to; ++i) {
+        ASSERT_EQ(h.ap.visited()[at + (i - from)], SyntheticStream::position_of(base_lat, i))
+            << "waypoint " << i;
+    }
+}
+
+TEST(WindowFeeder, ConfigRejectsWindowBelowThree) {
+    FeederConfig c;
+    c.window = 2;
+    EXPECT_TRUE(c.validate().has_value());
+    c.window = 3;
+    EXPECT_FALSE(c.validate().has_value());
+}
+
+TEST(WindowFeeder, LongPlanReachedOnceInOrderWithoutStarvation) {
+    Harness h;
+    h.feeder.replace_plan(test::synthetic(2500), h.now);
+    const int steps = h.run_until_done(6000);
+    ASSERT_LT(steps, 6000);
+    for (int i = 0; i < 3; ++i)
+        h.step();
+    EXPECT_EQ(h.reached, iota(0, 2500));
+    expect_visited(h, 41.0, 0, 2500);
+    EXPECT_EQ(h.ap.visited().size(), 2500u);
+    EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
+    EXPECT_EQ(h.ap.hold_requests(), 0);
+    EXPECT_EQ(h.feeder.progress().starvation_holds, 0u);
+    EXPECT_EQ(h.feeder.progress().waypoints_reached, 2500u);
+    EXPECT_TRUE(h.ap.parked());  // on the Stop item after the last waypoint
+    EXPECT_EQ(h.count(FeederEvent::Kind::PlanDone), 1u);
+}
+
+TEST(WindowFeeder, MinimumWindowOfThreeKeepsUp) {
+    FeederConfig c;
+    c.window = 3;
+    Impairments imp;
+    imp.requests_per_step = 1;
+    Harness h(c, imp);
+    h.feeder.replace_plan(test::synthetic(300), h.now);
+    ASSERT_LT(h.run_until_done(2000), 2000);
+    EXPECT_EQ(h.reached, iota(0, 300));
+    expect_visited(h, 41.0, 0, 300);
+    EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
+    EXPECT_EQ(h.feeder.progress().starvation_holds, 0u);
+}
+
+TEST(WindowFeeder, LateAndDuplicateReachedReportsAreAbsorbed) {
+    Impairments imp;
+    imp.duplicate_reached = 0.2;
+    imp.delay_reached = 0.2;
+    Harness h({}, imp, 7);
+    h.feeder.replace_plan(test::synthetic(2000), h.now);
+    ASSERT_LT(h.run_until_done(6000), 6000);
+    EXPECT_EQ(h.reached, iota(0, 2000));
+    expect_visited(h, 41.0, 0, 2000);
+    EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
+    EXPECT_EQ(h.feeder.progress().starvation_holds, 0u);
+    EXPECT_GT(h.feeder.progress().ignored_reached, 100u);
+}
+
+TEST(WindowFeeder, LostReachedReportsAreRecoveredFromCurrentTarget) {
+    Impairments imp;
+    imp.drop_reached = 0.15;
+    Harness h({}, imp, 11);
+    h.feeder.replace_plan(test::synthetic(2000), h.now);
+    ASSERT_LT(h.run_until_done(6000), 6000);
+    EXPECT_EQ(h.reached, iota(0, 2000));
+    expect_visited(h, 41.0, 0, 2000);
+    EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
+}
+
+TEST(WindowFeeder, FailedRequestsAreRetried) {
+    Impairments imp;
+    imp.fail_request = 0.2;
+    imp.requests_per_step = 3;
+    Harness h({}, imp, 3);
+    h.feeder.replace_plan(test::synthetic(1000), h.now);
+    ASSERT_LT(h.run_until_done(6000), 6000);
+    EXPECT_EQ(h.reached, iota(0, 1000));
+    expect_visited(h, 41.0, 0, 1000);
+    EXPECT_GT(h.feeder.progress().retries, 10u);
+    EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
+}
+
+TEST(WindowFeeder, RebootMidPlanRebuildsTheWindowAndCarriesOn) {
+    Harness h;
+    h.feeder.replace_plan(test::synthetic(800), h.now);
+    for (int i = 0; i < 300; ++i)
+        h.step();
+    const auto before = h.reached.size();
+    ASSERT_GT(before, 250u);
+    h.ap.reboot();
+    h.feeder.on_autopilot_rebooted(h.now);
+    EXPECT_EQ(h.feeder.progress().next_waypoint, before);
+    ASSERT_LT(h.run_until_done(3000), 3000);
+    EXPECT_EQ(h.reached, iota(0, 800));
+    expect_visited(h, 41.0, 0, 800);
+    EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
+}
+
+TEST(WindowFeeder, ReplacePlanKeepsCurrentTargetThenFollowsNewPlanWithoutStopping) {
+    Harness h;
+    h.feeder.replace_plan(test::synthetic(1000, 41.0), h.now);
+    for (int i = 0; i < 100; ++i)
+        h.step();
+    const auto target = *h.feeder.progress().next_waypoint;
+    const auto visited_before = h.ap.visited().size();
+    h.feeder.replace_plan(test::synthetic(200, 43.0), h.now);
+    h.drain();
+    ASSERT_LT(h.run_until_done(2000), 2000);
+    // The old current target, then the whole new plan.
+    ASSERT_EQ(h.ap.visited().size(), visited_before + 1 + 200);
+    EXPECT_EQ(h.ap.visited()[visited_before], SyntheticStream::position_of(41.0, target));
+    expect_visited(h, 43.0, 0, 200, visited_before + 1);
+    EXPECT_EQ(h.ap.hold_requests(), 0);
+    EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
+    EXPECT_EQ(h.feeder.progress().waypoints_reached, 200u);
+    EXPECT_EQ(h.feeder.progress().generation, 2u);
+}
+
+TEST(WindowFeeder, SkipHeadsForTheRequestedWaypointNow) {
+    Harness h;
+    h.feeder.replace_plan(test::synthetic(1000), h.now);
+    for (int i = 0; i < 50; ++i)
+        h.step();
+    const auto visited_before = h.ap.visited().size();
+    ASSERT_TRUE(h.feeder.skip_to(600, h.now));
+    EXPECT_FALSE(h.feeder.skip_to(5000, h.now));
+    ASSERT_LT(h.run_until_done(2000), 2000);
+    expect_visited(h, 41.0, 600, 1000, visited_before);
+    EXPECT_EQ(h.reached.back(), 999u);
+    EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
+}
+
+TEST(WindowFeeder, JumpToNamedElementContinuesThere) {
+    Harness h;
+    h.feeder.replace_plan(test::synthetic(100), h.now);
+    for (int i = 0; i < 10; ++i)
+        h.step();
+    const auto visited_before = h.ap.visited().size();
+    ASSERT_TRUE(h.feeder.jump_to("second-half", h.now));
+    EXPECT_FALSE(h.feeder.jump_to("nowhere", h.now));
+    ASSERT_LT(h.run_until_done(500), 500);
+    expect_visited(h, 41.0, 50, 100, visited_before);
+}
+
+TEST(WindowFeeder, PauseHoldsTheVehicleAndResumeContinues) {
+    Harness h;
+    h.feeder.replace_plan(test::synthetic(100), h.now);
+    for (int i = 0; i < 20; ++i)
+        h.step();
+    h.feeder.pause();
+    EXPECT_EQ(h.feeder.progress().state, PlanState::Paused);
+    h.step();
+    const auto reached_when_paused = h.reached.size();
+    for (int i = 0; i < 30; ++i)
+        h.step();
+    EXPECT_LE(h.reached.size(), reached_when_paused + 1);
+    EXPECT_FALSE(h.ap.in_auto());
+    h.feeder.resume();
+    ASSERT_LT(h.run_until_done(500), 500);
+    EXPECT_EQ(h.reached, iota(0, 100));
+    expect_visited(h, 41.0, 0, 100);
+}
+
+TEST(WindowFeeder, HoldWaypointsHoldForTheirTimeOrUntilReleased) {
+    Waypoint timed;
+    timed.action = WaypointAction::HoldFor;
+    timed.hold_seconds = 30.0;
+    Waypoint until;
+    until.action = WaypointAction::HoldUntilReleased;
+    Waypoint here;  // a hold without a position: held where waypoint 29 ends
+    here.action = WaypointAction::HoldFor;
+    here.hold_seconds = 10.0;
+    here.has_position = false;
+    Harness h;
+    h.feeder.replace_plan(test::synthetic(40, 41.0, {{10, timed}, {20, until}, {30, here}}), h.now);
+    int steps = 0;
+    while (h.reached.size() < 11 && steps++ < 100)
+        h.step();
+    ASSERT_EQ(h.reached.size(), 11u);
+    const TimePoint hold_start = h.now;
+    while (h.reached.size() < 12 && steps++ < 200)
+        h.step();
+    EXPECT_GE(h.now - hold_start, seconds(30));
+    EXPECT_LE(h.now - hold_start, seconds(36));
+    while (h.reached.size() < 21 && steps++ < 300)
+        h.step();
+    for (int i = 0; i < 100; ++i)
+        h.step();
+    EXPECT_EQ(h.reached.size(), 21u);  // held until released
+    EXPECT_FALSE(h.ap.in_auto());
+    h.feeder.release_hold(h.now);
+    ASSERT_LT(h.run_until_done(500), 500);
+    EXPECT_EQ(h.reached, iota(0, 40));
+    EXPECT_EQ(h.count(FeederEvent::Kind::HoldStarted), 3u);
+    EXPECT_EQ(h.count(FeederEvent::Kind::HoldEnded), 3u);
+    // Positioned items only went to the autopilot (39 of 40).
+    EXPECT_EQ(h.ap.visited().size(), 39u);
+    EXPECT_EQ(h.feeder.progress().starvation_holds, 0u);
+}
+
+TEST(WindowFeeder, ShortPlanEndsOnStopItem) {
+    Harness h;
+    h.feeder.replace_plan(test::synthetic(2), h.now);
+    ASSERT_LT(h.run_until_done(50), 50);
+    for (int i = 0; i < 10; ++i)
+        h.step();
+    EXPECT_EQ(h.reached, iota(0, 2));
+    EXPECT_TRUE(h.ap.parked());
+    EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
+    EXPECT_EQ(h.feeder.progress().state, PlanState::Done);
+}
+
+TEST(WindowFeeder, ProgressReportsWindowAndResumePoint) {
+    Harness h;
+    EXPECT_EQ(h.feeder.progress().state, PlanState::None);
+    h.feeder.replace_plan(test::synthetic(100), h.now);
+    for (int i = 0; i < 12; ++i)
+        h.step();
+    const auto p = h.feeder.progress();
+    EXPECT_EQ(p.state, PlanState::Running);
+    EXPECT_EQ(p.plan_name, "synthetic");
+    // Between a reached report and the rewrite of its slot the window is one short.
+    EXPECT_GE(p.window, 4u);
+    EXPECT_LE(p.window, 5u);
+    ASSERT_TRUE(p.next_waypoint.has_value());
+    EXPECT_EQ(*p.next_waypoint, p.waypoints_reached);
+    EXPECT_EQ(p.resume_index, p.next_waypoint);
+    EXPECT_EQ(p.element, "plan.elements[0]");
+}
+
+TEST(WindowFeeder, RequestTimeoutCountsAsFailureAndIsRetried) {
+    Harness h;
+    h.feeder.replace_plan(test::synthetic(10), h.now);
+    auto first = h.feeder.poll_request(h.now);
+    ASSERT_TRUE(first.has_value());
+    EXPECT_FALSE(h.feeder.poll_request(h.now).has_value());  // one outstanding at a time
+    h.now += seconds(6);
+    ASSERT_LE(h.feeder.poll_timeout(), h.now);
+    h.feeder.handle_timeout(h.now);
+    auto again = h.feeder.poll_request(h.now);
+    ASSERT_TRUE(again.has_value());
+    EXPECT_NE(again->id, first->id);
+    EXPECT_EQ(again->op.index(), first->op.index());
+    h.feeder.on_request_result(first->id, RequestResult::Ok, h.now);  // stale: ignored
+    EXPECT_FALSE(h.feeder.poll_request(h.now).has_value());
+    EXPECT_EQ(h.feeder.progress().retries, 1u);
+}
+
+}  // namespace
+}  // namespace airseg::flightplan
