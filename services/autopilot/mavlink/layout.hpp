@@ -21,8 +21,9 @@ namespace airseg::mavlink {
 
 template <std::size_t N>
 struct MessageLayout {
-    std::array<FieldInfo, N> wire{};               // fields in wire order
-    std::array<std::uint8_t, N> offset_by_decl{};  // byte offset of the i-th declared field
+    std::array<FieldInfo, N> wire{};                   // fields in wire order
+    std::array<std::uint8_t, N> offset_by_decl{};      // byte offset of the i-th declared field
+    std::array<std::uint8_t, N> wire_index_by_decl{};  // index in `wire` of the i-th declared field
     std::uint8_t crc_extra = 0;
     std::uint8_t base_length = 0;  // bytes of the base fields: the MAVLink 1 payload length
     std::uint8_t length = 0;       // bytes of all fields, extensions included
@@ -101,6 +102,7 @@ constexpr MessageLayout<N> make_layout(std::string_view message_name, std::span<
         }
         layout.wire[i] = entries[i].info;
         layout.offset_by_decl[entries[i].decl_index] = entries[i].info.offset;
+        layout.wire_index_by_decl[entries[i].decl_index] = static_cast<std::uint8_t>(i);
     }
     layout.length = static_cast<std::uint8_t>(offset);
     layout.crc_extra = crc_extra_of(message_name, layout.wire);

@@ -17,6 +17,7 @@ struct MessageInfo {
     std::uint8_t base_length = 0;       // bytes of the non-extension fields (the MAVLink 1 payload)
     std::uint8_t length = 0;            // bytes of all fields
     std::span<const FieldInfo> fields;  // wire order
+    std::span<const std::uint8_t> declaration_order;  // indices into `fields`, in XML declaration order
 
     /// The field called `name`, or nullptr.
     const FieldInfo* find_field(std::string_view field_name) const;
