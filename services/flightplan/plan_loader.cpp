@@ -135,14 +135,22 @@ std::optional<double> Loader::number_value(const YAML::Node& value, const std::s
         error(value, where, "must be a number");
         return std::nullopt;
     }
-    if ((lo_open ? !(v > lo) : !(v >= lo)) || !(v <= hi)) {
+    if (!lo_open && (v < lo || v > hi)) {
         std::ostringstream msg;
-        if (hi == INFINITY) {
-            msg << "must be " << (lo_open ? "> " : ">= ") << lo;
-        } else {
-            msg << "must be between " << lo << " and " << hi;
-        }
-        error(value, where, msg.str() + " (got " + value.Scalar() + ")");
+        msg << "must be between " << lo << " and " << hi << " (got " << value.Scalar() << ")";
+        error(value, where, msg.str());
+        return std::nullopt;
+    }
+    if (lo_open && !(v > lo)) {
+        std::ostringstream msg;
+        msg << "must be > " << lo << " (got " << value.Scalar() << ")";
+        error(value, where, msg.str());
+        return std::nullopt;
+    }
+    if (!(v <= hi)) {
+        std::ostringstream msg;
+        msg << "must be <= " << hi << " (got " << value.Scalar() << ")";
+        error(value, where, msg.str());
         return std::nullopt;
     }
     return v;

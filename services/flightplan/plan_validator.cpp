@@ -30,7 +30,7 @@ void check_legs(const Plan& plan, std::uint64_t limit, std::vector<Diagnostic>& 
         if (entry != kNoNode)
             stream.jump_to_node(entry);
         std::optional<Enu> last;
-        for (std::uint64_t n = 0; n < limit && !plan.no_fly.empty(); ++n) {
+        for (std::uint64_t n = 0; n < limit; ++n) {
             auto w = stream.next();
             if (!w)
                 break;

@@ -1,0 +1,207 @@
+// The YAML plan loader: example plans load, every error of a plan is reported at once with file:line:col
+// and element path, no-fly legs are rejected with their buffer.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "services/flightplan/plan_loader.hpp"
+
+namespace airseg::flightplan {
+namespace {
+
+std::vector<std::string> messages(const LoadResult& r) {
+    std::vector<std::string> out;
+    for (const auto& d : r.errors)
+        out.push_back(d.to_string());
+    return out;
+}
+
+TEST(PlanLoader, ExamplePlansLoad) {
+    int loaded = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(AIRSEG_SOURCE_DIR "/config/plans")) {
+        if (entry.path().extension() != ".yaml")
+            continue;
+        const auto r = load_plan_file(entry.path().string());
+        EXPECT_TRUE(r.ok()) << entry.path() << "\n" << to_string(r.errors);
+        ++loaded;
+    }
+    EXPECT_GE(loaded, 3);
+}
+
+TEST(PlanLoader, ExampleSurveyHasTheExpectedShape) {
+    const auto r = load_plan_file(AIRSEG_SOURCE_DIR "/config/plans/rover-survey.yaml");
+    ASSERT_TRUE(r.ok()) << to_string(r.errors);
+    const Plan& p = *r.plan;
+    EXPECT_EQ(p.name, "campus-survey");
+    EXPECT_EQ(p.vehicle.type, "rover");
+    EXPECT_DOUBLE_EQ(p.vehicle.min_spacing, 4.0);
+    EXPECT_DOUBLE_EQ(p.vehicle.cruise_speed, 1.5);
+    ASSERT_EQ(p.no_fly.size(), 1u);
+    EXPECT_DOUBLE_EQ(p.no_fly[0].buffer, 5.0);
+    ASSERT_TRUE(p.reactions.link_loss.has_value());
+    EXPECT_EQ(p.reactions.link_loss->action, ReactionAction::GotoBlock);
+    EXPECT_EQ(p.nodes[p.reactions.link_loss->target_node].path, "plan.blocks[0]");
+    EXPECT_DOUBLE_EQ(p.reactions.link_loss_seconds, 30.0);
+    const auto field = p.find("field");
+    ASSERT_NE(field, kNoNode);
+    EXPECT_EQ(p.nodes[field].path, "plan.elements[3]");
+    EXPECT_EQ(p.nodes[field].mark.line, 23);
+    ASSERT_TRUE(p.nodes[field].scan.has_value());
+    const auto patrol = p.find("patrol");
+    ASSERT_NE(patrol, kNoNode);
+    EXPECT_EQ(p.nodes[patrol].count, 6u);
+}
+
+TEST(PlanLoader, ReportsEveryErrorAtOnceWithLocation) {
+    const std::string text = R"(plan:
+  name: broken
+  colour: red
+  elements:
+    - waypoint: {lat: 95, lon: 1.98}
+    - scan:
+        rectangle: {sw: [41.0, 2.0], ne: [41.001, 2.001]}
+        spacing: 0
+    - waypoint: {lat: 41.0, lon: 2.0, sped: 3}
+    - goto: nowhere
+    - hold: {lat: 41.0, lon: 2.0}
+)";
+    const auto r = load_plan_text(text, "broken.yaml");
+    ASSERT_FALSE(r.ok());
+    const std::vector<std::string> expected = {
+        "broken.yaml:3:3: plan.colour: unknown field (expected one of: name, vehicle, reference, home, "
+        "no_fly, "
+        "geofence, reactions, elements, blocks)",
+        "broken.yaml:5:23: plan.elements[0].waypoint.lat: must be between -90 and 90 (got 95)",
+        "broken.yaml:8:18: plan.elements[1].scan.spacing: must be > 0 (got 0)",
+        "broken.yaml:9:39: plan.elements[2].waypoint.sped: unknown field (expected one of: name, lat, lon, "
+        "alt, "
+        "speed, radius)",
+        "broken.yaml:11:13: plan.elements[4].hold: needs exactly one of: seconds, until_released: true",
+    };
+    EXPECT_EQ(messages(r), expected);
+}
+
+TEST(PlanLoader, UnknownGotoTargetAndDuplicateNames) {
+    const std::string text = R"(plan:
+  name: names
+  elements:
+    - waypoint: {name: a, lat: 41.0, lon: 2.0}
+    - waypoint: {name: a, lat: 41.001, lon: 2.0}
+    - goto: nowhere
+  reactions:
+    link_loss: {after: 10, action: goto, target: missing}
+)";
+    const auto r = load_plan_text(text, "names.yaml");
+    ASSERT_FALSE(r.ok());
+    const auto m = messages(r);
+    ASSERT_EQ(m.size(), 3u) << to_string(r.errors);
+    EXPECT_EQ(m[0],
+              "names.yaml:5:7: plan.elements[1].name: duplicate name 'a' (first used at plan.elements[0])");
+    EXPECT_EQ(m[1], "names.yaml:6:7: plan.elements[2].goto: target 'nowhere' is not the name of any element");
+    EXPECT_EQ(
+        m[2],
+        "names.yaml:8:16: plan.reactions.link_loss.target: target 'missing' is not the name of any element");
+}
+
+TEST(PlanLoader, YamlSyntaxErrorIsLocated) {
+    const auto r = load_plan_text("plan:\n  name: [unclosed\n", "syntax.yaml");
+    ASSERT_EQ(r.errors.size(), 1u);
+    EXPECT_EQ(r.errors[0].file, "syntax.yaml");
+    EXPECT_GT(r.errors[0].line, 0);
+    EXPECT_NE(r.errors[0].message.find("YAML syntax error"), std::string::npos);
+}
+
+TEST(PlanLoader, GarbageNeverCrashes) {
+    const char* inputs[] = {"",
+                            "42",
+                            "plan: 7",
+                            "plan: {elements: 3}",
+                            "plan: {name: x, elements: [[1, 2]]}",
+                            "plan: {name: x, elements: [{waypoint: [1, 2]}]}",
+                            "- - -",
+                            "plan: {name: {a: b}}",
+                            "plan: {name: x, elements: [{scan: {polygon: [[1], [2, 3], 4]}}]}"};
+    for (const char* in : inputs) {
+        const auto r = load_plan_text(in, "garbage.yaml");
+        EXPECT_FALSE(r.ok()) << in;
+        EXPECT_FALSE(r.errors.empty()) << in;
+    }
+}
+
+std::string plan_with_leg_near_zone(double buffer) {
+    // The leg runs east along 41.0000; the zone starts ~3.3 m north of it.
+    return R"(plan:
+  name: zone
+  no_fly:
+    - name: barn
+      buffer: )" +
+           std::to_string(buffer) +
+           R"(
+      polygon: [[41.00003, 2.0005], [41.0002, 2.0005], [41.0002, 2.0007], [41.00003, 2.0007]]
+  elements:
+    - waypoint: {lat: 41.0, lon: 2.0}
+    - waypoint: {lat: 41.0, lon: 2.0012}
+)";
+}
+
+TEST(PlanLoader, LegCrossingNoFlyBufferIsRejected) {
+    const auto rejected = load_plan_text(plan_with_leg_near_zone(5.0), "zone.yaml");
+    ASSERT_FALSE(rejected.ok());
+    ASSERT_EQ(rejected.errors.size(), 1u);
+    EXPECT_EQ(rejected.errors[0].path, "plan.elements[1]");
+    EXPECT_EQ(rejected.errors[0].line, 9);
+    EXPECT_NE(rejected.errors[0].message.find("no-fly zone 'barn'"), std::string::npos);
+    EXPECT_TRUE(load_plan_text(plan_with_leg_near_zone(1.0), "zone.yaml").ok());
+}
+
+TEST(PlanLoader, ScanLegsThroughAZoneAreRejected) {
+    const std::string text = R"(plan:
+  name: scan-zone
+  no_fly:
+    - name: shed
+      polygon: [[41.0002, 2.0002], [41.0003, 2.0002], [41.0003, 2.0003], [41.0002, 2.0003]]
+  elements:
+    - scan: {rectangle: {sw: [41.0, 2.0], ne: [41.001, 2.001]}, spacing: 10}
+)";
+    const auto r = load_plan_text(text, "scan-zone.yaml");
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.errors[0].path, "plan.elements[0]");
+}
+
+TEST(PlanLoader, VehicleProfileBoundsSpacing) {
+    const std::string text = R"(plan:
+  name: plane
+  vehicle: {type: plane}
+  elements:
+    - scan: {rectangle: {sw: [41.0, 2.0], ne: [41.01, 2.01]}, spacing: 20}
+)";
+    const auto r = load_plan_text(text, "plane.yaml");
+    ASSERT_EQ(r.errors.size(), 1u) << to_string(r.errors);
+    EXPECT_EQ(r.errors[0].path, "plan.elements[0].scan.spacing");
+    EXPECT_NE(r.errors[0].message.find("min_spacing"), std::string::npos);
+}
+
+TEST(PlanLoader, LoopsWithoutWaypointsAreRejected) {
+    const auto forever = load_plan_text(R"(plan:
+  name: empty-loop
+  elements:
+    - waypoint: {lat: 41.0, lon: 2.0}
+    - repeat: {count: forever, elements: [{speed: 2}]}
+)",
+                                        "loop.yaml");
+    ASSERT_FALSE(forever.ok());
+    EXPECT_NE(forever.errors[0].message.find("produces no waypoints"), std::string::npos);
+    const auto cycle = load_plan_text(R"(plan:
+  name: goto-cycle
+  elements:
+    - waypoint: {lat: 41.0, lon: 2.0}
+    - speed: {name: again, value: 2}
+    - goto: again
+)",
+                                      "cycle.yaml");
+    ASSERT_FALSE(cycle.ok());
+    EXPECT_NE(cycle.errors[0].message.find("goto cycle"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace airseg::flightplan
