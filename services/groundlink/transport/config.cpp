@@ -89,8 +89,8 @@ std::ostream& operator<<(std::ostream& os, TransportEvent::Kind k) {
             return os << "path_up";
         case K::path_down:
             return os << "path_down";
-        case K::safe_given_up:
-            return os << "safe_given_up";
+        case K::safe_resent:
+            return os << "safe_resent";
     }
     return os << "TransportEvent::Kind(" << static_cast<int>(k) << ")";
 }

@@ -72,12 +72,12 @@ std::size_t encoded_size(const Chunk& c) {
     return 3;
 }
 
-std::vector<std::uint8_t> encode_data(std::uint8_t heard_mask, std::uint32_t frame_number24,
+std::vector<std::uint8_t> encode_data(std::uint8_t header_flags, std::uint32_t frame_number24,
                                       std::span<const Chunk> chunks) {
     std::vector<std::uint8_t> out;
     out.reserve(64);
     out.push_back(
-        static_cast<std::uint8_t>((static_cast<std::uint8_t>(Kind::data) << 6) | (heard_mask & 0x03U)));
+        static_cast<std::uint8_t>((static_cast<std::uint8_t>(Kind::data) << 6) | (header_flags & 0x07U)));
     wire::put_u24(out, frame_number24 & kFrameNumberMask);
     for (std::size_t i = 0; i < chunks.size(); ++i) {
         const bool last = i + 1 == chunks.size() && (std::holds_alternative<SafeChunk>(chunks[i]) ||
@@ -142,7 +142,7 @@ std::optional<std::span<const std::uint8_t>> check_crc(std::span<const std::uint
 }
 
 std::optional<Kind> kind_of(std::span<const std::uint8_t> frame) {
-    if (frame.empty() || (frame[0] & 0x3CU) != 0) {
+    if (frame.empty() || (frame[0] & 0x38U) != 0) {
         return std::nullopt;
     }
     const auto k = static_cast<std::uint8_t>(frame[0] >> 6);
@@ -156,8 +156,12 @@ std::uint8_t heard_mask_of(std::span<const std::uint8_t> frame) {
     return frame.empty() ? 0 : static_cast<std::uint8_t>(frame[0] & 0x03U);
 }
 
+bool urgent_of(std::span<const std::uint8_t> frame) {
+    return !frame.empty() && (frame[0] & kUrgentFlag) != 0;
+}
+
 std::optional<Hello> decode_hello(std::span<const std::uint8_t> frame) {
-    if (frame.size() != 1 + kHelloBodyBytes) {
+    if (frame.size() != 1 + kHelloBodyBytes || (frame[0] & kUrgentFlag) != 0) {
         return std::nullopt;
     }
     wire::Reader r(frame.subspan(1));

@@ -62,9 +62,13 @@ constexpr std::size_t fast_chunk_overhead(bool fragmented) {
 }
 std::size_t encoded_size(const Chunk& c);
 
+/// Header flags of a data frame: bits 0-1 the paths the sender hears, bit 2 the sender has urgent traffic
+/// (the peer should not borrow its transmit path).
+inline constexpr std::uint8_t kUrgentFlag = 0x04;
+
 /// Serializes a data frame (header, frame number, chunks) without tag and CRC. The last chunk omits its
 /// length.
-std::vector<std::uint8_t> encode_data(std::uint8_t heard_mask, std::uint32_t frame_number24,
+std::vector<std::uint8_t> encode_data(std::uint8_t header_flags, std::uint32_t frame_number24,
                                       std::span<const Chunk> chunks);
 
 struct Hello {
@@ -86,6 +90,7 @@ std::optional<std::span<const std::uint8_t>> check_crc(std::span<const std::uint
 
 [[nodiscard]] std::optional<Kind> kind_of(std::span<const std::uint8_t> frame);
 [[nodiscard]] std::uint8_t heard_mask_of(std::span<const std::uint8_t> frame);
+[[nodiscard]] bool urgent_of(std::span<const std::uint8_t> frame);
 std::optional<Hello> decode_hello(std::span<const std::uint8_t> frame);
 /// Frame number (24 bits) of a data frame; nullopt when too short.
 std::optional<std::uint32_t> frame_number_of(std::span<const std::uint8_t> frame);

@@ -63,17 +63,17 @@ std::optional<SafeSender::Segment> SafeSender::take_new(std::size_t max_data, bo
     s.data.assign(msg.begin() + static_cast<std::ptrdiff_t>(cut_offset_),
                   msg.begin() + static_cast<std::ptrdiff_t>(cut_offset_ + size));
     s.end = size == remaining;
+    Segment out{static_cast<std::uint16_t>(next_), s.end, s.data, false};
     s.transmissions = 1;
     s.last_sent = now;
     cut_offset_ += size;
     ++cut_fragments_;
     if (s.end) {
+        started_.push_back(std::move(queue_.front()));
         queue_.pop_front();
         cut_offset_ = 0;
         cut_fragments_ = 0;
-        ++inflight_messages_;
     }
-    Segment out{static_cast<std::uint16_t>(next_), s.end, s.data, false};
     inflight_.push_back(std::move(s));
     ++next_;
     return out;
@@ -100,14 +100,14 @@ void SafeSender::pop_acked_front() {
     while (!inflight_.empty() && inflight_.front().acked) {
         bytes_held_ -= inflight_.front().data.size();
         if (inflight_.front().end) {
-            --inflight_messages_;
+            started_.pop_front();
         }
         inflight_.pop_front();
         ++una_;
     }
 }
 
-SafeSender::AckResult SafeSender::on_ack(const frame::AckChunk& ack, TimePoint now) {
+SafeSender::AckResult SafeSender::on_ack(const frame::AckChunk& ack, TimePoint now, Duration reorder_slack) {
     AckResult r;
     const std::uint64_t span = next_ - una_;
     const auto delta = static_cast<std::uint16_t>(ack.next_expected - static_cast<std::uint16_t>(una_));
@@ -131,7 +131,7 @@ SafeSender::AckResult SafeSender::on_ack(const frame::AckChunk& ack, TimePoint n
     }
     if (r.newly_acked > 0) {
         for (auto& s : inflight_) {
-            if (!s.acked && !s.lost && s.last_sent < newest) {
+            if (!s.acked && !s.lost && s.last_sent + reorder_slack < newest) {
                 s.lost = true;
                 ++lost_count_;
                 ++r.newly_lost;
@@ -167,24 +167,21 @@ TimePoint SafeSender::next_timeout(Duration rto) const {
 }
 
 std::size_t SafeSender::reset() {
-    // Bytes leave bytes_held_ when their segment is acknowledged at the front of the window; everything still
-    // in inflight_ and the uncut rest of a partly sent message are released here.
-    std::size_t given_up = inflight_messages_;
-    if (cut_fragments_ > 0) {
-        bytes_held_ -= queue_.front().size() - cut_offset_;
-        queue_.pop_front();
-        ++given_up;
+    const std::size_t started = started_.size() + (cut_fragments_ > 0 ? 1 : 0);
+    for (auto it = started_.rbegin(); it != started_.rend(); ++it) {
+        queue_.push_front(std::move(*it));
     }
-    for (const auto& s : inflight_) {
-        bytes_held_ -= s.data.size();
-    }
+    started_.clear();
     inflight_.clear();
-    inflight_messages_ = 0;
     cut_offset_ = 0;
     cut_fragments_ = 0;
     una_ = next_ = 0;
     lost_count_ = 0;
-    return given_up;
+    bytes_held_ = 0;
+    for (const auto& m : queue_) {
+        bytes_held_ += m.size();
+    }
+    return started;
 }
 
 }  // namespace airseg::groundlink

@@ -47,17 +47,19 @@ class SafeSender {
         std::optional<Duration> rtt_sample;
         bool progress = false;  ///< the lowest unacknowledged segment advanced
     };
-    AckResult on_ack(const frame::AckChunk& ack, TimePoint now);
+    /// `reorder_slack`: a segment counts as lost only if one sent more than this later was acknowledged
+    /// (frames on two paths may arrive out of order).
+    AckResult on_ack(const frame::AckChunk& ack, TimePoint now, Duration reorder_slack = Duration::zero());
     /// Declares lost every outstanding segment last sent at or before now - rto; returns how many.
     std::size_t on_timeout(TimePoint now, Duration rto);
     /// When the oldest outstanding segment times out (kNever when none is outstanding).
     [[nodiscard]] TimePoint next_timeout(Duration rto) const;
 
-    /// Drops segments in flight and the partly sent message; returns how many messages were given up.
-    /// Messages never started stay queued and go out in the next session from sequence 0.
+    /// Starts over for a new session: every message not yet fully acknowledged goes back to the queue, in
+    /// order, to be sent again from sequence 0. Returns how many had been started.
     std::size_t reset();
 
-    [[nodiscard]] std::size_t pending_messages() const { return queue_.size() + inflight_messages_; }
+    [[nodiscard]] std::size_t pending_messages() const { return queue_.size() + started_.size(); }
     [[nodiscard]] std::size_t in_flight() const { return static_cast<std::size_t>(next_ - una_); }
 
   private:
@@ -73,12 +75,12 @@ class SafeSender {
     void pop_acked_front();
 
     std::size_t window_, queue_bytes_, max_message_;
-    std::deque<std::vector<std::uint8_t>> queue_;  // front may be partly cut
-    std::size_t cut_offset_ = 0;                   // bytes of queue_.front() already in segments
-    std::size_t cut_fragments_ = 0;                // segments cut from queue_.front()
-    std::size_t bytes_held_ = 0;                   // queued + in flight
-    std::size_t inflight_messages_ = 0;            // messages whose last segment is in flight
-    std::deque<InFlight> inflight_;                // index = seq - una_
+    std::deque<std::vector<std::uint8_t>> queue_;    // front may be partly cut
+    std::size_t cut_offset_ = 0;                     // bytes of queue_.front() already in segments
+    std::size_t cut_fragments_ = 0;                  // segments cut from queue_.front()
+    std::size_t bytes_held_ = 0;                     // queued + in flight
+    std::deque<std::vector<std::uint8_t>> started_;  // fully cut, not yet fully acknowledged
+    std::deque<InFlight> inflight_;                  // index = seq - una_
     std::uint64_t una_ = 0;
     std::uint64_t next_ = 0;
     std::size_t lost_count_ = 0;

@@ -42,6 +42,9 @@ struct TransportConfig {
     std::size_t paths = 1;                  ///< paths: 1 or 2 serial radio pairs
     PathMode path_mode = PathMode::single;  ///< path_mode: single | split | redundant
     std::size_t split_tx_path = 0;  ///< split_tx_path: this end's transmit path in split mode (peer: other)
+    /// split_borrow: in split mode, also send on the peer's transmit path while the peer leaves it mostly
+    /// idle (under a quarter of link_rate) and has no urgent traffic, so one-way bulk uses both pairs.
+    bool split_borrow = true;
     /// half_duplex: bytes received on a path consume that path's pacing budget too (radios share air time).
     bool half_duplex = true;
 
@@ -114,9 +117,11 @@ struct TransportEvent {
         peer_restarted,       ///< the peer came back with a new boot nonce; stream state was reset
         link_up,
         link_down,
-        path_up,        ///< `path` hears valid frames again
-        path_down,      ///< `path` went silent
-        safe_given_up,  ///< `count` Safe messages in flight were discarded because the peer restarted
+        path_up,    ///< `path` hears valid frames again
+        path_down,  ///< `path` went silent
+        /// the peer restarted while `count` Safe messages were in flight: they are sent again from the start
+        /// in the new session (the old incarnation may have received some of them)
+        safe_resent,
     };
     Kind kind = Kind::link_up;
     std::size_t path = 0;
@@ -171,7 +176,7 @@ struct LinkStats {
     std::uint64_t peer_restarts = 0;
     std::uint64_t acks_sent = 0;  ///< ACK chunks
     std::uint64_t acks_received = 0;
-    std::uint64_t safe_given_up = 0;
+    std::uint64_t safe_resent = 0;  ///< Safe messages sent again in a new session after a peer restart
     std::uint64_t events_dropped = 0;
     std::uint64_t deliveries_refused = 0;  ///< Safe segments not accepted because the delivery queue was full
 

@@ -60,6 +60,9 @@ class Transport::Impl {
     [[nodiscard]] bool keeps_alive(std::size_t path) const;
     [[nodiscard]] bool peer_mask_fresh() const;
     [[nodiscard]] std::uint8_t heard_mask() const;
+    [[nodiscard]] std::uint8_t header_flags() const;
+    [[nodiscard]] bool may_borrow(std::size_t path) const;
+    [[nodiscard]] Duration reorder_slack() const;
     [[nodiscard]] bool data_ready() const;
     [[nodiscard]] TimePoint ack_due() const;
     [[nodiscard]] TimePoint content_due(std::size_t path) const;
@@ -101,9 +104,12 @@ class Transport::Impl {
         std::size_t streak = 0;
         bool alive = false;
         std::deque<std::vector<std::uint8_t>> mirror;  // redundant mode: frames built for another path
+        double rx_rate = 0.0;                          // bytes/s heard on the path, moving average over ~1 s
+        TimePoint rx_rate_time{};
     };
     std::vector<Path> paths;
     std::uint8_t peer_mask = 0;
+    bool peer_urgent = false;
     TimePoint peer_mask_time{};
     bool peer_mask_known = false;
     bool link = false;

@@ -1,5 +1,6 @@
 // Frames in: deframing, CRC, authentication, replay window, handshake, chunk dispatch.
 #include <algorithm>
+#include <cmath>
 
 #include "services/groundlink/transport/transport_impl.hpp"
 
@@ -14,6 +15,11 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
     stats.bytes_received += bytes.size();
     stats.path[path].bytes_received += bytes.size();
     meter.on_bytes(bytes.size());
+    {
+        const double dt = std::chrono::duration<double>(now_ - ps.rx_rate_time).count();
+        ps.rx_rate = ps.rx_rate * std::exp(-std::max(dt, 0.0)) + static_cast<double>(bytes.size());
+        ps.rx_rate_time = now_;
+    }
     if (cfg.half_duplex) {
         // The peer's bytes occupied the shared air just now; they count against this end's budget on the
         // path.
@@ -88,6 +94,7 @@ void Transport::Impl::on_plain_frame(std::size_t path, std::span<const std::uint
     }
     rx_window.accept(number);
     on_authentic(path, frame::heard_mask_of(frame_bytes), now);
+    peer_urgent = frame::urgent_of(frame_bytes);
     if (!confirmed) {
         confirmed = true;
     }
@@ -205,7 +212,7 @@ void Transport::Impl::on_ack(const frame::AckChunk& a, TimePoint now) {
         return;
     }
     ++stats.acks_received;
-    const auto r = senders[a.channel].on_ack(a, now);
+    const auto r = senders[a.channel].on_ack(a, now, reorder_slack());
     if (r.rtt_sample) {
         rtt.sample(*r.rtt_sample);
     }
@@ -252,7 +259,7 @@ void Transport::Impl::on_hello(std::size_t path, const frame::Hello& h, TimePoin
         queue_hello_reply(frame::Hello{0, my_nonce, peer_nonce, true});
         return;
     }
-    if (!established || h.echo_nonce == 0) {
+    if (!established || (h.echo_nonce == 0 && h.sender_nonce != peer_nonce)) {
         // A peer that does not know this end (it started, or it is a replay): challenge it with a fresh
         // nonce; the session changes only if the answer echoes it.
         last_seen_peer = h.sender_nonce;
@@ -270,9 +277,9 @@ void Transport::Impl::accept_session(std::uint64_t peer, TimePoint now) {
     candidate = fresh_nonce();
     rx_window.reset();
     next_frame_number = 0;
-    std::size_t given_up = 0;
+    std::size_t resent = 0;
     for (std::size_t l = 0; l < senders.size(); ++l) {
-        given_up += senders[l].reset();
+        resent += senders[l].reset();
         receivers[l].reset();
         acks[l] = AckState{};
         backoff[l] = 0;
@@ -285,9 +292,9 @@ void Transport::Impl::accept_session(std::uint64_t peer, TimePoint now) {
     if (had_session) {
         ++stats.peer_restarts;
         push_event(TransportEvent::Kind::peer_restarted);
-        if (given_up > 0) {
-            stats.safe_given_up += given_up;
-            push_event(TransportEvent::Kind::safe_given_up, 0, given_up);
+        if (resent > 0) {
+            stats.safe_resent += resent;
+            push_event(TransportEvent::Kind::safe_resent, 0, resent);
         }
     }
     push_event(TransportEvent::Kind::session_established);

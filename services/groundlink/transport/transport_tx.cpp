@@ -26,6 +26,25 @@ std::uint8_t Transport::Impl::heard_mask() const {
     return m;
 }
 
+std::uint8_t Transport::Impl::header_flags() const {
+    return static_cast<std::uint8_t>(heard_mask() | (now_ < urgent_until ? frame::kUrgentFlag : 0));
+}
+
+bool Transport::Impl::may_borrow(std::size_t path) const {
+    const Path& ps = paths[path];
+    return cfg.split_borrow && ps.alive && !(peer_mask_fresh() && peer_urgent) &&
+           ps.rx_rate < 0.25 * cfg.link_rate_bytes_per_s;
+}
+
+Duration Transport::Impl::reorder_slack() const {
+    if (paths.size() < 2) {
+        return Duration::zero();  // one serial path never reorders
+    }
+    const auto frame_time = std::chrono::duration_cast<Duration>(std::chrono::duration<double>(
+        static_cast<double>(cfg.max_frame_payload + 32) / cfg.link_rate_bytes_per_s));
+    return std::max<Duration>(rtt.srtt() / 4, frame_time);
+}
+
 bool Transport::Impl::carries_data(std::size_t path) const {
     const auto bit = static_cast<std::uint8_t>(1U << path);
     switch (cfg.path_mode) {
@@ -34,7 +53,10 @@ bool Transport::Impl::carries_data(std::size_t path) const {
         case PathMode::split: {
             const std::size_t primary = cfg.split_tx_path;
             const bool fallback = peer_mask_fresh() && ((peer_mask >> primary) & 1U) == 0;
-            return fallback ? path != primary : path == primary;
+            if (fallback) {
+                return path != primary;
+            }
+            return path == primary || may_borrow(path);
         }
         case PathMode::redundant:
             // A path the peer reports silent stops carrying data while another one works.
@@ -260,7 +282,7 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
             return std::nullopt;
         }
         // A probe: an empty frame, so the peer can report whether it hears this path.
-        auto plain = frame::encode_data(heard_mask(), static_cast<std::uint32_t>(next_frame_number), {});
+        auto plain = frame::encode_data(header_flags(), static_cast<std::uint32_t>(next_frame_number), {});
         const MacContext ctx{my_nonce, peer_nonce, next_frame_number++};
         return frame::seal(std::move(plain), mac.get(), ctx);
     }
@@ -324,7 +346,7 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
     retx_credit = std::min(retx_credit + cfg.retransmit_share * frame_bytes, cap);
 
     auto plain = frame::encode_data(
-        heard_mask(), static_cast<std::uint32_t>(next_frame_number & frame::kFrameNumberMask), chunks);
+        header_flags(), static_cast<std::uint32_t>(next_frame_number & frame::kFrameNumberMask), chunks);
     const MacContext ctx{my_nonce, peer_nonce, next_frame_number++};
     auto sealed = frame::seal(std::move(plain), mac.get(), ctx);
     for (std::size_t q = 0; q < paths.size(); ++q) {

@@ -1,0 +1,371 @@
+// The core end to end, two instances in simulated time (sim_link.hpp).
+#include <gtest/gtest.h>
+
+#include "tests/unit/groundlink/sim_link.hpp"
+
+namespace airseg::groundlink {
+namespace {
+
+using namespace std::chrono_literals;
+using test::base_config;
+using test::pattern;
+using test::SimLink;
+
+std::vector<test::PathModel> one_path(test::Impairments imp = {}) {
+    test::PathModel p;
+    p.imp = imp;
+    return {p};
+}
+
+bool has_event(const test::Endpoint& e, TransportEvent::Kind k) {
+    return std::any_of(e.events.begin(), e.events.end(),
+                       [k](const TransportEvent& ev) { return ev.kind == k; });
+}
+
+std::size_t count_safe(const test::Endpoint& e, std::uint8_t prio) {
+    return static_cast<std::size_t>(std::count_if(
+        e.received.begin(), e.received.end(),
+        [prio](const Delivered& d) { return d.cls == MessageClass::safe && d.priority == prio; }));
+}
+
+TEST(TransportConfig, ValidateNamesEachProblem) {
+    EXPECT_TRUE(base_config(1).validate().empty());
+    TransportConfig c = base_config(1);
+    c.paths = 3;
+    c.boot_nonce = 0;
+    c.safe_window = 500;
+    const auto e = c.validate();
+    ASSERT_EQ(e.size(), 4U);  // paths, single-needs-1-path, window, nonce
+    EXPECT_NE(e[0].find("paths"), std::string::npos);
+    EXPECT_THROW(Transport(c, TimePoint{}), std::invalid_argument);
+    TransportConfig split = base_config(1);
+    split.path_mode = PathMode::split;
+    EXPECT_FALSE(split.validate().empty());
+    split.paths = 2;
+    EXPECT_TRUE(split.validate().empty());
+}
+
+TEST(Transport, HandshakeThenSafeBothWaysAuthenticated) {
+    SimLink link(base_config(0x1111), base_config(0x2222), one_path(), 1);
+    const auto m1 = pattern(300, 1);
+    const auto m2 = pattern(3000, 2);
+    ASSERT_EQ(link.a().core->send_safe(0, m1, link.now()), SendResult::accepted);
+    ASSERT_EQ(link.b().core->send_safe(2, m2, link.now()), SendResult::accepted);
+    link.run_for(5s);
+    ASSERT_FALSE(link.livelocked());
+    ASSERT_EQ(link.b().received.size(), 1U);
+    EXPECT_EQ(link.b().received[0].bytes, m1);
+    ASSERT_EQ(link.a().received.size(), 1U);
+    EXPECT_EQ(link.a().received[0].bytes, m2);
+    EXPECT_EQ(link.a().received[0].priority, 2);
+    for (int i = 0; i < 2; ++i) {
+        const auto& s = link.end(i).core->stats();
+        EXPECT_TRUE(s.authenticated);
+        EXPECT_TRUE(link.end(i).core->link_up());
+        EXPECT_TRUE(link.end(i).core->session_established());
+        EXPECT_EQ(s.mac_failures, 0U);
+        EXPECT_TRUE(has_event(link.end(i), TransportEvent::Kind::session_established));
+        EXPECT_TRUE(has_event(link.end(i), TransportEvent::Kind::link_up));
+    }
+    EXPECT_GT(link.a().core->stats().rtt_samples, 0U);
+}
+
+TEST(Transport, WithoutKeyStatsSayUnauthenticated) {
+    SimLink link(base_config(5, false), base_config(6, false), one_path(), 2);
+    link.a().core->send_safe(1, pattern(50, 9), link.now());
+    link.run_for(3s);
+    ASSERT_EQ(link.b().received.size(), 1U);
+    EXPECT_FALSE(link.a().core->stats().authenticated);
+    EXPECT_FALSE(link.b().core->stats().authenticated);
+}
+
+TEST(Transport, PacingNeverExceedsRateTimesElapsedPlusOneFrame) {
+    SimLink link(base_config(1), base_config(2), one_path(), 3);
+    for (std::uint32_t i = 0; i < 60; ++i) {
+        link.a().core->send_safe(3, pattern(1000, i), link.now());
+        link.a().core->send_fast(1, static_cast<std::uint16_t>(i % 5), pattern(40, i), link.now());
+    }
+    const TimePoint start = link.now();
+    bool violated = false;
+    link.run_until(start + 10s, [&] {
+        const double elapsed = std::chrono::duration<double>(link.now() - start).count();
+        const double allowed = 5760.0 * elapsed + static_cast<double>(link.largest_frame());
+        violated = violated || static_cast<double>(link.written(0, 0)) > allowed + 1.0;
+        return false;
+    });
+    EXPECT_FALSE(violated);
+    EXPECT_FALSE(link.livelocked());
+    EXPECT_GT(link.written(0, 0), 5760U * 10U * 8U / 10U);  // and it does use the link
+}
+
+TEST(Transport, UrgentMessageOvertakesBulkWithinAFewFrameTimes) {
+    SimLink link(base_config(1), base_config(2), one_path(), 4);
+    link.run_for(2s);  // handshake
+    for (std::uint32_t i = 0; i < 40; ++i) {
+        link.a().core->send_safe(3, pattern(2000, i), link.now());
+    }
+    link.run_for(3s);  // bulk is flowing
+    const TimePoint sent = link.now();
+    link.a().core->send_safe(0, pattern(20, 999), link.now());
+    TimePoint arrived{};
+    link.run_until(sent + 5s, [&] {
+        if (count_safe(link.b(), 0) == 1) {
+            arrived = link.now();
+            return true;
+        }
+        return false;
+    });
+    ASSERT_NE(arrived, TimePoint{});
+    // A frame in flight, the control frame itself and the radio latency; frames are capped at
+    // latency_frame_payload while urgent traffic is active, so this is a few tens of milliseconds.
+    EXPECT_LT(arrived - sent, 250ms);
+    EXPECT_LT(count_safe(link.b(), 3), 40U);  // bulk was still going
+}
+
+TEST(Transport, LowerPriorityGetsItsMinimumShare) {
+    TransportConfig a = base_config(1);
+    a.min_share = {0.0, 0.0, 0.0, 0.1, 0, 0, 0, 0};
+    SimLink link(a, base_config(2), one_path(), 5);
+    for (std::uint32_t i = 0; i < 200; ++i) {
+        link.a().core->send_safe(0, pattern(1000, i), link.now());
+        link.a().core->send_safe(3, pattern(1000, 10000 + i), link.now());
+    }
+    link.run_for(30s);
+    const std::size_t high = count_safe(link.b(), 0);
+    const std::size_t low = count_safe(link.b(), 3);
+    EXPECT_GT(high, 50U);
+    EXPECT_GT(low, 0U);
+    const double low_share = static_cast<double>(low) / static_cast<double>(high + low);
+    EXPECT_GT(low_share, 0.06);
+    EXPECT_LT(low_share, 0.2);
+}
+
+TEST(Transport, FastFreshestWinsEndToEnd) {
+    SimLink link(base_config(1), base_config(2), one_path(), 6);
+    link.run_for(2s);
+    for (std::uint32_t v = 0; v < 50; ++v) {
+        link.a().core->send_fast(1, 7, pattern(30, v), link.now());  // all before the next poll
+    }
+    link.run_for(1s);
+    std::vector<std::uint32_t> got;
+    for (const auto& d : link.b().received) {
+        if (d.cls == MessageClass::fast) {
+            got.push_back(test::id_of(d.bytes));
+            EXPECT_EQ(d.topic, 7);
+        }
+    }
+    ASSERT_EQ(got.size(), 1U);
+    EXPECT_EQ(got[0], 49U);
+    EXPECT_EQ(link.a().core->stats().tx_fast.replaced, 49U);
+}
+
+TEST(Transport, RttAndRtoFollowTheLinkLatency) {
+    test::Impairments slow;
+    slow.latency = 150ms;
+    SimLink link(base_config(1), base_config(2), one_path(slow), 7);
+    for (std::uint32_t i = 0; i < 100; ++i) {
+        link.a().core->send_safe(1, pattern(100, i), link.now());
+    }
+    link.run_for(20s);
+    const auto& s = link.a().core->stats();
+    ASSERT_GT(s.rtt_samples, 10U);
+    EXPECT_GT(s.srtt_ms, 300.0);  // two one-way latencies plus serialization
+    EXPECT_LT(s.srtt_ms, 700.0);
+    EXPECT_GE(s.rto_ms, s.srtt_ms);
+    EXPECT_LE(s.rto_ms, 2000.0);
+    EXPECT_EQ(s.tx_safe.retransmissions, 0U);  // no spurious timeouts on a clean slow link
+    EXPECT_EQ(count_safe(link.b(), 1), 100U);
+}
+
+TEST(Transport, PeerRestartIsDetectedAndBothResynchronize) {
+    SimLink link(base_config(0xA), base_config(0xB), one_path(), 8);
+    for (std::uint32_t i = 0; i < 5; ++i) {
+        link.a().core->send_safe(0, pattern(100, i), link.now());
+    }
+    link.run_for(3s);
+    ASSERT_EQ(count_safe(link.b(), 0), 5U);
+    link.restart(1, base_config(0xBB));  // B comes back with a new boot nonce
+    link.b().received.clear();
+    link.b().events.clear();
+    for (std::uint32_t i = 5; i < 10; ++i) {
+        link.a().core->send_safe(0, pattern(100, i), link.now());
+        link.b().core->send_safe(0, pattern(100, 100 + i), link.now());
+    }
+    link.run_for(5s);
+    EXPECT_TRUE(has_event(link.a(), TransportEvent::Kind::peer_restarted));
+    EXPECT_EQ(link.a().core->stats().peer_restarts, 1U);
+    EXPECT_TRUE(has_event(link.b(), TransportEvent::Kind::session_established));
+    ASSERT_EQ(count_safe(link.b(), 0), 5U);
+    for (std::uint32_t i = 0; i < 5; ++i) {
+        EXPECT_EQ(test::id_of(link.b().received[i].bytes), 5 + i);
+    }
+    EXPECT_EQ(count_safe(link.a(), 0), 5U);
+    EXPECT_TRUE(link.a().core->link_up());
+    EXPECT_TRUE(link.b().core->link_up());
+}
+
+TEST(Transport, ForgedAndReplayedFramesAreNeverDelivered) {
+    SimLink link(base_config(0x10), base_config(0x20), one_path(), 9);
+    for (std::uint32_t i = 0; i < 20; ++i) {
+        link.a().core->send_safe(0, pattern(200, i), link.now());
+        link.a().core->send_fast(1, 3, pattern(30, 500 + i), link.now());
+    }
+    link.run_for(5s);
+    const std::size_t delivered = link.b().received.size();
+    ASSERT_EQ(count_safe(link.b(), 0), 20U);
+
+    // Replays: every frame A ever wrote, again, in order and reversed.
+    const auto recorded = link.recorded(0);
+    for (const auto& f : recorded) {
+        link.inject(1, 0, f);
+    }
+    for (auto it = recorded.rbegin(); it != recorded.rend(); ++it) {
+        link.inject(1, 0, *it);
+    }
+    EXPECT_EQ(link.b().received.size(), delivered);
+    EXPECT_GT(link.b().core->stats().replays, 0U);
+
+    // Forgeries: a peer with the wrong key, and random bytes.
+    TransportConfig wrong = base_config(0x10);
+    (*wrong.key)[0] ^= 1;
+    SimLink evil(wrong, base_config(0x30), one_path(), 10);
+    evil.a().core->send_safe(0, pattern(50, 77), evil.now());
+    evil.run_for(2s);
+    std::mt19937 rng(3);
+    for (const auto& f : evil.recorded(0)) {
+        link.inject(1, 0, f);
+    }
+    for (int i = 0; i < 200; ++i) {
+        std::vector<std::uint8_t> junk(1 + rng() % 80);
+        for (auto& b : junk) {
+            b = static_cast<std::uint8_t>(rng());
+        }
+        link.inject(1, 0, junk);
+    }
+    EXPECT_EQ(link.b().received.size(), delivered);
+    EXPECT_GT(link.b().core->stats().mac_failures, 0U);
+    // The session survives: a genuine message still gets through.
+    link.a().core->send_safe(0, pattern(10, 4242), link.now());
+    link.run_for(3s);
+    EXPECT_EQ(count_safe(link.b(), 0), 21U);
+    EXPECT_FALSE(has_event(link.b(), TransportEvent::Kind::peer_restarted));
+}
+
+test::PathModel clean_path() {
+    return test::PathModel{};
+}
+
+TransportConfig dual(std::uint64_t nonce, PathMode mode, std::size_t tx_path) {
+    TransportConfig c = base_config(nonce);
+    c.paths = 2;
+    c.path_mode = mode;
+    c.split_tx_path = tx_path;
+    return c;
+}
+
+std::uint64_t bulk_bytes_delivered(PathMode mode, std::size_t paths, Duration run, std::uint64_t seed) {
+    TransportConfig a = paths == 1 ? base_config(1) : dual(1, mode, 0);
+    TransportConfig b = paths == 1 ? base_config(2) : dual(2, mode, 1);
+    std::vector<test::PathModel> models(paths, clean_path());
+    SimLink link(a, b, models, seed);
+    std::uint32_t next = 0;
+    const TimePoint end = link.now() + run;
+    while (link.now() < end) {
+        while (link.a().core->send_safe(3, pattern(1000, next), link.now()) == SendResult::accepted) {
+            ++next;
+        }
+        link.run_for(1s);
+    }
+    std::uint64_t bytes = 0;
+    for (const auto& d : link.b().received) {
+        bytes += d.bytes.size();
+    }
+    return bytes;
+}
+
+TEST(Transport, SplitModeNearlyDoublesThroughput) {
+    const auto single = bulk_bytes_delivered(PathMode::single, 1, 30s, 11);
+    const auto split = bulk_bytes_delivered(PathMode::split, 2, 30s, 11);
+    EXPECT_GT(static_cast<double>(single), 0.9 * 5760.0 * 28.0);
+    EXPECT_GT(static_cast<double>(split), 1.9 * static_cast<double>(single));
+}
+
+TEST(Transport, SplitFallsBackWhenAPairGoesSilentAndReturns) {
+    TransportConfig a = dual(1, PathMode::split, 0);
+    TransportConfig b = dual(2, PathMode::split, 1);
+    a.split_borrow = b.split_borrow = false;  // so path 1 carries A's data only while falling back
+    SimLink link(a, b, {clean_path(), clean_path()}, 12);
+    link.run_for(3s);
+    link.path(0).a_to_b_up = false;  // A's transmit pair dies
+    for (std::uint32_t i = 0; i < 30; ++i) {
+        link.a().core->send_safe(1, pattern(500, i), link.now());
+    }
+    link.run_for(15s);
+    EXPECT_EQ(count_safe(link.b(), 1), 30U);
+    EXPECT_TRUE(has_event(link.b(), TransportEvent::Kind::path_down));
+    const auto via_fallback = link.written(0, 1);
+    EXPECT_GT(via_fallback, 30U * 500U);
+    link.path(0).a_to_b_up = true;  // recovers
+    link.run_for(5s);
+    const auto before = link.written(0, 1);
+    for (std::uint32_t i = 30; i < 60; ++i) {
+        link.a().core->send_safe(1, pattern(500, i), link.now());
+    }
+    link.run_for(10s);
+    EXPECT_EQ(count_safe(link.b(), 1), 60U);
+    EXPECT_LT(link.written(0, 1) - before, 30U * 500U / 4);  // the bulk went back on path 0
+    EXPECT_TRUE(link.a().core->stats().path[0].peer_hears);
+}
+
+TEST(Transport, RedundantModeDropsDuplicatesAndSurvivesOnePathDying) {
+    SimLink link(dual(1, PathMode::redundant, 0), dual(2, PathMode::redundant, 0),
+                 {clean_path(), clean_path()}, 13);
+    for (std::uint32_t i = 0; i < 20; ++i) {
+        link.a().core->send_safe(0, pattern(200, i), link.now());
+    }
+    link.run_for(5s);
+    EXPECT_EQ(count_safe(link.b(), 0), 20U);
+    EXPECT_GT(link.b().core->stats().replays, 10U);  // the second copies
+    link.path(1).a_to_b_up = false;
+    link.path(1).b_to_a_up = false;
+    for (std::uint32_t i = 20; i < 40; ++i) {
+        link.a().core->send_safe(0, pattern(200, i), link.now());
+    }
+    link.run_for(10s);
+    EXPECT_EQ(count_safe(link.b(), 0), 40U);
+    EXPECT_TRUE(link.a().core->link_up());
+}
+
+TEST(Transport, FrameSizeShrinksUnderCorruption) {
+    test::Impairments noisy;
+    noisy.byte_corrupt = 1e-3;
+    SimLink link(base_config(1), base_config(2), one_path(noisy), 14);
+    for (std::uint32_t i = 0; i < 200; ++i) {
+        link.a().core->send_safe(3, pattern(1000, i), link.now());
+    }
+    link.run_for(30s);
+    const auto& s = link.a().core->stats();
+    EXPECT_GT(s.peer_suggested_payload, 60U);
+    EXPECT_LT(s.peer_suggested_payload, 300U);
+    EXPECT_LT(s.frame_payload, 300U);
+    EXPECT_GT(count_safe(link.b(), 3), 50U);
+}
+
+TEST(Transport, LinkGoesDownAfterSilenceAndComesBack) {
+    SimLink link(base_config(1), base_config(2), one_path(), 15);
+    link.run_for(3s);
+    ASSERT_TRUE(link.a().core->link_up());
+    link.path(0).a_to_b_up = false;
+    link.path(0).b_to_a_up = false;
+    link.run_for(5s);
+    EXPECT_FALSE(link.a().core->link_up());
+    EXPECT_TRUE(has_event(link.a(), TransportEvent::Kind::link_down));
+    link.path(0).a_to_b_up = true;
+    link.path(0).b_to_a_up = true;
+    link.run_for(3s);
+    EXPECT_TRUE(link.a().core->link_up());
+    EXPECT_TRUE(link.b().core->link_up());
+}
+
+}  // namespace
+}  // namespace airseg::groundlink
