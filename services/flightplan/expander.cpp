@@ -17,8 +17,11 @@ const char* to_string(WaypointAction action) {
     return "?";
 }
 
-Expander::Expander(std::shared_ptr<const Plan> plan, bool enforce_no_fly)
-    : plan_(std::move(plan)), enforce_no_fly_(enforce_no_fly), body_count_(plan_->nodes.size()) {
+Expander::Expander(std::shared_ptr<const Plan> plan, bool enforce_no_fly, bool fold_repeats)
+    : plan_(std::move(plan)),
+      enforce_no_fly_(enforce_no_fly),
+      fold_repeats_(fold_repeats),
+      body_count_(plan_->nodes.size()) {
     for (std::uint32_t i = 0; i < plan_->nodes.size(); ++i) {
         const Node& n = plan_->nodes[i];
         if (n.kind != NodeKind::Repeat)
@@ -109,6 +112,17 @@ bool Expander::activate_next_leaf(std::uint64_t* skip_budget) {
         Frame& f = stack_.back();
         const Node& container = nodes[f.node];
         if (f.next_child >= container.children.size()) {
+            if (fold_repeats_ && container.kind == NodeKind::Repeat && f.iteration >= 1 &&
+                body_count_[f.node]) {
+                // Iterations are identical: after two, every leg of the repeat has been seen once.
+                if (!container.repeat_count) {
+                    stack_.clear();
+                    return false;
+                }
+                position_ += (*container.repeat_count - f.iteration - 1) * *body_count_[f.node];
+                stack_.pop_back();
+                continue;
+            }
             if (container.kind == NodeKind::Repeat &&
                 (!container.repeat_count || f.iteration + 1 < *container.repeat_count)) {
                 ++f.iteration;

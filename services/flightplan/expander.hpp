@@ -23,7 +23,10 @@ namespace airseg::flightplan {
 
 class Expander final : public WaypointStream {
   public:
-    explicit Expander(std::shared_ptr<const Plan> plan, bool enforce_no_fly = true);
+    /// fold_repeats (for validation only): a goto-free repeat runs two iterations, then the stream moves past
+    /// it (indices still count all iterations); a goto-free repeat forever ends the stream after two.
+    explicit Expander(std::shared_ptr<const Plan> plan, bool enforce_no_fly = true,
+                      bool fold_repeats = false);
 
     std::optional<Waypoint> next() override;
     /// Seeks relative to the current origin (the plan start unless a jump happened); an index before the
@@ -58,6 +61,7 @@ class Expander final : public WaypointStream {
 
     std::shared_ptr<const Plan> plan_;
     bool enforce_no_fly_;
+    bool fold_repeats_;
     std::vector<std::optional<std::uint64_t>> body_count_;  // per repeat: waypoints of one iteration
     std::vector<Frame> stack_;
     StreamOrigin origin_;

@@ -26,7 +26,7 @@ void check_legs(const Plan& plan, std::uint64_t limit, std::vector<Diagnostic>& 
     }
     std::set<std::pair<std::uint32_t, std::size_t>> reported;  // (element, zone)
     for (auto entry : entries) {
-        Expander stream(view, /*enforce_no_fly=*/false);
+        Expander stream(view, /*enforce_no_fly=*/false, /*fold_repeats=*/true);
         if (entry != kNoNode)
             stream.jump_to_node(entry);
         std::optional<Enu> last;

@@ -1,9 +1,11 @@
 #pragma once
-// Geometric validation of a loaded plan: every leg of the expanded stream against every no-fly zone
-// (with its buffer). Runs the expander over the main element list and over each detached block, up to
-// `limit` waypoints each: finite plans below the limit are checked completely; an infinite plan (repeat
-// forever, goto loops) is checked over its first `limit` waypoints, which covers every leg of any loop
-// shorter than limit/2. The expander checks legs again while streaming.
+// Validation by expansion: every leg of the expanded stream is checked against every no-fly zone (with its
+// buffer), and a goto cycle that produces no waypoints is found. The expander runs over the main element
+// list and over each detached block with repeats folded: a goto-free repeat runs two iterations (which show
+// every leg it has, the wrap-around leg included) and is then stepped over, so a finite plan is checked
+// completely in time proportional to its distinct geometry. Gotos are followed literally, up to `limit`
+// waypoints per entry point; a plan that loops through gotos is checked over that prefix. The expander
+// checks legs again while streaming.
 #include <cstdint>
 #include <vector>
 

@@ -205,3 +205,37 @@ TEST(PlanLoader, LoopsWithoutWaypointsAreRejected) {
 
 }  // namespace
 }  // namespace airseg::flightplan
+
+namespace airseg::flightplan {
+namespace {
+
+TEST(PlanLoader, RepeatWrapLegAndTheLegAfterALongRepeatAreChecked) {
+    // A -> B -> C repeated 100000 times: only the wrap leg C -> A crosses 'middle'; the leg from C to D after
+    // the repeat crosses 'east'. Validation folds the repeat, so this is quick and still finds both.
+    const std::string text = R"(plan:
+  name: wrap
+  no_fly:
+    - name: middle
+      polygon: [[41.00045, 2.00055], [41.00055, 2.00055], [41.00055, 2.00065], [41.00045, 2.00065]]
+    - name: east
+      polygon: [[41.0009, 2.0015], [41.0011, 2.0015], [41.0011, 2.0016], [41.0009, 2.0016]]
+  elements:
+    - repeat:
+        count: 100000
+        elements:
+          - waypoint: {lat: 41.0, lon: 2.0}
+          - waypoint: {lat: 41.001, lon: 2.0}
+          - waypoint: {lat: 41.001, lon: 2.0012}
+    - waypoint: {lat: 41.001, lon: 2.002}
+)";
+    const auto r = load_plan_text(text, "wrap.yaml");
+    ASSERT_EQ(r.errors.size(), 2u) << to_string(r.errors);
+    EXPECT_EQ(r.errors[0].path, "plan.elements[0].repeat.elements[0]");
+    EXPECT_NE(r.errors[0].message.find("'middle'"), std::string::npos);
+    EXPECT_EQ(r.errors[1].path, "plan.elements[1]");
+    EXPECT_NE(r.errors[1].message.find("waypoint 300000 "), std::string::npos) << r.errors[1].message;
+    EXPECT_NE(r.errors[1].message.find("'east'"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace airseg::flightplan
