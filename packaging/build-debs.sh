@@ -1,0 +1,94 @@
+#!/bin/bash
+# build-debs.sh [--no-check] [--clean] ARCH...
+#
+# Builds the airseg .deb for each ARCH (amd64, armhf, armel) on Debian 12 from Debian packages
+# only, and writes it to dist/. amd64 is built natively; armhf and armel are cross-built with the
+# Debian cross compilers against a sysroot (packaging/make-sysroot.sh), without multiarch:
+# `dpkg-buildpackage -a ARCH -d` with AIRSEG_SYSROOT pointing at the sysroot.
+#
+# The tests run during each build (under qemu-arm for ARM) unless --no-check is given. Each
+# package is checked afterwards (packaging/check-deb.sh: lintian, fields, ELF format).
+# Work directories: build-pkg-ARCH/. Missing build tools are installed with apt-get (as root).
+set -euo pipefail
+. "$(dirname "$0")/lib.sh"
+
+check=1
+clean=0
+arches=()
+for a in "$@"; do
+  case "$a" in
+    --no-check) check=0 ;;
+    --clean) clean=1 ;;
+    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
+    -*) die "unknown option $a" ;;
+    *) arch_triplet "$a" >/dev/null; arches+=("$a") ;;
+  esac
+done
+[ ${#arches[@]} -gt 0 ] || die "usage: $0 [--no-check] [--clean] ARCH... (amd64 armhf armel)"
+
+build_arch=$(dpkg --print-architecture)
+[ "$build_arch" = amd64 ] || die "this script builds on amd64 (this machine is $build_arch)"
+
+version=$(dpkg-parsechangelog -l "$AIRSEG_ROOT/packaging/debian/changelog" -S Version)
+upstream=$(sed -n 's/^project(airseg VERSION \([0-9.]*\).*/\1/p' "$AIRSEG_ROOT/CMakeLists.txt")
+[ "${version%%-*}" = "$upstream" ] \
+  || log "warning: debian/changelog says $version but CMakeLists.txt says $upstream"
+
+ensure_packages "${AIRSEG_NATIVE_TOOLS[@]}" ccache
+mkdir -p "$AIRSEG_ROOT/dist"
+
+# Copies the source tree into DIR with debian/ at its top, keeping DIR's build directory
+# (obj-*) so that a rebuild is incremental unless --clean is given.
+stage_source() {
+  local dir=$1
+  mkdir -p "$dir"
+  find "$dir" -mindepth 1 -maxdepth 1 ! -name 'obj-*' -exec rm -rf {} +
+  if [ "$clean" = 1 ]; then rm -rf "$dir"/obj-*; fi
+  tar -C "$AIRSEG_ROOT" --exclude=./.git --exclude='./build*' --exclude=./dist --exclude=./sysroots \
+      --exclude=./.cache -cf - . | tar -C "$dir" -xf -
+  cp -a "$AIRSEG_ROOT/packaging/debian" "$dir/debian"
+}
+
+build_one() {
+  local arch=$1 work="$AIRSEG_ROOT/build-pkg-$1" src opts sysroot=""
+  src="$work/airseg-$version"
+  local -a dpkg_args=(-b -us -uc --no-sign)
+  opts="parallel=${AIRSEG_JOBS:-2} terse"
+  [ "$check" = 1 ] || opts="$opts nocheck"
+
+  if [ "$arch" = amd64 ]; then
+    ensure_packages "${AIRSEG_DEV_PACKAGES[@]}"
+  else
+    # shellcheck disable=SC2046
+    ensure_packages $(cross_tools "$arch")
+    sysroot="$AIRSEG_SYSROOTS/$arch"
+    "$AIRSEG_ROOT/packaging/ensure-sysroot.sh" "$arch" "$sysroot"
+    if [ "$check" = 1 ] && ! enable_arm_binfmt; then
+      log "warning: binfmt_misc for qemu-arm is not available; tests that spawn helper programs may fail"
+    fi
+    dpkg_args+=(-a "$arch" -d)
+  fi
+
+  log "building airseg $version for $arch in $work"
+  stage_source "$src"
+  rm -f "$work"/airseg*_"$arch".* "$work"/airseg*_"$arch".*deb
+  local start=$SECONDS
+  (cd "$src" && AIRSEG_SYSROOT="$sysroot" DEB_BUILD_OPTIONS="$opts" \
+     AIRSEG_CMAKE_ARGS="$(ccache_launcher_args)" dpkg-buildpackage "${dpkg_args[@]}") \
+     >"$work/build.log" 2>&1 || { tail -n 60 "$work/build.log"; die "build for $arch failed (log: $work/build.log)"; }
+  log "built $arch in $((SECONDS - start)) s (log: $work/build.log)"
+  log "$arch: $(grep -c ': warning: ' "$work/build.log" || true) compiler warnings"
+  if [ "$check" = 1 ]; then
+    # ctest's closing lines, for whoever reads this output.
+    grep -E '^[0-9]+% tests passed|^Total Test time' "$work/build.log" | sed "s/^/$arch: /" || true
+  fi
+  rm -f "$AIRSEG_ROOT"/dist/airseg*_"$arch".deb "$AIRSEG_ROOT"/dist/airseg*_"$arch".ddeb
+  cp "$work"/airseg*_"$version"_"$arch".deb "$AIRSEG_ROOT/dist/"
+  cp "$work"/airseg*_"$version"_"$arch".ddeb "$AIRSEG_ROOT/dist/" 2>/dev/null || true
+  "$AIRSEG_ROOT/packaging/check-deb.sh" "$arch" "$AIRSEG_ROOT/dist/airseg_${version}_$arch.deb"
+}
+
+for arch in "${arches[@]}"; do
+  build_one "$arch"
+done
+ls -l "$AIRSEG_ROOT"/dist/

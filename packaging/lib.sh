@@ -1,0 +1,70 @@
+# Shared helpers for the packaging scripts; sourced, never run.
+# shellcheck shell=bash
+
+AIRSEG_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+AIRSEG_SYSROOTS=${AIRSEG_SYSROOTS:-$AIRSEG_ROOT/sysroots}
+
+log() { printf '%s: %s\n' "$(basename "$0")" "$*" >&2; }
+die() { log "error: $*"; exit 1; }
+
+# GNU triplet of a Debian architecture this project builds for.
+arch_triplet() {
+  case "$1" in
+    amd64) echo x86_64-linux-gnu ;;
+    armhf) echo arm-linux-gnueabihf ;;
+    armel) echo arm-linux-gnueabi ;;
+    *) die "unsupported architecture '$1' (expected amd64, armhf or armel)" ;;
+  esac
+}
+
+# Installs the named Debian packages that are missing (needs root when any is).
+ensure_packages() {
+  local missing=() p
+  for p in "$@"; do
+    dpkg-query -W -f='${db:Status-Status}' "$p" 2>/dev/null | grep -qx installed || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  [ "$(id -u)" -eq 0 ] || die "missing packages (install them as root): ${missing[*]}"
+  log "installing: ${missing[*]}"
+  if [ -z "${AIRSEG_APT_UPDATED:-}" ]; then
+    apt-get update -qq || log "apt-get update reported errors; trying with the lists we have"
+    export AIRSEG_APT_UPDATED=1
+  fi
+  DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+}
+
+# The -dev packages the project builds against, read from Build-Depends in debian/control so the
+# host, every sysroot and the Debian package agree.
+mapfile -t AIRSEG_DEV_PACKAGES < <(sed -n '/^Build-Depends:/,/^[A-Z][A-Za-z-]*:/p' \
+  "$AIRSEG_ROOT/packaging/debian/control" | sed -e 's/^Build-Depends://' \
+  | grep -oE '^[[:space:]]*[a-z0-9][a-z0-9.+-]*-dev\b' | sed 's/^[[:space:]]*//' | sort -u)
+
+# Tools to build .debs natively.
+AIRSEG_NATIVE_TOOLS=(build-essential cmake ninja-build pkgconf debhelper dpkg-dev fakeroot lintian file)
+
+# Tools to cross-build for ARCH and run the results under qemu-user.
+cross_tools() {
+  case "$1" in
+    armhf) echo g++-arm-linux-gnueabihf ;;
+    armel) echo g++-arm-linux-gnueabi ;;
+  esac
+  echo mmdebstrap qemu-user-static binfmt-support
+}
+
+# Lets the kernel hand ARM ELF files to qemu-arm-static, so that a test which spawns a helper
+# binary (a simulator) runs it under the emulator too. Returns non-zero when that is impossible
+# (no root, no binfmt_misc); tests then run only through CMAKE_CROSSCOMPILING_EMULATOR.
+enable_arm_binfmt() {
+  if [ -r /proc/sys/fs/binfmt_misc/qemu-arm ] && grep -qx enabled /proc/sys/fs/binfmt_misc/qemu-arm; then
+    return 0
+  fi
+  [ "$(id -u)" -eq 0 ] || return 1
+  update-binfmts --enable qemu-arm >/dev/null 2>&1 || true
+  [ -r /proc/sys/fs/binfmt_misc/qemu-arm ] && grep -qx enabled /proc/sys/fs/binfmt_misc/qemu-arm
+}
+
+ccache_launcher_args() {
+  if command -v ccache >/dev/null; then
+    echo "-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache"
+  fi
+}

@@ -1,0 +1,44 @@
+#!/bin/bash
+# make-sysroot.sh ARCH [DIR]
+#
+# Builds a Debian 12 sysroot for ARCH (armhf, armel) holding the project's -dev packages, for the
+# cross compilers (--sysroot), for qemu-arm-static (-L) and for dpkg-shlibdeps (see
+# sysroot-dpkg-db.sh). Default DIR: sysroots/ARCH at the top of the tree. Takes about 10 s.
+# Set AIRSEG_MIRROR to use another Debian mirror.
+set -euo pipefail
+. "$(dirname "$0")/lib.sh"
+
+[ $# -ge 1 ] || die "usage: $0 ARCH [DIR]"
+arch=$1
+arch_triplet "$arch" >/dev/null
+dir=${2:-$AIRSEG_SYSROOTS/$arch}
+mirror=${AIRSEG_MIRROR:-http://deb.debian.org/debian}
+security=${AIRSEG_SECURITY_MIRROR:-http://deb.debian.org/debian-security}
+
+ensure_packages mmdebstrap dpkg-dev
+
+include=$(IFS=,; echo "libc6-dev,libstdc++-12-dev,${AIRSEG_DEV_PACKAGES[*]}")
+hook="$(cd "$(dirname "$0")" && pwd)/sysroot-dpkg-db.sh"
+
+attempt() {
+  rm -rf "$dir.tmp"
+  mmdebstrap --quiet --variant=extract --arch="$arch" --include="$include" \
+    --aptopt='Acquire::Retries "3"' --extract-hook="\"$hook\" \"\$1\"" \
+    bookworm "$dir.tmp" "$@"
+}
+
+mkdir -p "$(dirname "$dir")"
+# The security suite is tried first so the sysroot matches an up-to-date host; a mirror caught
+# in the middle of a sync fails it, and the point-release suites alone are a good sysroot too.
+if ! attempt "deb $mirror bookworm main" "deb $mirror bookworm-updates main" \
+             "deb $security bookworm-security main"; then
+  log "retrying without bookworm-security"
+  attempt "deb $mirror bookworm main" "deb $mirror bookworm-updates main" \
+    || die "mmdebstrap failed for $arch"
+fi
+rm -rf "$dir"
+mv "$dir.tmp" "$dir"
+# The recorded file lists name the directory the sysroot was built in; keep them true.
+sed -i "s|^$dir.tmp/|$dir/|" "$dir"/var/lib/dpkg/info/*.list
+echo "$arch ${AIRSEG_DEV_PACKAGES[*]}" >"$dir/.airseg-sysroot"
+log "sysroot for $arch ready in $dir"
