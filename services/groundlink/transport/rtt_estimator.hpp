@@ -1,6 +1,6 @@
 #pragma once
 // Round-trip time and retransmission timeout after RFC 6298 (SRTT, RTTVAR, RTO = SRTT + 4·RTTVAR), plus the
-// receiver's acknowledgement delay, clamped to [rto_min, rto_max].
+// receiver's acknowledgement delay and one frame time, clamped to [rto_min, rto_max].
 #include <algorithm>
 #include <chrono>
 
@@ -10,8 +10,10 @@ namespace airseg::groundlink {
 
 class RttEstimator {
   public:
-    RttEstimator(Duration initial, Duration min, Duration max, Duration ack_delay)
-        : initial_(initial), min_(min), max_(max), ack_delay_(ack_delay) {}
+    /// `frame_time`: air time of the largest frame; a lost acknowledgement is repaired by the next one, about
+    /// a frame later, so the timeout leaves room for it.
+    RttEstimator(Duration initial, Duration min, Duration max, Duration ack_delay, Duration frame_time = {})
+        : initial_(initial), min_(min), max_(max), ack_delay_(ack_delay + frame_time) {}
 
     void sample(Duration rtt) {
         if (rtt < Duration::zero()) {

@@ -145,15 +145,18 @@ SafeSender::AckResult SafeSender::on_ack(const frame::AckChunk& ack, TimePoint n
 }
 
 std::size_t SafeSender::on_timeout(TimePoint now, Duration rto) {
-    std::size_t n = 0;
+    InFlight* oldest = nullptr;
     for (auto& s : inflight_) {
-        if (!s.acked && !s.lost && s.last_sent + rto <= now) {
-            s.lost = true;
-            ++lost_count_;
-            ++n;
+        if (!s.acked && !s.lost && (oldest == nullptr || s.last_sent < oldest->last_sent)) {
+            oldest = &s;
         }
     }
-    return n;
+    if (oldest == nullptr || oldest->last_sent + rto > now) {
+        return 0;
+    }
+    oldest->lost = true;
+    ++lost_count_;
+    return 1;
 }
 
 TimePoint SafeSender::next_timeout(Duration rto) const {

@@ -50,7 +50,8 @@ class SafeSender {
     /// `reorder_slack`: a segment counts as lost only if one sent more than this later was acknowledged
     /// (frames on two paths may arrive out of order).
     AckResult on_ack(const frame::AckChunk& ack, TimePoint now, Duration reorder_slack = Duration::zero());
-    /// Declares lost every outstanding segment last sent at or before now - rto; returns how many.
+    /// Declares the oldest outstanding segment lost if it was last sent at or before now - rto (the rest are
+    /// judged by the acknowledgements its resending brings back); returns how many (0 or 1).
     std::size_t on_timeout(TimePoint now, Duration rto);
     /// When the oldest outstanding segment times out (kNever when none is outstanding).
     [[nodiscard]] TimePoint next_timeout(Duration rto) const;

@@ -26,7 +26,9 @@ Transport::Impl::Impl(TransportConfig config, TimePoint now)
     : cfg(checked(std::move(config))),
       now_(now),
       reassembly(cfg.fast_reassembly_timeout, cfg.max_message_size),
-      rtt(cfg.rto_initial, cfg.rto_min, cfg.rto_max, cfg.ack_delay) {
+      rtt(cfg.rto_initial, cfg.rto_min, cfg.rto_max, cfg.ack_delay,
+          std::chrono::duration_cast<Duration>(std::chrono::duration<double>(
+              static_cast<double>(cfg.max_frame_payload + 32) / cfg.link_rate_bytes_per_s))) {
     if (cfg.key) {
         mac = std::make_unique<FrameMac>(*cfg.key);
     }

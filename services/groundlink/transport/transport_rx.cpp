@@ -20,12 +20,12 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
         ps.rx_rate = ps.rx_rate * std::exp(-std::max(dt, 0.0)) + static_cast<double>(bytes.size());
         ps.rx_rate_time = now_;
     }
-    if (cfg.half_duplex) {
-        // The peer's bytes occupied the shared air just now; they count against this end's budget on the
-        // path.
+    if (cfg.half_duplex && ps.next_free > now_) {
+        // The peer's bytes took air time this end had counted on while its own budget is still running: yield
+        // it. An idle end is not held back, so a saturating peer cannot starve its acknowledgements.
         const auto air = std::chrono::duration_cast<Duration>(
             std::chrono::duration<double>(static_cast<double>(bytes.size()) / cfg.link_rate_bytes_per_s));
-        ps.next_free = std::max(ps.next_free, now_ - air) + air;
+        ps.next_free += air;
     }
     ps.deframer.feed(
         bytes, [&](std::vector<std::uint8_t>&& plain) { on_plain_frame(path, plain, now_); },

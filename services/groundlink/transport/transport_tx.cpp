@@ -9,6 +9,7 @@ namespace {
 
 constexpr std::size_t kMinUsefulSafe = 16;  // do not top up a frame with a Safe sliver smaller than this
 constexpr std::size_t kMaxDataChunks = 64;
+constexpr double kLossyFraction = 0.15;  // declared-lost share of Safe segments above which frames stay small
 
 }  // namespace
 
@@ -82,7 +83,10 @@ std::size_t Transport::Impl::payload_cap() const {
     if (cfg.adaptive_frame_size && peer_suggested > 0) {
         cap = std::clamp(peer_suggested, cfg.min_frame_payload, cfg.max_frame_payload);
     }
-    if (now_ < urgent_until) {
+    // Under heavy frame loss small frames shorten each repair round trip, which bounds stalls; under urgent
+    // traffic they bound how long a frame already on the air holds the urgent message back.
+    const bool lossy = sent_window >= 20.0 && lost_window > kLossyFraction * sent_window;
+    if (now_ < urgent_until || lossy) {
         cap = std::min(cap, cfg.latency_frame_payload);
     }
     return std::max(cap, cfg.min_frame_payload);
