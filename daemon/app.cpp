@@ -1,0 +1,265 @@
+#include "daemon/app.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <csignal>
+#include <cstdlib>
+#include <filesystem>
+#include <thread>
+#include <vector>
+
+#include "daemon/config_loader.hpp"
+#include "daemon/logging.hpp"
+#include "daemon/systemd_notifier.hpp"
+#include "services/common/port_service.hpp"
+#include "services/status/status_messages.hpp"
+#include "services/status/status_service.hpp"
+
+namespace airseg::daemon {
+
+namespace {
+
+PortKeeperConfig port_config(const std::string& path, int baud, std::chrono::milliseconds min,
+                             std::chrono::milliseconds max) {
+    PortKeeperConfig c;
+    c.serial.path = path;
+    c.serial.baud = static_cast<unsigned>(baud);
+    c.reconnect_min = min;
+    c.reconnect_max = max;
+    return c;
+}
+
+}  // namespace
+
+class App::Impl {
+  public:
+    Impl(CliOptions options, Config config)
+        : options_(std::move(options)),
+          config_(std::move(config)),
+          strand_(asio::make_strand(io_)),
+          signals_(strand_, SIGTERM, SIGINT, SIGHUP),
+          watchdog_timer_(strand_),
+          context_{io_, bus_, health_, commands_, progress_interval()} {}
+
+    int run() {
+        ensure_state_dir();
+        build_services();
+        line_sub_ = bus_.subscribe<status::StatusLine>(
+            strand_, [this](const status::StatusLine& line) { notifier_.status(line.text); });
+        do_signals();
+        start_services();
+        if (notifier_.watchdog_period()) {
+            spdlog::info(
+                "systemd: watchdog every {} ms",
+                std::chrono::duration_cast<std::chrono::milliseconds>(*notifier_.watchdog_period()).count());
+            do_watchdog();
+        }
+        arm_test_hang();
+
+        // Keeps run() going while services wait on nothing but signals; shutdown() ends it with io_.stop().
+        auto work = asio::require(io_.get_executor(), asio::execution::outstanding_work.tracked);
+        const unsigned threads = config_.threads > 0 ? static_cast<unsigned>(config_.threads)
+                                                     : std::max(1u, std::thread::hardware_concurrency());
+        std::vector<std::thread> pool;
+        for (unsigned i = 1; i < threads; ++i) {
+            pool.emplace_back([this] { io_.run(); });
+        }
+        io_.run();
+        for (auto& t : pool) {
+            t.join();
+        }
+        spdlog::info("airsegd: stopped");
+        return 0;
+    }
+
+  private:
+    Duration progress_interval() const {
+        // Services tick well inside the watchdog period so one late tick cannot cost a ping.
+        Duration interval = std::chrono::seconds(1);
+        if (notifier_.watchdog_period()) {
+            interval = std::min<Duration>(interval, *notifier_.watchdog_period() / 4);
+        }
+        return interval;
+    }
+
+    void ensure_state_dir() {
+        std::error_code ec;
+        std::filesystem::create_directories(config_.state_dir, ec);
+        if (ec) {
+            spdlog::warn("airsegd: state_dir {}: {}; flight plan progress will not survive a restart",
+                         config_.state_dir, ec.message());
+        }
+    }
+
+    void build_services() {
+        services_.push_back(std::make_unique<status::StatusService>(
+            context_, status::StatusServiceConfig{config_.status.socket, config_.status.socket_mode}));
+        const auto& ap = config_.autopilot;
+        services_.push_back(std::make_unique<PortService>(
+            "autopilot", context_,
+            std::vector{port_config(ap.port, ap.bauds.empty() ? ap.baud : ap.bauds.front(), ap.reconnect_min,
+                                    ap.reconnect_max)}));
+        const auto& gl = config_.groundlink;
+        std::vector<PortKeeperConfig> radios;
+        if (gl.mode != "udp") {
+            for (const auto& port : gl.ports) {
+                radios.push_back(port_config(port, gl.baud, gl.reconnect_min, gl.reconnect_max));
+            }
+        }
+        services_.push_back(std::make_unique<PortService>("groundlink", context_, std::move(radios)));
+    }
+
+    void start_services() {
+        auto remaining = std::make_shared<std::size_t>(services_.size());
+        for (auto& s : services_) {
+            s->start([this, remaining] {
+                asio::post(strand_, [this, remaining] {
+                    if (--*remaining == 0) {
+                        spdlog::info("airsegd {}: all {} services started", AIRSEG_VERSION, services_.size());
+                        notifier_.ready();
+                    }
+                });
+            });
+        }
+    }
+
+    void do_signals() {
+        signals_.async_wait([this](boost::system::error_code ec, int signo) {
+            if (ec) {
+                return;
+            }
+            if (signo == SIGHUP) {
+                reload();
+                do_signals();
+                return;
+            }
+            spdlog::info("airsegd: {} received, stopping", signo == SIGTERM ? "SIGTERM" : "SIGINT");
+            shutdown();
+        });
+    }
+
+    void shutdown() {
+        if (stopping_) {
+            return;
+        }
+        stopping_ = true;
+        notifier_.stopping();
+        watchdog_timer_.cancel();
+        boost::system::error_code ignored;
+        signals_.cancel(ignored);
+        line_sub_.reset();
+        auto remaining = std::make_shared<std::size_t>(services_.size());
+        for (auto& s : services_) {
+            s->stop([this, remaining] {
+                asio::post(strand_, [this, remaining] {
+                    if (--*remaining == 0) {
+                        // Everything that must be flushed has been; anything still pending is abandoned.
+                        io_.stop();
+                    }
+                });
+            });
+        }
+    }
+
+    void reload() {
+        notifier_.reloading();
+        auto result = load_config_file(options_.config_path, options_.overrides);
+        if (!result.ok()) {
+            for (const auto& e : result.errors) {
+                spdlog::error("config: {}", e.to_string());
+            }
+            spdlog::error("config: {} is invalid; keeping the running configuration", options_.config_path);
+            notifier_.ready();
+            return;
+        }
+        if (options_.log_level) {
+            result.config.log_level = *options_.log_level;  // the command line wins over the file
+        }
+        const auto changes = diff_config(config_, result.config);
+        if (changes.empty()) {
+            spdlog::info("config: reloaded {}, nothing changed", options_.config_path);
+        }
+        for (const auto& c : changes) {
+            if (c.runtime) {
+                spdlog::info("config: {}: {} -> {} (applied)", c.key, c.from, c.to);
+            } else {
+                spdlog::warn("config: {}: {} -> {} (takes effect after a restart)", c.key, c.from, c.to);
+            }
+        }
+        set_log_level(result.config.log_level);
+        config_.log_level = result.config.log_level;
+        notifier_.ready();
+    }
+
+    void do_watchdog() {
+        const auto period = std::chrono::duration_cast<Duration>(*notifier_.watchdog_period());
+        const auto stalled = health_.stalled(SteadyClock::now(), period);
+        if (stalled.empty()) {
+            notifier_.watchdog();
+            watchdog_complained_ = false;
+        } else if (!watchdog_complained_) {
+            // No ping: systemd will restart the daemon if this lasts for the watchdog period.
+            spdlog::error("watchdog: not pinging systemd: no progress from {}", fmt::join(stalled, ", "));
+            watchdog_complained_ = true;
+        }
+        watchdog_timer_.expires_after(period / 2);
+        watchdog_timer_.async_wait([this](boost::system::error_code ec) {
+            if (!ec) {
+                do_watchdog();
+            }
+        });
+    }
+
+    void arm_test_hang() {
+#ifdef AIRSEG_TEST_HANG_INJECTION
+        // Test-only (build option AIRSEG_TEST_HANG_INJECTION): AIRSEG_TEST_HANG=<service>:<delay ms> blocks
+        // that service's strand after the delay, as a deadlock would, to prove the watchdog stops pinging.
+        const char* spec = std::getenv("AIRSEG_TEST_HANG");
+        if (spec == nullptr) {
+            return;
+        }
+        const std::string text(spec);
+        const auto colon = text.find(':');
+        const std::string name = text.substr(0, colon);
+        const long delay_ms =
+            colon == std::string::npos ? 0 : std::strtol(text.c_str() + colon + 1, nullptr, 10);
+        for (auto& s : services_) {
+            if (s->name() == name) {
+                auto timer =
+                    std::make_shared<asio::steady_timer>(strand_, std::chrono::milliseconds(delay_ms));
+                timer->async_wait([timer, svc = s.get()](boost::system::error_code ec) {
+                    if (!ec) {
+                        svc->inject_hang();
+                    }
+                });
+            }
+        }
+#endif
+    }
+
+    CliOptions options_;
+    Config config_;
+    asio::io_context io_;
+    Strand strand_;
+    asio::signal_set signals_;
+    asio::steady_timer watchdog_timer_;
+    SystemdNotifier notifier_;
+    Bus bus_;
+    HealthRegistry health_;
+    CommandDispatcher commands_;
+    ServiceContext context_;
+    std::vector<std::unique_ptr<Service>> services_;
+    Subscription line_sub_;
+    bool stopping_ = false;
+    bool watchdog_complained_ = false;
+};
+
+App::App(CliOptions options, Config config)
+    : impl_(std::make_unique<Impl>(std::move(options), std::move(config))) {}
+App::~App() = default;
+int App::run() {
+    return impl_->run();
+}
+
+}  // namespace airseg::daemon

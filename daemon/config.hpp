@@ -1,0 +1,47 @@
+#pragma once
+// The daemon's configuration: one struct per component with its defaults. The YAML key of each field is
+// written next to it; the schema (config_schema.cpp) is the single place that maps keys to fields, with
+// types, ranges and documentation.
+#include <chrono>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace airseg::daemon {
+
+using std::chrono::milliseconds;
+
+struct StatusConfig {
+    std::string socket = "/run/airseg/status.sock";  // status.socket
+    unsigned socket_mode = 0660;                     // status.socket_mode (octal)
+};
+
+struct AutopilotConfig {
+    std::string board = "apm2";          // autopilot.board: apm2 | pixhawk
+    std::string port = "/dev/ttyACM0";   // autopilot.port
+    int baud = 115200;                   // autopilot.baud
+    std::vector<int> bauds;              // autopilot.bauds: tried in turn when non-empty
+    bool reset_on_open = true;           // autopilot.reset_on_open
+    milliseconds reconnect_min{500};     // autopilot.reconnect_min
+    milliseconds reconnect_max{10'000};  // autopilot.reconnect_max
+};
+
+struct GroundlinkConfig {
+    std::string mode = "single";                     // groundlink.mode: single | split | redundant | udp
+    std::vector<std::string> ports{"/dev/ttyUSB0"};  // groundlink.ports: one or two serial devices
+    int baud = 57600;                                // groundlink.baud
+    std::string key_file;                            // groundlink.key_file: empty = no authentication
+    milliseconds reconnect_min{500};                 // groundlink.reconnect_min
+    milliseconds reconnect_max{10'000};              // groundlink.reconnect_max
+};
+
+struct Config {
+    int threads = 0;                            // threads: 0 = one per core
+    std::string log_level = "info";             // log_level
+    std::string state_dir = "/var/lib/airseg";  // state_dir
+    StatusConfig status;
+    AutopilotConfig autopilot;
+    GroundlinkConfig groundlink;
+};
+
+}  // namespace airseg::daemon

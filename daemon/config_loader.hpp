@@ -1,0 +1,43 @@
+#pragma once
+// Reads and validates the configuration. Every problem in a file is reported, each with the key path and its
+// file:line:column, so one run of `airsegd --check-config` shows everything that needs fixing.
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "daemon/config.hpp"
+
+namespace airseg::daemon {
+
+struct ConfigError {
+    std::string where;  // "file:line:column", or "--set" for a command-line override
+    std::string key;    // dotted key path, may be empty for syntax errors
+    std::string message;
+
+    std::string to_string() const;
+};
+
+struct ConfigResult {
+    Config config;
+    std::vector<ConfigError> errors;
+    bool ok() const { return errors.empty(); }
+};
+
+/// Loads `path`, then applies each "key=value" override in order.
+ConfigResult load_config_file(const std::string& path, const std::vector<std::string>& overrides = {});
+
+/// Same from text; `source` names it in error locations.
+ConfigResult load_config_text(std::string_view text, const std::string& source,
+                              const std::vector<std::string>& overrides = {});
+
+struct ConfigChange {
+    std::string key;
+    std::string from;
+    std::string to;
+    bool runtime;  // can be applied without a restart
+};
+
+/// Keys whose values differ between two configurations.
+std::vector<ConfigChange> diff_config(const Config& before, const Config& after);
+
+}  // namespace airseg::daemon

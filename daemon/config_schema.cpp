@@ -1,0 +1,324 @@
+#include "daemon/config_schema.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "daemon/duration.hpp"
+
+namespace airseg::daemon {
+namespace {
+
+std::string scalar_text(const YAML::Node& node) {
+    return node.IsScalar() ? node.Scalar() : std::string("(not a scalar)");
+}
+
+template <class Ref>
+KeySpec integer(std::string path, Ref ref, long long min, long long max, std::string doc,
+                bool runtime = false) {
+    KeySpec spec;
+    spec.path = std::move(path);
+    spec.type_name = fmt::format("integer {}..{}", min, max);
+    spec.doc = std::move(doc);
+    spec.runtime = runtime;
+    spec.apply = [ref, min, max](const YAML::Node& node, Config& c) -> std::optional<std::string> {
+        long long v = 0;
+        if (!node.IsScalar() || !YAML::convert<long long>::decode(node, v)) {
+            return fmt::format("expected an integer, got '{}'", scalar_text(node));
+        }
+        if (v < min || v > max) {
+            return fmt::format("{} is out of range {}..{}", v, min, max);
+        }
+        ref(c) = static_cast<std::remove_reference_t<decltype(ref(c))>>(v);
+        return std::nullopt;
+    };
+    spec.show = [ref](const Config& c) { return std::to_string(ref(const_cast<Config&>(c))); };
+    return spec;
+}
+
+template <class Ref>
+KeySpec octal_mode(std::string path, Ref ref, std::string doc) {
+    KeySpec spec;
+    spec.path = std::move(path);
+    spec.type_name = "octal file mode, e.g. \"0660\"";
+    spec.doc = std::move(doc);
+    spec.apply = [ref](const YAML::Node& node, Config& c) -> std::optional<std::string> {
+        const std::string text = node.IsScalar() ? node.Scalar() : "";
+        if (text.empty() || text.size() > 4 || text.find_first_not_of("01234567") != std::string::npos) {
+            return fmt::format("expected an octal mode like \"0660\", got '{}'", scalar_text(node));
+        }
+        ref(c) = static_cast<unsigned>(std::stoul(text, nullptr, 8));
+        return std::nullopt;
+    };
+    spec.show = [ref](const Config& c) { return fmt::format("\"{:04o}\"", ref(const_cast<Config&>(c))); };
+    return spec;
+}
+
+template <class Ref>
+KeySpec boolean(std::string path, Ref ref, std::string doc, bool runtime = false) {
+    KeySpec spec;
+    spec.path = std::move(path);
+    spec.type_name = "boolean";
+    spec.doc = std::move(doc);
+    spec.runtime = runtime;
+    spec.apply = [ref](const YAML::Node& node, Config& c) -> std::optional<std::string> {
+        bool v = false;
+        if (!node.IsScalar() || !YAML::convert<bool>::decode(node, v)) {
+            return fmt::format("expected true or false, got '{}'", scalar_text(node));
+        }
+        ref(c) = v;
+        return std::nullopt;
+    };
+    spec.show = [ref](const Config& c) { return ref(const_cast<Config&>(c)) ? "true" : "false"; };
+    return spec;
+}
+
+template <class Ref>
+KeySpec string(std::string path, Ref ref, std::string doc, bool allow_empty, bool runtime = false) {
+    KeySpec spec;
+    spec.path = std::move(path);
+    spec.type_name = allow_empty ? "string (may be empty)" : "string";
+    spec.doc = std::move(doc);
+    spec.runtime = runtime;
+    spec.apply = [ref, allow_empty](const YAML::Node& node, Config& c) -> std::optional<std::string> {
+        if (node.IsNull() && allow_empty) {
+            ref(c).clear();
+            return std::nullopt;
+        }
+        if (!node.IsScalar()) {
+            return "expected a string";
+        }
+        if (node.Scalar().empty() && !allow_empty) {
+            return "must not be empty";
+        }
+        ref(c) = node.Scalar();
+        return std::nullopt;
+    };
+    spec.show = [ref](const Config& c) { return fmt::format("\"{}\"", ref(const_cast<Config&>(c))); };
+    return spec;
+}
+
+template <class Ref>
+KeySpec choice(std::string path, Ref ref, std::vector<std::string> choices, std::string doc,
+               bool runtime = false) {
+    KeySpec spec;
+    spec.path = std::move(path);
+    spec.type_name = fmt::format("one of {}", fmt::join(choices, " | "));
+    spec.doc = std::move(doc);
+    spec.runtime = runtime;
+    spec.apply = [ref, choices](const YAML::Node& node, Config& c) -> std::optional<std::string> {
+        if (!node.IsScalar() || std::find(choices.begin(), choices.end(), node.Scalar()) == choices.end()) {
+            return fmt::format("expected one of {}, got '{}'", fmt::join(choices, ", "), scalar_text(node));
+        }
+        ref(c) = node.Scalar();
+        return std::nullopt;
+    };
+    spec.show = [ref](const Config& c) { return ref(const_cast<Config&>(c)); };
+    return spec;
+}
+
+template <class Ref>
+KeySpec duration(std::string path, Ref ref, milliseconds min, milliseconds max, std::string doc,
+                 bool runtime = false) {
+    KeySpec spec;
+    spec.path = std::move(path);
+    spec.type_name = fmt::format("duration {}..{}", format_duration(min), format_duration(max));
+    spec.doc = std::move(doc);
+    spec.runtime = runtime;
+    spec.apply = [ref, min, max](const YAML::Node& node, Config& c) -> std::optional<std::string> {
+        auto d = node.IsScalar() ? parse_duration(node.Scalar()) : std::nullopt;
+        if (!d) {
+            return fmt::format("expected a duration like 1500ms, 3s or 2m, got '{}'", scalar_text(node));
+        }
+        if (*d < min || *d > max) {
+            return fmt::format("{} is out of range {}..{}", format_duration(*d), format_duration(min),
+                               format_duration(max));
+        }
+        ref(c) = *d;
+        return std::nullopt;
+    };
+    spec.show = [ref](const Config& c) { return format_duration(ref(const_cast<Config&>(c))); };
+    return spec;
+}
+
+template <class Ref>
+KeySpec string_list(std::string path, Ref ref, std::size_t min_items, std::size_t max_items,
+                    std::string doc) {
+    KeySpec spec;
+    spec.path = std::move(path);
+    spec.type_name = fmt::format("list of {}..{} strings", min_items, max_items);
+    spec.doc = std::move(doc);
+    spec.apply = [ref, min_items, max_items](const YAML::Node& node,
+                                             Config& c) -> std::optional<std::string> {
+        if (!node.IsSequence()) {
+            return "expected a list, e.g. [/dev/ttyUSB0, /dev/ttyUSB1]";
+        }
+        if (node.size() < min_items || node.size() > max_items) {
+            return fmt::format("expected {} to {} entries, got {}", min_items, max_items, node.size());
+        }
+        std::vector<std::string> out;
+        for (const auto& item : node) {
+            if (!item.IsScalar() || item.Scalar().empty()) {
+                return "every entry must be a non-empty string";
+            }
+            out.push_back(item.Scalar());
+        }
+        ref(c) = std::move(out);
+        return std::nullopt;
+    };
+    spec.show = [ref](const Config& c) {
+        return fmt::format("[{}]", fmt::join(ref(const_cast<Config&>(c)), ", "));
+    };
+    return spec;
+}
+
+const std::vector<int> kStandardBauds{9600, 19200, 38400, 57600, 115200, 230400, 460800, 500000, 921600};
+
+std::optional<std::string> check_baud(long long v) {
+    if (std::find(kStandardBauds.begin(), kStandardBauds.end(), v) == kStandardBauds.end()) {
+        return fmt::format("{} is not a supported baud rate (one of {})", v, fmt::join(kStandardBauds, ", "));
+    }
+    return std::nullopt;
+}
+
+template <class Ref>
+KeySpec baud(std::string path, Ref ref, std::string doc) {
+    KeySpec spec;
+    spec.path = std::move(path);
+    spec.type_name = "baud rate";
+    spec.doc = std::move(doc);
+    spec.apply = [ref](const YAML::Node& node, Config& c) -> std::optional<std::string> {
+        long long v = 0;
+        if (!node.IsScalar() || !YAML::convert<long long>::decode(node, v)) {
+            return fmt::format("expected a baud rate, got '{}'", scalar_text(node));
+        }
+        if (auto err = check_baud(v)) {
+            return err;
+        }
+        ref(c) = static_cast<int>(v);
+        return std::nullopt;
+    };
+    spec.show = [ref](const Config& c) { return std::to_string(ref(const_cast<Config&>(c))); };
+    return spec;
+}
+
+template <class Ref>
+KeySpec baud_list(std::string path, Ref ref, std::string doc) {
+    KeySpec spec;
+    spec.path = std::move(path);
+    spec.type_name = "list of baud rates";
+    spec.doc = std::move(doc);
+    spec.apply = [ref](const YAML::Node& node, Config& c) -> std::optional<std::string> {
+        if (!node.IsSequence()) {
+            return "expected a list of baud rates, e.g. [115200, 57600]";
+        }
+        std::vector<int> out;
+        for (const auto& item : node) {
+            long long v = 0;
+            if (!item.IsScalar() || !YAML::convert<long long>::decode(item, v)) {
+                return fmt::format("expected a baud rate, got '{}'", scalar_text(item));
+            }
+            if (auto err = check_baud(v)) {
+                return err;
+            }
+            out.push_back(static_cast<int>(v));
+        }
+        ref(c) = std::move(out);
+        return std::nullopt;
+    };
+    spec.show = [ref](const Config& c) {
+        return fmt::format("[{}]", fmt::join(ref(const_cast<Config&>(c)), ", "));
+    };
+    return spec;
+}
+
+std::vector<KeySpec> build_schema() {
+    using std::chrono::hours;
+    using std::chrono::seconds;
+    std::vector<KeySpec> s;
+    // General
+    s.push_back(integer(
+        "threads", [](Config& c) -> int& { return c.threads; }, 0, 64,
+        "worker threads running the event loop; 0 = one per CPU core"));
+    s.push_back(choice(
+        "log_level", [](Config& c) -> std::string& { return c.log_level; },
+        {"trace", "debug", "info", "warn", "error", "critical", "off"}, "least severe log level written",
+        true));
+    s.push_back(string(
+        "state_dir", [](Config& c) -> std::string& { return c.state_dir; },
+        "directory for persistent state (flight plan and progress)", false));
+    // Status
+    s.push_back(string(
+        "status.socket", [](Config& c) -> std::string& { return c.status.socket; },
+        "Unix socket serving the status document and on-board commands", false));
+    s.push_back(octal_mode(
+        "status.socket_mode", [](Config& c) -> unsigned& { return c.status.socket_mode; },
+        "permissions of the status socket"));
+    // Autopilot
+    s.push_back(choice(
+        "autopilot.board", [](Config& c) -> std::string& { return c.autopilot.board; }, {"apm2", "pixhawk"},
+        "autopilot board family"));
+    s.push_back(string(
+        "autopilot.port", [](Config& c) -> std::string& { return c.autopilot.port; },
+        "serial device of the autopilot", false));
+    s.push_back(baud(
+        "autopilot.baud", [](Config& c) -> int& { return c.autopilot.baud; },
+        "baud rate of the autopilot port"));
+    s.push_back(baud_list(
+        "autopilot.bauds", [](Config& c) -> std::vector<int>& { return c.autopilot.bauds; },
+        "baud rates tried in turn (the first that yields a valid frame is kept); empty = baud"));
+    s.push_back(boolean(
+        "autopilot.reset_on_open", [](Config& c) -> bool& { return c.autopilot.reset_on_open; },
+        "the board reboots when its port is opened (APM 2.x on USB)"));
+    s.push_back(duration(
+        "autopilot.reconnect_min", [](Config& c) -> milliseconds& { return c.autopilot.reconnect_min; },
+        milliseconds(10), seconds(60), "first retry delay after the port could not be opened or was lost"));
+    s.push_back(duration(
+        "autopilot.reconnect_max", [](Config& c) -> milliseconds& { return c.autopilot.reconnect_max; },
+        milliseconds(10), hours(1), "longest retry delay (the delay doubles up to this)"));
+    // Ground link
+    s.push_back(choice(
+        "groundlink.mode", [](Config& c) -> std::string& { return c.groundlink.mode; },
+        {"single", "split", "redundant", "udp"}, "how the ground radios are used"));
+    s.push_back(string_list(
+        "groundlink.ports", [](Config& c) -> std::vector<std::string>& { return c.groundlink.ports; }, 1, 2,
+        "serial devices of the ground radios (two for split and redundant)"));
+    s.push_back(baud(
+        "groundlink.baud", [](Config& c) -> int& { return c.groundlink.baud; },
+        "baud rate of the ground radio ports"));
+    s.push_back(string(
+        "groundlink.key_file", [](Config& c) -> std::string& { return c.groundlink.key_file; },
+        "pre-shared key file (mode 0600) authenticating every frame; empty = none", true));
+    s.push_back(duration(
+        "groundlink.reconnect_min", [](Config& c) -> milliseconds& { return c.groundlink.reconnect_min; },
+        milliseconds(10), seconds(60),
+        "first retry delay after a radio port could not be opened or was lost"));
+    s.push_back(duration(
+        "groundlink.reconnect_max", [](Config& c) -> milliseconds& { return c.groundlink.reconnect_max; },
+        milliseconds(10), hours(1), "longest retry delay for the radio ports"));
+    return s;
+}
+
+}  // namespace
+
+const std::vector<KeySpec>& config_schema() {
+    static const std::vector<KeySpec> schema = build_schema();
+    return schema;
+}
+
+const KeySpec* find_key(const std::string& path) {
+    for (const auto& spec : config_schema()) {
+        if (spec.path == path) {
+            return &spec;
+        }
+    }
+    return nullptr;
+}
+
+bool is_section(const std::string& path) {
+    const std::string prefix = path + ".";
+    return std::any_of(config_schema().begin(), config_schema().end(),
+                       [&](const KeySpec& spec) { return spec.path.starts_with(prefix); });
+}
+
+}  // namespace airseg::daemon

@@ -1,0 +1,90 @@
+#include "services/common/command_dispatcher.hpp"
+
+#include <atomic>
+
+namespace airseg {
+
+const char* to_string(Role r) {
+    return r == Role::Control ? "control" : "monitor";
+}
+
+const char* to_string(CommandStatus s) {
+    switch (s) {
+        case CommandStatus::Ok:
+            return "ok";
+        case CommandStatus::Refused:
+            return "refused";
+        case CommandStatus::BadRequest:
+            return "bad_request";
+        case CommandStatus::UnknownCommand:
+            return "unknown_command";
+        case CommandStatus::Forbidden:
+            return "forbidden";
+        case CommandStatus::Failed:
+            return "failed";
+    }
+    return "failed";
+}
+
+Json CommandResult::to_json() const {
+    if (status == CommandStatus::Ok) {
+        return Json{{"ok", true}, {"result", result}};
+    }
+    return Json{{"ok", false}, {"status", to_string(status)}, {"error", error}};
+}
+
+void CommandDispatcher::add(const std::string& name, Strand strand, Role required, Handler handler) {
+    std::lock_guard lock(mutex_);
+    entries_[name] = std::make_shared<const Entry>(Entry{std::move(strand), required, std::move(handler)});
+}
+
+void CommandDispatcher::dispatch(const Json& request, Role caller, Reply reply) const {
+    if (!request.is_object() || !request.contains("cmd") || !request["cmd"].is_string()) {
+        reply(CommandResult::fail(CommandStatus::BadRequest,
+                                  "request must be a JSON object with a string \"cmd\""));
+        return;
+    }
+    const auto name = request["cmd"].get<std::string>();
+    std::shared_ptr<const Entry> entry;
+    {
+        std::lock_guard lock(mutex_);
+        auto it = entries_.find(name);
+        if (it != entries_.end()) {
+            entry = it->second;
+        }
+    }
+    if (!entry) {
+        reply(CommandResult::fail(CommandStatus::UnknownCommand, "unknown command '" + name + "'"));
+        return;
+    }
+    if (entry->required == Role::Control && caller != Role::Control) {
+        reply(CommandResult::fail(CommandStatus::Forbidden,
+                                  "'" + name + "' needs the control role; this connection is a monitor"));
+        return;
+    }
+    // Guard the exactly-once promise: a handler bug must not answer twice on a connection.
+    auto answered = std::make_shared<std::atomic<bool>>(false);
+    Reply once = [answered, reply = std::move(reply)](CommandResult r) {
+        if (!answered->exchange(true)) {
+            reply(std::move(r));
+        }
+    };
+    asio::post(entry->strand, [entry, request, once] {
+        try {
+            entry->handler(request, once);
+        } catch (const std::exception& e) {
+            once(CommandResult::fail(CommandStatus::BadRequest, e.what()));
+        }
+    });
+}
+
+std::vector<std::string> CommandDispatcher::names() const {
+    std::lock_guard lock(mutex_);
+    std::vector<std::string> out;
+    for (const auto& [name, entry] : entries_) {
+        out.push_back(name);
+    }
+    return out;
+}
+
+}  // namespace airseg

@@ -1,0 +1,75 @@
+#include "services/common/service.hpp"
+
+#include <spdlog/spdlog.h>
+
+namespace airseg {
+
+Service::Service(std::string name, ServiceContext& ctx)
+    : ctx_(ctx), name_(std::move(name)), strand_(asio::make_strand(ctx.io)), tick_timer_(strand_) {
+    ctx_.health.add(name_, SteadyClock::now());
+}
+
+Service::~Service() = default;
+
+void Service::start(std::function<void()> started) {
+    asio::dispatch(strand_, [this, started = std::move(started)] {
+        running_ = true;
+        on_start();
+        do_tick();
+        if (started) {
+            started();
+        }
+    });
+}
+
+void Service::stop(std::function<void()> stopped) {
+    {
+        std::lock_guard lock(hang_mutex_);
+        hang_released_ = true;
+    }
+    hang_cv_.notify_all();
+    asio::dispatch(strand_, [this, stopped = std::move(stopped)] {
+        if (running_) {
+            running_ = false;
+            tick_timer_.cancel();
+            on_stop();
+        }
+        if (stopped) {
+            stopped();
+        }
+    });
+}
+
+void Service::inject_hang() {
+    asio::post(strand_, [this] {
+        spdlog::warn("{}: test hang injected: blocking this service's strand", name_);
+        std::unique_lock lock(hang_mutex_);
+        hang_cv_.wait(lock, [this] { return hang_released_; });
+    });
+}
+
+void Service::set_health(Health health, std::string error) {
+    const std::string shown = error;
+    if (ctx_.health.set(name_, health, std::move(error))) {
+        if (health == Health::Up) {
+            spdlog::info("{}: up", name_);
+        } else {
+            spdlog::warn("{}: {}{}{}", name_, to_string(health), shown.empty() ? "" : ": ", shown);
+        }
+    }
+}
+
+void Service::do_tick() {
+    if (!running_) {
+        return;
+    }
+    ctx_.health.progress(name_, SteadyClock::now());
+    tick_timer_.expires_after(ctx_.progress_interval);
+    tick_timer_.async_wait([this](boost::system::error_code ec) {
+        if (!ec) {
+            do_tick();
+        }
+    });
+}
+
+}  // namespace airseg

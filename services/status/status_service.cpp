@@ -1,0 +1,76 @@
+#include "services/status/status_service.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include "services/status/status_document.hpp"
+
+namespace airseg::status {
+
+StatusService::StatusService(ServiceContext& ctx, StatusServiceConfig config)
+    : Service("status", ctx),
+      config_(std::move(config)),
+      server_(strand(), ctx.commands),
+      refresh_timer_(strand()),
+      socket_timer_(strand()),
+      started_at_(SteadyClock::now()) {}
+
+nlohmann::json StatusService::document() const {
+    const double uptime = std::chrono::duration<double>(SteadyClock::now() - started_at_).count();
+    return build_document(ctx_.health.snapshot(), sections_, uptime);
+}
+
+void StatusService::on_start() {
+    sections_sub_ = ctx_.bus.subscribe<StatusSection>(strand(), [this](const StatusSection& s) {
+        sections_[s.name] = s.value;
+        publish_summary();
+    });
+    ctx_.commands.add("status", strand(), Role::Monitor, [this](const Json&, CommandDispatcher::Reply reply) {
+        reply(CommandResult::ok(document()));
+    });
+    do_open_socket();
+    do_refresh();
+}
+
+void StatusService::on_stop() {
+    refresh_timer_.cancel();
+    socket_timer_.cancel();
+    sections_sub_.reset();
+    server_.close();
+}
+
+void StatusService::do_open_socket() {
+    const std::string error = server_.open(config_.socket_path, config_.socket_mode);
+    if (error.empty()) {
+        spdlog::info("status: serving {}", config_.socket_path);
+        set_health(Health::Up);
+        return;
+    }
+    // Without the socket the daemon still flies; it says so and tries again.
+    set_health(Health::Degraded, error);
+    socket_timer_.expires_after(config_.socket_retry);
+    socket_timer_.async_wait([this](boost::system::error_code ec) {
+        if (!ec) {
+            do_open_socket();
+        }
+    });
+}
+
+void StatusService::do_refresh() {
+    publish_summary();
+    refresh_timer_.expires_after(config_.refresh_interval);
+    refresh_timer_.async_wait([this](boost::system::error_code ec) {
+        if (!ec) {
+            do_refresh();
+        }
+    });
+}
+
+void StatusService::publish_summary() {
+    auto line = summary_line(ctx_.health.snapshot(), sections_);
+    if (line != last_summary_) {
+        last_summary_ = line;
+        ctx_.bus.publish_latest(StatusLine{std::move(line)});
+    }
+}
+
+}  // namespace airseg::status
