@@ -114,7 +114,7 @@ class Reader {
             if (!value(v, depth + 1)) {
                 return false;
             }
-            obj.emplace_back(std::move(key), std::move(v));
+            obj.push_back(JsonMember{std::move(key), std::move(v)});
             skip_space();
             if (pos_ < text_.size() && text_[pos_] == ',') {
                 ++pos_;
@@ -307,6 +307,19 @@ class Reader {
 };
 
 }  // namespace
+
+const std::string* JsonValue::as_string() const {
+    return std::get_if<std::string>(&value);
+}
+const JsonNumber* JsonValue::as_number() const {
+    return std::get_if<JsonNumber>(&value);
+}
+const JsonArray* JsonValue::as_array() const {
+    return std::get_if<JsonArray>(&value);
+}
+const JsonObject* JsonValue::as_object() const {
+    return std::get_if<JsonObject>(&value);
+}
 
 bool JsonNumber::is_integer() const {
     return text.find_first_of(".eE") == std::string::npos;

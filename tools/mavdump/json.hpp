@@ -14,8 +14,9 @@
 namespace airseg::mavdump {
 
 struct JsonValue;
+struct JsonMember;
 using JsonArray = std::vector<JsonValue>;
-using JsonObject = std::vector<std::pair<std::string, JsonValue>>;
+using JsonObject = std::vector<JsonMember>;  // in document order
 
 struct JsonNumber {
     std::string text;
@@ -26,10 +27,15 @@ struct JsonValue {
     std::variant<std::nullptr_t, bool, JsonNumber, std::string, JsonArray, JsonObject> value;
 
     const JsonValue* member(std::string_view key) const;  // nullptr when absent or not an object
-    const std::string* as_string() const { return std::get_if<std::string>(&value); }
-    const JsonNumber* as_number() const { return std::get_if<JsonNumber>(&value); }
-    const JsonArray* as_array() const { return std::get_if<JsonArray>(&value); }
-    const JsonObject* as_object() const { return std::get_if<JsonObject>(&value); }
+    const std::string* as_string() const;
+    const JsonNumber* as_number() const;
+    const JsonArray* as_array() const;
+    const JsonObject* as_object() const;
+};
+
+struct JsonMember {
+    std::string key;
+    JsonValue value;
 };
 
 struct JsonParseResult {
