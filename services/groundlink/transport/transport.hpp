@@ -38,51 +38,74 @@ enum class MessageClass : std::uint8_t {
 /// Every field has its YAML key (under `groundlink.transport`) next to it. Durations are std::chrono
 /// durations.
 struct TransportConfig {
-    double link_rate_bytes_per_s = 5760.0;  ///< link_rate: bytes/s the core may write to each path (pacing)
-    std::size_t paths = 1;                  ///< paths: 1 or 2 serial radio pairs
-    PathMode path_mode = PathMode::single;  ///< path_mode: single | split | redundant
-    std::size_t split_tx_path = 0;  ///< split_tx_path: this end's transmit path in split mode (peer: other)
+    /// link_rate: bytes/s the core may write to each path (pacing); 57600 baud is about 5760 B/s.
+    double link_rate_bytes_per_s = 5760.0;
+    /// paths: 1 or 2 serial radio pairs.
+    std::size_t paths = 1;
+    /// path_mode: single | split | redundant.
+    PathMode path_mode = PathMode::single;
+    /// split_tx_path: this end's transmit path in split mode (the peer configures the other one).
+    std::size_t split_tx_path = 0;
     /// split_borrow: in split mode, also send on the peer's transmit path while the peer leaves it mostly
     /// idle (under a quarter of link_rate) and has no urgent traffic, so one-way bulk uses both pairs.
     bool split_borrow = true;
-    /// half_duplex: bytes received on a path consume that path's pacing budget too (radios share air time).
+    /// half_duplex: bytes received on a path while this end's budget is running push that budget back (the
+    /// radios of a pair share their air time).
     bool half_duplex = true;
 
-    std::size_t max_frame_payload = 1024;  ///< max_frame_payload: chunk bytes per frame on a clean link
-    std::size_t min_frame_payload = 48;    ///< min_frame_payload: floor of the adaptive frame size
-    bool adaptive_frame_size = true;  ///< adaptive_frame_size: shrink frames as the peer measures corruption
-    /// latency_frame_payload: frame ceiling while traffic above the lowest priority is active, so one frame
-    /// of bulk never holds an urgent message back by more than this many bytes of air time.
+    /// max_frame_payload: chunk bytes per frame on a clean link.
+    std::size_t max_frame_payload = 1024;
+    /// min_frame_payload: floor of the adaptive frame size.
+    std::size_t min_frame_payload = 48;
+    /// adaptive_frame_size: follow the frame size the peer suggests from the corruption it measures.
+    bool adaptive_frame_size = true;
+    /// latency_frame_payload: frame ceiling while Fast or non-bulk traffic is active (or frame loss is
+    /// heavy), so a frame already on the air holds an urgent message back by at most this many bytes of air
+    /// time.
     std::size_t latency_frame_payload = 192;
-    Duration latency_hold =
-        std::chrono::seconds(2);  ///< latency_hold: how long that ceiling stays after such traffic
+    /// latency_hold: how long that ceiling stays after such traffic.
+    Duration latency_hold = std::chrono::seconds(2);
 
-    std::size_t priorities = 4;  ///< priorities: levels 0 (highest: control) .. priorities-1 (bulk)
+    /// priorities: levels 0 (highest: control) .. priorities-1 (bulk). Safe channel = priority.
+    std::size_t priorities = 4;
     /// min_share: fraction of the link each priority gets when it has traffic, even under higher-priority
     /// load.
     std::array<double, kMaxPriorities> min_share{0.0, 0.05, 0.05, 0.05, 0.05, 0.05, 0.05, 0.05};
 
-    std::size_t safe_window = 64;  ///< safe_window: Safe segments in flight per channel (≤ 128)
-    std::size_t safe_queue_bytes =
-        256 * 1024;  ///< safe_queue_bytes: queued + in-flight Safe bytes per channel
-    std::size_t max_message_size = 64 * 1024;  ///< max_message_size: largest message either class accepts
-    double retransmit_share = 0.3;  ///< retransmit_share: link share retransmissions may take from others
-    Duration ack_delay = std::chrono::milliseconds(100);  ///< ack_delay: longest wait before acknowledging
-    std::size_t ack_every = 4;  ///< ack_every: acknowledge at once after this many segments
-    Duration rto_initial = std::chrono::milliseconds(1000);  ///< rto_initial: before any round-trip sample
-    Duration rto_min = std::chrono::milliseconds(250);       ///< rto_min
-    Duration rto_max = std::chrono::milliseconds(2000);      ///< rto_max: cap of the exponential backoff
+    /// safe_window: Safe segments in flight per channel (at most kMaxSafeWindow).
+    std::size_t safe_window = 64;
+    /// safe_queue_bytes: queued plus unacknowledged Safe bytes per channel; beyond it send_safe refuses.
+    std::size_t safe_queue_bytes = 256 * 1024;
+    /// max_message_size: largest message either class accepts (at most 255 x max_frame_payload).
+    std::size_t max_message_size = 64 * 1024;
+    /// retransmit_share: link share Safe retransmissions may take while Fast traffic waits.
+    double retransmit_share = 0.3;
+    /// ack_delay: longest wait before acknowledging Safe segments.
+    Duration ack_delay = std::chrono::milliseconds(100);
+    /// ack_every: acknowledge at once after this many new segments.
+    std::size_t ack_every = 4;
+    /// rto_initial: retransmission timeout before the first round-trip sample.
+    Duration rto_initial = std::chrono::milliseconds(1000);
+    /// rto_min, rto_max: bounds of the retransmission timeout; rto_max also caps the backoff.
+    Duration rto_min = std::chrono::milliseconds(250);
+    Duration rto_max = std::chrono::milliseconds(2000);
 
-    std::size_t fast_queue_cap = 16;  ///< fast_queue_cap: per priority, oldest dropped
-    Duration fast_reassembly_timeout = std::chrono::milliseconds(1000);  ///< fast_reassembly_timeout
+    /// fast_queue_cap: Fast messages waiting per priority; the oldest is dropped beyond it.
+    std::size_t fast_queue_cap = 16;
+    /// fast_reassembly_timeout: an incomplete fragmented Fast message is dropped after this.
+    Duration fast_reassembly_timeout = std::chrono::milliseconds(1000);
 
-    Duration keepalive_interval =
-        std::chrono::milliseconds(500);                        ///< keepalive_interval: idle path probe period
-    Duration hello_interval = std::chrono::milliseconds(500);  ///< hello_interval: handshake retry period
-    Duration link_down_after = std::chrono::seconds(3);        ///< link_down_after: silence that marks down
-    std::size_t link_up_frames = 2;  ///< link_up_frames: valid frames needed to mark a path/link up again
+    /// keepalive_interval: an idle path gets a probe frame this often.
+    Duration keepalive_interval = std::chrono::milliseconds(500);
+    /// hello_interval: handshake retry period.
+    Duration hello_interval = std::chrono::milliseconds(500);
+    /// link_down_after: silence that marks a path (and with all paths, the link) down.
+    Duration link_down_after = std::chrono::seconds(3);
+    /// link_up_frames: valid frames needed to mark a path up again.
+    std::size_t link_up_frames = 2;
 
-    std::size_t delivery_queue_cap = 1024;  ///< delivery_queue_cap: messages waiting for poll_message()
+    /// delivery_queue_cap: messages waiting for poll_message(); Safe segments are not acknowledged beyond it.
+    std::size_t delivery_queue_cap = 1024;
 
     /// key: pre-shared 32-byte key (from key_file, read by the adapter). Without it frames carry no MAC and
     /// LinkStats::authenticated is false.
