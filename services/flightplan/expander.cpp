@@ -22,6 +22,8 @@ Expander::Expander(std::shared_ptr<const Plan> plan, bool enforce_no_fly, bool f
       enforce_no_fly_(enforce_no_fly),
       fold_repeats_(fold_repeats),
       body_count_(plan_->nodes.size()) {
+    for (const auto& zone : plan_->no_fly)
+        zone_boxes_.push_back(Box::around(zone.local, zone.buffer));
     for (std::uint32_t i = 0; i < plan_->nodes.size(); ++i) {
         const Node& n = plan_->nodes[i];
         if (n.kind != NodeKind::Repeat)
@@ -239,8 +241,10 @@ std::optional<Waypoint> Expander::next() {
     }
     Waypoint w = make_waypoint();
     if (enforce_no_fly_ && w.has_position && last_position_) {
-        for (const auto& zone : plan_->no_fly) {
-            if (segment_violates_zone(*last_position_, w.local, zone.local, zone.buffer)) {
+        for (std::size_t z = 0; z < plan_->no_fly.size(); ++z) {
+            const auto& zone = plan_->no_fly[z];
+            if (zone_boxes_[z].may_touch(*last_position_, w.local) &&
+                segment_violates_zone(*last_position_, w.local, zone.local, zone.buffer)) {
                 error_ = "the leg to waypoint " + std::to_string(w.index) + " (" + element_path(w.element) +
                          ") enters no-fly zone '" + zone.name + "'";
                 leaf_ = kNoNode;

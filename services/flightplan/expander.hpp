@@ -62,7 +62,9 @@ class Expander final : public WaypointStream {
     std::shared_ptr<const Plan> plan_;
     bool enforce_no_fly_;
     bool fold_repeats_;
-    std::vector<std::optional<std::uint64_t>> body_count_;  // per repeat: waypoints of one iteration
+    std::vector<std::optional<std::uint64_t>> body_count_;
+    std::vector<Box>
+        zone_boxes_;  // per no-fly zone, buffer included  // per repeat: waypoints of one iteration
     std::vector<Frame> stack_;
     StreamOrigin origin_;
     std::uint64_t position_ = 0;

@@ -45,6 +45,22 @@ LatLon LocalFrame::to_geo(Enu p) const {
     return {ref_.lat + p.n / metres_per_rad_lat_ / kDegToRad, lon};
 }
 
+Box Box::around(std::span<const Enu> points, double margin) {
+    Box b{INFINITY, INFINITY, -INFINITY, -INFINITY};
+    for (const Enu p : points) {
+        b.min_e = std::min(b.min_e, p.e - margin);
+        b.min_n = std::min(b.min_n, p.n - margin);
+        b.max_e = std::max(b.max_e, p.e + margin);
+        b.max_n = std::max(b.max_n, p.n + margin);
+    }
+    return b;
+}
+
+bool Box::may_touch(Enu a, Enu b) const {
+    return std::max(a.e, b.e) >= min_e && std::min(a.e, b.e) <= max_e && std::max(a.n, b.n) >= min_n &&
+           std::min(a.n, b.n) <= max_n;
+}
+
 double distance(Enu a, Enu b) {
     return std::hypot(a.e - b.e, a.n - b.n);
 }

@@ -46,6 +46,14 @@ class LocalFrame {
     double metres_per_rad_lon_;
 };
 
+/// Axis-aligned bounds, used to skip the exact zone tests for legs far from a zone.
+struct Box {
+    double min_e = 0.0, min_n = 0.0, max_e = 0.0, max_n = 0.0;
+    static Box around(std::span<const Enu> points, double margin);
+    /// True when the bounding box of segment a-b overlaps this box.
+    bool may_touch(Enu a, Enu b) const;
+};
+
 double distance(Enu a, Enu b);
 double distance_point_segment(Enu p, Enu a, Enu b);
 double distance_segment_segment(Enu a, Enu b, Enu c, Enu d);

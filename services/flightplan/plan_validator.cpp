@@ -24,6 +24,9 @@ void check_legs(const Plan& plan, std::uint64_t limit, std::vector<Diagnostic>& 
         for (auto b : plan.nodes[plan.blocks_list].children)
             entries.push_back(b);
     }
+    std::vector<Box> boxes;
+    for (const auto& zone : plan.no_fly)
+        boxes.push_back(Box::around(zone.local, zone.buffer));
     std::set<std::pair<std::uint32_t, std::size_t>> reported;  // (element, zone)
     for (auto entry : entries) {
         Expander stream(view, /*enforce_no_fly=*/false, /*fold_repeats=*/true);
@@ -38,8 +41,10 @@ void check_legs(const Plan& plan, std::uint64_t limit, std::vector<Diagnostic>& 
                 continue;
             for (std::size_t z = 0; z < plan.no_fly.size(); ++z) {
                 const auto& zone = plan.no_fly[z];
-                const bool bad = last ? segment_violates_zone(*last, w->local, zone.local, zone.buffer)
-                                      : point_violates(w->local, zone);
+                const Enu from = last.value_or(w->local);
+                const bool bad = boxes[z].may_touch(from, w->local) &&
+                                 (last ? segment_violates_zone(*last, w->local, zone.local, zone.buffer)
+                                       : point_violates(w->local, zone));
                 if (!bad || !reported.emplace(w->element, z).second)
                     continue;
                 const Node& node = plan.nodes[w->element];

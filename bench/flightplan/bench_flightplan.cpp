@@ -1,0 +1,156 @@
+// Flight plan benchmarks: expansion rate and memory of a 1,000,000-waypoint scan, seek cost, plan load
+// (with no-fly validation) and the rolling-window feeder's cost per reached waypoint.
+//
+// Memory is measured with a counting allocator (this binary replaces global operator new/delete): the
+// "peak_heap_bytes" counter is the largest heap growth while the stream is expanded, i.e. what the
+// expansion itself allocates on top of the loaded plan. "maxrss_delta_kib" is getrusage's view of the
+// same run (page granularity, process-wide).
+#include <benchmark/benchmark.h>
+#include <malloc.h>
+#include <sys/resource.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+#include <random>
+
+#include "services/flightplan/expander.hpp"
+#include "services/flightplan/plan_loader.hpp"
+#include "services/flightplan/window_feeder.hpp"
+
+namespace {
+std::atomic<std::int64_t> g_live{0};
+std::atomic<std::int64_t> g_peak{0};
+
+void note_alloc(void* p) {
+    if (p == nullptr)
+        return;
+    const auto now = g_live.fetch_add(static_cast<std::int64_t>(malloc_usable_size(p))) +
+                     static_cast<std::int64_t>(malloc_usable_size(p));
+    auto peak = g_peak.load();
+    while (now > peak && !g_peak.compare_exchange_weak(peak, now)) {
+    }
+}
+}  // namespace
+
+void* operator new(std::size_t n) {
+    void* p = std::malloc(n == 0 ? 1 : n);
+    if (p == nullptr)
+        throw std::bad_alloc();
+    note_alloc(p);
+    return p;
+}
+void operator delete(void* p) noexcept {
+    if (p == nullptr)
+        return;
+    g_live.fetch_sub(static_cast<std::int64_t>(malloc_usable_size(p)));
+    std::free(p);
+}
+void operator delete(void* p, std::size_t) noexcept {
+    operator delete(p);
+}
+
+namespace airseg::flightplan {
+namespace {
+
+// 4.0 km x 4.0 km, lines 4 m apart, a waypoint every 4 m: 1000 lines x 1001 points = 1,001,000 waypoints.
+const char* kMillionScan = R"(plan:
+  name: million
+  vehicle: {type: rover}
+  no_fly:
+    - name: tower
+      buffer: 10
+      polygon: [[41.05, 2.05], [41.051, 2.05], [41.051, 2.051], [41.05, 2.051]]
+  elements:
+    - scan: {rectangle: {sw: [41.0, 2.0], ne: [41.036, 2.0477]}, spacing: 4, step: 4, heading: 0}
+)";
+
+std::shared_ptr<const Plan> million_plan() {
+    static std::shared_ptr<const Plan> plan = [] {
+        auto r = load_plan_text(kMillionScan, "million.yaml");
+        if (!r.ok())
+            std::abort();
+        return r.plan;
+    }();
+    return plan;
+}
+
+long maxrss_kib() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return u.ru_maxrss;
+}
+
+void BM_ExpandMillionWaypointScan(benchmark::State& state) {
+    auto plan = million_plan();
+    std::int64_t peak_growth = 0;
+    std::uint64_t produced = 0;
+    const long rss_before = maxrss_kib();
+    for (auto _ : state) {
+        const auto base = g_live.load();
+        g_peak.store(base);
+        Expander e(plan);
+        std::uint64_t n = 0;
+        while (auto w = e.next()) {
+            benchmark::DoNotOptimize(w->position.lat);
+            ++n;
+        }
+        produced = n;
+        peak_growth = std::max(peak_growth, g_peak.load() - base);
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(produced) * state.iterations());
+    state.counters["waypoints"] = static_cast<double>(produced);
+    state.counters["peak_heap_bytes"] = static_cast<double>(peak_growth);
+    state.counters["maxrss_delta_kib"] = static_cast<double>(maxrss_kib() - rss_before);
+}
+BENCHMARK(BM_ExpandMillionWaypointScan)->Unit(benchmark::kMillisecond);
+
+void BM_SeekInMillionWaypointScan(benchmark::State& state) {
+    auto plan = million_plan();
+    Expander e(plan);
+    std::mt19937_64 rng(1);
+    const std::uint64_t total = plan->nodes[plan->main_list].count.value();
+    for (auto _ : state) {
+        const std::uint64_t target = rng() % total;
+        benchmark::DoNotOptimize(e.seek(target));
+        benchmark::DoNotOptimize(e.next());
+    }
+}
+BENCHMARK(BM_SeekInMillionWaypointScan)->Unit(benchmark::kMicrosecond);
+
+void BM_LoadAndValidateMillionWaypointPlan(benchmark::State& state) {
+    for (auto _ : state) {
+        auto r = load_plan_text(kMillionScan, "million.yaml");
+        benchmark::DoNotOptimize(r.plan);
+    }
+}
+BENCHMARK(BM_LoadAndValidateMillionWaypointPlan)->Unit(benchmark::kMillisecond);
+
+// The feeder's own work per reached waypoint: reached report, refill, one partial write, result.
+void BM_FeederPerReachedWaypoint(benchmark::State& state) {
+    auto plan = million_plan();
+    WindowFeeder feeder;
+    TimePoint now{};
+    feeder.replace_plan({std::make_unique<Expander>(plan), "million"}, now);
+    auto settle = [&] {
+        while (auto r = feeder.poll_request(now))
+            feeder.on_request_result(r->id, RequestResult::Ok, now);
+        while (feeder.poll_event()) {
+        }
+    };
+    settle();
+    std::uint16_t slot = 1;
+    for (auto _ : state) {
+        feeder.on_reached(slot, now);
+        settle();
+        slot = slot >= feeder.config().window ? 1 : slot + 1;
+        now += seconds(1);
+    }
+    state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_FeederPerReachedWaypoint);
+
+}  // namespace
+}  // namespace airseg::flightplan
+
+BENCHMARK_MAIN();
