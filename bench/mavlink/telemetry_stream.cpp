@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include "services/autopilot/mavlink/encoder.hpp"
@@ -25,14 +26,14 @@ TelemetryStream make_telemetry_stream(double seconds, unsigned seed) {
         const auto ms = static_cast<std::uint32_t>(tick * 100);
         const double t = tick / 10.0;
         const double heading = std::fmod(t * 3.0, 360.0);
-        const auto lat = static_cast<std::int32_t>(-353632621 + 40.0 * t * std::cos(heading * M_PI / 180));
-        const auto lon = static_cast<std::int32_t>(1491652374 + 40.0 * t * std::sin(heading * M_PI / 180));
+        const auto lat = static_cast<std::int32_t>(-353632621 + 40.0 * t * std::cos(heading * std::numbers::pi / 180));
+        const auto lon = static_cast<std::int32_t>(1491652374 + 40.0 * t * std::sin(heading * std::numbers::pi / 180));
 
         Attitude att;
         att.time_boot_ms = ms;
         att.roll = noise(rng);
         att.pitch = noise(rng);
-        att.yaw = static_cast<float>(heading * M_PI / 180);
+        att.yaw = static_cast<float>(heading * std::numbers::pi / 180);
         att.rollspeed = noise(rng);
         att.pitchspeed = noise(rng);
         att.yawspeed = 0.05f + noise(rng);
@@ -44,8 +45,8 @@ TelemetryStream make_telemetry_stream(double seconds, unsigned seed) {
             pos.lon = lon;
             pos.alt = 584000 + static_cast<std::int32_t>(rng() % 100);
             pos.relative_alt = static_cast<std::int32_t>(rng() % 100);
-            pos.vx = static_cast<std::int16_t>(150 * std::cos(heading * M_PI / 180));
-            pos.vy = static_cast<std::int16_t>(150 * std::sin(heading * M_PI / 180));
+            pos.vx = static_cast<std::int16_t>(150 * std::cos(heading * std::numbers::pi / 180));
+            pos.vy = static_cast<std::int16_t>(150 * std::sin(heading * std::numbers::pi / 180));
             pos.hdg = static_cast<std::uint16_t>(heading * 100);
             emit(pos);
             GpsRawInt gps;
