@@ -360,6 +360,7 @@ void WindowFeeder::request_failed(TimePoint now) {
     ++counters_.failures;
     fault_ = true;
     retry_not_before_ = now + config_.fault_backoff;
+    fault_hold_pending_ = true;
     emit(FeederEvent::Kind::RequestFailed, nullptr, generation_, {},
          "autopilot request failed after retries");
 }
@@ -450,8 +451,11 @@ std::optional<FeederRequest> WindowFeeder::poll_request(TimePoint now) {
     if (outstanding_)
         return std::nullopt;
     const auto want = desired_mode();
-    if (want == Mode::Hold && mode_ != Mode::Hold && now >= retry_not_before_)
+    // Holding is tried at once after a fault, then at the backoff pace like everything else.
+    if (want == Mode::Hold && mode_ != Mode::Hold && (now >= retry_not_before_ || fault_hold_pending_)) {
+        fault_hold_pending_ = false;
         return issue(HoldVehicle{}, now);
+    }
     if (queue_.empty() || now < retry_not_before_)
         return std::nullopt;
     if (!mission_ok_) {

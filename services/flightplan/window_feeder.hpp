@@ -139,6 +139,7 @@ class WindowFeeder {
     bool fault_ = false;
     TimePoint retry_not_before_ = TimePoint::min();
     std::uint32_t consecutive_failures_ = 0;
+    bool fault_hold_pending_ = false;
     std::deque<Waypoint> holds_;  // holds to run, front first (the one being held while holding_)
     bool holding_ = false;
     std::optional<TimePoint> hold_until_;  // empty while holding: until released

@@ -163,6 +163,7 @@ struct Impairments {
     double delay_reached = 0.0;      // probability a reached report arrives one step late
     double drop_reached = 0.0;       // probability a reached report is lost
     double fail_request = 0.0;       // probability a request fails
+    bool fail_writes = false;        // every partial write fails (the autopilot refuses them)
     int requests_per_step = 2;       // link budget
     bool report_current = true;      // MISSION_CURRENT every step
 };
@@ -179,7 +180,8 @@ class Harness {
             auto r = feeder.poll_request(now);
             if (!r)
                 break;
-            const bool fail = chance(imp_.fail_request);
+            const bool fail =
+                chance(imp_.fail_request) || (imp_.fail_writes && std::holds_alternative<WriteItems>(r->op));
             const RequestResult res = fail ? RequestResult::Failed : ap.apply(*r);
             feeder.on_request_result(r->id, res, now);
             drain();
@@ -235,6 +237,8 @@ class Harness {
             n += e.kind == kind;
         return n;
     }
+
+    Impairments& impairments() { return imp_; }
 
     WindowFeeder feeder;
     SimAutopilot ap;

@@ -106,6 +106,26 @@ TEST(WindowFeeder, FailedRequestsAreRetried) {
     EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
 }
 
+TEST(WindowFeeder, PersistentWriteFailuresHoldTheVehicleUntilTheWindowIsBack) {
+    Harness h;
+    h.feeder.replace_plan(test::synthetic(300), h.now);
+    for (int i = 0; i < 30; ++i)
+        h.step();
+    h.impairments().fail_writes = true;
+    for (int i = 0; i < 40; ++i)
+        h.step();
+    EXPECT_GE(h.count(FeederEvent::Kind::RequestFailed), 1u);
+    EXPECT_FALSE(h.ap.in_auto());
+    EXPECT_GE(h.ap.hold_requests(), 1);
+    const auto reached_while_failing = h.reached.size();
+    EXPECT_LT(reached_while_failing, 30u + 5u);  // at most the window's worth went by
+    h.impairments().fail_writes = false;
+    ASSERT_LT(h.run_until_done(2000), 2000);
+    EXPECT_EQ(h.reached, iota(0, 300));
+    expect_visited(h, 41.0, 0, 300);  // never drove to a stale slot
+    EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
+}
+
 TEST(WindowFeeder, RebootMidPlanRebuildsTheWindowAndCarriesOn) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(800), h.now);
