@@ -80,7 +80,7 @@ class Parser {
       public:
         template <class F>
         explicit Sink(F& f)
-            : object_(&f),
+            : object_(const_cast<void*>(static_cast<const void*>(&f))),
               call_([](void* o, const Frame& fr) { (*static_cast<std::remove_reference_t<F>*>(o))(fr); }) {}
         void operator()(const Frame& f) const { call_(object_, f); }
 

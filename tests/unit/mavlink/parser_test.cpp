@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -239,6 +240,18 @@ TEST(MavlinkParser, SequenceGapsCountLostFramesPerSender) {
     EXPECT_EQ(parser.link(2, 1)->last_seq, 11);
     EXPECT_EQ(parser.link(3, 1), nullptr);
     EXPECT_EQ(parser.links().size(), 2u);
+}
+
+TEST(MavlinkParser, AcceptsConstAndMoveOnlyCallables) {
+    Encoder e(1, 1);
+    const Bytes frame = heartbeat_frame(e, 4);
+    Parser parser;
+    int seen = 0;
+    const auto counter = [&seen](const Frame&) { ++seen; };
+    parser.push(frame, counter);
+    auto owner = std::make_unique<int>(0);
+    parser.push(frame, [&seen, o = std::move(owner)](const Frame&) { seen += 1 + *o; });
+    EXPECT_EQ(seen, 2);
 }
 
 TEST(MavlinkParser, SequenceWrapIsNotALoss) {
