@@ -1,0 +1,193 @@
+// airsegd as systemd runs it: a real NOTIFY_SOCKET, signals, the status socket and airsegctl.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/support/process.hpp"
+
+namespace airseg::test {
+namespace {
+
+class DaemonProcess : public ::testing::Test {
+  protected:
+    DaemonProcess() : notify(dir.file("notify.sock")) {}
+
+    std::vector<std::string> daemon_args(const std::string& config = source_path("config/airseg.yaml")) {
+        return {binary("daemon/airsegd"),
+                "--config",
+                config,
+                "--set",
+                "status.socket=" + socket(),
+                "--set",
+                "state_dir=" + dir.file("state"),
+                "--set",
+                "autopilot.port=" + dir.file("ttyACM0"),
+                "--set",
+                "groundlink.ports=[" + dir.file("ttyUSB0") + "]"};
+    }
+    std::map<std::string, std::string> env(const std::string& watchdog_usec = "400000") {
+        return {{"NOTIFY_SOCKET", notify.path()}, {"WATCHDOG_USEC", watchdog_usec}};
+    }
+    std::string socket() const { return dir.file("status.sock"); }
+    RunResult ctl(std::vector<std::string> args) {
+        args.insert(args.begin(), binary("client/airsegctl"));
+        return run(args);
+    }
+
+    TempDir dir;
+    NotifyListener notify;
+};
+
+TEST_F(DaemonProcess, ReadyPingsAnswersAndStopsCleanlyWithoutAnyDevice) {
+    const auto started = std::chrono::steady_clock::now();
+    Subprocess daemon(daemon_args(), env(), dir.path());
+    auto ready = notify.wait_for("READY=1", 10s);
+    ASSERT_TRUE(ready) << daemon.err();
+    EXPECT_LT(*ready - started, 1s) << "READY=1 must come within 1 s";
+
+    // Pings keep coming while every service runs.
+    const auto first = notify.messages().size();
+    ASSERT_TRUE(wait_until([&] {
+        notify.drain();
+        return notify.count("WATCHDOG=1", first) >= 3;
+    }));
+    ASSERT_TRUE(notify.wait_for("STATUS=", 5s));
+    ASSERT_TRUE(wait_until([&] {
+        notify.drain();
+        return notify.count("autopilot: DOWN (no " + dir.file("ttyACM0") + ")") > 0;
+    })) << "STATUS= must say why the autopilot is down";
+
+    auto status = ctl({"status", "--local", "--socket", socket(), "--json"});
+    ASSERT_EQ(status.exit_code, 0) << status.err;
+    auto doc = nlohmann::json::parse(status.out);
+    EXPECT_EQ(doc["services"]["autopilot"]["health"], "down");
+    EXPECT_EQ(doc["services"]["groundlink"]["health"], "down");
+    EXPECT_EQ(doc["services"]["status"]["health"], "up");
+
+    auto human = ctl({"status", "--socket", socket()});
+    ASSERT_EQ(human.exit_code, 0);
+    EXPECT_NE(human.out.find("autopilot    DOWN"), std::string::npos) << human.out;
+
+    const auto before_stop = notify.messages().size();
+    const auto term_at = std::chrono::steady_clock::now();
+    daemon.signal(SIGTERM);
+    auto code = daemon.wait_exit(5s);
+    ASSERT_TRUE(code) << "airsegd did not exit after SIGTERM";
+    EXPECT_EQ(*code, 0);
+    EXPECT_LT(std::chrono::steady_clock::now() - term_at, 2s);
+    EXPECT_TRUE(notify.wait_for("STOPPING=1", 1s, before_stop));
+    EXPECT_FALSE(std::filesystem::exists(socket())) << "the status socket is removed on exit";
+}
+
+TEST_F(DaemonProcess, AStuckServiceStopsTheWatchdogPings) {
+    auto e = env("300000");
+    e["AIRSEG_TEST_HANG"] = "groundlink:600";
+    Subprocess daemon(daemon_args(), e, dir.path());
+    ASSERT_TRUE(notify.wait_for("READY=1", 10s)) << daemon.err();
+    ASSERT_TRUE(notify.wait_for("WATCHDOG=1", 5s)) << "pings before the hang";
+
+    // After the hang the pings stop for good: find a silence of three watchdog periods while it still runs.
+    bool silent = wait_until(
+        [&] {
+            notify.drain();
+            const auto& m = notify.messages();
+            std::chrono::steady_clock::time_point last{};
+            for (const auto& msg : m) {
+                if (msg.text.find("WATCHDOG=1") != std::string::npos) {
+                    last = msg.at;
+                }
+            }
+            return std::chrono::steady_clock::now() - last > 900ms;
+        },
+        10s);
+    EXPECT_TRUE(silent) << "WATCHDOG=1 kept coming although a service was stuck";
+    EXPECT_TRUE(daemon.running());
+    EXPECT_TRUE(wait_until([&] {
+        return daemon.err().find("no progress from groundlink") != std::string::npos;
+    })) << daemon.err();
+
+    daemon.signal(SIGTERM);
+    auto code = daemon.wait_exit(5s);
+    ASSERT_TRUE(code);
+    EXPECT_EQ(*code, 0);
+}
+
+TEST_F(DaemonProcess, AnInvalidConfigExits78AndStartsNothing) {
+    const std::string bad = dir.file("bad.yaml");
+    write_file(bad, read_file(source_path("config/airseg.yaml")) + "bogus_key: 1\n");
+    const int bogus_line = [&] {
+        const auto text = read_file(bad);
+        return static_cast<int>(std::count(text.begin(), text.end(), '\n'));
+    }();
+    Subprocess daemon(daemon_args(bad), env(), dir.path());
+    auto code = daemon.wait_exit(10s);
+    ASSERT_TRUE(code);
+    EXPECT_EQ(*code, 78);
+    EXPECT_NE(daemon.err().find(bad + ":" + std::to_string(bogus_line) + ":1: bogus_key"), std::string::npos)
+        << daemon.err();
+    notify.drain();
+    EXPECT_EQ(notify.count("READY=1"), 0u);
+    EXPECT_FALSE(std::filesystem::exists(socket()));
+
+    auto check =
+        run({binary("daemon/airsegd"), "--check-config", "--config", source_path("config/airseg.yaml")});
+    EXPECT_EQ(check.exit_code, 0) << check.err;
+    auto check_bad = run({binary("daemon/airsegd"), "--check-config", "--config", bad});
+    EXPECT_EQ(check_bad.exit_code, 78);
+}
+
+TEST_F(DaemonProcess, SighupAppliesRuntimeKeysAndKeepsTheRunningConfigOnErrors) {
+    const std::string config = dir.file("airseg.yaml");
+    const std::string original = read_file(source_path("config/airseg.yaml"));
+    write_file(config, original);
+    Subprocess daemon(daemon_args(config), env(), dir.path());
+    ASSERT_TRUE(notify.wait_for("READY=1", 10s)) << daemon.err();
+
+    std::string changed = original;
+    changed.replace(changed.find("log_level: info"), 15, "log_level: debug");
+    write_file(config, changed);
+    daemon.signal(SIGHUP);
+    EXPECT_TRUE(wait_until([&] {
+        return daemon.err().find("log_level: info -> debug (applied)") != std::string::npos;
+    })) << daemon.err();
+
+    std::string broken = changed;
+    broken.replace(broken.find("threads: 0"), 10, "threads: lots");
+    write_file(config, broken);
+    daemon.signal(SIGHUP);
+    EXPECT_TRUE(wait_until([&] {
+        return daemon.err().find("keeping the running configuration") != std::string::npos;
+    })) << daemon.err();
+    EXPECT_NE(daemon.err().find("threads: expected an integer"), std::string::npos);
+    EXPECT_TRUE(daemon.running());
+    auto status = ctl({"status", "--socket", socket(), "--json"});
+    EXPECT_EQ(status.exit_code, 0);
+
+    daemon.signal(SIGTERM);
+    EXPECT_EQ(daemon.wait_exit(5s), 0);
+}
+
+TEST_F(DaemonProcess, ClientExitCodes) {
+    auto no_daemon = ctl({"status", "--socket", dir.file("nobody.sock")});
+    EXPECT_EQ(no_daemon.exit_code, 3);
+    EXPECT_NE(no_daemon.err.find("is airsegd running?"), std::string::npos);
+    EXPECT_EQ(ctl({"frobnicate"}).exit_code, 2);
+    EXPECT_EQ(ctl({}).exit_code, 2);
+    EXPECT_EQ(ctl({"status", "--bogus"}).exit_code, 2);
+    auto help = ctl({"--help"});
+    EXPECT_EQ(help.exit_code, 0);
+    EXPECT_NE(help.out.find("Exit codes"), std::string::npos);
+}
+
+TEST_F(DaemonProcess, UnknownCommandsAreRefusedByTheDaemon) {
+    Subprocess daemon(daemon_args(), env(), dir.path());
+    ASSERT_TRUE(notify.wait_for("READY=1", 10s)) << daemon.err();
+    ASSERT_TRUE(wait_until([&] { return std::filesystem::exists(socket()); }));
+    auto r = ctl({"request", R"({"cmd":"warp"})", "--socket", socket()});
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("unknown command 'warp'"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace airseg::test

@@ -1,0 +1,100 @@
+#pragma once
+// Test support: run the real binaries as child processes and wait on conditions with generous timeouts.
+#include <sys/types.h>
+
+#include <chrono>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace airseg::test {
+
+using namespace std::chrono_literals;
+
+/// Polls `condition` until it holds or `timeout` passes; never a fixed sleep in a test.
+bool wait_until(const std::function<bool()>& condition, std::chrono::milliseconds timeout = 10s,
+                std::chrono::milliseconds poll = 10ms);
+
+/// A unique temporary directory, removed with everything in it.
+class TempDir {
+  public:
+    TempDir();
+    ~TempDir();
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    const std::string& path() const { return path_; }
+    std::string file(const std::string& name) const { return path_ + "/" + name; }
+
+  private:
+    std::string path_;
+};
+
+std::string read_file(const std::string& path);
+void write_file(const std::string& path, const std::string& text);
+
+/// Path of a binary built in this tree, e.g. binary("daemon/airsegd").
+std::string binary(const std::string& relative);
+std::string source_path(const std::string& relative);
+
+class Subprocess {
+  public:
+    /// Starts argv[0] with argv; `env` entries are added to (or replace) the test's environment. stdout and
+    /// stderr go to files in `log_dir` named after the program.
+    Subprocess(std::vector<std::string> argv, std::map<std::string, std::string> env,
+               const std::string& log_dir);
+    ~Subprocess();  // SIGKILLs a process still running
+    Subprocess(const Subprocess&) = delete;
+    Subprocess& operator=(const Subprocess&) = delete;
+
+    pid_t pid() const { return pid_; }
+    void signal(int signo) const;
+    /// Waits for exit; returns the exit code (128+signal when killed), or nullopt on timeout.
+    std::optional<int> wait_exit(std::chrono::milliseconds timeout);
+    bool running();
+    std::string out() const;
+    std::string err() const;
+
+  private:
+    pid_t pid_ = -1;
+    std::optional<int> exit_code_;
+    std::string out_path_;
+    std::string err_path_;
+};
+
+/// Runs a command to completion and returns {exit code, stdout, stderr}.
+struct RunResult {
+    int exit_code = -1;
+    std::string out;
+    std::string err;
+};
+RunResult run(std::vector<std::string> argv, std::map<std::string, std::string> env = {},
+              std::chrono::milliseconds timeout = 30s);
+
+/// A datagram socket standing in for systemd's NOTIFY_SOCKET: records every message sd_notify sends.
+class NotifyListener {
+  public:
+    struct Message {
+        std::chrono::steady_clock::time_point at;
+        std::string text;
+    };
+    explicit NotifyListener(const std::string& path);
+    ~NotifyListener();
+    const std::string& path() const { return path_; }
+    /// Reads whatever has arrived (non-blocking).
+    void drain();
+    /// Waits until a message contains `needle`; returns its arrival time.
+    std::optional<std::chrono::steady_clock::time_point> wait_for(const std::string& needle,
+                                                                  std::chrono::milliseconds timeout,
+                                                                  std::size_t from_index = 0);
+    const std::vector<Message>& messages() const { return messages_; }
+    std::size_t count(const std::string& needle, std::size_t from_index = 0) const;
+
+  private:
+    std::string path_;
+    int fd_ = -1;
+    std::vector<Message> messages_;
+};
+
+}  // namespace airseg::test
