@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Installs what building, testing and running airseg needs on Debian 12, from Debian's packages only.
+set -euo pipefail
+packages=(
+  cmake ninja-build g++ pkg-config ccache
+  libboost-dev libboost-program-options-dev libyaml-cpp-dev libspdlog-dev libfmt-dev
+  libgpiod-dev libsystemd-dev libsodium-dev nlohmann-json3-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  clang
+)
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then
+  sudo="sudo"
+fi
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ "${#missing[@]}" -gt 0 ]; then
+  echo "install-deps: installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo apt-get update -qq
+  $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
