@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Each line of code knows its room: only hal/ touches termios and libgpiod, only daemon/ talks to systemd,
+# and nothing outside services/autopilot/ (and the tools that speak to an autopilot) knows MAVLink.
+set -euo pipefail
+root=${1:?source dir}
+cd "$root"
+fail=0
+check() {
+  local what=$1 pattern=$2 allowed=$3
+  local hits
+  hits=$(grep -rlE "$pattern" --include='*.cpp' --include='*.hpp' --include='*.h' \
+           daemon services hal client tools 2>/dev/null | grep -vE "$allowed" || true)
+  if [ -n "$hits" ]; then
+    echo "FAIL: $what outside its room:"
+    echo "$hits" | sed 's/^/  /'
+    fail=1
+  else
+    echo "ok: $what"
+  fi
+}
+check "termios/ioctl serial headers" '#include <(termios\.h|asm/termbits\.h|sys/ioctl\.h|pty\.h)>' '^hal/'
+check "libgpiod" '#include <gpiod\.h>' '^hal/'
+check "sd-daemon / sd_notify" '(#include <systemd/sd-daemon\.h>|sd_notify\()' '^daemon/'
+check "MAVLink outside the autopilot layer" '#include "services/autopilot/mavlink/' '^(services/autopilot/|tools/(mavdump|apmsim)/)'
+exit $fail
