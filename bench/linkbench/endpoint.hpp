@@ -27,6 +27,7 @@ struct EndpointSetup {
     LinkMode mode = LinkMode::single;
     bool is_a = true;  ///< end A transmits on path 0 in dual mode, end B on path 1
     TimePoint now{};
+    double pacing_factor = 1.0;  ///< a pacing protocol's link rate as a fraction of baud/10
 };
 
 class BenchEndpoint {

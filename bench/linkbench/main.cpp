@@ -15,32 +15,44 @@ namespace {
 using namespace airseg;
 using namespace airseg::linkbench;
 
-constexpr const char* kUsage = R"(usage: linkbench [--json] [--duration SECONDS] [--strict]
+constexpr const char* kUsage = R"(usage: linkbench [--json] [--verbose] [--duration SECONDS] [--strict]
 
 Runs every scenario on airseg's ground-link transport ("ours") and on a model of the seed's MAREA serial
 transport, over the same simulated radio pairs (half duplex, air rate = serial rate, 1 ms turnaround,
 252-byte air packets, 2 KiB radio FIFO without flow control), in simulated time.
 
 Scenarios, for 57600 and 115200 baud, single pair and dual pair (split: each end transmits on its own pair):
-  clean            bulk Safe A->B (1024-byte messages, 24 kept offered) + Fast A->B 32 bytes at 10 Hz
+  clean            run 1: bulk Safe A->B alone (1024-byte messages, 24 kept offered): goodput, stall;
+                   run 2: the same bulk plus Fast A->B, 32 bytes at 10 Hz: Fast latency and delivery
   corrupt=1e-5..3  the same with that probability of a corrupted byte, both directions
   frameloss=N%     the same with N % of air packets lost, both directions
   outage=30s       the same with a 30 s outage of both directions starting at 20 s (90 s run)
   bidir            bulk Safe both ways (dual/single ratio of this row is a target)
 
   --json            one JSON object per scenario instead of the table
-  --duration S      seconds of simulated time per scenario (default 60; the outage runs 30 s longer)
+  --verbose         also print where the bytes went (wire use, air busy, FIFO overflow)
+  --duration S      seconds of simulated time per scenario (default 40; the outage runs 30 s longer)
+  --turnaround-ms X  radio turnaround (default 1)
+  --pacing F        the transport's link_rate as a fraction of baud/10 (default 1.0)
   --strict          exit status 1 when a target fails
 )";
 
-std::vector<Scenario> scenarios(Duration length) {
+struct Knobs {
+    Duration length = std::chrono::seconds(40);
+    Duration turnaround = std::chrono::milliseconds(1);
+    double pacing_factor = 1.0;
+};
+
+std::vector<Scenario> scenarios(const Knobs& k) {
     std::vector<Scenario> list;
     for (std::uint32_t baud : {57600U, 115200U}) {
         for (LinkMode mode : {LinkMode::single, LinkMode::dual}) {
             Scenario base;
             base.baud = baud;
             base.mode = mode;
-            base.duration = length;
+            base.duration = k.length;
+            base.turnaround = k.turnaround;
+            base.pacing_factor = k.pacing_factor;
             list.push_back(base);
             for (auto [label, p] :
                  {std::pair{"corrupt=1e-5", 1e-5}, {"corrupt=1e-4", 1e-4}, {"corrupt=1e-3", 1e-3}}) {
@@ -59,7 +71,7 @@ std::vector<Scenario> scenarios(Duration length) {
             Scenario outage = base;
             outage.impairment = "outage=30s";
             outage.outage = linksim::Outage{std::chrono::seconds(20), std::chrono::seconds(30)};
-            outage.duration = length + std::chrono::seconds(30);
+            outage.duration = k.length + std::chrono::seconds(30);
             list.push_back(outage);
             Scenario bidir = base;
             bidir.impairment = "bidir";
@@ -75,11 +87,15 @@ std::vector<Scenario> scenarios(Duration length) {
 int main(int argc, char** argv) {
     bool json = false;
     bool strict = false;
-    long seconds = 60;
+    bool verbose = false;
+    long seconds = 40;
+    Knobs knobs;
     for (int i = 1; i < argc; ++i) {
         const std::string_view arg = argv[i];
         if (arg == "--json") {
             json = true;
+        } else if (arg == "--verbose") {
+            verbose = true;
         } else if (arg == "--strict") {
             strict = true;
         } else if (arg == "--duration" && i + 1 < argc) {
@@ -89,6 +105,24 @@ int main(int argc, char** argv) {
                 std::cerr << "linkbench: --duration wants whole seconds within [5, 3600], got '" << v
                           << "'\n";
                 return 2;
+            }
+        } else if ((arg == "--turnaround-ms" || arg == "--pacing") && i + 1 < argc) {
+            const std::string_view v = argv[++i];
+            double x = 0;
+            auto [ptr, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
+            const bool pacing = arg == "--pacing";
+            if (ec != std::errc{} || ptr != v.data() + v.size() || x < 0 ||
+                (pacing && (x < 0.1 || x > 2.0)) || x > 1000) {
+                std::cerr << "linkbench: " << arg << " wants "
+                          << (pacing ? "a factor within [0.1, 2]" : "milliseconds within [0, 1000]")
+                          << ", got '" << v << "'\n";
+                return 2;
+            }
+            if (pacing) {
+                knobs.pacing_factor = x;
+            } else {
+                knobs.turnaround =
+                    std::chrono::duration_cast<Duration>(std::chrono::duration<double, std::milli>(x));
             }
         } else if (arg == "--help" || arg == "-h") {
             std::cout << kUsage;
@@ -100,7 +134,8 @@ int main(int argc, char** argv) {
     }
 
     std::vector<Row> rows;
-    for (const Scenario& s : scenarios(std::chrono::seconds(seconds))) {
+    knobs.length = std::chrono::seconds(seconds);
+    for (const Scenario& s : scenarios(knobs)) {
         rows.push_back({s, run_scenario(s, make_transport_endpoint), run_scenario(s, make_seed_endpoint)});
     }
     const auto checks = check_targets(rows);
@@ -112,6 +147,9 @@ int main(int argc, char** argv) {
                 << "this build has no ground-link transport core: only the seed's figures are measured\n";
         }
         print_table(std::cout, rows);
+        if (verbose) {
+            print_diagnostics(std::cout, rows);
+        }
         print_targets(std::cout, checks);
     }
     bool failed = false;

@@ -66,6 +66,24 @@ void print_table(std::ostream& os, const std::vector<Row>& rows) {
     }
 }
 
+void print_diagnostics(std::ostream& os, const std::vector<Row>& rows) {
+    os << "\ndiagnostics (ours / seed): wire = bytes written by A / by B on all pairs, % of one line's "
+          "rate\n";
+    os << std::left << std::setw(7) << "baud" << std::setw(8) << "mode" << std::setw(15) << "impairment"
+       << std::right << std::setw(17) << "wire A %" << std::setw(17) << "wire B %" << std::setw(17)
+       << "air busy %" << std::setw(21) << "FIFO overflow B" << '\n';
+    for (const Row& r : rows) {
+        os << std::left << std::setw(7) << r.scenario.baud << std::setw(8) << to_string(r.scenario.mode)
+           << std::setw(15) << r.scenario.impairment << std::right << std::setw(17)
+           << pair(r, &ScenarioResult::wire_ab_pct, 1) << std::setw(17)
+           << pair(r, &ScenarioResult::wire_ba_pct, 1) << std::setw(17)
+           << pair(r, &ScenarioResult::air_utilisation_pct, 1) << std::setw(21)
+           << (fig(r.ours, static_cast<double>(r.ours.radio_overflow), 0) + " / " +
+               fig(r.seed, static_cast<double>(r.seed.radio_overflow), 0))
+           << '\n';
+    }
+}
+
 std::vector<TargetCheck> check_targets(const std::vector<Row>& rows) {
     std::vector<TargetCheck> checks;
     auto add = [&](const std::string& name, const Row* row,
@@ -159,6 +177,10 @@ void print_json(std::ostream& os, const std::vector<Row>& rows) {
             j[prefix + "max_stall_s"] = x.max_stall_s;
             j[prefix + "safe_messages"] = x.safe_messages;
             j[prefix + "damaged_deliveries"] = x.damaged_deliveries;
+            j[prefix + "wire_ab_pct"] = x.wire_ab_pct;
+            j[prefix + "wire_ba_pct"] = x.wire_ba_pct;
+            j[prefix + "air_utilisation_pct"] = x.air_utilisation_pct;
+            j[prefix + "radio_overflow_bytes"] = x.radio_overflow;
         };
         put("", r.ours);
         put("seed_", r.seed);

@@ -25,6 +25,8 @@ struct TargetCheck {
 const char* to_string(LinkMode m);
 
 void print_table(std::ostream& os, const std::vector<Row>& rows);
+/// Where the bytes went: wire use per direction, air utilisation, FIFO overflow.
+void print_diagnostics(std::ostream& os, const std::vector<Row>& rows);
 std::vector<TargetCheck> check_targets(const std::vector<Row>& rows);
 void print_targets(std::ostream& os, const std::vector<TargetCheck>& checks);
 /// One line of JSON per row.

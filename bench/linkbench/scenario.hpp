@@ -20,26 +20,36 @@ struct Scenario {
     std::optional<linksim::Outage> outage;  ///< both directions, every pair
     bool bidirectional = false;             ///< bulk Safe traffic both ways (otherwise A→B only)
     Duration duration = std::chrono::seconds(60);
+    Duration turnaround = std::chrono::milliseconds(1);  ///< radio dead air when the sending side changes
+    double pacing_factor =
+        1.0;  ///< the transport's link_rate as a fraction of baud/10 (the seed never paces)
 };
 
 struct ScenarioResult {
     bool ran = false;          ///< false when the protocol is not available in this build
     double goodput_pct = 0.0;  ///< intact, unique Safe payload per second (both ways if bidirectional)
                                ///< as % of one line's payload rate (baud/10 bytes/s)
-    double fast_p50_ms = 0.0;  ///< Fast A→B latency; NaN when nothing arrived
+    double fast_p50_ms = 0.0;  ///< Fast A→B latency (second run); NaN when nothing arrived
     double fast_p99_ms = 0.0;
     double fast_delivery_pct = 0.0;  ///< Fast messages sent (until 2 s before the end) that arrived
     double max_stall_s = 0.0;        ///< longest time without a Safe delivery A→B
     std::uint64_t safe_messages = 0;
     std::uint64_t damaged_deliveries = 0;  ///< messages whose content differs from what was sent
+    // Where the bytes went (diagnostics printed by --verbose):
+    double wire_ab_pct = 0.0;          ///< bytes A wrote, all pairs, % of one line's rate
+    double wire_ba_pct = 0.0;          ///< bytes B wrote, all pairs, % of one line's rate
+    double air_utilisation_pct = 0.0;  ///< air busy on pair 0 (packets and turnarounds)
+    std::uint64_t radio_overflow = 0;  ///< bytes dropped at a full radio FIFO, all pairs and directions
 };
 
 using EndpointFactory = std::function<std::unique_ptr<BenchEndpoint>(const EndpointSetup&)>;
 
 /// The radio pair every scenario uses: SiK-like half-duplex radios whose air byte rate equals the serial byte
-/// rate, 1 ms turnaround, 252-byte air packets, 2 KiB FIFO, 4 KiB host UART buffer.
+/// rate, Scenario::turnaround, 252-byte air packets, 2 KiB FIFO, 4 KiB host UART buffer.
 linksim::RadioConfig bench_radio(const Scenario& s, std::uint64_t seed);
 
+/// Two runs of the scenario: bulk Safe alone (goodput, stalls, wire use) and bulk plus Fast telemetry A→B at
+/// 10 Hz (Fast latency and delivery while bulk saturates the link).
 ScenarioResult run_scenario(const Scenario& s, const EndpointFactory& make);
 
 }  // namespace airseg::linkbench

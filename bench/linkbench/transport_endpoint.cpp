@@ -11,7 +11,7 @@ constexpr std::uint8_t kBulkPriority = 3;
 
 groundlink::TransportConfig bench_config(const EndpointSetup& setup) {
     groundlink::TransportConfig c;
-    c.link_rate_bytes_per_s = setup.baud / 10.0;
+    c.link_rate_bytes_per_s = setup.pacing_factor * setup.baud / 10.0;
     c.half_duplex = true;
     if (setup.mode == LinkMode::dual) {
         c.paths = 2;
