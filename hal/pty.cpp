@@ -151,14 +151,8 @@ class Pty::Impl : public std::enable_shared_from_this<Impl> {
     const std::string& link_path() const { return config_.link_path; }
     const std::string& slave_path() const { return slave_path_; }
 
-    void set_peer_handlers(PeerHandler on_open, PeerHandler on_close, bool set_open, bool set_close) {
-        if (set_open) {
-            on_peer_open_ = std::move(on_open);
-        }
-        if (set_close) {
-            on_peer_close_ = std::move(on_close);
-        }
-    }
+    void set_on_peer_open(PeerHandler handler) { on_peer_open_ = std::move(handler); }
+    void set_on_peer_close(PeerHandler handler) { on_peer_close_ = std::move(handler); }
 
     void start_reading(BytesHandler on_bytes) {
         on_bytes_ = std::make_shared<const BytesHandler>(std::move(on_bytes));
@@ -361,10 +355,10 @@ const std::string& Pty::slave_path() const {
     return impl_->slave_path();
 }
 void Pty::on_peer_open(PeerHandler handler) {
-    impl_->set_peer_handlers(std::move(handler), {}, true, false);
+    impl_->set_on_peer_open(std::move(handler));
 }
 void Pty::on_peer_close(PeerHandler handler) {
-    impl_->set_peer_handlers({}, std::move(handler), false, true);
+    impl_->set_on_peer_close(std::move(handler));
 }
 void Pty::start_reading(BytesHandler on_bytes) {
     impl_->start_reading(std::move(on_bytes));

@@ -1,10 +1,12 @@
 #pragma once
 // Helpers for HAL tests: drive an io_context until a condition holds, and a raw pty pair made by the test.
 #include <fcntl.h>
+#include <poll.h>
 #include <pty.h>
 #include <termios.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -51,14 +53,23 @@ inline ssize_t drain(int fd, std::vector<std::uint8_t>& out) {
     }
 }
 
+/// Writes all of `bytes` to a possibly non-blocking fd; when the fd is full, waits in poll() for room
+/// (another thread must be draining it) up to the generous timeout.
 inline bool write_all(int fd, const std::vector<std::uint8_t>& bytes) {
+    const auto deadline = std::chrono::steady_clock::now() + kGenerousTimeout;
     std::size_t done = 0;
     while (done < bytes.size()) {
         const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-        if (n <= 0) {
-            return false;
+        if (n > 0) {
+            done += static_cast<std::size_t>(n);
+            continue;
         }
-        done += static_cast<std::size_t>(n);
+        if (n < 0 && errno == EAGAIN && std::chrono::steady_clock::now() < deadline) {
+            pollfd p{fd, POLLOUT, 0};
+            ::poll(&p, 1, 10);
+            continue;
+        }
+        return false;
     }
     return true;
 }
