@@ -39,7 +39,9 @@ SourceMark mark_of(const YAML::Node& node) {
 
 class Loader {
   public:
-    explicit Loader(std::string file) : file_(std::move(file)) { plan_.source_file = file_; }
+    Loader(std::string file, std::size_t max_elements) : file_(std::move(file)), max_elements_(max_elements) {
+        plan_.source_file = file_;
+    }
 
     LoadResult run(const YAML::Node& doc, const LoadOptions& options);
 
@@ -83,6 +85,8 @@ class Loader {
     void derive_counts(const LoadOptions& options);
 
     std::string file_;
+    std::size_t max_elements_;
+    bool too_many_elements_ = false;
     Plan plan_;
     std::vector<Diagnostic> errors_;
     std::optional<LatLon> first_coordinate_;
@@ -242,6 +246,13 @@ void Loader::parse_leaf_common(const YAML::Node& body, Node& node, const std::st
 }
 
 void Loader::parse_element(const YAML::Node& item, std::uint32_t parent, const std::string& path) {
+    // YAML aliases can make a small file describe an exponential number of elements.
+    if (plan_.nodes.size() >= max_elements_) {
+        if (!too_many_elements_)
+            error(item, path, "more than " + std::to_string(max_elements_) + " elements");
+        too_many_elements_ = true;
+        return;
+    }
     if (!item.IsMap() || item.size() != 1) {
         error(item, path,
               "an element is a mapping with exactly one of: waypoint, hold, scan, orbit, speed, repeat, "
@@ -456,7 +467,7 @@ void Loader::parse_vehicle(const YAML::Node& v, const std::string& path) {
             error(v["type"], path + ".type", "unknown vehicle type (expected rover, boat, plane or copter)");
         }
     }
-    if (auto x = number(v, "min_spacing", path, false, 0.0, 1e5, true))
+    if (auto x = number(v, "min_spacing", path, false, 0.1, 1e5))
         plan_.vehicle.min_spacing = *x;
     if (auto x = number(v, "arrival_radius", path, false, 0.0, 1e5, true))
         plan_.vehicle.arrival_radius = *x;
@@ -594,8 +605,14 @@ void Loader::finish_geometry() {
             continue;
         }
         node.scan.emplace(std::move(local), raw.spacing, raw.heading, raw.step, plan_.vehicle.min_spacing);
-        if (node.scan->total_count() == 0)
+        if (node.scan->too_many_lines()) {
+            error(node.mark, node.path + ".scan.spacing",
+                  "too small for this polygon (more than " + std::to_string(ScanPattern::kMaxLines) +
+                      " lines)");
+            node.scan.reset();
+        } else if (node.scan->total_count() == 0) {
             error(node.mark, node.path + ".scan.polygon", "polygon has no area");
+        }
     }
     for (auto& [id, raw] : orbits_) {
         Node& node = plan_.nodes[id];
@@ -738,7 +755,13 @@ LoadResult Loader::run(const YAML::Node& doc, const LoadOptions& options) {
 }  // namespace
 
 LoadResult load_plan_text(std::string_view text, const std::string& source_name, const LoadOptions& options) {
-    Loader loader(source_name);
+    if (text.size() > kMaxPlanTextBytes) {
+        LoadResult r;
+        r.errors.push_back(
+            {source_name, 0, 0, "", "plan larger than " + std::to_string(kMaxPlanTextBytes) + " bytes"});
+        return r;
+    }
+    Loader loader(source_name, options.max_elements);
     YAML::Node doc;
     try {
         doc = YAML::Load(std::string(text));
@@ -765,9 +788,10 @@ LoadResult load_plan_file(const std::string& path, const LoadOptions& options) {
         r.errors.push_back({path, 0, 0, "", "cannot open the file"});
         return r;
     }
-    std::ostringstream buf;
-    buf << in.rdbuf();
-    return load_plan_text(buf.str(), path, options);
+    std::string text(kMaxPlanTextBytes + 1, '\0');
+    in.read(text.data(), static_cast<std::streamsize>(text.size()));
+    text.resize(static_cast<std::size_t>(in.gcount()));
+    return load_plan_text(text, path, options);
 }
 
 }  // namespace airseg::flightplan

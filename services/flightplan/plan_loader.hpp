@@ -13,12 +13,16 @@
 
 namespace airseg::flightplan {
 
+inline constexpr std::size_t kMaxPlanTextBytes = 16u << 20;
+
 struct LoadOptions {
     /// Legs checked against no-fly zones at load time, per entry point (main list, each detached block).
     /// Finite plans below this size are checked completely; see docs/flight-plan.md for infinite ones.
     std::uint64_t leg_check_limit = 4'000'000;
     /// Refuse plans whose finite element lists expand to more waypoints than this.
     std::uint64_t max_finite_waypoints = 100'000'000;
+    /// Refuse plans with more elements than this (YAML aliases can describe millions in a few bytes).
+    std::size_t max_elements = 50'000;
 };
 
 struct LoadResult {

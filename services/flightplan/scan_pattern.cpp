@@ -22,8 +22,12 @@ ScanPattern::ScanPattern(std::vector<Enu> polygon, double spacing, double headin
     }
     if (rotated_.size() < 3 || !(spacing_ > 0.0) || !(vmax_ > vmin_))
         return;
-    lines_ =
-        std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::ceil((vmax_ - vmin_) / spacing_ - 1e-9)));
+    const double lines = std::ceil((vmax_ - vmin_) / spacing_ - 1e-9);
+    if (lines > static_cast<double>(kMaxLines)) {
+        too_many_lines_ = true;
+        return;
+    }
+    lines_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(lines));
     for (std::uint64_t k = 0; k < lines_; ++k)
         total_ += line(k).count;
 }

@@ -25,9 +25,13 @@ class ScanPattern {
         std::uint64_t count = 0;
     };
 
+    /// Beyond this many lines the pattern is refused (too_many_lines()) rather than computed.
+    static constexpr std::uint64_t kMaxLines = 10'000'000;
+
     ScanPattern(std::vector<Enu> polygon, double spacing, double heading_deg, double step,
                 double min_spacing);
 
+    bool too_many_lines() const { return too_many_lines_; }
     std::uint64_t line_count() const { return lines_; }
     /// Waypoints of the whole scan (computed once at construction, O(lines x vertices)).
     std::uint64_t total_count() const { return total_; }
@@ -50,6 +54,7 @@ class ScanPattern {
     double vmax_ = 0.0;
     std::uint64_t lines_ = 0;
     std::uint64_t total_ = 0;
+    bool too_many_lines_ = false;
 };
 
 }  // namespace airseg::flightplan

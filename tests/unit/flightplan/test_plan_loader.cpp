@@ -239,3 +239,92 @@ TEST(PlanLoader, RepeatWrapLegAndTheLegAfterALongRepeatAreChecked) {
 
 }  // namespace
 }  // namespace airseg::flightplan
+
+#include <fstream>
+#include <random>
+
+#include "services/flightplan/expander.hpp"
+
+namespace airseg::flightplan {
+namespace {
+
+TEST(PlanLoader, MutatedPlansNeverCrash) {
+    std::ifstream in(AIRSEG_SOURCE_DIR "/config/plans/rover-survey.yaml", std::ios::binary);
+    const std::string original((std::istreambuf_iterator<char>(in)), {});
+    ASSERT_FALSE(original.empty());
+    const std::string alphabet = "{}[]:,-&*#!|>'\"\n 0123456789.e-+~";
+    std::mt19937 rng(123);
+    int accepted = 0;
+    for (int k = 0; k < 300; ++k) {
+        std::string t = original;
+        const int edits = 1 + static_cast<int>(rng() % 4);
+        for (int e = 0; e < edits && !t.empty(); ++e) {
+            const std::size_t pos = rng() % t.size();
+            switch (rng() % 4) {
+                case 0:
+                    t.erase(pos, 1);
+                    break;
+                case 1:
+                    t.insert(pos, 1, alphabet[rng() % alphabet.size()]);
+                    break;
+                case 2:
+                    if (std::isdigit(static_cast<unsigned char>(t[pos])))
+                        t[pos] = static_cast<char>('0' + rng() % 10);
+                    break;
+                default:
+                    t.insert(pos, t.substr(pos, rng() % 40));
+                    break;
+            }
+        }
+        const auto r = load_plan_text(t, "mutated.yaml");
+        if (!r.ok()) {
+            EXPECT_FALSE(r.errors.empty());
+            continue;
+        }
+        ++accepted;
+        Expander e(r.plan);
+        for (int i = 0; i < 2000 && e.next(); ++i) {
+        }
+    }
+    EXPECT_GT(accepted, 0);
+}
+
+TEST(PlanLoader, AliasExplosionIsBounded) {
+    // Seven levels of ten aliases each: 10^7 elements described in a few hundred bytes.
+    std::string text =
+        "plan:\n  name: bomb\n  blocks:\n    - name: b0\n      elements: &e0 [{waypoint: {lat: 41.0, lon: "
+        "2.0}}]\n";
+    for (int level = 1; level <= 7; ++level) {
+        text +=
+            "    - name: b" + std::to_string(level) + "\n      elements: &e" + std::to_string(level) + " [";
+        for (int i = 0; i < 10; ++i) {
+            text += std::string(i ? ", " : "") + "{repeat: {count: 1, elements: *e" +
+                    std::to_string(level - 1) + "}}";
+        }
+        text += "]\n";
+    }
+    text += "  elements: *e7\n";
+    LoadOptions options;
+    options.max_elements = 2000;
+    const auto r = load_plan_text(text, "bomb.yaml", options);
+    ASSERT_FALSE(r.ok());
+    bool bounded = false;
+    for (const auto& d : r.errors)
+        bounded = bounded || d.message.find("more than 2000 elements") != std::string::npos;
+    EXPECT_TRUE(bounded) << to_string(r.errors);
+}
+
+TEST(PlanLoader, HugeScanIsRefusedNotComputed) {
+    const auto r = load_plan_text(R"(plan:
+  name: huge
+  vehicle: {min_spacing: 0.1}
+  elements:
+    - scan: {rectangle: {sw: [-60.0, -170.0], ne: [60.0, 170.0]}, spacing: 0.1}
+)",
+                                  "huge.yaml");
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.errors[0].path, "plan.elements[0].scan.spacing");
+}
+
+}  // namespace
+}  // namespace airseg::flightplan
