@@ -22,11 +22,10 @@ if [ -z "$area" ]; then
     exit 2
 fi
 
-if [ ! -f "$build/CMakeCache.txt" ]; then
-    CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-        -DAIRSEG_BUILD_FUZZ=ON -DAIRSEG_BUILD_TESTS=OFF -DAIRSEG_BUILD_BENCH=OFF \
-        -DAIRSEG_SANITIZE=fuzzer-no-link,address,undefined >/dev/null
-fi
+# Tests stay configured (not built): the fuzz targets share the test tree's CMake files.
+CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DAIRSEG_BUILD_FUZZ=ON -DAIRSEG_BUILD_TESTS=ON -DAIRSEG_BUILD_BENCH=OFF \
+    -DAIRSEG_SANITIZE=fuzzer-no-link,address,undefined >/dev/null
 cmake --build "$build" -j2 --target "$target"
 
 work="$build/fuzz-corpus/$target"
