@@ -108,9 +108,7 @@ void WindowFeeder::start_fresh(std::uint16_t first_slot, TimePoint now) {
     fresh_slot_ = first_slot;
     need_set_current_ = true;
     refill(now);
-    if (!queue_.empty() && !queue_[0].stop && queue_[0].wp.first_of_element) {
-        emit(FeederEvent::Kind::ElementStarted, &queue_[0].wp, queue_[0].generation, queue_[0].element_path);
-    }
+    announce_head();
     check_done();
 }
 
@@ -210,9 +208,7 @@ void WindowFeeder::complete_through(std::size_t position, TimePoint now) {
     if (!holds_.empty() && !holding_)
         begin_hold(now);
     refill(now);
-    if (!queue_.empty() && !queue_[0].stop && queue_[0].wp.first_of_element) {
-        emit(FeederEvent::Kind::ElementStarted, &queue_[0].wp, queue_[0].generation, queue_[0].element_path);
-    }
+    announce_head();
     check_starvation();
     check_done();
 }
@@ -221,12 +217,24 @@ std::string WindowFeeder::stream_path(const Waypoint& wp) const {
     return stream_ ? stream_->element_path(wp.element) : std::string{};
 }
 
+void WindowFeeder::announce_head() {
+    // Elements are reported strictly one after the other: the head's start waits for any hold to end.
+    if (holding_ || queue_.empty() || queue_[0].stop || queue_[0].announced)
+        return;
+    queue_[0].announced = true;
+    if (queue_[0].wp.first_of_element) {
+        emit(FeederEvent::Kind::ElementStarted, &queue_[0].wp, queue_[0].generation, queue_[0].element_path);
+    }
+}
+
 void WindowFeeder::begin_hold(TimePoint now) {
     const Waypoint wp = holds_.front();
     holding_ = true;
     hold_wp_ = wp;
     if (!wp.has_position) {
         // A hold without a position has no reached report of its own: reaching it is starting it.
+        if (wp.first_of_element)
+            emit(FeederEvent::Kind::ElementStarted, &wp, generation_, stream_path(wp));
         emit(FeederEvent::Kind::WaypointReached, &wp, generation_, stream_path(wp));
         ++reached_;
     }
@@ -242,14 +250,20 @@ void WindowFeeder::begin_hold(TimePoint now) {
 void WindowFeeder::end_hold(TimePoint now) {
     if (!holding_)
         return;
-    emit(FeederEvent::Kind::HoldEnded, &*hold_wp_, generation_, stream_path(*hold_wp_));
+    const Waypoint wp = *hold_wp_;
+    emit(FeederEvent::Kind::HoldEnded, &wp, generation_, stream_path(wp));
+    if (!wp.has_position && wp.last_of_element)
+        emit(FeederEvent::Kind::ElementFinished, &wp, generation_, stream_path(wp));
     holding_ = false;
     hold_until_.reset();
     hold_wp_.reset();
     if (!holds_.empty())
         holds_.pop_front();
-    if (!holds_.empty())
+    if (!holds_.empty()) {
         begin_hold(now);
+    } else {
+        announce_head();
+    }
 }
 
 void WindowFeeder::check_done() {

@@ -86,6 +86,7 @@ class WindowFeeder {
         std::uint16_t slot = 1;
         std::uint32_t generation = 0;
         std::string element_path;
+        bool announced = false;  // ElementStarted considered (once, when it became the head)
         MissionItem item() const;
     };
     struct Outstanding {
@@ -105,6 +106,7 @@ class WindowFeeder {
     void begin_hold(TimePoint now);
     void end_hold(TimePoint now);
     void check_done();
+    void announce_head();
     std::string stream_path(const Waypoint& wp) const;
     void request_failed(TimePoint now);
     void check_starvation();

@@ -294,3 +294,110 @@ TEST(WindowFeeder, RequestTimeoutCountsAsFailureAndIsRetried) {
 
 }  // namespace
 }  // namespace airseg::flightplan
+
+#include "services/flightplan/expander.hpp"
+#include "services/flightplan/plan_loader.hpp"
+
+namespace airseg::flightplan {
+namespace {
+
+TEST(WindowFeeder, ExampleSurveyPlanElementsStartAndFinishInOrder) {
+    const auto r = load_plan_file(AIRSEG_SOURCE_DIR "/config/plans/rover-survey.yaml");
+    ASSERT_TRUE(r.ok()) << to_string(r.errors);
+    std::vector<Waypoint> expected;
+    {
+        Expander all(r.plan);
+        while (auto w = all.next())
+            expected.push_back(*w);
+    }
+    test::Harness h;
+    h.feeder.replace_plan({std::make_unique<Expander>(r.plan), r.plan->name}, h.now);
+    std::vector<std::string> started;
+    std::string open_element;
+    std::size_t seen = 0;
+    for (int i = 0; i < 2000 && h.feeder.progress().state != PlanState::Done; ++i) {
+        h.step();
+        for (; seen < h.events.size(); ++seen) {
+            const auto& e = h.events[seen];
+            if (e.kind == FeederEvent::Kind::ElementStarted) {
+                EXPECT_EQ(open_element, "") << "started " << e.element_path << " inside " << open_element;
+                open_element = e.element_path;
+                started.push_back(e.element_path);
+            } else if (e.kind == FeederEvent::Kind::ElementFinished) {
+                EXPECT_EQ(e.element_path, open_element);
+                open_element.clear();
+            } else if (e.kind == FeederEvent::Kind::HoldStarted && e.element_path == "plan.elements[7]") {
+                h.feeder.release_hold(h.now);  // the operator check
+            }
+        }
+    }
+    ASSERT_EQ(h.feeder.progress().state, PlanState::Done);
+    const std::vector<std::string> want = {"plan.elements[0]",
+                                           "plan.elements[1]",
+                                           "plan.elements[3]",
+                                           "plan.elements[4]",
+                                           "plan.elements[5]",
+                                           "plan.elements[6].repeat.elements[0]",
+                                           "plan.elements[6].repeat.elements[1]",
+                                           "plan.elements[6].repeat.elements[0]",
+                                           "plan.elements[6].repeat.elements[1]",
+                                           "plan.elements[6].repeat.elements[0]",
+                                           "plan.elements[6].repeat.elements[1]",
+                                           "plan.elements[7]",
+                                           "plan.elements[8]"};
+    EXPECT_EQ(started, want);
+    std::vector<std::uint64_t> all(expected.size());
+    for (std::size_t i = 0; i < all.size(); ++i)
+        all[i] = i;
+    EXPECT_EQ(h.reached, all);
+    // Only positioned waypoints go to the autopilot, in plan order.
+    std::vector<LatLon> positioned;
+    for (const auto& w : expected) {
+        if (w.has_position)
+            positioned.push_back(w.position);
+    }
+    EXPECT_EQ(h.ap.visited(), positioned);
+    EXPECT_EQ(h.count(FeederEvent::Kind::HoldStarted), 2u);
+    EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
+    EXPECT_EQ(h.feeder.progress().starvation_holds, 0u);
+}
+
+}  // namespace
+}  // namespace airseg::flightplan
+
+namespace airseg::flightplan {
+namespace {
+
+TEST(WindowFeeder, ClearPlanHoldsTheVehicleAndStopsFeeding) {
+    test::Harness h;
+    h.feeder.replace_plan(test::synthetic(100), h.now);
+    for (int i = 0; i < 20; ++i)
+        h.step();
+    h.feeder.clear_plan();
+    EXPECT_EQ(h.feeder.progress().state, PlanState::None);
+    const int writes = h.ap.writes();
+    for (int i = 0; i < 20; ++i)
+        h.step();
+    EXPECT_FALSE(h.ap.in_auto());
+    EXPECT_EQ(h.ap.writes(), writes);
+    EXPECT_LE(h.ap.visited().size(), 21u);
+}
+
+TEST(WindowFeeder, NewPlanAfterDoneStartsFromTheParkedVehicle) {
+    test::Harness h;
+    h.feeder.replace_plan(test::synthetic(12, 41.0), h.now);
+    ASSERT_LT(h.run_until_done(100), 100);
+    for (int i = 0; i < 3; ++i)
+        h.step();
+    ASSERT_TRUE(h.ap.parked());
+    h.feeder.replace_plan(test::synthetic(30, 42.0), h.now);
+    ASSERT_LT(h.run_until_done(200), 200);
+    ASSERT_EQ(h.ap.visited().size(), 42u);
+    for (std::uint64_t i = 0; i < 30; ++i) {
+        EXPECT_EQ(h.ap.visited()[12 + i], test::SyntheticStream::position_of(42.0, i));
+    }
+    EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
+}
+
+}  // namespace
+}  // namespace airseg::flightplan
