@@ -2,6 +2,7 @@
 // Internal state of Transport (see transport.hpp for the contract). Split over transport.cpp (public calls,
 // timers, link state), transport_rx.cpp (frames in, handshake) and transport_tx.cpp (scheduler, frames out).
 #include <array>
+#include <cmath>
 #include <deque>
 #include <memory>
 #include <optional>
@@ -20,6 +21,12 @@
 #include "services/groundlink/transport/transport.hpp"
 
 namespace airseg::groundlink {
+
+/// Bytes/s moving average with a 1 s time constant: `rate` was last updated at `then`.
+inline double decayed_rate(double rate, TimePoint then, TimePoint now) {
+    const double dt = std::chrono::duration<double>(now - then).count();
+    return dt > 0.0 ? rate * std::exp(-dt) : rate;
+}
 
 /// The core's deadlines; poll_timeout() is the earliest of them.
 enum class Timer : std::uint8_t { transmit, retransmit, reassembly, liveness, count };
@@ -63,7 +70,12 @@ class Transport::Impl {
     [[nodiscard]] std::uint8_t header_flags() const;
     [[nodiscard]] bool may_borrow(std::size_t path) const;
     [[nodiscard]] Duration reorder_slack() const;
-    [[nodiscard]] bool data_ready() const;
+    /// Any Safe or Fast traffic ready; `bulk`: include the lowest priority.
+    [[nodiscard]] bool data_ready(bool bulk) const;
+    /// Half-duplex air gate of a path: open; only urgent (non-bulk) traffic, for an end using less than half
+    /// the air; closed until the shared budget is paid.
+    enum class AirGate : std::uint8_t { open, urgent_only, closed };
+    [[nodiscard]] AirGate air_gate(std::size_t path) const;
     [[nodiscard]] TimePoint ack_due() const;
     [[nodiscard]] TimePoint content_due(std::size_t path) const;
     [[nodiscard]] std::size_t payload_cap() const;
@@ -106,6 +118,9 @@ class Transport::Impl {
         std::deque<std::vector<std::uint8_t>> mirror;  // redundant mode: frames built for another path
         double rx_rate = 0.0;                          // bytes/s heard on the path, moving average over ~1 s
         TimePoint rx_rate_time{};
+        TimePoint air_debt{};  // half duplex: air budget of both ends together
+        double tx_rate = 0.0;  // bytes/s written to the path, same average
+        TimePoint tx_rate_time{};
     };
     std::vector<Path> paths;
     std::uint8_t peer_mask = 0;
@@ -133,6 +148,7 @@ class Transport::Impl {
     double retx_credit = 0.0;
     std::array<bool, kMaxPriorities> fast_turn{};
     TimePoint urgent_until{};
+    bool bulk_blocked = false;  // while filling a frame through an urgent_only gate
     double sent_window = 0.0;
     double lost_window = 0.0;
 

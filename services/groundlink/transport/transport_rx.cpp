@@ -16,16 +16,17 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
     stats.path[path].bytes_received += bytes.size();
     meter.on_bytes(bytes.size());
     {
-        const double dt = std::chrono::duration<double>(now_ - ps.rx_rate_time).count();
-        ps.rx_rate = ps.rx_rate * std::exp(-std::max(dt, 0.0)) + static_cast<double>(bytes.size());
+        ps.rx_rate = decayed_rate(ps.rx_rate, ps.rx_rate_time, now_) + static_cast<double>(bytes.size());
         ps.rx_rate_time = now_;
     }
-    if (cfg.half_duplex && ps.next_free > now_) {
-        // The peer's bytes took air time this end had counted on while its own budget is still running: yield
-        // it. An idle end is not held back, so a saturating peer cannot starve its acknowledgements.
+    if (cfg.half_duplex) {
+        // The peer's bytes took air time of the shared pair: they count against the air budget of both ends,
+        // with a margin (half as much again while the peer has urgent traffic) so that together the ends stay
+        // below the air rate and a queue that built up in the radios drains. Only the heavier user waits for
+        // that budget (air_ok), so a saturating end cannot starve the other.
         const auto air = std::chrono::duration_cast<Duration>(
             std::chrono::duration<double>(static_cast<double>(bytes.size()) / cfg.link_rate_bytes_per_s));
-        ps.next_free += air;
+        ps.air_debt = std::max(ps.air_debt, now_ - air) + (peer_urgent ? air + air / 2 : air + air / 10);
     }
     ps.deframer.feed(
         bytes, [&](std::vector<std::uint8_t>&& plain) { on_plain_frame(path, plain, now_); },

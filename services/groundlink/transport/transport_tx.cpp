@@ -34,7 +34,7 @@ std::uint8_t Transport::Impl::header_flags() const {
 bool Transport::Impl::may_borrow(std::size_t path) const {
     const Path& ps = paths[path];
     return cfg.split_borrow && ps.alive && !(peer_mask_fresh() && peer_urgent) &&
-           ps.rx_rate < 0.25 * cfg.link_rate_bytes_per_s;
+           decayed_rate(ps.rx_rate, ps.rx_rate_time, now_) < 0.25 * cfg.link_rate_bytes_per_s;
 }
 
 Duration Transport::Impl::reorder_slack() const {
@@ -86,23 +86,41 @@ std::size_t Transport::Impl::payload_cap() const {
     // Under heavy frame loss small frames shorten each repair round trip, which bounds stalls; under urgent
     // traffic they bound how long a frame already on the air holds the urgent message back.
     const bool lossy = sent_window >= 20.0 && lost_window > kLossyFraction * sent_window;
-    if (now_ < urgent_until || lossy) {
+    // The peer's urgent traffic waits for this end's frame on shared air, so it counts as well.
+    const bool peer_waiting = cfg.half_duplex && peer_urgent && peer_mask_fresh();
+    if (now_ < urgent_until || lossy || peer_waiting) {
         cap = std::min(cap, cfg.latency_frame_payload);
     }
     return std::max(cap, cfg.min_frame_payload);
 }
 
 bool Transport::Impl::level_ready(std::size_t level, bool retx_ok) const {
+    if (bulk_blocked && level + 1 == senders.size()) {
+        return false;
+    }
     return !fast[level].empty() || (retx_ok && senders[level].has_lost()) || senders[level].can_send_new();
 }
 
-bool Transport::Impl::data_ready() const {
-    for (std::size_t l = 0; l < senders.size(); ++l) {
+bool Transport::Impl::data_ready(bool bulk) const {
+    const std::size_t levels = bulk ? senders.size() : senders.size() - 1;
+    for (std::size_t l = 0; l < levels; ++l) {
         if (level_ready(l, true)) {
             return true;
         }
     }
     return false;
+}
+
+Transport::Impl::AirGate Transport::Impl::air_gate(std::size_t path) const {
+    const Path& ps = paths[path];
+    if (!cfg.half_duplex || now_ >= ps.air_debt) {
+        return AirGate::open;
+    }
+    // An end using less than half the air still sends its urgent traffic, so a saturating peer cannot starve
+    // it; its bulk, and everything of a heavier end, waits for the air budget both ends share.
+    return decayed_rate(ps.tx_rate, ps.tx_rate_time, now_) < 0.5 * cfg.link_rate_bytes_per_s
+               ? AirGate::urgent_only
+               : AirGate::closed;
 }
 
 TimePoint Transport::Impl::ack_due() const {
@@ -125,8 +143,13 @@ TimePoint Transport::Impl::content_due(std::size_t path) const {
         return std::min(t, ps.next_hello);
     }
     if (carries_data(path)) {
-        if (!ps.mirror.empty() || data_ready()) {
+        const AirGate gate = air_gate(path);
+        if (!ps.mirror.empty() || (gate == AirGate::open && data_ready(true)) ||
+            (gate == AirGate::urgent_only && data_ready(false))) {
             return std::min(t, now_);
+        }
+        if (data_ready(true)) {
+            t = std::min(t, ps.air_debt);
         }
         t = std::min(t, ack_due());
     }
@@ -158,6 +181,10 @@ void Transport::Impl::account_sent(std::size_t path, std::size_t bytes, TimePoin
     const auto air = std::chrono::duration_cast<Duration>(
         std::chrono::duration<double>(static_cast<double>(bytes) / cfg.link_rate_bytes_per_s));
     ps.next_free = std::max(ps.next_free, now) + air;
+    ps.air_debt = std::max(ps.air_debt, now) + air;  // the shared-air budget counts both ends
+    ps.tx_rate = decayed_rate(ps.tx_rate, ps.tx_rate_time, now) + static_cast<double>(bytes);
+    ps.tx_rate_time = now;
+
     ps.last_sent = now;
     ++stats.frames_sent;
     stats.bytes_sent += bytes;
@@ -192,8 +219,10 @@ bool Transport::Impl::add_data_chunk(std::vector<frame::Chunk>& chunks,
                                      std::vector<std::vector<std::uint8_t>>& storage, std::size_t& room,
                                      bool first, TimePoint now) {
     const std::size_t levels = senders.size();
-    const bool any_fast =
-        std::any_of(fast.begin(), fast.end(), [](const FastQueue& q) { return !q.empty(); });
+    bool any_fast = false;  // Fast traffic this frame could carry
+    for (std::size_t l = 0; l < levels; ++l) {
+        any_fast = any_fast || (!fast[l].empty() && !(bulk_blocked && l + 1 == levels));
+    }
     const bool retx_ok = retx_credit > 0.0 || !any_fast;
 
     // Level order: a lower level that has earned its minimum share goes first, then strict priority.
@@ -319,12 +348,17 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
         room = room > frame::encoded_size(c) ? room - frame::encoded_size(c) : 0;
     }
     std::size_t data_chunks = 0;
-    while (data_chunks < kMaxDataChunks && add_data_chunk(chunks, storage, room, data_chunks == 0, now)) {
+    const AirGate gate = air_gate(path);  // closed: only acknowledgements and keepalives go out
+    bulk_blocked = gate == AirGate::urgent_only;
+    while (gate != AirGate::closed && data_chunks < kMaxDataChunks &&
+           add_data_chunk(chunks, storage, room, data_chunks == 0, now)) {
         ++data_chunks;
         if (room <= frame::safe_chunk_overhead()) {
             break;
         }
     }
+
+    bulk_blocked = false;
     if (data_chunks == 0 && !ack_is_due && !keepalive_due) {
         return std::nullopt;  // only opportunistic content: wait for a frame worth sending
     }

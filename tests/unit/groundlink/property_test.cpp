@@ -2,6 +2,7 @@
 // exactly once and in order per channel, and nothing is delivered that was not sent.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <map>
 #include <set>
 
@@ -105,7 +106,10 @@ void run_seed(std::uint64_t seed) {
 }
 
 TEST(TransportProperty, SafeExactlyOnceInOrderUnderRandomImpairments) {
-    for (std::uint64_t seed = 1; seed <= 24; ++seed) {
+    // AIRSEG_PROPERTY_SEEDS=n runs more seeds (the default keeps the suite fast).
+    const char* env = std::getenv("AIRSEG_PROPERTY_SEEDS");
+    const std::uint64_t seeds = env != nullptr ? std::strtoull(env, nullptr, 10) : 24;
+    for (std::uint64_t seed = 1; seed <= seeds; ++seed) {
         run_seed(seed);
         if (HasFatalFailure()) {
             return;

@@ -59,6 +59,10 @@ class SimLink {
     [[nodiscard]] std::uint64_t written(int e, std::size_t p) const {
         return written_[static_cast<std::size_t>(e)][p];
     }
+    /// How long frames already written to path `p` still queue for air time (the radios' buffer).
+    [[nodiscard]] Duration air_backlog(std::size_t p) const {
+        return air_free_[p] > now_ ? air_free_[p] - now_ : Duration::zero();
+    }
     /// Largest single frame written.
     [[nodiscard]] std::size_t largest_frame() const { return largest_frame_; }
     /// Called after every step; return true to stop.
