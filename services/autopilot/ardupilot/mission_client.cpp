@@ -1,0 +1,624 @@
+#include "services/autopilot/ardupilot/mission_client.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace airseg::autopilot::ardupilot {
+
+namespace mav = airseg::mavlink;
+
+namespace {
+// MAV_MISSION_RESULT values used here.
+constexpr std::uint8_t kAccepted = 0;
+constexpr std::uint8_t kNoSpace = 4;
+constexpr std::uint8_t kInvalidSequence = 13;
+constexpr std::uint8_t kMissionTypeMission = 0;
+
+const char* mission_result_name(std::uint8_t type) {
+    static const char* const kNames[] = {"ACCEPTED",
+                                         "ERROR",
+                                         "UNSUPPORTED_FRAME",
+                                         "UNSUPPORTED",
+                                         "NO_SPACE",
+                                         "INVALID",
+                                         "INVALID_PARAM1",
+                                         "INVALID_PARAM2",
+                                         "INVALID_PARAM3",
+                                         "INVALID_PARAM4",
+                                         "INVALID_PARAM5",
+                                         "INVALID_PARAM6",
+                                         "INVALID_PARAM7",
+                                         "INVALID_SEQUENCE",
+                                         "DENIED",
+                                         "OPERATION_CANCELLED"};
+    return type < std::size(kNames) ? kNames[type] : "unknown result";
+}
+
+bool is_global_frame(std::uint8_t frame) {
+    switch (frame) {
+        case 0:   // MAV_FRAME_GLOBAL
+        case 3:   // MAV_FRAME_GLOBAL_RELATIVE_ALT
+        case 5:   // MAV_FRAME_GLOBAL_INT
+        case 6:   // MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
+        case 10:  // MAV_FRAME_GLOBAL_TERRAIN_ALT
+        case 11:  // MAV_FRAME_GLOBAL_TERRAIN_ALT_INT
+            return true;
+        default:
+            return false;
+    }
+}
+}  // namespace
+
+const char* to_string(MissionResult r) {
+    switch (r) {
+        case MissionResult::Success:
+            return "success";
+        case MissionResult::Timeout:
+            return "timeout";
+        case MissionResult::Denied:
+            return "denied";
+        case MissionResult::NoSpace:
+            return "no space";
+        case MissionResult::InvalidArgument:
+            return "invalid argument";
+        case MissionResult::Cancelled:
+            return "cancelled";
+        case MissionResult::Busy:
+            return "busy";
+    }
+    return "?";
+}
+std::ostream& operator<<(std::ostream& os, MissionResult r) {
+    return os << to_string(r);
+}
+
+const char* to_string(MissionOperation op) {
+    switch (op) {
+        case MissionOperation::Upload:
+            return "upload";
+        case MissionOperation::Download:
+            return "download";
+        case MissionOperation::WritePartial:
+            return "partial write";
+        case MissionOperation::SetCurrent:
+            return "set current";
+        case MissionOperation::Clear:
+            return "clear";
+    }
+    return "?";
+}
+
+mav::MissionItemInt to_int_item(const mav::MissionItem& f) {
+    mav::MissionItemInt i;
+    i.target_system = f.target_system;
+    i.target_component = f.target_component;
+    i.seq = f.seq;
+    i.frame = f.frame;
+    i.command = f.command;
+    i.current = f.current;
+    i.autocontinue = f.autocontinue;
+    i.param1 = f.param1;
+    i.param2 = f.param2;
+    i.param3 = f.param3;
+    i.param4 = f.param4;
+    const double scale = is_global_frame(f.frame) ? 1e7 : 1.0;
+    i.x = static_cast<std::int32_t>(std::lround(static_cast<double>(f.x) * scale));
+    i.y = static_cast<std::int32_t>(std::lround(static_cast<double>(f.y) * scale));
+    i.z = f.z;
+    i.mission_type = f.mission_type;
+    return i;
+}
+
+mav::MissionItem to_float_item(const mav::MissionItemInt& i) {
+    mav::MissionItem f;
+    f.target_system = i.target_system;
+    f.target_component = i.target_component;
+    f.seq = i.seq;
+    f.frame = i.frame;
+    f.command = i.command;
+    f.current = i.current;
+    f.autocontinue = i.autocontinue;
+    f.param1 = i.param1;
+    f.param2 = i.param2;
+    f.param3 = i.param3;
+    f.param4 = i.param4;
+    const double scale = is_global_frame(i.frame) ? 1e-7 : 1.0;
+    f.x = static_cast<float>(static_cast<double>(i.x) * scale);
+    f.y = static_cast<float>(static_cast<double>(i.y) * scale);
+    f.z = i.z;
+    f.mission_type = i.mission_type;
+    return f;
+}
+
+MissionClient::MissionClient(Outbox& outbox, std::uint8_t target_sysid, std::uint8_t target_compid,
+                             MissionConfig config)
+    : out_(outbox), target_sysid_(target_sysid), target_compid_(target_compid), config_(config) {}
+
+// --- queueing ----------------------------------------------------------------------------------------------
+
+std::uint32_t MissionClient::upload(std::vector<mav::MissionItemInt> items, TimePoint now) {
+    WorkItem w;
+    w.op = MissionOperation::Upload;
+    w.items = std::move(items);
+    return enqueue(std::move(w), now);
+}
+
+std::uint32_t MissionClient::download(TimePoint now) {
+    WorkItem w;
+    w.op = MissionOperation::Download;
+    return enqueue(std::move(w), now);
+}
+
+std::uint32_t MissionClient::write_partial(std::uint16_t first, std::vector<mav::MissionItemInt> items,
+                                           TimePoint now) {
+    WorkItem w;
+    w.op = MissionOperation::WritePartial;
+    w.first = first;
+    w.items = std::move(items);
+    return enqueue(std::move(w), now);
+}
+
+std::uint32_t MissionClient::set_current(std::uint16_t seq, TimePoint now) {
+    WorkItem w;
+    w.op = MissionOperation::SetCurrent;
+    w.first = seq;
+    return enqueue(std::move(w), now);
+}
+
+std::uint32_t MissionClient::clear(TimePoint now) {
+    WorkItem w;
+    w.op = MissionOperation::Clear;
+    return enqueue(std::move(w), now);
+}
+
+std::uint32_t MissionClient::enqueue(WorkItem w, TimePoint now) {
+    w.id = next_id_++;
+    if (w.op == MissionOperation::Upload || w.op == MissionOperation::WritePartial) {
+        const std::size_t end = static_cast<std::size_t>(w.first) + w.items.size();
+        if (w.items.empty() && w.op == MissionOperation::WritePartial) {
+            reject(w.op, w.id, MissionResult::InvalidArgument, "a partial write needs at least one item");
+            return w.id;
+        }
+        if (end > config_.max_items) {
+            reject(w.op, w.id, MissionResult::InvalidArgument,
+                   "slots up to " + std::to_string(end) + " exceed mission.max_items " +
+                       std::to_string(config_.max_items));
+            return w.id;
+        }
+        // The vehicle addresses items by seq: make each item carry its slot and our target.
+        for (std::size_t i = 0; i < w.items.size(); ++i) {
+            auto& it = w.items[i];
+            it.seq = static_cast<std::uint16_t>(w.first + i);
+            it.target_system = target_sysid_;
+            it.target_component = target_compid_;
+            it.mission_type = kMissionTypeMission;
+        }
+    }
+    if (work_.size() >= kMaxQueued) {
+        reject(w.op, w.id, MissionResult::Busy, std::to_string(kMaxQueued) + " mission operations queued");
+        return w.id;
+    }
+    work_.push_back(std::move(w));
+    if (work_.size() == 1) {
+        start_front(now);
+    }
+    return work_.back().id;
+}
+
+void MissionClient::reject(MissionOperation op, std::uint32_t id, MissionResult r, std::string detail) {
+    done_.push_back(MissionCompletion{id, op, r, std::move(detail), {}});
+}
+
+void MissionClient::cancel_all(const std::string& why) {
+    for (auto& w : work_) {
+        done_.push_back(MissionCompletion{w.id, w.op, MissionResult::Cancelled, why, {}});
+    }
+    work_.clear();
+}
+
+// --- sending -----------------------------------------------------------------------------------------------
+
+Duration MissionClient::base_timeout() const {
+    Duration t = config_.initial_timeout;
+    if (srtt_) {
+        // A floor on the variance term keeps a perfectly steady link from getting a razor-thin timeout.
+        t = *srtt_ + std::max<Duration>(4 * rttvar_, milliseconds(100));
+    }
+    return std::clamp(t, config_.min_timeout, config_.max_timeout);
+}
+
+void MissionClient::start_front(TimePoint now) {
+    while (!work_.empty() && work_.front().step == Step::NotStarted) {
+        WorkItem& w = work_.front();
+        switch (w.op) {
+            case MissionOperation::Upload:
+            case MissionOperation::WritePartial:
+                w.step = Step::WaitRequest;
+                w.next_seq = w.first;
+                break;
+            case MissionOperation::Download:
+                w.step = Step::WaitCount;
+                break;
+            case MissionOperation::SetCurrent:
+                w.step = Step::WaitCurrent;
+                break;
+            case MissionOperation::Clear:
+                w.step = Step::WaitAck;
+                break;
+        }
+        transmit(w, now, false);
+    }
+}
+
+void MissionClient::send_item(WorkItem& w, std::uint16_t seq, bool as_int) {
+    const auto& item = w.items[static_cast<std::size_t>(seq - w.first)];
+    if (as_int) {
+        out_.send(item);
+    } else {
+        out_.send(to_float_item(item));
+    }
+}
+
+// Sends what the current step waits an answer for: first transmission, or a retry after a timeout.
+void MissionClient::transmit(WorkItem& w, TimePoint now, bool retry) {
+    switch (w.step) {
+        case Step::WaitRequest:
+            if (w.any_request) {
+                send_item(w, w.next_seq, w.answer_int);
+            } else if (w.op == MissionOperation::Upload) {
+                mav::MissionCount m;
+                m.target_system = target_sysid_;
+                m.target_component = target_compid_;
+                m.count = static_cast<std::uint16_t>(w.items.size());
+                m.mission_type = kMissionTypeMission;
+                out_.send(m);
+            } else {
+                mav::MissionWritePartialList m;
+                m.target_system = target_sysid_;
+                m.target_component = target_compid_;
+                m.start_index = static_cast<std::int16_t>(w.first);
+                m.end_index = static_cast<std::int16_t>(w.first + w.items.size() - 1);
+                m.mission_type = kMissionTypeMission;
+                out_.send(m);
+            }
+            break;
+        case Step::WaitAck:
+            if (w.op == MissionOperation::Clear) {
+                mav::MissionClearAll m;
+                m.target_system = target_sysid_;
+                m.target_component = target_compid_;
+                m.mission_type = kMissionTypeMission;
+                out_.send(m);
+            } else if (w.items.empty()) {
+                mav::MissionCount m;  // an empty upload is acknowledged right after its count
+                m.target_system = target_sysid_;
+                m.target_component = target_compid_;
+                m.mission_type = kMissionTypeMission;
+                out_.send(m);
+            } else {
+                send_item(w, w.next_seq, w.answer_int);
+            }
+            break;
+        case Step::WaitCount: {
+            mav::MissionRequestList m;
+            m.target_system = target_sysid_;
+            m.target_component = target_compid_;
+            m.mission_type = kMissionTypeMission;
+            out_.send(m);
+            break;
+        }
+        case Step::WaitItem:
+            if (config_.use_int) {
+                mav::MissionRequestInt m;
+                m.target_system = target_sysid_;
+                m.target_component = target_compid_;
+                m.seq = w.next_seq;
+                m.mission_type = kMissionTypeMission;
+                out_.send(m);
+            } else {
+                mav::MissionRequest m;
+                m.target_system = target_sysid_;
+                m.target_component = target_compid_;
+                m.seq = w.next_seq;
+                m.mission_type = kMissionTypeMission;
+                out_.send(m);
+            }
+            break;
+        case Step::WaitCurrent: {
+            mav::MissionSetCurrent m;
+            m.target_system = target_sysid_;
+            m.target_component = target_compid_;
+            m.seq = w.first;
+            out_.send(m);
+            break;
+        }
+        case Step::NotStarted:
+            return;
+    }
+    if (retry) {
+        ++stats_.retransmissions;
+        backoff_ = std::min(backoff_ * 2, 16u);
+    }
+    w.retransmitted = retry;
+    w.sent_at = now;
+    w.deadline = now + current_timeout();
+}
+
+// Karn's rule: after a retransmission the timeout stays backed off until an unambiguous RTT sample arrives,
+// otherwise a link slower than the initial guess would never yield one.
+Duration MissionClient::current_timeout() const {
+    return std::min<Duration>(base_timeout() * backoff_, config_.max_timeout);
+}
+
+// The vehicle answered something sent with the current step: take an RTT sample and refresh the budget.
+void MissionClient::progress(WorkItem& w, TimePoint now) {
+    if (!w.retransmitted && w.sent_at != TimePoint{}) {
+        const Duration r = now - w.sent_at;
+        if (!srtt_) {
+            srtt_ = r;
+            rttvar_ = r / 2;
+        } else {
+            const Duration err = *srtt_ > r ? *srtt_ - r : r - *srtt_;
+            rttvar_ = (3 * rttvar_ + err) / 4;
+            srtt_ = (7 * *srtt_ + r) / 8;
+        }
+        backoff_ = 1;
+    }
+    w.attempt = 0;
+}
+
+// The one exit point of a running work item.
+void MissionClient::finish(MissionResult result, std::string detail, TimePoint now) {
+    WorkItem w = std::move(work_.front());
+    work_.pop_front();
+    MissionCompletion c{w.id, w.op, result, std::move(detail), {}};
+    if (w.op == MissionOperation::Download && result == MissionResult::Success) {
+        c.items = std::move(w.items);
+    }
+    done_.push_back(std::move(c));
+    start_front(now);
+}
+
+void MissionClient::handle_timeout(TimePoint now) {
+    if (work_.empty() || now < work_.front().deadline) {
+        return;
+    }
+    WorkItem& w = work_.front();
+    if (w.attempt >= config_.retries) {
+        std::string where;
+        switch (w.step) {
+            case Step::WaitRequest:
+                where = w.any_request ? "waiting for the request after item " + std::to_string(w.next_seq)
+                                      : "waiting for the first item request";
+                break;
+            case Step::WaitAck:
+                where = "waiting for MISSION_ACK";
+                break;
+            case Step::WaitCount:
+                where = "waiting for MISSION_COUNT";
+                break;
+            case Step::WaitItem:
+                where = "waiting for item " + std::to_string(w.next_seq) + " of " + std::to_string(w.count);
+                break;
+            case Step::WaitCurrent:
+                where = "waiting for MISSION_CURRENT " + std::to_string(w.first);
+                break;
+            case Step::NotStarted:
+                break;
+        }
+        finish(MissionResult::Timeout,
+               "no answer after " + std::to_string(w.attempt + 1) + " attempts, " + where, now);
+        return;
+    }
+    ++w.attempt;
+    transmit(w, now, true);
+}
+
+TimePoint MissionClient::poll_timeout() const {
+    return work_.empty() ? kNever : work_.front().deadline;
+}
+
+std::optional<MissionCompletion> MissionClient::poll_completion() {
+    if (done_.empty()) {
+        return std::nullopt;
+    }
+    auto c = std::move(done_.front());
+    done_.pop_front();
+    return c;
+}
+
+// --- receiving ---------------------------------------------------------------------------------------------
+
+bool MissionClient::addressed_to_us(std::uint8_t target_system) const {
+    return target_system == 0 || target_system == out_.sysid();
+}
+
+bool MissionClient::handle_frame(const mav::Frame& f, TimePoint now) {
+    if (f.sysid != target_sysid_) {
+        return false;
+    }
+    switch (f.msgid) {
+        case mav::MissionRequestInt::kId: {
+            const auto m = mav::decode_payload<mav::MissionRequestInt>(f.payload_view());
+            if (addressed_to_us(m.target_system) && m.mission_type == kMissionTypeMission) {
+                on_request(m.seq, true, now);
+            }
+            return true;
+        }
+        case mav::MissionRequest::kId: {
+            const auto m = mav::decode_payload<mav::MissionRequest>(f.payload_view());
+            if (addressed_to_us(m.target_system) && m.mission_type == kMissionTypeMission) {
+                on_request(m.seq, false, now);
+            }
+            return true;
+        }
+        case mav::MissionAck::kId: {
+            const auto m = mav::decode_payload<mav::MissionAck>(f.payload_view());
+            if (addressed_to_us(m.target_system) && m.mission_type == kMissionTypeMission) {
+                on_ack(m.type, now);
+            }
+            return true;
+        }
+        case mav::MissionCount::kId: {
+            const auto m = mav::decode_payload<mav::MissionCount>(f.payload_view());
+            if (addressed_to_us(m.target_system) && m.mission_type == kMissionTypeMission) {
+                on_count(m.count, now);
+            }
+            return true;
+        }
+        case mav::MissionItemInt::kId: {
+            const auto m = mav::decode_payload<mav::MissionItemInt>(f.payload_view());
+            if (addressed_to_us(m.target_system) && m.mission_type == kMissionTypeMission) {
+                on_item(m, now);
+            }
+            return true;
+        }
+        case mav::MissionItem::kId: {
+            const auto m = mav::decode_payload<mav::MissionItem>(f.payload_view());
+            if (addressed_to_us(m.target_system) && m.mission_type == kMissionTypeMission) {
+                on_item(to_int_item(m), now);
+            }
+            return true;
+        }
+        case mav::MissionCurrent::kId:
+            on_current(mav::decode_payload<mav::MissionCurrent>(f.payload_view()).seq, now);
+            return true;
+        default:
+            return false;
+    }
+}
+
+void MissionClient::on_request(std::uint16_t seq, bool as_int, TimePoint now) {
+    if (work_.empty() || (work_.front().step != Step::WaitRequest && work_.front().step != Step::WaitAck) ||
+        (work_.front().op != MissionOperation::Upload &&
+         work_.front().op != MissionOperation::WritePartial)) {
+        ++stats_.ignored_frames;
+        return;
+    }
+    WorkItem& w = work_.front();
+    const std::size_t end = static_cast<std::size_t>(w.first) + w.items.size();
+    if (seq < w.first || seq >= end) {
+        ++stats_.ignored_frames;
+        return;
+    }
+    const bool fresh = !w.any_request || seq > w.highest_sent;
+    if (fresh) {
+        progress(w, now);
+    } else {
+        ++stats_.duplicate_requests;
+    }
+    w.any_request = true;
+    w.highest_sent = std::max(w.highest_sent, seq);
+    w.next_seq = seq;
+    w.answer_int = as_int;
+    w.step = (seq + 1u == end) ? Step::WaitAck : Step::WaitRequest;
+    // Answer every request, a repeated one too: the vehicle asks again when our item was lost.
+    send_item(w, seq, as_int);
+    w.retransmitted = !fresh;
+    w.sent_at = now;
+    if (!fresh) {
+        ++stats_.retransmissions;
+    }
+    w.deadline = now + current_timeout();
+}
+
+void MissionClient::on_ack(std::uint8_t type, TimePoint now) {
+    if (work_.empty()) {
+        ++stats_.ignored_frames;
+        return;
+    }
+    WorkItem& w = work_.front();
+    const bool uploading = w.op == MissionOperation::Upload || w.op == MissionOperation::WritePartial;
+    if (!(uploading || w.op == MissionOperation::Clear) ||
+        (w.step != Step::WaitRequest && w.step != Step::WaitAck)) {
+        ++stats_.ignored_frames;
+        return;
+    }
+    if (type == kAccepted) {
+        if (w.step == Step::WaitAck) {
+            progress(w, now);
+            finish(MissionResult::Success, {}, now);
+        } else {
+            ++stats_
+                  .ignored_frames;  // an acceptance before the last item: left over from an earlier transfer
+        }
+        return;
+    }
+    if (type == kInvalidSequence && uploading) {
+        ++stats_.invalid_sequence_acks;
+        return;
+    }
+    const std::string detail = std::string("autopilot answered MAV_MISSION_") + mission_result_name(type);
+    finish(type == kNoSpace ? MissionResult::NoSpace : MissionResult::Denied, detail, now);
+}
+
+void MissionClient::on_count(std::uint16_t count, TimePoint now) {
+    if (work_.empty() || work_.front().op != MissionOperation::Download) {
+        ++stats_.ignored_frames;
+        return;
+    }
+    WorkItem& w = work_.front();
+    if (w.step != Step::WaitCount) {
+        ++stats_.ignored_frames;  // the answer to a repeated REQUEST_LIST
+        return;
+    }
+    progress(w, now);
+    if (count > config_.max_items) {
+        finish(MissionResult::Denied,
+               "autopilot announced " + std::to_string(count) + " items, more than mission.max_items", now);
+        return;
+    }
+    w.count = count;
+    w.items.clear();
+    w.items.reserve(count);
+    w.next_seq = 0;
+    if (count == 0) {
+        mav::MissionAck ack;
+        ack.target_system = target_sysid_;
+        ack.target_component = target_compid_;
+        ack.type = kAccepted;
+        out_.send(ack);
+        finish(MissionResult::Success, {}, now);
+        return;
+    }
+    w.step = Step::WaitItem;
+    transmit(w, now, false);
+}
+
+void MissionClient::on_item(const mav::MissionItemInt& item, TimePoint now) {
+    if (work_.empty() || work_.front().step != Step::WaitItem) {
+        ++stats_.ignored_frames;
+        return;
+    }
+    WorkItem& w = work_.front();
+    if (item.seq != w.next_seq) {
+        ++stats_.ignored_frames;  // a late answer to an earlier request
+        return;
+    }
+    progress(w, now);
+    w.items.push_back(item);
+    ++w.next_seq;
+    if (w.next_seq == w.count) {
+        mav::MissionAck ack;
+        ack.target_system = target_sysid_;
+        ack.target_component = target_compid_;
+        ack.type = kAccepted;
+        out_.send(ack);
+        finish(MissionResult::Success, {}, now);
+        return;
+    }
+    transmit(w, now, false);
+}
+
+void MissionClient::on_current(std::uint16_t seq, TimePoint now) {
+    if (work_.empty() || work_.front().step != Step::WaitCurrent) {
+        return;  // MISSION_CURRENT is also streamed: not an error
+    }
+    WorkItem& w = work_.front();
+    if (seq == w.first) {
+        progress(w, now);
+        finish(MissionResult::Success, {}, now);
+    }
+}
+
+}  // namespace airseg::autopilot::ardupilot

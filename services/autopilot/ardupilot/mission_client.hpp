@@ -1,0 +1,156 @@
+#pragma once
+// MissionClient: the ground side of the MAVLink mission protocol, sans-IO.
+//
+// Operations: full upload (MISSION_COUNT, then the items the vehicle requests), download
+// (MISSION_REQUEST_LIST), partial write (MISSION_WRITE_PARTIAL_LIST), set current (MISSION_SET_CURRENT,
+// confirmed by MISSION_CURRENT), clear (MISSION_CLEAR_ALL). Each is one work item with its own Step, a retry
+// budget that is refreshed whenever the transfer makes progress, and exactly one Completion. Work items run
+// one at a time, in the order they were queued.
+//
+// Timeouts follow the link: every answered first transmission is an RTT sample; the timeout is
+// SRTT + 4 RTTVAR (RFC 6298), kept between min_timeout and max_timeout, doubled on each retransmission and
+// kept doubled until an unambiguous sample arrives (Karn's rule). A fixed half-second timeout fails over a
+// loaded 57600 radio; this one does not.
+//
+// The vehicle may ask for an item with MISSION_REQUEST (answered with MISSION_ITEM, float degrees) or
+// MISSION_REQUEST_INT (answered with MISSION_ITEM_INT); a download accepts either item form.
+// MAV_MISSION_INVALID_SEQUENCE during an upload means a duplicate item crossed a request on the link; it is
+// counted and the transfer goes on.
+//
+// Contract: enqueue with upload()/download()/write_partial()/set_current()/clear(); feed every frame from the
+// autopilot to handle_frame(); call handle_timeout(now) when poll_timeout() is due; after each input drain
+// the shared Outbox and poll_completion().
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "services/autopilot/ardupilot/outbox.hpp"
+#include "services/autopilot/autopilot_config.hpp"
+#include "services/autopilot/mavlink/frame.hpp"
+#include "services/autopilot/mavlink/messages.hpp"
+#include "services/common/time.hpp"
+
+namespace airseg::autopilot::ardupilot {
+
+enum class MissionResult : std::uint8_t {
+    Success,
+    Timeout,          // retry budget spent without progress
+    Denied,           // MAV_MISSION_DENIED / ERROR / UNSUPPORTED...
+    NoSpace,          // MAV_MISSION_NO_SPACE
+    InvalidArgument,  // refused before anything was sent (detail says why)
+    Cancelled,        // cancel_all(): link down, reboot, shutdown
+    Busy,             // too many operations queued
+};
+const char* to_string(MissionResult r);
+std::ostream& operator<<(std::ostream& os, MissionResult r);
+
+enum class MissionOperation : std::uint8_t { Upload, Download, WritePartial, SetCurrent, Clear };
+const char* to_string(MissionOperation op);
+
+struct MissionCompletion {
+    std::uint32_t id = 0;
+    MissionOperation operation = MissionOperation::Upload;
+    MissionResult result = MissionResult::Success;
+    std::string detail;
+    std::vector<mavlink::MissionItemInt> items;  // Download: the whole mission, slot 0 (home) first
+};
+
+struct MissionClientStats {
+    std::uint64_t retransmissions = 0;
+    std::uint64_t duplicate_requests = 0;  // the vehicle asked again for an item already sent
+    std::uint64_t invalid_sequence_acks = 0;
+    std::uint64_t ignored_frames = 0;  // mission frames that matched no running operation
+};
+
+class MissionClient {
+  public:
+    static constexpr std::size_t kMaxQueued = 16;
+
+    MissionClient(Outbox& outbox, std::uint8_t target_sysid, std::uint8_t target_compid,
+                  MissionConfig config);
+
+    std::uint32_t upload(std::vector<mavlink::MissionItemInt> items, TimePoint now);
+    std::uint32_t download(TimePoint now);
+    std::uint32_t write_partial(std::uint16_t first, std::vector<mavlink::MissionItemInt> items,
+                                TimePoint now);
+    std::uint32_t set_current(std::uint16_t seq, TimePoint now);
+    std::uint32_t clear(TimePoint now);
+    /// Ends every queued and running operation with Cancelled.
+    void cancel_all(const std::string& why);
+
+    /// Returns true when the frame belonged to the mission protocol (it may still have been ignored).
+    bool handle_frame(const mavlink::Frame& frame, TimePoint now);
+    void handle_timeout(TimePoint now);
+    TimePoint poll_timeout() const;
+    std::optional<MissionCompletion> poll_completion();
+
+    bool idle() const { return work_.empty(); }
+    /// The timeout from the RTT estimate alone.
+    Duration base_timeout() const;
+    /// The timeout a transmission gets now: base_timeout() times the backoff left by retransmissions.
+    Duration current_timeout() const;
+    std::optional<Duration> smoothed_rtt() const { return srtt_; }
+    const MissionClientStats& stats() const { return stats_; }
+
+  private:
+    enum class Step : std::uint8_t {
+        NotStarted,
+        WaitRequest,  // upload / partial: count or partial list sent, waiting for the vehicle's requests
+        WaitAck,      // upload / partial: last item sent; clear: CLEAR_ALL sent
+        WaitCount,    // download: REQUEST_LIST sent
+        WaitItem,     // download: REQUEST for next_seq sent
+        WaitCurrent,  // set current: SET_CURRENT sent, waiting for MISSION_CURRENT
+    };
+    struct WorkItem {
+        std::uint32_t id = 0;
+        MissionOperation op = MissionOperation::Upload;
+        Step step = Step::NotStarted;
+        std::vector<mavlink::MissionItemInt> items;
+        std::uint16_t first = 0;     // partial write: first slot; set current: the slot
+        std::uint16_t count = 0;     // download: items announced
+        std::uint16_t next_seq = 0;  // upload: last item sent; download: next item wanted
+        bool any_request = false;    // upload: the vehicle asked for at least one item
+        unsigned attempt = 0;        // retries of the current step
+        TimePoint deadline = kNever;
+        TimePoint sent_at{};
+        bool retransmitted = false;  // Karn's rule: no RTT sample from a retransmission
+        bool answer_int = true;      // reply form for the last request
+        std::uint16_t highest_sent = 0;
+    };
+
+    std::uint32_t enqueue(WorkItem item, TimePoint now);
+    void start_front(TimePoint now);
+    void transmit(WorkItem& w, TimePoint now, bool retry);
+    void send_item(WorkItem& w, std::uint16_t seq, bool as_int);
+    void progress(WorkItem& w, TimePoint now);
+    void finish(MissionResult result, std::string detail, TimePoint now);
+    void reject(MissionOperation op, std::uint32_t id, MissionResult r, std::string detail);
+
+    void on_request(std::uint16_t seq, bool as_int, TimePoint now);
+    void on_ack(std::uint8_t type, TimePoint now);
+    void on_count(std::uint16_t count, TimePoint now);
+    void on_item(const mavlink::MissionItemInt& item, TimePoint now);
+    void on_current(std::uint16_t seq, TimePoint now);
+    bool addressed_to_us(std::uint8_t target_system) const;
+
+    Outbox& out_;
+    std::uint8_t target_sysid_;
+    std::uint8_t target_compid_;
+    MissionConfig config_;
+    std::deque<WorkItem> work_;
+    std::deque<MissionCompletion> done_;
+    std::uint32_t next_id_ = 1;
+    std::optional<Duration> srtt_;
+    Duration rttvar_{};
+    unsigned backoff_ = 1;
+    MissionClientStats stats_;
+};
+
+/// MISSION_ITEM (float degrees) as MISSION_ITEM_INT (degrees * 1e7), and back.
+mavlink::MissionItemInt to_int_item(const mavlink::MissionItem& item);
+mavlink::MissionItem to_float_item(const mavlink::MissionItemInt& item);
+
+}  // namespace airseg::autopilot::ardupilot

@@ -1,0 +1,160 @@
+#pragma once
+// The autopilot-neutral interface: what flightplan, groundlink and status see of the autopilot. Plain
+// structs, no MAVLink; they travel on the bus. A driver (ardupilot/) translates them to and from its
+// autopilot's protocol, so nothing outside services/autopilot/ depends on one vendor's structures.
+#include <cstdint>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+namespace airseg::autopilot {
+
+/// The vehicle states of the USAL virtual autopilot, as the rest of the system reasons about them.
+enum class VehicleState : std::uint8_t {
+    Unknown,             // no heartbeat yet, or link down
+    ConfigureCheck,      // booting, calibrating, being configured
+    Parking,             // stopped (Rover HOLD)
+    Directed,            // RC pilot driving (Rover MANUAL)
+    ManualNavigation,    // ground joystick driving through RC override (Rover MANUAL + override)
+    WaypointNavigation,  // following the mission fed by the flight plan manager (Rover AUTO)
+    Manual,              // failsafe: RC pilot only; leaving it needs an explicit operator reset
+};
+const char* to_string(VehicleState s);
+std::optional<VehicleState> vehicle_state_from_string(std::string_view text);
+std::ostream& operator<<(std::ostream& os, VehicleState s);
+
+enum class GpsFix : std::uint8_t { None, NoFix, Fix2D, Fix3D, Dgps, RtkFloat, RtkFixed };
+
+struct Position {
+    double lat = 0.0;  // degrees
+    double lon = 0.0;  // degrees
+    double alt = 0.0;  // metres above mean sea level
+    bool operator==(const Position&) const = default;
+};
+
+struct Telemetry {
+    std::optional<Position> position;           // empty until the autopilot reports one
+    double relative_alt = 0.0;                  // metres above home
+    double roll = 0.0, pitch = 0.0, yaw = 0.0;  // radians
+    double ground_speed = 0.0;                  // m/s
+    double heading = 0.0;                       // degrees, 0..360
+    GpsFix gps_fix = GpsFix::None;
+    unsigned satellites = 0;
+    std::optional<double> battery_voltage;  // volts
+    std::optional<int> battery_remaining;   // percent
+    std::optional<double> battery_current;  // amperes
+    std::string mode;                       // the autopilot's own mode name ("AUTO", "HOLD", ...)
+    VehicleState state = VehicleState::Unknown;
+    std::uint16_t mission_current = 0;
+    std::optional<Position> home;
+};
+
+/// One slot of the autopilot's mission, in neutral terms.
+struct MissionItem {
+    enum class Kind : std::uint8_t {
+        Waypoint,  // drive to position, then continue with the next slot
+        Stop,      // stay at position indefinitely (ArduPilot: NAV_LOITER_UNLIM)
+        JumpTo,    // continue at jump_slot, forever (ArduPilot: DO_JUMP, repeat -1)
+    };
+    Kind kind = Kind::Waypoint;
+    double lat = 0.0;
+    double lon = 0.0;
+    double alt = 0.0;              // metres, relative to home
+    std::optional<double> speed;   // m/s on the leg to this item (informational for Rover)
+    std::optional<double> radius;  // acceptance radius, metres
+    std::optional<double> hold_s;  // seconds to wait on arrival
+    std::uint16_t jump_slot = 0;
+    bool operator==(const MissionItem&) const = default;
+};
+
+// --- events (every one delivered) --------------------------------------------------------------------------
+struct WaypointReached {
+    std::uint16_t seq = 0;
+};
+enum class ModeChangeCause : std::uint8_t {
+    Requested,  // the change this system asked for
+    External,   // the RC pilot, the autopilot itself (failsafe, end of mission), another ground station
+};
+struct ModeChanged {
+    VehicleState from = VehicleState::Unknown;
+    VehicleState to = VehicleState::Unknown;
+    std::string from_mode, to_mode;  // the autopilot's own names
+    ModeChangeCause cause = ModeChangeCause::External;
+};
+struct LinkUp {};
+struct LinkDown {
+    std::string reason;
+};
+/// The autopilot restarted on its own: its parameters and mission were resynchronised; whoever keeps state on
+/// it (the flight plan manager's window) must rebuild it.
+struct AutopilotRebooted {
+    std::string evidence;  // "time_boot_ms went back", "heartbeat gap with boot messages"
+};
+struct Ready {
+    double seconds_from_open = 0.0;
+};
+struct StatusText {
+    int severity = 6;
+    std::string text;
+};
+/// The autopilot moved on to another mission slot (on its own, or after a set-current request).
+struct MissionCurrentChanged {
+    std::uint16_t seq = 0;
+};
+
+// --- requests and their results
+// ------------------------------------------------------------------------------
+enum class RequestResult : std::uint8_t {
+    Ok,
+    Refused,    // the autopilot answered no, or the transition is not allowed from the current state
+    Timeout,    // no confirmation within the retry budget
+    Busy,       // another operation of the same kind is running
+    NotReady,   // the autopilot is not connected / not READY
+    Invalid,    // bad arguments (named in detail)
+    Cancelled,  // the link went down or the autopilot rebooted while the request ran
+};
+const char* to_string(RequestResult r);
+std::ostream& operator<<(std::ostream& os, RequestResult r);
+
+enum class RequestKind : std::uint8_t {
+    SetState,
+    UploadMission,
+    WriteItems,
+    DownloadMission,
+    SetCurrent,
+    ClearMission,
+    GetParam,
+    SetParam,
+};
+const char* to_string(RequestKind k);
+
+struct RequestDone {
+    std::uint32_t id = 0;
+    RequestKind kind = RequestKind::SetState;
+    RequestResult result = RequestResult::Ok;
+    std::string detail;                 // for people, when not ok
+    std::vector<MissionItem> items;     // DownloadMission
+    std::optional<double> param_value;  // GetParam / SetParam (the value read back)
+};
+
+using Event = std::variant<WaypointReached, MissionCurrentChanged, ModeChanged, LinkUp, LinkDown,
+                           AutopilotRebooted, Ready, StatusText, RequestDone>;
+
+/// What status shows as autopilot.* keys.
+struct AutopilotStatus {
+    bool link_up = false;                        // autopilot.link
+    bool ready = false;                          // autopilot.ready
+    std::optional<double> ready_s;               // autopilot.ready_s: open -> READY, seconds
+    VehicleState state = VehicleState::Unknown;  // autopilot.state
+    std::string mode;                            // autopilot.mode
+    std::optional<Position> position;            // autopilot.position
+    std::uint16_t mission_current = 0;           // autopilot.mission_current
+    unsigned reboots = 0;                        // autopilot.reboots
+    unsigned reconnects = 0;  // autopilot.reconnects (filled by the service from its port keeper)
+    unsigned reset_pulses = 0;
+};
+
+}  // namespace airseg::autopilot
