@@ -8,7 +8,7 @@
 #
 # The tests run during each build (under qemu-arm for ARM) unless --no-check is given. Each
 # package is checked afterwards (packaging/check-deb.sh: lintian, fields, ELF format).
-# Work directories: build-pkg-ARCH/. Missing build tools are installed with apt-get (as root).
+# Work directories: build-pkg-ARCH/. AIRSEG_SOURCE_DIR packages another tree. Missing build tools are installed with apt-get (as root).
 set -euo pipefail
 . "$(dirname "$0")/lib.sh"
 
@@ -34,6 +34,8 @@ upstream=$(sed -n 's/^project(airseg VERSION \([0-9.]*\).*/\1/p' "$AIRSEG_ROOT/C
 [ "${version%%-*}" = "$upstream" ] \
   || log "warning: debian/changelog says $version but CMakeLists.txt says $upstream"
 
+# The tree to package: this one, or AIRSEG_SOURCE_DIR (e.g. an export of a commit).
+source_tree=${AIRSEG_SOURCE_DIR:-$AIRSEG_ROOT}
 ensure_packages "${AIRSEG_NATIVE_TOOLS[@]}" ccache
 mkdir -p "$AIRSEG_ROOT/dist"
 
@@ -44,15 +46,17 @@ stage_source() {
   mkdir -p "$dir"
   find "$dir" -mindepth 1 -maxdepth 1 ! -name 'obj-*' -exec rm -rf {} +
   if [ "$clean" = 1 ]; then rm -rf "$dir"/obj-*; fi
-  tar -C "$AIRSEG_ROOT" --exclude=./.git --exclude='./build*' --exclude=./dist --exclude=./sysroots \
+  tar -C "$source_tree" --exclude=./.git --exclude='./build*' --exclude=./dist --exclude=./sysroots \
       --exclude=./.cache -cf - . | tar -C "$dir" -xf -
-  cp -a "$AIRSEG_ROOT/packaging/debian" "$dir/debian"
+  cp -a "$source_tree/packaging/debian" "$dir/debian"
 }
 
 build_one() {
   local arch=$1 work="$AIRSEG_ROOT/build-pkg-$1" src opts sysroot=""
   src="$work/airseg-$version"
   local -a dpkg_args=(-b -us -uc --no-sign)
+  # debian/ is fresh on every run, so skipping the pre-clean only keeps the cmake build directory.
+  [ "$clean" = 1 ] || dpkg_args+=(--no-pre-clean)
   opts="parallel=${AIRSEG_JOBS:-2} terse"
   [ "$check" = 1 ] || opts="$opts nocheck"
 

@@ -34,7 +34,7 @@ start=$SECONDS
 # shellcheck disable=SC2046
 cmake -S "$src" -B "$build" -G Ninja \
   -DCMAKE_TOOLCHAIN_FILE="$AIRSEG_ROOT/packaging/toolchain-$arch.cmake" -DAIRSEG_SYSROOT="$sysroot" \
-  -DAIRSEG_BUILD_BENCH=OFF -DAIRSEG_BUILD_FUZZ=OFF $(ccache_launcher_args) >"$build.configure.log" \
+  -DAIRSEG_BUILD_FUZZ=OFF $(ccache_launcher_args) >"$build.configure.log" \
   || { cat "$build.configure.log"; die "configure failed"; }
 cmake --build "$build" -j "$jobs"
 built=$SECONDS

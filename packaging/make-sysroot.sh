@@ -12,6 +12,8 @@ set -euo pipefail
 arch=$1
 arch_triplet "$arch" >/dev/null
 dir=${2:-$AIRSEG_SYSROOTS/$arch}
+mkdir -p "$(dirname "$dir")"
+dir="$(cd "$(dirname "$dir")" && pwd)/$(basename "$dir")"
 mirror=${AIRSEG_MIRROR:-http://deb.debian.org/debian}
 security=${AIRSEG_SECURITY_MIRROR:-http://deb.debian.org/debian-security}
 
@@ -27,7 +29,6 @@ attempt() {
     bookworm "$dir.tmp" "$@"
 }
 
-mkdir -p "$(dirname "$dir")"
 # The security suite is tried first so the sysroot matches an up-to-date host; a mirror caught
 # in the middle of a sync fails it, and the point-release suites alone are a good sysroot too.
 if ! attempt "deb $mirror bookworm main" "deb $mirror bookworm-updates main" \

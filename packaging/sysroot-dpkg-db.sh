@@ -16,6 +16,8 @@ root=$(cd "$1" && pwd)
 admin="$root/var/lib/dpkg"
 archives="$root/var/cache/apt/archives"
 mkdir -p "$admin/info" "$admin/updates"
+# Database format 1: info files of Multi-Arch: same packages are named pkg:arch.*
+echo 1 >"$admin/info/format"
 : >"$admin/status"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
