@@ -39,7 +39,7 @@ const std::string kScanPlan = R"(plan:
         heading: 90
 )";
 
-TEST(Expander, ScanLinesAreSpacedAlternateAndCoverThePolygon) {
+TEST(FlightplanExpander, ScanLinesAreSpacedAlternateAndCoverThePolygon) {
     auto plan = load(kScanPlan);
     ASSERT_TRUE(plan);
     const auto wps = expand_all(plan);
@@ -83,7 +83,7 @@ TEST(Expander, ScanLinesAreSpacedAlternateAndCoverThePolygon) {
     EXPECT_EQ(wps.back().index, wps.size() - 1);
 }
 
-TEST(Expander, ConcavePolygonIsCoveredAndStepAddsPoints) {
+TEST(FlightplanExpander, ConcavePolygonIsCoveredAndStepAddsPoints) {
     // An L shape, lines along north (heading 0), a waypoint at most every 10 m.
     auto plan = load(R"(plan:
   name: l-shape
@@ -151,7 +151,7 @@ const std::string kMixedPlan = R"(plan:
         - goto: r
 )";
 
-TEST(Expander, RepeatSpeedHoldAndOrbitSemantics) {
+TEST(FlightplanExpander, RepeatSpeedHoldAndOrbitSemantics) {
     auto plan = load(kMixedPlan);
     ASSERT_TRUE(plan);
     const auto wps = expand_all(plan);
@@ -187,7 +187,7 @@ TEST(Expander, RepeatSpeedHoldAndOrbitSemantics) {
     EXPECT_EQ(until_released, 6u);
 }
 
-TEST(Expander, SeekAndRestoreMatchAFullExpansion) {
+TEST(FlightplanExpander, SeekAndRestoreMatchAFullExpansion) {
     auto plan = load(kMixedPlan);
     ASSERT_TRUE(plan);
     const auto all = expand_all(plan);
@@ -212,7 +212,7 @@ TEST(Expander, SeekAndRestoreMatchAFullExpansion) {
     EXPECT_EQ(fresh.next()->local, all[17].local);
 }
 
-TEST(Expander, JumpIntoDetachedBlockThenGotoBackIntoLoop) {
+TEST(FlightplanExpander, JumpIntoDetachedBlockThenGotoBackIntoLoop) {
     auto plan = load(kMixedPlan);
     ASSERT_TRUE(plan);
     Expander e(plan);
@@ -239,7 +239,7 @@ TEST(Expander, JumpIntoDetachedBlockThenGotoBackIntoLoop) {
     EXPECT_FALSE(again.restore(origin, 4));  // before the jump: not part of this stream
 }
 
-TEST(Expander, ForeverRepeatSeeksFarInConstantTime) {
+TEST(FlightplanExpander, ForeverRepeatSeeksFarInConstantTime) {
     auto plan = load(R"(plan:
   name: forever
   elements:
@@ -263,7 +263,7 @@ TEST(Expander, ForeverRepeatSeeksFarInConstantTime) {
     EXPECT_DOUBLE_EQ(w->speed, 2.5);  // set by the previous iteration
 }
 
-TEST(Expander, StopsOnALegIntoANoFlyZoneAddedAfterValidation) {
+TEST(FlightplanExpander, StopsOnALegIntoANoFlyZoneAddedAfterValidation) {
     auto loaded = load(kScanPlan);
     ASSERT_TRUE(loaded);
     auto plan = std::make_shared<Plan>(*loaded);
@@ -281,7 +281,7 @@ TEST(Expander, StopsOnALegIntoANoFlyZoneAddedAfterValidation) {
     EXPECT_FALSE(e.next().has_value());
 }
 
-TEST(Expander, MillionWaypointScanStreamsInSmallMemory) {
+TEST(FlightplanExpander, MillionWaypointScanStreamsInSmallMemory) {
     // 1 km x 1 km at 4 m spacing, 4 m step: 250 lines of 251 points. The bench runs the million; here the
     // point is the exact count and the step bound while streaming line by line.
     auto plan = load(R"(plan:

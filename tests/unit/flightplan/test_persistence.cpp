@@ -55,7 +55,7 @@ SavedProgress sample_progress() {
     return p;
 }
 
-TEST(Persistence, RoundTripAndOverwriteLeaveNoTempFiles) {
+TEST(FlightplanPersistence, RoundTripAndOverwriteLeaveNoTempFiles) {
     TempDir dir;
     StateStore store(dir.path() / "state");
     ASSERT_FALSE(store.save_plan(kPlanText, "plans/p.yaml").has_value());
@@ -79,7 +79,7 @@ TEST(Persistence, RoundTripAndOverwriteLeaveNoTempFiles) {
     EXPECT_EQ(files, 2);
 }
 
-TEST(Persistence, TruncatedProgressIsSetAsideEveryTime) {
+TEST(FlightplanPersistence, TruncatedProgressIsSetAsideEveryTime) {
     TempDir dir;
     StateStore store(dir.path());
     ASSERT_FALSE(store.save_plan(kPlanText, "p.yaml"));
@@ -97,7 +97,7 @@ TEST(Persistence, TruncatedProgressIsSetAsideEveryTime) {
     }
 }
 
-TEST(Persistence, GarbageAndEveryTruncationNeverCrash) {
+TEST(FlightplanPersistence, GarbageAndEveryTruncationNeverCrash) {
     TempDir dir;
     StateStore store(dir.path());
     ASSERT_FALSE(store.save_plan(kPlanText, "p.yaml"));
@@ -127,7 +127,7 @@ TEST(Persistence, GarbageAndEveryTruncationNeverCrash) {
     }
 }
 
-TEST(Persistence, AlteredPlanAndForeignProgressAreRejected) {
+TEST(FlightplanPersistence, AlteredPlanAndForeignProgressAreRejected) {
     TempDir dir;
     StateStore store(dir.path());
     ASSERT_FALSE(store.save_plan(kPlanText, "p.yaml"));
@@ -148,7 +148,7 @@ TEST(Persistence, AlteredPlanAndForeignProgressAreRejected) {
     EXPECT_TRUE(fs::exists(store.plan_path().string() + ".corrupt-1"));
 }
 
-TEST(Persistence, InterruptedWriteLeavesThePreviousStateIntact) {
+TEST(FlightplanPersistence, InterruptedWriteLeavesThePreviousStateIntact) {
     TempDir dir;
     StateStore store(dir.path());
     ASSERT_FALSE(store.save_plan(kPlanText, "p.yaml"));
@@ -161,7 +161,7 @@ TEST(Persistence, InterruptedWriteLeavesThePreviousStateIntact) {
     EXPECT_FALSE(fs::exists(store.progress_path().string() + ".tmp"));
 }
 
-TEST(Persistence, RestartResumesAtTheFirstUnreachedWaypoint) {
+TEST(FlightplanPersistence, RestartResumesAtTheFirstUnreachedWaypoint) {
     TempDir dir;
     const std::string text = R"(plan:
   name: resume

@@ -16,7 +16,7 @@ std::vector<std::string> messages(const LoadResult& r) {
     return out;
 }
 
-TEST(PlanLoader, ExamplePlansLoad) {
+TEST(FlightplanLoader, ExamplePlansLoad) {
     int loaded = 0;
     for (const auto& entry : std::filesystem::directory_iterator(AIRSEG_SOURCE_DIR "/config/plans")) {
         if (entry.path().extension() != ".yaml")
@@ -28,7 +28,7 @@ TEST(PlanLoader, ExamplePlansLoad) {
     EXPECT_GE(loaded, 3);
 }
 
-TEST(PlanLoader, ExampleSurveyHasTheExpectedShape) {
+TEST(FlightplanLoader, ExampleSurveyHasTheExpectedShape) {
     const auto r = load_plan_file(AIRSEG_SOURCE_DIR "/config/plans/rover-survey.yaml");
     ASSERT_TRUE(r.ok()) << to_string(r.errors);
     const Plan& p = *r.plan;
@@ -52,7 +52,7 @@ TEST(PlanLoader, ExampleSurveyHasTheExpectedShape) {
     EXPECT_EQ(p.nodes[patrol].count, 6u);
 }
 
-TEST(PlanLoader, ReportsEveryErrorAtOnceWithLocation) {
+TEST(FlightplanLoader, ReportsEveryErrorAtOnceWithLocation) {
     const std::string text = R"(plan:
   name: broken
   colour: red
@@ -81,7 +81,7 @@ TEST(PlanLoader, ReportsEveryErrorAtOnceWithLocation) {
     EXPECT_EQ(messages(r), expected);
 }
 
-TEST(PlanLoader, UnknownGotoTargetAndDuplicateNames) {
+TEST(FlightplanLoader, UnknownGotoTargetAndDuplicateNames) {
     const std::string text = R"(plan:
   name: names
   elements:
@@ -103,7 +103,7 @@ TEST(PlanLoader, UnknownGotoTargetAndDuplicateNames) {
         "names.yaml:8:16: plan.reactions.link_loss.target: target 'missing' is not the name of any element");
 }
 
-TEST(PlanLoader, YamlSyntaxErrorIsLocated) {
+TEST(FlightplanLoader, YamlSyntaxErrorIsLocated) {
     const auto r = load_plan_text("plan:\n  name: [unclosed\n", "syntax.yaml");
     ASSERT_EQ(r.errors.size(), 1u);
     EXPECT_EQ(r.errors[0].file, "syntax.yaml");
@@ -111,7 +111,7 @@ TEST(PlanLoader, YamlSyntaxErrorIsLocated) {
     EXPECT_NE(r.errors[0].message.find("YAML syntax error"), std::string::npos);
 }
 
-TEST(PlanLoader, GarbageNeverCrashes) {
+TEST(FlightplanLoader, GarbageNeverCrashes) {
     const char* inputs[] = {"",
                             "42",
                             "plan: 7",
@@ -144,7 +144,7 @@ std::string plan_with_leg_near_zone(double buffer) {
 )";
 }
 
-TEST(PlanLoader, LegCrossingNoFlyBufferIsRejected) {
+TEST(FlightplanLoader, LegCrossingNoFlyBufferIsRejected) {
     const auto rejected = load_plan_text(plan_with_leg_near_zone(5.0), "zone.yaml");
     ASSERT_FALSE(rejected.ok());
     ASSERT_EQ(rejected.errors.size(), 1u);
@@ -154,7 +154,7 @@ TEST(PlanLoader, LegCrossingNoFlyBufferIsRejected) {
     EXPECT_TRUE(load_plan_text(plan_with_leg_near_zone(1.0), "zone.yaml").ok());
 }
 
-TEST(PlanLoader, ScanLegsThroughAZoneAreRejected) {
+TEST(FlightplanLoader, ScanLegsThroughAZoneAreRejected) {
     const std::string text = R"(plan:
   name: scan-zone
   no_fly:
@@ -168,7 +168,7 @@ TEST(PlanLoader, ScanLegsThroughAZoneAreRejected) {
     EXPECT_EQ(r.errors[0].path, "plan.elements[0]");
 }
 
-TEST(PlanLoader, VehicleProfileBoundsSpacing) {
+TEST(FlightplanLoader, VehicleProfileBoundsSpacing) {
     const std::string text = R"(plan:
   name: plane
   vehicle: {type: plane}
@@ -181,7 +181,7 @@ TEST(PlanLoader, VehicleProfileBoundsSpacing) {
     EXPECT_NE(r.errors[0].message.find("min_spacing"), std::string::npos);
 }
 
-TEST(PlanLoader, LoopsWithoutWaypointsAreRejected) {
+TEST(FlightplanLoader, LoopsWithoutWaypointsAreRejected) {
     const auto forever = load_plan_text(R"(plan:
   name: empty-loop
   elements:
@@ -209,7 +209,7 @@ TEST(PlanLoader, LoopsWithoutWaypointsAreRejected) {
 namespace airseg::flightplan {
 namespace {
 
-TEST(PlanLoader, RepeatWrapLegAndTheLegAfterALongRepeatAreChecked) {
+TEST(FlightplanLoader, RepeatWrapLegAndTheLegAfterALongRepeatAreChecked) {
     // A -> B -> C repeated 100000 times: only the wrap leg C -> A crosses 'middle'; the leg from C to D after
     // the repeat crosses 'east'. Validation folds the repeat, so this is quick and still finds both.
     const std::string text = R"(plan:
@@ -248,7 +248,7 @@ TEST(PlanLoader, RepeatWrapLegAndTheLegAfterALongRepeatAreChecked) {
 namespace airseg::flightplan {
 namespace {
 
-TEST(PlanLoader, MutatedPlansNeverCrash) {
+TEST(FlightplanLoader, MutatedPlansNeverCrash) {
     std::ifstream in(AIRSEG_SOURCE_DIR "/config/plans/rover-survey.yaml", std::ios::binary);
     const std::string original((std::istreambuf_iterator<char>(in)), {});
     ASSERT_FALSE(original.empty());
@@ -289,7 +289,7 @@ TEST(PlanLoader, MutatedPlansNeverCrash) {
     EXPECT_GT(accepted, 0);
 }
 
-TEST(PlanLoader, AliasExplosionIsBounded) {
+TEST(FlightplanLoader, AliasExplosionIsBounded) {
     // Seven levels of ten aliases each: 10^7 elements described in a few hundred bytes.
     std::string text =
         "plan:\n  name: bomb\n  blocks:\n    - name: b0\n      elements: &e0 [{waypoint: {lat: 41.0, lon: "
@@ -314,7 +314,7 @@ TEST(PlanLoader, AliasExplosionIsBounded) {
     EXPECT_TRUE(bounded) << to_string(r.errors);
 }
 
-TEST(PlanLoader, HugeScanIsRefusedNotComputed) {
+TEST(FlightplanLoader, HugeScanIsRefusedNotComputed) {
     const auto r = load_plan_text(R"(plan:
   name: huge
   vehicle: {min_spacing: 0.1}

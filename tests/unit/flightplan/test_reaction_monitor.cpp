@@ -15,7 +15,7 @@ ReactionSettings link_only(Duration after) {
     return s;
 }
 
-TEST(ReactionMonitor, LinkLossFiresOnceAfterTheDelayAndRecovers) {
+TEST(FlightplanReactions, LinkLossFiresOnceAfterTheDelayAndRecovers) {
     ReactionMonitor m(link_only(seconds(30)));
     const TimePoint t0{};
     m.on_link(false, t0);
@@ -40,7 +40,7 @@ TEST(ReactionMonitor, LinkLossFiresOnceAfterTheDelayAndRecovers) {
     EXPECT_FALSE(m.link_loss_active());
 }
 
-TEST(ReactionMonitor, ShortLinkDropoutsDoNotFire) {
+TEST(FlightplanReactions, ShortLinkDropoutsDoNotFire) {
     ReactionMonitor m(link_only(seconds(10)));
     TimePoint t{};
     for (int i = 0; i < 20; ++i) {
@@ -53,7 +53,7 @@ TEST(ReactionMonitor, ShortLinkDropoutsDoNotFire) {
     EXPECT_FALSE(m.poll_trigger().has_value());
 }
 
-TEST(ReactionMonitor, LowBatteryFiresOnceWithHysteresis) {
+TEST(FlightplanReactions, LowBatteryFiresOnceWithHysteresis) {
     ReactionSettings s;
     s.low_battery = Reaction{ReactionAction::ReturnHome, "", 0};
     s.low_battery_percent = 20.0;
@@ -72,7 +72,7 @@ TEST(ReactionMonitor, LowBatteryFiresOnceWithHysteresis) {
     EXPECT_EQ(m.rejected_samples(), 2u);
 }
 
-TEST(ReactionMonitor, GeofenceFromALoadedPlan) {
+TEST(FlightplanReactions, GeofenceFromALoadedPlan) {
     const auto r = load_plan_file(AIRSEG_SOURCE_DIR "/config/plans/rover-survey.yaml");
     ASSERT_TRUE(r.ok()) << to_string(r.errors);
     ReactionMonitor m(ReactionSettings::from_plan(*r.plan));

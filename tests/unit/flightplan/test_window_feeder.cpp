@@ -28,7 +28,7 @@ void expect_visited(const Harness& h, double base_lat, std::uint64_t from, std::
     }
 }
 
-TEST(WindowFeeder, ConfigRejectsWindowBelowThree) {
+TEST(FlightplanFeeder, ConfigRejectsWindowBelowThree) {
     FeederConfig c;
     c.window = 2;
     EXPECT_TRUE(c.validate().has_value());
@@ -36,7 +36,7 @@ TEST(WindowFeeder, ConfigRejectsWindowBelowThree) {
     EXPECT_FALSE(c.validate().has_value());
 }
 
-TEST(WindowFeeder, LongPlanReachedOnceInOrderWithoutStarvation) {
+TEST(FlightplanFeeder, LongPlanReachedOnceInOrderWithoutStarvation) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(2500), h.now);
     const int steps = h.run_until_done(6000);
@@ -54,7 +54,7 @@ TEST(WindowFeeder, LongPlanReachedOnceInOrderWithoutStarvation) {
     EXPECT_EQ(h.count(FeederEvent::Kind::PlanDone), 1u);
 }
 
-TEST(WindowFeeder, MinimumWindowOfThreeKeepsUp) {
+TEST(FlightplanFeeder, MinimumWindowOfThreeKeepsUp) {
     FeederConfig c;
     c.window = 3;
     Impairments imp;
@@ -68,7 +68,7 @@ TEST(WindowFeeder, MinimumWindowOfThreeKeepsUp) {
     EXPECT_EQ(h.feeder.progress().starvation_holds, 0u);
 }
 
-TEST(WindowFeeder, LateAndDuplicateReachedReportsAreAbsorbed) {
+TEST(FlightplanFeeder, LateAndDuplicateReachedReportsAreAbsorbed) {
     Impairments imp;
     imp.duplicate_reached = 0.2;
     imp.delay_reached = 0.2;
@@ -82,7 +82,7 @@ TEST(WindowFeeder, LateAndDuplicateReachedReportsAreAbsorbed) {
     EXPECT_GT(h.feeder.progress().ignored_reached, 100u);
 }
 
-TEST(WindowFeeder, LostReachedReportsAreRecoveredFromCurrentTarget) {
+TEST(FlightplanFeeder, LostReachedReportsAreRecoveredFromCurrentTarget) {
     Impairments imp;
     imp.drop_reached = 0.15;
     Harness h({}, imp, 11);
@@ -93,7 +93,7 @@ TEST(WindowFeeder, LostReachedReportsAreRecoveredFromCurrentTarget) {
     EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
 }
 
-TEST(WindowFeeder, FailedRequestsAreRetried) {
+TEST(FlightplanFeeder, FailedRequestsAreRetried) {
     Impairments imp;
     imp.fail_request = 0.2;
     imp.requests_per_step = 3;
@@ -106,7 +106,7 @@ TEST(WindowFeeder, FailedRequestsAreRetried) {
     EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
 }
 
-TEST(WindowFeeder, PersistentWriteFailuresHoldTheVehicleUntilTheWindowIsBack) {
+TEST(FlightplanFeeder, PersistentWriteFailuresHoldTheVehicleUntilTheWindowIsBack) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(300), h.now);
     for (int i = 0; i < 30; ++i)
@@ -126,7 +126,7 @@ TEST(WindowFeeder, PersistentWriteFailuresHoldTheVehicleUntilTheWindowIsBack) {
     EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
 }
 
-TEST(WindowFeeder, RebootMidPlanRebuildsTheWindowAndCarriesOn) {
+TEST(FlightplanFeeder, RebootMidPlanRebuildsTheWindowAndCarriesOn) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(800), h.now);
     for (int i = 0; i < 300; ++i)
@@ -142,7 +142,7 @@ TEST(WindowFeeder, RebootMidPlanRebuildsTheWindowAndCarriesOn) {
     EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
 }
 
-TEST(WindowFeeder, ReplacePlanKeepsCurrentTargetThenFollowsNewPlanWithoutStopping) {
+TEST(FlightplanFeeder, ReplacePlanKeepsCurrentTargetThenFollowsNewPlanWithoutStopping) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(1000, 41.0), h.now);
     for (int i = 0; i < 100; ++i)
@@ -162,7 +162,7 @@ TEST(WindowFeeder, ReplacePlanKeepsCurrentTargetThenFollowsNewPlanWithoutStoppin
     EXPECT_EQ(h.feeder.progress().generation, 2u);
 }
 
-TEST(WindowFeeder, SkipHeadsForTheRequestedWaypointNow) {
+TEST(FlightplanFeeder, SkipHeadsForTheRequestedWaypointNow) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(1000), h.now);
     for (int i = 0; i < 50; ++i)
@@ -176,7 +176,7 @@ TEST(WindowFeeder, SkipHeadsForTheRequestedWaypointNow) {
     EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
 }
 
-TEST(WindowFeeder, JumpToNamedElementContinuesThere) {
+TEST(FlightplanFeeder, JumpToNamedElementContinuesThere) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(100), h.now);
     for (int i = 0; i < 10; ++i)
@@ -188,7 +188,7 @@ TEST(WindowFeeder, JumpToNamedElementContinuesThere) {
     expect_visited(h, 41.0, 50, 100, visited_before);
 }
 
-TEST(WindowFeeder, PauseHoldsTheVehicleAndResumeContinues) {
+TEST(FlightplanFeeder, PauseHoldsTheVehicleAndResumeContinues) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(100), h.now);
     for (int i = 0; i < 20; ++i)
@@ -207,7 +207,7 @@ TEST(WindowFeeder, PauseHoldsTheVehicleAndResumeContinues) {
     expect_visited(h, 41.0, 0, 100);
 }
 
-TEST(WindowFeeder, HoldWaypointsHoldForTheirTimeOrUntilReleased) {
+TEST(FlightplanFeeder, HoldWaypointsHoldForTheirTimeOrUntilReleased) {
     Waypoint timed;
     timed.action = WaypointAction::HoldFor;
     timed.hold_seconds = 30.0;
@@ -244,7 +244,7 @@ TEST(WindowFeeder, HoldWaypointsHoldForTheirTimeOrUntilReleased) {
     EXPECT_EQ(h.feeder.progress().starvation_holds, 0u);
 }
 
-TEST(WindowFeeder, ShortPlanEndsOnStopItem) {
+TEST(FlightplanFeeder, ShortPlanEndsOnStopItem) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(2), h.now);
     ASSERT_LT(h.run_until_done(50), 50);
@@ -256,7 +256,7 @@ TEST(WindowFeeder, ShortPlanEndsOnStopItem) {
     EXPECT_EQ(h.feeder.progress().state, PlanState::Done);
 }
 
-TEST(WindowFeeder, ProgressReportsWindowAndResumePoint) {
+TEST(FlightplanFeeder, ProgressReportsWindowAndResumePoint) {
     Harness h;
     EXPECT_EQ(h.feeder.progress().state, PlanState::None);
     h.feeder.replace_plan(test::synthetic(100), h.now);
@@ -274,7 +274,7 @@ TEST(WindowFeeder, ProgressReportsWindowAndResumePoint) {
     EXPECT_EQ(p.element, "plan.elements[0]");
 }
 
-TEST(WindowFeeder, RequestTimeoutCountsAsFailureAndIsRetried) {
+TEST(FlightplanFeeder, RequestTimeoutCountsAsFailureAndIsRetried) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(10), h.now);
     auto first = h.feeder.poll_request(h.now);
@@ -301,7 +301,7 @@ TEST(WindowFeeder, RequestTimeoutCountsAsFailureAndIsRetried) {
 namespace airseg::flightplan {
 namespace {
 
-TEST(WindowFeeder, ExampleSurveyPlanElementsStartAndFinishInOrder) {
+TEST(FlightplanFeeder, ExampleSurveyPlanElementsStartAndFinishInOrder) {
     const auto r = load_plan_file(AIRSEG_SOURCE_DIR "/config/plans/rover-survey.yaml");
     ASSERT_TRUE(r.ok()) << to_string(r.errors);
     std::vector<Waypoint> expected;
@@ -368,7 +368,7 @@ TEST(WindowFeeder, ExampleSurveyPlanElementsStartAndFinishInOrder) {
 namespace airseg::flightplan {
 namespace {
 
-TEST(WindowFeeder, ClearPlanHoldsTheVehicleAndStopsFeeding) {
+TEST(FlightplanFeeder, ClearPlanHoldsTheVehicleAndStopsFeeding) {
     test::Harness h;
     h.feeder.replace_plan(test::synthetic(100), h.now);
     for (int i = 0; i < 20; ++i)
@@ -383,7 +383,7 @@ TEST(WindowFeeder, ClearPlanHoldsTheVehicleAndStopsFeeding) {
     EXPECT_LE(h.ap.visited().size(), 21u);
 }
 
-TEST(WindowFeeder, NewPlanAfterDoneStartsFromTheParkedVehicle) {
+TEST(FlightplanFeeder, NewPlanAfterDoneStartsFromTheParkedVehicle) {
     test::Harness h;
     h.feeder.replace_plan(test::synthetic(12, 41.0), h.now);
     ASSERT_LT(h.run_until_done(100), 100);
