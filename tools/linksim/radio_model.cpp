@@ -237,7 +237,6 @@ void RadioModel::deliver(Side from, std::vector<std::uint8_t> packet, TimePoint 
         ++d.stats.packets_lost;
         return;
     }
-    const double ber_byte = imp.bit_error_rate > 0.0 ? 1.0 - std::pow(1.0 - imp.bit_error_rate, 8.0) : 0.0;
     const TimePoint ready = end + imp.latency;
     // Capacity counts only bytes not yet written to the host by the time this packet is ready.
     auto pending_begin = std::upper_bound(d.serial_out.begin(), d.serial_out.end(), ready,
@@ -252,8 +251,12 @@ void RadioModel::deliver(Side from, std::vector<std::uint8_t> packet, TimePoint 
         if (chance(d, imp.byte_corruption)) {
             b ^= random_bit(d.rng);
         }
-        if (chance(d, ber_byte)) {
-            b ^= random_bit(d.rng);
+        if (imp.bit_error_rate > 0.0) {
+            for (int bit = 0; bit < 8; ++bit) {
+                if (chance(d, imp.bit_error_rate)) {
+                    b ^= static_cast<std::uint8_t>(1U << bit);
+                }
+            }
         }
         if (b != original) {
             ++d.stats.bytes_corrupted;

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <numeric>
 #include <stdexcept>
 #include <vector>
@@ -189,6 +190,25 @@ TEST(RadioModel, ImpairmentRatesMatchConfiguration) {
     EXPECT_NEAR(static_cast<double>(st.bytes_lost) / 50'000.0, 0.02, 0.004);
     EXPECT_NEAR(static_cast<double>(st.bytes_corrupted) / 50'000.0, 0.05 * 0.98, 0.006);
     EXPECT_EQ(st.bytes_out, 50'000u - st.bytes_lost);
+}
+
+TEST(RadioModel, BitErrorRateFlipsBitsAtThatRate) {
+    RadioConfig c = clean(Duplex::Full);
+    c.seed = 11;
+    c.impairment[index(Side::A)].bit_error_rate = 0.01;
+    RadioModel model(c, kStart);
+    const auto sent = pattern(40'000);
+    Drive drive(model, sent, {});
+    drive.run(seconds(8));
+    const auto& got = drive.received[index(Side::B)];
+    ASSERT_EQ(got.size(), sent.size());
+    std::size_t flipped = 0;
+    for (std::size_t i = 0; i < got.size(); ++i) {
+        flipped += static_cast<std::size_t>(__builtin_popcount(static_cast<unsigned>(got[i] ^ sent[i])));
+    }
+    EXPECT_NEAR(static_cast<double>(flipped) / (8.0 * 40'000.0), 0.01, 0.001);
+    EXPECT_NEAR(static_cast<double>(model.stats(Side::A).bytes_corrupted) / 40'000.0, 1.0 - std::pow(0.99, 8),
+                0.006);
 }
 
 TEST(RadioModel, OutageLosesOnlyPacketsInsideIt) {
