@@ -21,7 +21,7 @@ std::vector<Duration> sampled_changes(LedPattern p, Duration span) {
     return changes;
 }
 
-TEST(BlinkPatternTest, BootingBlinksFastAndEvenly) {
+TEST(HalBlinkPatternTest, BootingBlinksFastAndEvenly) {
     EXPECT_TRUE(led_level(LedPattern::Booting, milliseconds(0)));
     EXPECT_TRUE(led_level(LedPattern::Booting, milliseconds(99)));
     EXPECT_FALSE(led_level(LedPattern::Booting, milliseconds(100)));
@@ -29,14 +29,14 @@ TEST(BlinkPatternTest, BootingBlinksFastAndEvenly) {
     EXPECT_EQ(blink_period(LedPattern::Booting), milliseconds(200));
 }
 
-TEST(BlinkPatternTest, ReadyBlinksSlowly) {
+TEST(HalBlinkPatternTest, ReadyBlinksSlowly) {
     EXPECT_TRUE(led_level(LedPattern::Ready, milliseconds(999)));
     EXPECT_FALSE(led_level(LedPattern::Ready, milliseconds(1000)));
     EXPECT_FALSE(led_level(LedPattern::Ready, milliseconds(1999)));
     EXPECT_TRUE(led_level(LedPattern::Ready, milliseconds(2000)));
 }
 
-TEST(BlinkPatternTest, LinkUpIsMostlyOnWithABlip) {
+TEST(HalBlinkPatternTest, LinkUpIsMostlyOnWithABlip) {
     int on = 0;
     for (int ms = 0; ms < 2000; ++ms) {
         on += led_level(LedPattern::LinkUp, milliseconds(ms)) ? 1 : 0;
@@ -45,24 +45,24 @@ TEST(BlinkPatternTest, LinkUpIsMostlyOnWithABlip) {
     EXPECT_FALSE(led_level(LedPattern::LinkUp, milliseconds(1950)));
 }
 
-TEST(BlinkPatternTest, FaultFlashesTwicePerSecond) {
+TEST(HalBlinkPatternTest, FaultFlashesTwicePerSecond) {
     const auto changes = sampled_changes(LedPattern::Fault, milliseconds(1000));
     EXPECT_EQ(changes, (std::vector<Duration>{milliseconds(100), milliseconds(200), milliseconds(300)}));
 }
 
-TEST(BlinkPatternTest, OffNeverLightsOrChanges) {
+TEST(HalBlinkPatternTest, OffNeverLightsOrChanges) {
     EXPECT_TRUE(sampled_changes(LedPattern::Off, milliseconds(5000)).empty());
     EXPECT_FALSE(led_level(LedPattern::Off, milliseconds(123)));
     EXPECT_EQ(next_led_change(LedPattern::Off, milliseconds(0)), Duration::max());
 }
 
-TEST(BlinkPatternTest, NegativeElapsedCountsAsStart) {
+TEST(HalBlinkPatternTest, NegativeElapsedCountsAsStart) {
     EXPECT_TRUE(led_level(LedPattern::Booting, -milliseconds(50)));
     EXPECT_EQ(next_led_change(LedPattern::Booting, -milliseconds(50)), milliseconds(100));
 }
 
 // next_led_change must predict exactly the changes that sampling finds, for every pattern and from any time.
-TEST(BlinkPatternTest, NextChangeAgreesWithSampling) {
+TEST(HalBlinkPatternTest, NextChangeAgreesWithSampling) {
     for (auto p : {LedPattern::Booting, LedPattern::Ready, LedPattern::LinkUp, LedPattern::Fault}) {
         const Duration span = 3 * blink_period(p);
         const auto sampled = sampled_changes(p, span);

@@ -5,7 +5,7 @@
 namespace airseg::hal {
 namespace {
 
-TEST(ManualClockTest, StartsAwayFromZeroAndMovesOnlyWhenTold) {
+TEST(HalManualClockTest, StartsAwayFromZeroAndMovesOnlyWhenTold) {
     ManualClock clock;
     EXPECT_NE(clock.now(), TimePoint{});
     const TimePoint t0 = clock.now();
@@ -16,7 +16,7 @@ TEST(ManualClockTest, StartsAwayFromZeroAndMovesOnlyWhenTold) {
     EXPECT_EQ(clock.now() - t0, milliseconds(2250));
 }
 
-TEST(ManualClockTest, NegativeAdvanceIsIgnoredButSetMayGoBack) {
+TEST(HalManualClockTest, NegativeAdvanceIsIgnoredButSetMayGoBack) {
     ManualClock clock(TimePoint{} + seconds(10));
     clock.advance(-seconds(5));
     EXPECT_EQ(clock.now(), TimePoint{} + seconds(10));
@@ -24,7 +24,7 @@ TEST(ManualClockTest, NegativeAdvanceIsIgnoredButSetMayGoBack) {
     EXPECT_EQ(clock.now(), TimePoint{} + seconds(3));
 }
 
-TEST(ManualClockTest, UsableThroughTheInterface) {
+TEST(HalManualClockTest, UsableThroughTheInterface) {
     ManualClock manual;
     const Clock& clock = manual;
     const TimePoint before = clock.now();
@@ -32,7 +32,7 @@ TEST(ManualClockTest, UsableThroughTheInterface) {
     EXPECT_GT(clock.now(), before);
 }
 
-TEST(SteadyClockTest, IsMonotonic) {
+TEST(HalSteadyClockTest, IsMonotonic) {
     SteadyClock clock;
     const TimePoint a = clock.now();
     const TimePoint b = clock.now();

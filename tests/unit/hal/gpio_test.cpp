@@ -29,7 +29,7 @@ GpioLineRequest by_name(const std::string& name, GpioDirection direction = GpioD
     return r;
 }
 
-TEST(GpioRequestTest, NeedsExactlyOneWayToAddressALine) {
+TEST(HalGpioRequestTest, NeedsExactlyOneWayToAddressALine) {
     EXPECT_EQ(GpioLineRequest::validate(GpioLineRequest{}).size(), 1u);
     auto both = output_at("gpiochip0", 3);
     both.line_name = "LED";
@@ -40,7 +40,7 @@ TEST(GpioRequestTest, NeedsExactlyOneWayToAddressALine) {
     EXPECT_EQ(output_at("gpiochip1", 7).describe(), "gpiochip1:7");
 }
 
-class FakeGpioTest : public ::testing::Test {
+class HalFakeGpioTest : public ::testing::Test {
   protected:
     void SetUp() override {
         gpio_.add_line("gpiochip0", 17, "STATUS_LED");
@@ -51,7 +51,7 @@ class FakeGpioTest : public ::testing::Test {
     FakeGpio gpio_{clock_};
 };
 
-TEST_F(FakeGpioTest, RecordsEveryLevelWithItsTime) {
+TEST_F(HalFakeGpioTest, RecordsEveryLevelWithItsTime) {
     const auto r = gpio_.request(output_at("gpiochip0", 17, true));
     ASSERT_TRUE(r.ok()) << r.message;
     const TimePoint t0 = clock_.now();
@@ -72,7 +72,7 @@ TEST_F(FakeGpioTest, RecordsEveryLevelWithItsTime) {
     EXPECT_EQ(gpio_.history("gpiochip0:17").size(), 3u) << "chip:offset and name address the same line";
 }
 
-TEST_F(FakeGpioTest, FindsLinesByNameAcrossChips) {
+TEST_F(HalFakeGpioTest, FindsLinesByNameAcrossChips) {
     const auto r = gpio_.request(by_name("ARM_SWITCH", GpioDirection::Input));
     ASSERT_TRUE(r.ok()) << r.message;
     EXPECT_EQ(r.line->name(), "gpiochip1:2");
@@ -82,7 +82,7 @@ TEST_F(FakeGpioTest, FindsLinesByNameAcrossChips) {
     EXPECT_TRUE(r.line->set(true)) << "an input cannot be driven";
 }
 
-TEST_F(FakeGpioTest, UnknownLinesAndDoubleRequestsFailWithTheLineNamed) {
+TEST_F(HalFakeGpioTest, UnknownLinesAndDoubleRequestsFailWithTheLineNamed) {
     const auto missing = gpio_.request(by_name("NO_SUCH_LINE"));
     EXPECT_FALSE(missing.ok());
     EXPECT_EQ(missing.error, std::errc::no_such_file_or_directory);
@@ -98,7 +98,7 @@ TEST_F(FakeGpioTest, UnknownLinesAndDoubleRequestsFailWithTheLineNamed) {
     EXPECT_TRUE(gpio_.request(by_name("APM_RESET")).ok()) << "a released line can be requested again";
 }
 
-TEST(GpioPulseTest, HoldsTheLineActiveForTheWidthThenReleasesIt) {
+TEST(HalGpioPulseTest, HoldsTheLineActiveForTheWidthThenReleasesIt) {
     boost::asio::io_context io;
     SteadyClock clock;
     FakeGpio gpio(clock);
@@ -122,7 +122,7 @@ TEST(GpioPulseTest, HoldsTheLineActiveForTheWidthThenReleasesIt) {
     EXPECT_GE(h[2].at - h[1].at, milliseconds(20));
 }
 
-TEST(LedBlinkerTest, DrivesThePatternOnTheLineAndTurnsOffWhenDestroyed) {
+TEST(HalLedBlinkerTest, DrivesThePatternOnTheLineAndTurnsOffWhenDestroyed) {
     boost::asio::io_context io;
     SteadyClock clock;
     FakeGpio gpio(clock);
@@ -149,7 +149,7 @@ TEST(LedBlinkerTest, DrivesThePatternOnTheLineAndTurnsOffWhenDestroyed) {
     EXPECT_FALSE(gpio.value("STATUS_LED")) << "no timer may fire after destruction";
 }
 
-TEST(LedBlinkerTest, ConstantPatternNeedsNoTimer) {
+TEST(HalLedBlinkerTest, ConstantPatternNeedsNoTimer) {
     boost::asio::io_context io;
     ManualClock clock;
     FakeGpio gpio(clock);
@@ -196,7 +196,7 @@ std::string find_simulated_chip() {
     return {};
 }
 
-TEST(LibgpiodTest, MissingChipIsReportedByName) {
+TEST(HalLibgpiodTest, MissingChipIsReportedByName) {
     LibgpiodFactory gpio;
     const auto r = gpio.request(output_at("gpiochip-airseg-missing", 0));
     EXPECT_FALSE(r.ok());
@@ -204,20 +204,20 @@ TEST(LibgpiodTest, MissingChipIsReportedByName) {
     EXPECT_NE(r.message.find("gpiochip-airseg-missing"), std::string::npos) << r.message;
 }
 
-TEST(LibgpiodTest, MissingLineNameIsReportedByName) {
+TEST(HalLibgpiodTest, MissingLineNameIsReportedByName) {
     LibgpiodFactory gpio;
     const auto r = gpio.request(by_name("AIRSEG_NO_SUCH_LINE"));
     EXPECT_FALSE(r.ok());
     EXPECT_NE(r.message.find("AIRSEG_NO_SUCH_LINE"), std::string::npos) << r.message;
 }
 
-TEST(LibgpiodTest, InvalidRequestIsRejectedBeforeTouchingTheKernel) {
+TEST(HalLibgpiodTest, InvalidRequestIsRejectedBeforeTouchingTheKernel) {
     LibgpiodFactory gpio;
     const auto r = gpio.request(GpioLineRequest{});
     EXPECT_EQ(r.error, std::errc::invalid_argument);
 }
 
-TEST(LibgpiodTest, OffsetBeyondTheChipIsRejected) {
+TEST(HalLibgpiodTest, OffsetBeyondTheChipIsRejected) {
     if (!have_gpiochip()) {
         GTEST_SKIP() << "no /dev/gpiochip* on this machine";
     }
@@ -227,7 +227,7 @@ TEST(LibgpiodTest, OffsetBeyondTheChipIsRejected) {
     EXPECT_NE(r.message.find("out of range"), std::string::npos) << r.message;
 }
 
-TEST(LibgpiodTest, DrivesALineOnASimulatedChip) {
+TEST(HalLibgpiodTest, DrivesALineOnASimulatedChip) {
     if (!have_gpiochip()) {
         GTEST_SKIP() << "no /dev/gpiochip* on this machine";
     }

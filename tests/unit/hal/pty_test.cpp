@@ -58,7 +58,7 @@ class PeerFd {
     int fd_;
 };
 
-class PtyTest : public ::testing::Test {
+class HalPtyTest : public ::testing::Test {
   protected:
     void SetUp() override {
         ASSERT_FALSE(dir_.path().empty());
@@ -87,23 +87,23 @@ std::string read_link(const std::string& path) {
     return n > 0 ? std::string(buf, static_cast<std::size_t>(n)) : std::string();
 }
 
-TEST(PtyConfigTest, RejectsEmptyPathAndZeroPeriod) {
+TEST(HalPtyConfigTest, RejectsEmptyPathAndZeroPeriod) {
     PtyConfig c;
     c.peer_check_period = Duration::zero();
     EXPECT_EQ(PtyConfig::validate(c).size(), 2u);
 }
 
-TEST_F(PtyTest, PublishesSlaveAtTheLinkPath) {
+TEST_F(HalPtyTest, PublishesSlaveAtTheLinkPath) {
     open_pty();
     EXPECT_EQ(read_link(link()), pty_.slave_path());
     EXPECT_EQ(pty_.slave_path().rfind("/dev/pts/", 0), 0u) << pty_.slave_path();
     EXPECT_FALSE(pty_.peer_connected());
 }
 
-class PtyPeerTest : public PtyTest, public ::testing::WithParamInterface<bool> {};
+class HalPtyPeerTest : public HalPtyTest, public ::testing::WithParamInterface<bool> {};
 
 // With reading on, a peer close surfaces as EIO on the master; with it off, only the periodic poll sees it.
-TEST_P(PtyPeerTest, DetectsPeerOpenAndClose) {
+TEST_P(HalPtyPeerTest, DetectsPeerOpenAndClose) {
     const bool reading = GetParam();
     open_pty();
     if (reading) {
@@ -122,9 +122,9 @@ TEST_P(PtyPeerTest, DetectsPeerOpenAndClose) {
     EXPECT_EQ(closes_, 2);
 }
 
-INSTANTIATE_TEST_SUITE_P(ReadingOnOff, PtyPeerTest, ::testing::Bool());
+INSTANTIATE_TEST_SUITE_P(HalReadingOnOff, HalPtyPeerTest, ::testing::Bool());
 
-TEST_F(PtyTest, DataFlowsBothWays) {
+TEST_F(HalPtyTest, DataFlowsBothWays) {
     open_pty();
     pty_.start_reading(
         [this](std::span<const std::uint8_t> b) { received_.insert(received_.end(), b.begin(), b.end()); });
@@ -147,14 +147,14 @@ TEST_F(PtyTest, DataFlowsBothWays) {
     EXPECT_EQ(at_peer, down);
 }
 
-TEST_F(PtyTest, WritesWithoutPeerAreDropped) {
+TEST_F(HalPtyTest, WritesWithoutPeerAreDropped) {
     EXPECT_EQ(pty_.write({1}), WriteResult::NotOpen);
     open_pty();
     EXPECT_EQ(pty_.write({1, 2, 3}), WriteResult::NoPeer);
     EXPECT_EQ(pty_.queued_bytes(), 0u);
 }
 
-TEST_F(PtyTest, UnplugMakesThePeerFailAndRemovesTheLink) {
+TEST_F(HalPtyTest, UnplugMakesThePeerFailAndRemovesTheLink) {
     open_pty();
     PeerFd peer(link());
     ASSERT_GE(peer.get(), 0);
@@ -174,7 +174,7 @@ TEST_F(PtyTest, UnplugMakesThePeerFailAndRemovesTheLink) {
     EXPECT_EQ(errno, EIO);
 }
 
-TEST_F(PtyTest, ReplugServesTheSamePathAgain) {
+TEST_F(HalPtyTest, ReplugServesTheSamePathAgain) {
     open_pty();
     pty_.start_reading(
         [this](std::span<const std::uint8_t> b) { received_.insert(received_.end(), b.begin(), b.end()); });
@@ -191,13 +191,13 @@ TEST_F(PtyTest, ReplugServesTheSamePathAgain) {
     EXPECT_EQ(received_, (std::vector<std::uint8_t>{0xAA, 0x55}));
 }
 
-TEST_F(PtyTest, ReplacesAStaleSymlink) {
+TEST_F(HalPtyTest, ReplacesAStaleSymlink) {
     ASSERT_EQ(::symlink("/dev/pts/does-not-exist", link().c_str()), 0);
     open_pty();
     EXPECT_EQ(read_link(link()), pty_.slave_path());
 }
 
-TEST_F(PtyTest, RefusesToReplaceARegularFile) {
+TEST_F(HalPtyTest, RefusesToReplaceARegularFile) {
     { std::ofstream(link()) << "precious"; }
     const auto result = pty_.open();
     EXPECT_EQ(result.error, make_error_code(HalError::PathOccupied));
@@ -208,7 +208,7 @@ TEST_F(PtyTest, RefusesToReplaceARegularFile) {
     EXPECT_EQ(content, "precious");
 }
 
-TEST_F(PtyTest, DestructionRemovesTheLink) {
+TEST_F(HalPtyTest, DestructionRemovesTheLink) {
     {
         Pty scoped(io_.get_executor(), PtyConfig{link()});
         ASSERT_TRUE(scoped.open().ok());
@@ -220,7 +220,7 @@ TEST_F(PtyTest, DestructionRemovesTheLink) {
 }
 
 // The way the simulators use it: airsegd's SerialPort opens the link, the simulator pulls the cable.
-TEST_F(PtyTest, SerialPortAsPeerSeesOneUnplugAndCanReopenAfterReplug) {
+TEST_F(HalPtyTest, SerialPortAsPeerSeesOneUnplugAndCanReopenAfterReplug) {
     open_pty();
     pty_.start_reading(
         [this](std::span<const std::uint8_t> b) { received_.insert(received_.end(), b.begin(), b.end()); });

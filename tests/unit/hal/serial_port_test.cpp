@@ -22,7 +22,7 @@ struct Received {
     std::vector<std::pair<std::error_code, std::string>> errors;
 };
 
-class SerialPortTest : public ::testing::Test {
+class HalSerialPortTest : public ::testing::Test {
   protected:
     void SetUp() override { ASSERT_TRUE(pty_.ok()) << "openpty failed"; }
 
@@ -48,7 +48,7 @@ class SerialPortTest : public ::testing::Test {
     Received received_;
 };
 
-TEST(SerialConfigTest, RejectsNonStandardBaudNamingIt) {
+TEST(HalSerialConfigTest, RejectsNonStandardBaudNamingIt) {
     SerialConfig c;
     c.path = "/dev/ttyS9";
     c.baud = 12345;
@@ -60,7 +60,7 @@ TEST(SerialConfigTest, RejectsNonStandardBaudNamingIt) {
         << "should list the supported rates: " << errors[0];
 }
 
-TEST(SerialConfigTest, AcceptsEveryStandardBaud) {
+TEST(HalSerialConfigTest, AcceptsEveryStandardBaud) {
     for (unsigned baud : {9600u, 19200u, 38400u, 57600u, 115200u, 230400u, 460800u, 500000u, 921600u}) {
         SerialConfig c;
         c.path = "/dev/ttyS0";
@@ -69,14 +69,14 @@ TEST(SerialConfigTest, AcceptsEveryStandardBaud) {
     }
 }
 
-TEST(SerialConfigTest, RejectsEmptyPathAndHandDrivenRtsUnderFlowControl) {
+TEST(HalSerialConfigTest, RejectsEmptyPathAndHandDrivenRtsUnderFlowControl) {
     SerialConfig c;
     c.rtscts = true;
     c.rts_on_open = true;
     EXPECT_EQ(SerialConfig::validate(c).size(), 2u);
 }
 
-TEST_F(SerialPortTest, InvalidBaudIsRejectedWithMessage) {
+TEST_F(HalSerialPortTest, InvalidBaudIsRejectedWithMessage) {
     SerialPort port(io_.get_executor());
     auto c = config_for(pty_);
     c.baud = 14400;
@@ -86,7 +86,7 @@ TEST_F(SerialPortTest, InvalidBaudIsRejectedWithMessage) {
     EXPECT_FALSE(port.is_open());
 }
 
-TEST_F(SerialPortTest, NonexistentPathErrorNamesThePath) {
+TEST_F(HalSerialPortTest, NonexistentPathErrorNamesThePath) {
     SerialPort port(io_.get_executor());
     SerialConfig c;
     c.path = "/nonexistent/ttyAIRSEG0";
@@ -96,7 +96,7 @@ TEST_F(SerialPortTest, NonexistentPathErrorNamesThePath) {
     EXPECT_FALSE(port.is_open());
 }
 
-TEST_F(SerialPortTest, RegularFileIsNotATerminal) {
+TEST_F(HalSerialPortTest, RegularFileIsNotATerminal) {
     char name[] = "/tmp/airseg-hal-notatty-XXXXXX";
     const int fd = ::mkstemp(name);
     ASSERT_GE(fd, 0);
@@ -110,9 +110,9 @@ TEST_F(SerialPortTest, RegularFileIsNotATerminal) {
     EXPECT_NE(result.message.find(name), std::string::npos) << result.message;
 }
 
-class SerialPortBaudTest : public SerialPortTest, public ::testing::WithParamInterface<unsigned> {};
+class HalSerialPortBaudTest : public HalSerialPortTest, public ::testing::WithParamInterface<unsigned> {};
 
-TEST_P(SerialPortBaudTest, BytesFlowBothWays) {
+TEST_P(HalSerialPortBaudTest, BytesFlowBothWays) {
     SerialPort port(io_.get_executor());
     open_and_read(port, config_for(pty_, GetParam()));
 
@@ -132,9 +132,9 @@ TEST_P(SerialPortBaudTest, BytesFlowBothWays) {
     EXPECT_TRUE(received_.errors.empty());
 }
 
-INSTANTIATE_TEST_SUITE_P(StandardRates, SerialPortBaudTest, ::testing::Values(57600u, 115200u));
+INSTANTIATE_TEST_SUITE_P(HalStandardRates, HalSerialPortBaudTest, ::testing::Values(57600u, 115200u));
 
-TEST_F(SerialPortTest, LargeWritesArriveInOrder) {
+TEST_F(HalSerialPortTest, LargeWritesArriveInOrder) {
     SerialPort port(io_.get_executor());
     open_and_read(port, config_for(pty_));
 
@@ -156,7 +156,7 @@ TEST_F(SerialPortTest, LargeWritesArriveInOrder) {
     EXPECT_EQ(at_master, expected);
 }
 
-TEST_F(SerialPortTest, WriteQueueIsBounded) {
+TEST_F(HalSerialPortTest, WriteQueueIsBounded) {
     SerialPort port(io_.get_executor());
     auto c = config_for(pty_);
     c.max_queued_bytes = 1000;
@@ -168,12 +168,12 @@ TEST_F(SerialPortTest, WriteQueueIsBounded) {
     EXPECT_EQ(port.write(std::vector<std::uint8_t>(300, 0x55)), WriteResult::Queued);
 }
 
-TEST_F(SerialPortTest, WriteOnClosedPortIsRefused) {
+TEST_F(HalSerialPortTest, WriteOnClosedPortIsRefused) {
     SerialPort port(io_.get_executor());
     EXPECT_EQ(port.write({1, 2, 3}), WriteResult::NotOpen);
 }
 
-TEST_F(SerialPortTest, ModemLinesOnPtyWarnButOpen) {
+TEST_F(HalSerialPortTest, ModemLinesOnPtyWarnButOpen) {
     SerialPort port(io_.get_executor());
     auto c = config_for(pty_);
     c.dtr_on_open = true;
@@ -187,7 +187,7 @@ TEST_F(SerialPortTest, ModemLinesOnPtyWarnButOpen) {
     EXPECT_TRUE(port.is_open());
 }
 
-TEST_F(SerialPortTest, PeerCloseIsReportedOnceAsUnplugged) {
+TEST_F(HalSerialPortTest, PeerCloseIsReportedOnceAsUnplugged) {
     SerialPort port(io_.get_executor());
     open_and_read(port, config_for(pty_));
     pty_.close_master();
@@ -200,7 +200,7 @@ TEST_F(SerialPortTest, PeerCloseIsReportedOnceAsUnplugged) {
     EXPECT_FALSE(port.is_open());
 }
 
-TEST_F(SerialPortTest, UnplugWithWritesPendingIsStillReportedOnce) {
+TEST_F(HalSerialPortTest, UnplugWithWritesPendingIsStillReportedOnce) {
     SerialPort port(io_.get_executor());
     open_and_read(port, config_for(pty_));
     for (int i = 0; i < 16; ++i) {
@@ -215,7 +215,7 @@ TEST_F(SerialPortTest, UnplugWithWritesPendingIsStillReportedOnce) {
     EXPECT_EQ(port.queued_bytes(), 0u);
 }
 
-TEST_F(SerialPortTest, ReopenAfterUnplugWorks) {
+TEST_F(HalSerialPortTest, ReopenAfterUnplugWorks) {
     SerialPort port(io_.get_executor());
     open_and_read(port, config_for(pty_));
     pty_.close_master();
@@ -238,7 +238,7 @@ TEST_F(SerialPortTest, ReopenAfterUnplugWorks) {
     EXPECT_EQ(received_.errors.size(), 1u);
 }
 
-TEST_F(SerialPortTest, CloseIsNotAnErrorEvent) {
+TEST_F(HalSerialPortTest, CloseIsNotAnErrorEvent) {
     SerialPort port(io_.get_executor());
     open_and_read(port, config_for(pty_));
     EXPECT_EQ(port.write(pattern_bytes(100000, 3)), WriteResult::Queued);
@@ -249,7 +249,7 @@ TEST_F(SerialPortTest, CloseIsNotAnErrorEvent) {
     EXPECT_EQ(port.queued_bytes(), 0u);
 }
 
-TEST_F(SerialPortTest, DestroyingThePortWithOperationsPendingIsSafe) {
+TEST_F(HalSerialPortTest, DestroyingThePortWithOperationsPendingIsSafe) {
     {
         SerialPort port(io_.get_executor());
         open_and_read(port, config_for(pty_));

@@ -29,7 +29,7 @@ std::vector<std::uint8_t> read_exactly(int fd, std::size_t want, std::chrono::mi
     return out;
 }
 
-TEST(SerialPortThreadsTest, WorksOnAStrandOfAThreadPool) {
+TEST(HalSerialPortThreadsTest, WorksOnAStrandOfAThreadPool) {
     TestPty pty;
     ASSERT_TRUE(pty.ok());
     boost::asio::io_context io;

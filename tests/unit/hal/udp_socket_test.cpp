@@ -35,7 +35,7 @@ UdpConfig loopback(std::uint16_t remote_port = 0) {
     return c;
 }
 
-class UdpSocketTest : public ::testing::Test {
+class HalUdpSocketTest : public ::testing::Test {
   protected:
     void SetUp() override {
         ASSERT_TRUE(ground_.open(loopback()).ok());
@@ -52,7 +52,7 @@ class UdpSocketTest : public ::testing::Test {
     Inbox air_inbox_;
 };
 
-TEST(UdpConfigTest, NamesBadAddressesAndMissingPorts) {
+TEST(HalUdpConfigTest, NamesBadAddressesAndMissingPorts) {
     UdpConfig c;
     c.bind_address = "not-an-ip";
     c.remote_address = "10.0.0.300";
@@ -63,7 +63,7 @@ TEST(UdpConfigTest, NamesBadAddressesAndMissingPorts) {
     EXPECT_NE(errors[2].find("remote_port"), std::string::npos);
 }
 
-TEST_F(UdpSocketTest, DatagramsFlowAndTheReplyGoesToTheLastSender) {
+TEST_F(HalUdpSocketTest, DatagramsFlowAndTheReplyGoesToTheLastSender) {
     EXPECT_FALSE(ground_.remote().has_value());
     EXPECT_EQ(ground_.send({1}), WriteResult::NoPeer);
 
@@ -80,7 +80,7 @@ TEST_F(UdpSocketTest, DatagramsFlowAndTheReplyGoesToTheLastSender) {
     EXPECT_EQ(air_inbox_.datagrams[0], (std::vector<std::uint8_t>{9, 8, 7}));
 }
 
-TEST_F(UdpSocketTest, OversizeDatagramsAreDroppedWholeAndCounted) {
+TEST_F(HalUdpSocketTest, OversizeDatagramsAreDroppedWholeAndCounted) {
     EXPECT_EQ(air_.send(std::vector<std::uint8_t>(UdpSocket::kMaxDatagram + 1, 0)), WriteResult::TooLarge);
 
     // A foreign sender that ignores the limit.
@@ -97,7 +97,7 @@ TEST_F(UdpSocketTest, OversizeDatagramsAreDroppedWholeAndCounted) {
     EXPECT_EQ(ground_inbox_.datagrams[0], small);
 }
 
-TEST_F(UdpSocketTest, BindingAPortInUseFailsWithTheAddressNamed) {
+TEST_F(HalUdpSocketTest, BindingAPortInUseFailsWithTheAddressNamed) {
     UdpSocket other(io_.get_executor());
     UdpConfig c = loopback();
     c.bind_port = ground_.local_endpoint().port();
@@ -106,7 +106,7 @@ TEST_F(UdpSocketTest, BindingAPortInUseFailsWithTheAddressNamed) {
     EXPECT_NE(r.message.find("127.0.0.1:" + std::to_string(c.bind_port)), std::string::npos) << r.message;
 }
 
-TEST_F(UdpSocketTest, ClosedSocketRefusesToSendAndReportsNothing) {
+TEST_F(HalUdpSocketTest, ClosedSocketRefusesToSendAndReportsNothing) {
     air_.close();
     EXPECT_EQ(air_.send({1}), WriteResult::NotOpen);
     test::run_until_idle(io_, std::chrono::milliseconds(50));
