@@ -121,6 +121,7 @@ class Transport::Impl {
         TimePoint air_debt{};  // half duplex: air budget of both ends together
         double tx_rate = 0.0;  // bytes/s written to the path, same average
         TimePoint tx_rate_time{};
+        std::size_t last_frame = 0;  // bytes of the latest frame written
     };
     std::vector<Path> paths;
     std::uint8_t peer_mask = 0;

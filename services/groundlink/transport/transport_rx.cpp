@@ -26,7 +26,7 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
         // that budget (air_ok), so a saturating end cannot starve the other.
         const auto air = std::chrono::duration_cast<Duration>(
             std::chrono::duration<double>(static_cast<double>(bytes.size()) / cfg.link_rate_bytes_per_s));
-        ps.air_debt = std::max(ps.air_debt, now_ - air) + (peer_urgent ? air + air / 2 : air + air / 10);
+        ps.air_debt = std::max(ps.air_debt, now_ - air) + (peer_urgent ? air + air / 2 : air + air / 4);
     }
     ps.deframer.feed(
         bytes, [&](std::vector<std::uint8_t>&& plain) { on_plain_frame(path, plain, now_); },

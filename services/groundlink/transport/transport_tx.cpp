@@ -9,6 +9,7 @@ namespace {
 
 constexpr std::size_t kMinUsefulSafe = 16;  // do not top up a frame with a Safe sliver smaller than this
 constexpr std::size_t kMaxDataChunks = 64;
+constexpr double kFairShare = 0.45;      // of link_rate, below which an end is not held back on shared air
 constexpr double kLossyFraction = 0.15;  // declared-lost share of Safe segments above which frames stay small
 
 }  // namespace
@@ -116,11 +117,16 @@ Transport::Impl::AirGate Transport::Impl::air_gate(std::size_t path) const {
     if (!cfg.half_duplex || now_ >= ps.air_debt) {
         return AirGate::open;
     }
-    // An end using less than half the air still sends its urgent traffic, so a saturating peer cannot starve
-    // it; its bulk, and everything of a heavier end, waits for the air budget both ends share.
-    return decayed_rate(ps.tx_rate, ps.tx_rate_time, now_) < 0.5 * cfg.link_rate_bytes_per_s
-               ? AirGate::urgent_only
-               : AirGate::closed;
+    // An end using less than its fair share of the air (a little under half) is not held back, so a
+    // saturating peer cannot starve it and two saturating ends share the air; while the peer has urgent
+    // traffic only its urgent traffic goes. A heavier end waits for the air budget both ends share.
+    // The average decays between frames; half a frame restores its mean over the sawtooth.
+    const double rate =
+        decayed_rate(ps.tx_rate, ps.tx_rate_time, now_) + 0.5 * static_cast<double>(ps.last_frame);
+    if (rate >= kFairShare * cfg.link_rate_bytes_per_s) {
+        return AirGate::closed;
+    }
+    return peer_urgent && peer_mask_fresh() ? AirGate::urgent_only : AirGate::open;
 }
 
 TimePoint Transport::Impl::ack_due() const {
@@ -184,6 +190,7 @@ void Transport::Impl::account_sent(std::size_t path, std::size_t bytes, TimePoin
     ps.air_debt = std::max(ps.air_debt, now) + air;  // the shared-air budget counts both ends
     ps.tx_rate = decayed_rate(ps.tx_rate, ps.tx_rate_time, now) + static_cast<double>(bytes);
     ps.tx_rate_time = now;
+    ps.last_frame = bytes;
 
     ps.last_sent = now;
     ++stats.frames_sent;
