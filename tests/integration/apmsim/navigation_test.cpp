@@ -1,0 +1,178 @@
+// RoverSim driving missions in simulated time: reached events, HOLD at the end, retargeting, mode history.
+#include <gtest/gtest.h>
+
+#include "tests/integration/apmsim/sim_harness.hpp"
+
+namespace airseg::apmsim::test {
+namespace {
+
+std::vector<std::uint16_t> reached_seqs(const SimHarness& h, std::size_t from = 0) {
+    std::vector<std::uint16_t> seqs;
+    for (const auto& r : h.all<mv::MissionItemReached>(from)) {
+        seqs.push_back(r.seq);
+    }
+    return seqs;
+}
+
+TEST(ApmsimNav, DrivesTheMissionInOrderThenHolds) {
+    SimHarness h;
+    h.boot();
+    ASSERT_EQ(h.upload(line_mission(h.sim.config().home, 5, 20)), 0);
+    h.set_mode(RoverMode::Auto);
+    ASSERT_EQ(h.last<mv::CommandAck>()->result, 0);
+    EXPECT_EQ(h.sim.state().mode, RoverMode::Auto);
+    ASSERT_TRUE(h.run_until([&] { return h.sim.state().mode == RoverMode::Hold; }, seconds(120)));
+    EXPECT_EQ(reached_seqs(h), (std::vector<std::uint16_t>{1, 2, 3, 4, 5}));
+    std::vector<std::string> texts;
+    for (const auto& t : h.all<mv::Statustext>()) {
+        const auto s = std::string(mv::text_of(t.text));
+        if (s.find("waypoint #") != std::string::npos) {
+            texts.push_back(s);
+        }
+    }
+    ASSERT_EQ(texts.size(), 5u);
+    EXPECT_EQ(texts[0].rfind("Reached waypoint #1 dist ", 0), 0u) << texts[0];
+    // 100 m at CRUISE_SPEED 2 m/s: about 50 s of simulated time.
+    EXPECT_GT(h.now - kStart, seconds(45));
+    const auto& hist = h.sim.mode_history();
+    EXPECT_EQ(hist.back().to, RoverMode::Hold);
+    EXPECT_EQ(hist.back().cause, "mission end");
+    EXPECT_EQ(hist.back().mission_count, 6u);
+    EXPECT_NEAR(distance_m(h.sim.state().position, offset(h.sim.config().home, 0, 100)), 0, 3.0);
+}
+
+TEST(ApmsimNav, TextOnlyStyleSendsNoReachedMessage) {
+    RoverSimConfig c;
+    c.reached_style = ReachedStyle::TextOnly;
+    SimHarness h(c);
+    h.boot();
+    ASSERT_EQ(h.upload(line_mission(h.sim.config().home, 2, 10)), 0);
+    h.set_mode(RoverMode::Auto);
+    ASSERT_TRUE(h.run_until([&] { return h.sim.state().mode == RoverMode::Hold; }, seconds(60)));
+    EXPECT_TRUE(h.all<mv::MissionItemReached>().empty());
+    EXPECT_EQ(h.sim.reached().size(), 2u);
+    int reached_texts = 0;
+    for (const auto& t : h.all<mv::Statustext>()) {
+        reached_texts += mv::text_of(t.text).find("Reached waypoint #") != std::string_view::npos ? 1 : 0;
+    }
+    EXPECT_EQ(reached_texts, 2);
+}
+
+TEST(ApmsimNav, SetCurrentRetargetsAtOnce) {
+    SimHarness h;
+    h.boot();
+    ASSERT_EQ(h.upload(line_mission(h.sim.config().home, 5, 30)), 0);
+    h.set_mode(RoverMode::Auto);
+    h.run_for(seconds(3));
+    EXPECT_EQ(h.sim.state().current_seq, 1);
+    mv::MissionSetCurrent sc;
+    sc.seq = 4;
+    std::size_t from = h.received.size();
+    h.send(sc);
+    auto cur = h.last<mv::MissionCurrent>(from);
+    ASSERT_TRUE(cur);
+    EXPECT_EQ(cur->seq, 4);
+    const auto s = h.sim.state();
+    EXPECT_EQ(s.current_seq, 4);
+    ASSERT_TRUE(s.target);
+    EXPECT_NEAR(distance_m(*s.target, offset(h.sim.config().home, 0, 120)), 0, 0.5);
+    ASSERT_TRUE(h.run_until([&] { return h.sim.state().mode == RoverMode::Hold; }, seconds(200)));
+    EXPECT_EQ(reached_seqs(h, from), (std::vector<std::uint16_t>{4, 5}));
+}
+
+TEST(ApmsimNav, NewMissionKeepsTheTargetBeingDrivenTo) {
+    SimHarness h;
+    h.boot();
+    ASSERT_EQ(h.upload(line_mission(h.sim.config().home, 3, 40)), 0);
+    h.set_mode(RoverMode::Auto);
+    h.run_for(seconds(5));
+    const auto before = h.sim.state();
+    ASSERT_EQ(before.current_seq, 1);
+    // A different mission, eastwards: the rover still drives to the old item 1 first.
+    std::vector<mv::MissionItemInt> east{waypoint(h.sim.config().home, 0, 0)};
+    for (int i = 1; i <= 3; ++i) {
+        east.push_back(waypoint(h.sim.config().home, 0, 40.0 * i));
+    }
+    ASSERT_EQ(h.upload(east), 0);
+    const auto after = h.sim.state();
+    ASSERT_TRUE(after.target);
+    EXPECT_NEAR(distance_m(*after.target, offset(h.sim.config().home, 0, 40)), 0, 0.5);
+    const std::size_t from = h.received.size();
+    ASSERT_TRUE(h.run_until([&] { return !h.sim.reached().empty(); }, seconds(60)));
+    EXPECT_NEAR(distance_m(h.sim.state().position, offset(h.sim.config().home, 0, 40)), 0, 3.0);
+    // Then it carries on with the new item 2.
+    ASSERT_TRUE(h.run_until([&] { return h.sim.reached().size() >= 2; }, seconds(120)));
+    EXPECT_NEAR(distance_m(h.sim.state().position, waypoint_point(east[2])), 0, 3.0);
+    (void)from;
+}
+
+TEST(ApmsimNav, RebootStopsTheMissionAndResumesNothing) {
+    SimHarness h;
+    h.boot();
+    ASSERT_EQ(h.upload(line_mission(h.sim.config().home, 3, 30)), 0);
+    h.set_mode(RoverMode::Auto);
+    h.run_for(seconds(5));
+    h.sim.reboot(h.now);
+    h.boot();
+    const auto s = h.sim.state();
+    EXPECT_EQ(s.mode, RoverMode::Manual);
+    EXPECT_EQ(s.current_seq, 0);
+    const auto& hist = h.sim.mode_history();
+    ASSERT_GE(hist.size(), 3u);
+    EXPECT_EQ(hist[hist.size() - 2].cause, "reboot");
+    EXPECT_EQ(hist[hist.size() - 2].to, RoverMode::Initialising);
+    EXPECT_EQ(hist.back().to, RoverMode::Manual);
+}
+
+TEST(ApmsimNav, RtlDrivesHomeThenHolds) {
+    SimHarness h;
+    h.boot();
+    ASSERT_EQ(h.upload(line_mission(h.sim.config().home, 1, 30)), 0);
+    h.set_mode(RoverMode::Auto);
+    ASSERT_TRUE(h.run_until([&] { return h.sim.state().mode == RoverMode::Hold; }, seconds(60)));
+    h.set_mode(RoverMode::Rtl);
+    ASSERT_TRUE(h.run_until([&] { return h.sim.state().mode == RoverMode::Hold; }, seconds(60)));
+    EXPECT_EQ(h.sim.mode_history().back().cause, "rtl end");
+    EXPECT_LT(distance_m(h.sim.state().position, h.sim.config().home), 3.0);
+}
+
+TEST(ApmsimNav, DeterministicWithTheSameSeed) {
+    auto run = [](std::uint64_t seed) {
+        RoverSimConfig c;
+        c.seed = seed;
+        SimHarness h(c);
+        h.sim.faults().loss = 0.01;
+        h.boot();
+        h.send(mv::ParamRequestList{});
+        h.run_for(seconds(3));
+        return std::make_pair(h.sim.counters().bytes_lost, h.received.size());
+    };
+    EXPECT_EQ(run(7), run(7));
+    EXPECT_NE(run(7), run(8));
+}
+
+TEST(ApmsimNav, HeartbeatStall) {
+    SimHarness h;
+    h.boot();
+    h.sim.stall_heartbeats(seconds(5), h.now);
+    std::size_t from = h.received.size();
+    h.run_for(milliseconds(4900));
+    EXPECT_TRUE(h.all<mv::Heartbeat>(from).empty());
+    from = h.received.size();
+    h.run_for(seconds(2));
+    EXPECT_FALSE(h.all<mv::Heartbeat>(from).empty());
+}
+
+TEST(ApmsimNav, ScheduledReboot) {
+    SimHarness h;
+    h.boot();
+    h.sim.schedule_reboot(h.now + seconds(10));
+    h.run_for(seconds(9));
+    EXPECT_EQ(h.sim.state().boots, 1u);
+    h.run_for(seconds(2));
+    EXPECT_EQ(h.sim.state().boots, 2u);
+    EXPECT_EQ(h.sim.state().phase, BootPhase::Silent);
+}
+
+}  // namespace
+}  // namespace airseg::apmsim::test

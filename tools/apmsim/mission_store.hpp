@@ -1,0 +1,69 @@
+#pragma once
+// The board's stored mission (its EEPROM): item 0 is home, items 1.. are the plan. Survives reboots.
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace airseg::apmsim {
+
+/// MAV_CMD values the simulator acts on; every other command is stored and skipped when reached.
+inline constexpr std::uint16_t kCmdNavWaypoint = 16;
+inline constexpr std::uint16_t kCmdNavLoiterUnlimited = 17;
+inline constexpr std::uint16_t kCmdNavLoiterTurns = 18;
+inline constexpr std::uint16_t kCmdNavLoiterTime = 19;
+inline constexpr std::uint16_t kCmdNavReturnToLaunch = 20;
+
+struct StoredItem {
+    std::uint16_t command = kCmdNavWaypoint;
+    std::uint8_t frame = 3;  // MAV_FRAME_GLOBAL_RELATIVE_ALT
+    std::uint8_t autocontinue = 1;
+    float param1 = 0, param2 = 0, param3 = 0, param4 = 0;
+    std::int32_t lat_e7 = 0;
+    std::int32_t lon_e7 = 0;
+    float alt = 0;
+
+    /// Commands the rover drives to (a location to reach).
+    bool is_location() const {
+        return command == kCmdNavWaypoint || command == kCmdNavLoiterUnlimited ||
+               command == kCmdNavLoiterTurns || command == kCmdNavLoiterTime;
+    }
+    bool operator==(const StoredItem&) const = default;
+};
+
+class MissionStore {
+  public:
+    explicit MissionStore(std::size_t capacity, StoredItem home) : capacity_(capacity), items_{home} {}
+
+    /// Items the board can hold, home included.
+    std::size_t capacity() const { return capacity_; }
+    /// Items stored, home included (what MISSION_COUNT reports); never below 1.
+    std::size_t count() const { return items_.size(); }
+    const StoredItem& at(std::size_t seq) const { return items_.at(seq); }
+    const std::vector<StoredItem>& items() const { return items_; }
+
+    /// Writes item `seq`, appending when seq == count(). False when seq is past the end or capacity.
+    bool write(std::size_t seq, const StoredItem& item) {
+        if (seq > items_.size() || seq >= capacity_) {
+            return false;
+        }
+        if (seq == items_.size()) {
+            items_.push_back(item);
+        } else {
+            items_[seq] = item;
+        }
+        return true;
+    }
+    /// Keeps the first `count` items (home always stays).
+    void truncate(std::size_t count) {
+        if (count >= 1 && count < items_.size()) {
+            items_.resize(count);
+        }
+    }
+    void set_home(const StoredItem& home) { items_[0] = home; }
+
+  private:
+    std::size_t capacity_;
+    std::vector<StoredItem> items_;
+};
+
+}  // namespace airseg::apmsim

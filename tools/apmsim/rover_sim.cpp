@@ -1,0 +1,312 @@
+#include "tools/apmsim/rover_sim.hpp"
+
+#include <algorithm>
+
+#include "services/autopilot/mavlink/messages.hpp"
+
+namespace airseg::apmsim {
+
+namespace mv = mavlink;
+
+namespace {
+
+constexpr std::uint8_t kSeverityInfo = 6;
+constexpr std::uint8_t kSeverityCritical = 2;
+constexpr double kIdleAmps = 1.5;
+
+StoredItem home_item(const RoverSimConfig& c) {
+    StoredItem h;
+    h.frame = 0;  // MAV_FRAME_GLOBAL: home altitude is absolute
+    h.lat_e7 = static_cast<std::int32_t>(std::lround(c.home.lat * 1e7));
+    h.lon_e7 = static_cast<std::int32_t>(std::lround(c.home.lon * 1e7));
+    h.alt = c.home_alt;
+    return h;
+}
+
+}  // namespace
+
+std::vector<std::string> RoverSimConfig::validate(const RoverSimConfig& c) {
+    std::vector<std::string> errors;
+    if (!(c.home.lat >= -89 && c.home.lat <= 89) || !(c.home.lon >= -180 && c.home.lon <= 180)) {
+        errors.emplace_back("home: latitude must be within ±89 and longitude within ±180 degrees");
+    }
+    if (c.mission_capacity < 1 || c.mission_capacity > 65535) {
+        errors.emplace_back("mission capacity: must be 1..65535 items (home included)");
+    }
+    if (c.boot_delay < Duration::zero() || c.calib_time < Duration::zero()) {
+        errors.emplace_back("boot delay and calibration time must not be negative");
+    }
+    if (c.physics_step <= Duration::zero() || c.mission_rerequest <= Duration::zero() ||
+        c.mission_give_up <= Duration::zero()) {
+        errors.emplace_back("physics step and mission timers must be positive");
+    }
+    return errors;
+}
+
+std::string_view phase_name(BootPhase p) {
+    switch (p) {
+        case BootPhase::Silent:
+            return "silent";
+        case BootPhase::Calibrating:
+            return "calibrating";
+        case BootPhase::Ready:
+            return "ready";
+    }
+    return "?";
+}
+
+RoverSim::RoverSim(RoverSimConfig config, TimePoint now)
+    : config_(std::move(config)),
+      started_(now),
+      now_(now),
+      rng_(config_.seed),
+      params_(ParamTable::rover_defaults()),
+      store_(config_.mission_capacity, home_item(config_)),
+      out_(config_.version),
+      server_(store_, out_,
+              MissionHooks{
+                  [this](std::uint16_t seq) { return set_current(seq, now_); },
+                  [this] { return mode_ == RoverMode::Auto && mission_running_; },
+                  [this] { mission_changed(); },
+                  [this](const StoredItem& item) { return guided_goto(item); },
+                  [this] { return home_item(config_); },
+                  [this] { return current_seq_; },
+              },
+              config_.mission_rerequest, config_.mission_give_up),
+      parser_(std::make_unique<mv::Parser>()),
+      vehicle_(config_.home) {
+    last_step_ = now;
+    reboot(now);
+}
+
+void RoverSim::reboot(TimePoint now) {
+    advance(now);
+    out_.drop_held();
+    server_.reset();
+    streams_.clear();
+    parser_ = std::make_unique<mv::Parser>();
+    ++boots_;
+    boot_started_ = now;
+    reboot_at_ = kNever;
+    armed_ = false;
+    mission_running_ = false;
+    mission_complete_ = false;
+    current_seq_ = 0;
+    target_.reset();
+    leg_start_.reset();
+    guided_target_.reset();
+    rc_override_.fill(0);
+    if (mode_ != RoverMode::Initialising) {
+        set_mode(RoverMode::Initialising, "reboot", now);
+    }
+    enter_phase(BootPhase::Silent, now);
+}
+
+void RoverSim::port_opened(TimePoint now) {
+    if (config_.reset_on_open) {
+        reboot(now);
+    }
+}
+
+void RoverSim::enter_phase(BootPhase phase, TimePoint now) {
+    phase_ = phase;
+    switch (phase) {
+        case BootPhase::Silent:
+            phase_until_ = now + config_.boot_delay;
+            next_heartbeat_ = kNever;
+            break;
+        case BootPhase::Calibrating:
+            phase_until_ = now + config_.calib_time;
+            heartbeat_sent_this_boot_ = false;
+            next_heartbeat_ = now;
+            text(kSeverityInfo, "Initialising APM...");
+            text(kSeverityCritical, "Beginning INS calibration; do not move vehicle");
+            break;
+        case BootPhase::Ready: {
+            phase_until_ = kNever;
+            const auto initial = mode_from_number(static_cast<std::uint32_t>(params_.get("INITIAL_MODE", 0)));
+            set_mode(initial && *initial != RoverMode::Initialising ? *initial : RoverMode::Manual,
+                     boots_ == 1 ? "power on" : "reboot", now);
+            armed_ = params_.get("ARMING_REQUIRE", 0) == 0;  // no arming step: armed from boot
+            load_stream_rates(now);
+            text(kSeverityInfo, "Ready to drive.");
+            next_heartbeat_ = now;
+            break;
+        }
+    }
+}
+
+void RoverSim::advance(TimePoint now) {
+    now = std::max(now, now_);
+    // The electronics draw a steady current whether or not the car moves.
+    consumed_mah_ += kIdleAmps * std::chrono::duration<double>(now - now_).count() * 1000.0 / 3600.0;
+    // Whole physics steps up to `now`; mission events happen at the step that causes them.
+    if (!physics_active()) {
+        last_step_ = std::max(last_step_, now - config_.physics_step);
+    }
+    while (last_step_ + config_.physics_step <= now) {
+        last_step_ += config_.physics_step;
+        now_ = last_step_;
+        out_.set_reply_context(now_, Duration::zero());
+        physics_step(last_step_);
+    }
+    now_ = now;
+}
+
+void RoverSim::handle_timeout(TimePoint now) {
+    if (reboot_at_ <= now) {
+        reboot(std::max(reboot_at_, now_));
+    }
+    advance(now);
+    if (phase_until_ <= now) {
+        enter_phase(phase_ == BootPhase::Silent ? BootPhase::Calibrating : BootPhase::Ready, now);
+    }
+    if (next_heartbeat_ <= now) {
+        send_heartbeat(now);
+        next_heartbeat_ = std::max(next_heartbeat_ + seconds(1), now);
+    }
+    if (phase_ == BootPhase::Ready) {
+        for (std::uint32_t id : streams_.take_due(now)) {
+            send_stream_message(id, now);
+        }
+    }
+    out_.set_reply_context(now, faults_.slow);
+    server_.handle_timeout(now);
+    out_.release(now);
+}
+
+TimePoint RoverSim::poll_timeout() const {
+    TimePoint t =
+        std::min({phase_until_, next_heartbeat_, reboot_at_, out_.next_release(), server_.poll_timeout()});
+    if (phase_ == BootPhase::Ready) {
+        t = std::min(t, streams_.next_due());
+    }
+    if (physics_active()) {
+        t = std::min(t, last_step_ + config_.physics_step);
+    }
+    return t;
+}
+
+void RoverSim::handle_bytes(std::span<const std::uint8_t> bytes, TimePoint now) {
+    handle_timeout(now);
+    counters_.bytes_in += bytes.size();
+    std::vector<std::uint8_t> in(bytes.begin(), bytes.end());
+    impair(in);
+    if (phase_ == BootPhase::Silent) {
+        return;  // the bootloader and the early start-up do not read MAVLink
+    }
+    parser_->push(in, [&](const mv::Frame& f) {
+        ++counters_.frames_in;
+        out_.set_reply_context(now, faults_.slow);
+        dispatch(f, now);
+    });
+    out_.release(now);
+}
+
+std::vector<std::uint8_t> RoverSim::poll_transmit() {
+    auto bytes = out_.take();
+    impair(bytes);
+    counters_.bytes_out += bytes.size();
+    return bytes;
+}
+
+void RoverSim::dispatch(const mv::Frame& f, TimePoint now) {
+    const bool mission_frame = f.msgid == mv::MissionRequestList::kId || f.msgid == mv::MissionRequest::kId ||
+                               f.msgid == mv::MissionRequestInt::kId || f.msgid == mv::MissionCount::kId ||
+                               f.msgid == mv::MissionItem::kId || f.msgid == mv::MissionItemInt::kId ||
+                               f.msgid == mv::MissionWritePartialList::kId ||
+                               f.msgid == mv::MissionClearAll::kId || f.msgid == mv::MissionSetCurrent::kId ||
+                               f.msgid == mv::MissionAck::kId;
+    if (mission_frame) {
+        if (faults_.ignore_mission) {
+            ++counters_.frames_ignored;
+            return;
+        }
+        server_.handle(f, now);
+        return;
+    }
+    switch (f.msgid) {
+        case mv::ParamRequestList::kId:
+        case mv::ParamRequestRead::kId:
+        case mv::ParamSet::kId:
+            on_param(f);
+            return;
+        case mv::CommandLong::kId:
+            on_command_long(f, now);
+            return;
+        case mv::SetMode::kId:
+            on_set_mode(f, now);
+            return;
+        case mv::RequestDataStream::kId:
+            on_request_data_stream(f, now);
+            return;
+        case mv::RcChannelsOverride::kId:
+            on_rc_override(f, now);
+            return;
+        default:
+            ++counters_.frames_ignored;  // heartbeats of the GCS and everything the board does not serve
+            return;
+    }
+}
+
+double RoverSim::uniform() {
+    return static_cast<double>(rng_() >> 11) * 0x1.0p-53;
+}
+
+void RoverSim::impair(std::vector<std::uint8_t>& bytes) {
+    if (faults_.loss <= 0 && faults_.corrupt <= 0) {
+        return;
+    }
+    std::vector<std::uint8_t> kept;
+    kept.reserve(bytes.size());
+    for (std::uint8_t b : bytes) {
+        if (faults_.loss > 0 && uniform() < faults_.loss) {
+            ++counters_.bytes_lost;
+            continue;
+        }
+        if (faults_.corrupt > 0 && uniform() < faults_.corrupt) {
+            ++counters_.bytes_corrupted;
+            b = static_cast<std::uint8_t>(b ^ (1U << (rng_() % 8)));
+        }
+        kept.push_back(b);
+    }
+    bytes = std::move(kept);
+}
+
+void RoverSim::text(std::uint8_t severity, std::string_view message) {
+    mv::Statustext t;
+    t.severity = severity;
+    mv::set_text(t.text, message);
+    out_.send(t);
+}
+
+std::uint32_t RoverSim::time_boot_ms(TimePoint now) const {
+    return static_cast<std::uint32_t>(std::chrono::duration_cast<milliseconds>(now - boot_started_).count());
+}
+
+std::uint64_t RoverSim::unix_us(TimePoint now) const {
+    return config_.unix_time_at_start_us +
+           static_cast<std::uint64_t>(std::chrono::duration_cast<microseconds>(now - started_).count());
+}
+
+SimState RoverSim::state() const {
+    SimState s;
+    s.phase = phase_;
+    s.mode = mode_;
+    s.armed = armed_;
+    s.position = vehicle_.position();
+    s.heading_deg = vehicle_.heading() * 180.0 / 3.14159265358979323846;
+    s.speed = vehicle_.speed();
+    s.current_seq = current_seq_;
+    s.mission_count = store_.count();
+    s.target = target_;
+    s.target_distance = target_ ? distance_m(vehicle_.position(), *target_) : 0;
+    s.time_boot_ms = time_boot_ms(now_);
+    s.boots = boots_;
+    const double capacity = std::max(1.0F, params_.get("BATT_CAPACITY", 3300));
+    s.battery_remaining = std::clamp(100.0 * (1.0 - consumed_mah_ / capacity), 0.0, 100.0);
+    s.odometer = vehicle_.odometer();
+    return s;
+}
+
+}  // namespace airseg::apmsim

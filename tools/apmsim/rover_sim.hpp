@@ -1,0 +1,238 @@
+#pragma once
+// RoverSim: a simulated APM:Rover board, sans-IO. Bytes and simulated time go in, bytes come out; it never
+// reads a clock or touches a descriptor, so tests and benchmarks can run it in-process in simulated time and
+// airseg-apmsim (main.cpp) runs it on a pseudo-terminal in scaled real time.
+//
+// Contract (the driver's loop):
+//   RoverSim sim(config, now);                 // power on: the boot sequence starts at `now`
+//   sim.handle_bytes(bytes_from_gcs, now);     // whenever bytes arrive
+//   sim.handle_timeout(now);                   // when now >= sim.poll_timeout()
+//   write(sim.poll_transmit());                // after each of the above
+//   re-arm the timer at sim.poll_timeout()     // the single earliest deadline
+// Board events: port_opened(now) (the USB DTR reset), reboot(now), schedule_reboot(at), rc_pilot(mode, now).
+// Time must not go backwards between calls.
+//
+// What it does: boot sequence (silent, then "Initialising APM..." and heartbeats in CALIBRATING, then
+// STANDBY and "Ready to drive."), 1 Hz heartbeats with Rover custom modes, telemetry streams, parameters,
+// the mission protocol (mission_server.hpp), modes and a kinematic vehicle that drives missions, RTL,
+// guided targets and RC overrides, and the fault injection of Faults. Every mode change is recorded with
+// its cause in mode_history().
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <random>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "services/autopilot/mavlink/frame.hpp"
+#include "services/autopilot/mavlink/parser.hpp"
+#include "services/common/time.hpp"
+#include "tools/apmsim/mission_server.hpp"
+#include "tools/apmsim/mission_store.hpp"
+#include "tools/apmsim/outbox.hpp"
+#include "tools/apmsim/param_table.hpp"
+#include "tools/apmsim/rover_mode.hpp"
+#include "tools/apmsim/stream_scheduler.hpp"
+#include "tools/apmsim/vehicle_model.hpp"
+
+namespace airseg::apmsim {
+
+enum class ReachedStyle : std::uint8_t {
+    MessageAndText,  // MISSION_ITEM_REACHED and the STATUSTEXT
+    TextOnly,        // the STATUSTEXT alone, as APM:Rover 2.x firmware does
+};
+
+struct RoverSimConfig {
+    GeoPoint home{41.2756, 1.9866};  // a car park in Castelldefels
+    float home_alt = 5.0F;           // metres above mean sea level
+    Duration boot_delay = seconds(2);
+    Duration calib_time = seconds(3);
+    bool reset_on_open = true;  // an APM on USB reboots when the port is opened
+    std::size_t mission_capacity = 150;
+    ReachedStyle reached_style = ReachedStyle::MessageAndText;
+    mavlink::Version version = mavlink::Version::V2;
+    std::uint64_t seed = 1;
+    Duration mission_rerequest = seconds(1);
+    Duration mission_give_up = seconds(8);
+    Duration physics_step = milliseconds(20);
+    /// Wall-clock time (µs since 1970) at the simulated time passed to the constructor, for SYSTEM_TIME and
+    /// GPS time stamps.
+    std::uint64_t unix_time_at_start_us = 1'401'580'800'000'000;  // 2014-06-01
+
+    static std::vector<std::string> validate(const RoverSimConfig& c);
+};
+
+/// Faults that can be switched while running.
+struct Faults {
+    double loss = 0;     // probability each byte (either direction) is lost
+    double corrupt = 0;  // probability each byte (either direction) has one bit flipped
+    bool ignore_mission = false;
+    Duration slow{0};  // delay of every answer to a request
+};
+
+enum class BootPhase : std::uint8_t { Silent, Calibrating, Ready };
+std::string_view phase_name(BootPhase p);
+
+struct ModeChange {
+    TimePoint at{};
+    RoverMode from = RoverMode::Initialising;
+    RoverMode to = RoverMode::Initialising;
+    std::string cause;  // "mission end", "command", "rc pilot", "reboot", "rtl end", "power on"
+    std::uint16_t current_seq = 0;
+    std::size_t mission_count = 0;  // items stored, home included
+};
+
+struct ReachedEvent {
+    TimePoint at{};
+    std::uint16_t seq = 0;
+    double distance = 0;  // metres from the item when it counted as reached
+    bool passed = false;  // went past it rather than inside WP_RADIUS
+};
+
+struct SimState {
+    BootPhase phase = BootPhase::Silent;
+    RoverMode mode = RoverMode::Initialising;
+    bool armed = false;
+    GeoPoint position;
+    double heading_deg = 0;
+    double speed = 0;
+    std::uint16_t current_seq = 0;
+    std::size_t mission_count = 0;
+    std::optional<GeoPoint> target;
+    double target_distance = 0;
+    std::uint32_t time_boot_ms = 0;
+    std::uint32_t boots = 0;
+    double battery_remaining = 100;  // percent
+    double odometer = 0;             // metres
+};
+
+struct SimCounters {
+    std::uint64_t bytes_in = 0;
+    std::uint64_t bytes_out = 0;
+    std::uint64_t bytes_lost = 0;       // by the loss fault, both directions
+    std::uint64_t bytes_corrupted = 0;  // by the corruption fault, both directions
+    std::uint64_t frames_in = 0;
+    std::uint64_t frames_ignored = 0;  // not for us, while silent, or mission frames while ignoring
+    std::uint64_t heartbeats_sent = 0;
+    std::uint64_t heartbeats_stalled = 0;
+};
+
+class RoverSim {
+  public:
+    static constexpr std::uint8_t kSysid = 1;
+    static constexpr std::uint8_t kCompid = 1;
+    static constexpr std::size_t kMaxReachedLog = 4096;
+
+    RoverSim(RoverSimConfig config, TimePoint now);
+
+    void handle_bytes(std::span<const std::uint8_t> bytes, TimePoint now);
+    void handle_timeout(TimePoint now);
+    std::vector<std::uint8_t> poll_transmit();
+    TimePoint poll_timeout() const;
+
+    /// A program opened the port (the board sees DTR): reboots when reset_on_open.
+    void port_opened(TimePoint now);
+    void reboot(TimePoint now);
+    /// Reboots when simulated time reaches `at` (kNever cancels).
+    void schedule_reboot(TimePoint at) { reboot_at_ = at; }
+    /// The RC pilot flips the mode switch. False while the board is not ready.
+    bool rc_pilot(RoverMode mode, TimePoint now);
+    /// Heartbeats stop for `d` from `now` (everything else goes on).
+    void stall_heartbeats(Duration d, TimePoint now) { hb_stall_until_ = now + d; }
+
+    Faults& faults() { return faults_; }
+    const Faults& faults() const { return faults_; }
+    SimState state() const;
+    const std::vector<ModeChange>& mode_history() const { return mode_history_; }
+    const std::deque<ReachedEvent>& reached() const { return reached_; }
+    const ParamTable& params() const { return params_; }
+    ParamTable& params() { return params_; }
+    const MissionStore& mission() const { return store_; }
+    const MissionServerStats& mission_stats() const { return server_.stats(); }
+    const SimCounters& counters() const { return counters_; }
+    const RoverSimConfig& config() const { return config_; }
+    TimePoint started() const { return started_; }
+
+  private:
+    // rover_sim.cpp: time, boot, bytes, faults
+    void advance(TimePoint now);
+    void enter_phase(BootPhase phase, TimePoint now);
+    void dispatch(const mavlink::Frame& f, TimePoint now);
+    void impair(std::vector<std::uint8_t>& bytes);
+    double uniform();
+    void text(std::uint8_t severity, std::string_view message);
+    std::uint32_t time_boot_ms(TimePoint now) const;
+    std::uint64_t unix_us(TimePoint now) const;
+    // rover_sim_nav.cpp: modes, navigation, physics
+    bool set_mode(RoverMode mode, const std::string& cause, TimePoint now);
+    void physics_step(TimePoint at);
+    void load_item(std::uint16_t seq, TimePoint now);
+    void on_target_reached(double distance, bool passed, TimePoint now);
+    bool set_current(std::uint16_t seq, TimePoint now);
+    bool guided_goto(const StoredItem& item);
+    void mission_changed();
+    bool physics_active() const;
+    DriveLimits limits() const;
+    GeoPoint home_point() const { return config_.home; }
+    // rover_sim_commands.cpp: parameters, commands, RC
+    void on_param(const mavlink::Frame& f);
+    void send_param(std::size_t index);
+    void apply_param_side_effects(const std::string& name, TimePoint now);
+    void on_command_long(const mavlink::Frame& f, TimePoint now);
+    void on_set_mode(const mavlink::Frame& f, TimePoint now);
+    void on_request_data_stream(const mavlink::Frame& f, TimePoint now);
+    void on_rc_override(const mavlink::Frame& f, TimePoint now);
+    void load_stream_rates(TimePoint now);
+    // rover_sim_telemetry.cpp
+    void send_heartbeat(TimePoint now);
+    void send_stream_message(std::uint32_t msgid, TimePoint now);
+    void send_mission_current();
+    void send_home_position();
+    void send_autopilot_version();
+    std::uint16_t rc_input(int channel, TimePoint now) const;
+
+    RoverSimConfig config_;
+    TimePoint started_;
+    TimePoint now_;
+    std::mt19937_64 rng_;
+    Faults faults_;
+    SimCounters counters_;
+    ParamTable params_;
+    MissionStore store_;
+    Outbox out_;
+    MissionServer server_;
+    StreamScheduler streams_;
+    std::unique_ptr<mavlink::Parser> parser_;
+    VehicleModel vehicle_;
+
+    BootPhase phase_ = BootPhase::Silent;
+    TimePoint phase_until_ = kNever;
+    TimePoint boot_started_{};
+    std::uint32_t boots_ = 0;
+    TimePoint reboot_at_ = kNever;
+    TimePoint next_heartbeat_ = kNever;
+    TimePoint hb_stall_until_{};
+    TimePoint last_step_{};
+    bool heartbeat_sent_this_boot_ = false;
+
+    RoverMode mode_ = RoverMode::Initialising;
+    bool armed_ = false;
+    std::vector<ModeChange> mode_history_;
+
+    // Navigation: the target is a copy of the item's location, taken when the item became current.
+    std::uint16_t current_seq_ = 0;
+    bool mission_running_ = false;
+    bool mission_complete_ = false;
+    std::optional<GeoPoint> target_;
+    std::optional<GeoPoint> leg_start_;
+    std::optional<GeoPoint> guided_target_;
+    std::deque<ReachedEvent> reached_;
+
+    std::array<std::uint16_t, 8> rc_override_{};  // 0: not overridden
+    TimePoint rc_override_at_{};
+    double consumed_mah_ = 0;
+};
+
+}  // namespace airseg::apmsim

@@ -1,0 +1,274 @@
+// RoverSim: parameters, commands, mode requests, stream requests and RC overrides from the GCS.
+#include <algorithm>
+#include <cmath>
+
+#include "services/autopilot/mavlink/messages.hpp"
+#include "tools/apmsim/rover_sim.hpp"
+
+namespace airseg::apmsim {
+
+namespace mv = mavlink;
+
+namespace {
+
+// MAV_CMD values served.
+constexpr std::uint16_t kCmdReturnToLaunch = 20;
+constexpr std::uint16_t kCmdDoSetMode = 176;
+constexpr std::uint16_t kCmdDoSetMissionCurrent = 224;
+constexpr std::uint16_t kCmdPreflightRebootShutdown = 246;
+constexpr std::uint16_t kCmdMissionStart = 300;
+constexpr std::uint16_t kCmdComponentArmDisarm = 400;
+constexpr std::uint16_t kCmdGetHomePosition = 410;
+constexpr std::uint16_t kCmdSetMessageInterval = 511;
+constexpr std::uint16_t kCmdRequestMessage = 512;
+constexpr std::uint16_t kCmdRequestAutopilotCapabilities = 520;
+
+// MAV_RESULT values.
+constexpr std::uint8_t kAccepted = 0;
+constexpr std::uint8_t kTemporarilyRejected = 1;
+constexpr std::uint8_t kDenied = 2;
+constexpr std::uint8_t kUnsupported = 3;
+constexpr std::uint8_t kFailed = 4;
+
+constexpr std::uint8_t kModeFlagCustomModeEnabled = 1;
+
+bool for_us(std::uint8_t target_system) {
+    return target_system == RoverSim::kSysid || target_system == 0;
+}
+
+}  // namespace
+
+void RoverSim::on_param(const mv::Frame& f) {
+    if (f.msgid == mv::ParamRequestList::kId) {
+        if (!for_us(mv::decode_payload<mv::ParamRequestList>(f.payload_view()).target_system)) {
+            return;
+        }
+        for (std::size_t i = 0; i < params_.size(); ++i) {
+            send_param(i);
+        }
+        return;
+    }
+    if (f.msgid == mv::ParamRequestRead::kId) {
+        const auto m = mv::decode_payload<mv::ParamRequestRead>(f.payload_view());
+        if (!for_us(m.target_system)) {
+            return;
+        }
+        if (m.param_index >= 0) {
+            if (static_cast<std::size_t>(m.param_index) < params_.size()) {
+                send_param(static_cast<std::size_t>(m.param_index));
+            }
+        } else if (const auto i = params_.index_of(mv::text_of(m.param_id))) {
+            send_param(*i);
+        }
+        return;  // an unknown parameter gets no answer, as on the board
+    }
+    const auto m = mv::decode_payload<mv::ParamSet>(f.payload_view());
+    if (!for_us(m.target_system)) {
+        return;
+    }
+    const std::string name(mv::text_of(m.param_id));
+    if (const auto i = params_.set(name, m.param_value)) {
+        apply_param_side_effects(name, now_);
+        send_param(*i);
+    }
+}
+
+void RoverSim::send_param(std::size_t index) {
+    const Param& p = params_.at(index);
+    mv::ParamValue v;
+    mv::set_text(v.param_id, p.name);
+    v.param_value = p.value;
+    v.param_type = static_cast<std::uint8_t>(p.type);
+    v.param_count = static_cast<std::uint16_t>(params_.size());
+    v.param_index = static_cast<std::uint16_t>(index);
+    out_.reply(v);
+}
+
+void RoverSim::apply_param_side_effects(const std::string& name, TimePoint now) {
+    if (name.rfind("SR0_", 0) == 0 && phase_ == BootPhase::Ready) {
+        load_stream_rates(now);
+    }
+}
+
+void RoverSim::load_stream_rates(TimePoint now) {
+    for (const auto& g : stream_groups()) {
+        streams_.set_group_rate(g.group, params_.get("SR0_" + std::string(g.param_suffix), 0), now);
+    }
+}
+
+void RoverSim::on_request_data_stream(const mv::Frame& f, TimePoint now) {
+    const auto m = mv::decode_payload<mv::RequestDataStream>(f.payload_view());
+    if (!for_us(m.target_system) || phase_ != BootPhase::Ready) {
+        return;
+    }
+    const double hz =
+        m.start_stop == 0 ? 0.0 : std::min<double>(m.req_message_rate, StreamScheduler::kMaxRateHz);
+    // ArduPilot stores the rate in the port's SRn_ parameter, so it outlives a reboot.
+    for (const auto& g : stream_groups()) {
+        if (m.req_stream_id == 0 || static_cast<std::uint8_t>(g.group) == m.req_stream_id) {
+            params_.set("SR0_" + std::string(g.param_suffix), static_cast<float>(hz));
+            streams_.set_group_rate(g.group, hz, now);
+        }
+    }
+}
+
+void RoverSim::on_set_mode(const mv::Frame& f, TimePoint now) {
+    const auto m = mv::decode_payload<mv::SetMode>(f.payload_view());
+    if (!for_us(m.target_system)) {
+        return;
+    }
+    std::uint8_t result = kFailed;
+    const auto mode = mode_from_number(m.custom_mode);
+    if (phase_ != BootPhase::Ready) {
+        result = kTemporarilyRejected;
+    } else if ((m.base_mode & kModeFlagCustomModeEnabled) != 0 && mode && *mode != RoverMode::Initialising) {
+        result = set_mode(*mode, "command", now) ? kAccepted : kFailed;
+    }
+    mv::CommandAck ack;  // later firmware acknowledges SET_MODE with the message id as the command
+    ack.command = mv::SetMode::kId;
+    ack.result = result;
+    ack.target_system = f.sysid;
+    ack.target_component = f.compid;
+    out_.reply(ack);
+}
+
+void RoverSim::on_command_long(const mv::Frame& f, TimePoint now) {
+    const auto c = mv::decode_payload<mv::CommandLong>(f.payload_view());
+    if (!for_us(c.target_system)) {
+        return;
+    }
+    std::uint8_t result = kUnsupported;
+    bool reboot_after_ack = false;
+    const bool ready = phase_ == BootPhase::Ready;
+    switch (c.command) {
+        case kCmdDoSetMode: {
+            const auto mode = mode_from_number(static_cast<std::uint32_t>(c.param2));
+            if (!ready) {
+                result = kTemporarilyRejected;
+            } else if ((static_cast<int>(c.param1) & kModeFlagCustomModeEnabled) == 0 || !mode ||
+                       *mode == RoverMode::Initialising) {
+                result = kFailed;
+            } else {
+                result = set_mode(*mode, "command", now) ? kAccepted : kFailed;
+            }
+            break;
+        }
+        case kCmdMissionStart:
+            result = !ready                                      ? kTemporarilyRejected
+                     : set_mode(RoverMode::Auto, "command", now) ? kAccepted
+                                                                 : kFailed;
+            break;
+        case kCmdReturnToLaunch:
+            result = !ready                                     ? kTemporarilyRejected
+                     : set_mode(RoverMode::Rtl, "command", now) ? kAccepted
+                                                                : kFailed;
+            break;
+        case kCmdComponentArmDisarm:
+            if (!ready) {
+                result = kTemporarilyRejected;
+            } else {
+                armed_ = c.param1 >= 0.5F;
+                result = kAccepted;
+            }
+            break;
+        case kCmdDoSetMissionCurrent: {
+            const auto seq = static_cast<std::uint16_t>(std::clamp(c.param1, 0.0F, 65535.0F));
+            result = seq < store_.count() && set_current(seq, now) ? kAccepted : kDenied;
+            if (result == kAccepted) {
+                send_mission_current();
+            }
+            break;
+        }
+        case kCmdPreflightRebootShutdown:
+            if (std::lround(c.param1) == 1) {
+                result = kAccepted;
+                reboot_after_ack = true;
+            } else {
+                result = kUnsupported;
+            }
+            break;
+        case kCmdGetHomePosition:
+            send_home_position();
+            result = kAccepted;
+            break;
+        case kCmdRequestAutopilotCapabilities:
+            send_autopilot_version();
+            result = kAccepted;
+            break;
+        case kCmdRequestMessage: {
+            const auto id = static_cast<std::uint32_t>(std::max(0.0F, c.param1));
+            result = kAccepted;
+            if (id == mv::HomePosition::kId) {
+                send_home_position();
+            } else if (id == mv::AutopilotVersion::kId) {
+                send_autopilot_version();
+            } else if (ready && (id == mv::SysStatus::kId || id == mv::GpsRawInt::kId ||
+                                 id == mv::Attitude::kId || id == mv::GlobalPositionInt::kId ||
+                                 id == mv::VfrHud::kId || id == mv::MissionCurrent::kId ||
+                                 id == mv::SystemTime::kId || id == mv::BatteryStatus::kId ||
+                                 id == mv::NavControllerOutput::kId || id == mv::RcChannels::kId ||
+                                 id == mv::RcChannelsRaw::kId || id == mv::ServoOutputRaw::kId)) {
+                send_stream_message(id, now);
+            } else {
+                result = kDenied;
+            }
+            break;
+        }
+        case kCmdSetMessageInterval: {
+            const auto id = static_cast<std::uint32_t>(std::max(0.0F, c.param1));
+            const float us = c.param2;
+            if (us < -0.5F) {
+                streams_.set_message_interval(id, Duration::zero(), now);  // -1: stop it
+            } else if (us < 0.5F) {
+                streams_.set_message_interval(id, std::nullopt, now);  // 0: back to the default
+            } else {
+                const auto interval = std::max<Duration>(
+                    std::chrono::duration_cast<Duration>(std::chrono::duration<double, std::micro>(us)),
+                    milliseconds(20));  // the same 50 Hz ceiling as the stream groups
+                streams_.set_message_interval(id, interval, now);
+            }
+            result = kAccepted;
+            break;
+        }
+        default:
+            break;
+    }
+    mv::CommandAck ack;
+    ack.command = c.command;
+    ack.result = result;
+    ack.target_system = f.sysid;
+    ack.target_component = f.compid;
+    if (reboot_after_ack) {
+        out_.send(ack);  // the acknowledgement leaves before the board goes down
+        reboot(now);
+        return;
+    }
+    out_.reply(ack);
+}
+
+void RoverSim::on_rc_override(const mv::Frame& f, TimePoint now) {
+    const auto m = mv::decode_payload<mv::RcChannelsOverride>(f.payload_view());
+    if (!for_us(m.target_system)) {
+        return;
+    }
+    const std::array<std::uint16_t, 8> ch{m.chan1_raw, m.chan2_raw, m.chan3_raw, m.chan4_raw,
+                                          m.chan5_raw, m.chan6_raw, m.chan7_raw, m.chan8_raw};
+    for (std::size_t i = 0; i < ch.size(); ++i) {
+        if (ch[i] != UINT16_MAX) {  // UINT16_MAX: leave this channel as it is
+            rc_override_[i] = ch[i];
+        }
+    }
+    rc_override_at_ = now;
+}
+
+std::uint16_t RoverSim::rc_input(int channel, TimePoint now) const {
+    const auto i = static_cast<std::size_t>(channel - 1);
+    const auto timeout = std::chrono::duration_cast<Duration>(
+        std::chrono::duration<double>(std::max(0.0F, params_.get("RC_OVERRIDE_TIME", 3))));
+    if (i < rc_override_.size() && rc_override_[i] != 0 && now - rc_override_at_ <= timeout) {
+        return rc_override_[i];
+    }
+    return static_cast<std::uint16_t>(params_.get("RC" + std::to_string(channel) + "_TRIM", 1500));
+}
+
+}  // namespace airseg::apmsim

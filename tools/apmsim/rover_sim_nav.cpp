@@ -1,0 +1,226 @@
+// RoverSim: modes, mission navigation and the vehicle's motion.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "services/autopilot/mavlink/messages.hpp"
+#include "tools/apmsim/rover_sim.hpp"
+
+namespace airseg::apmsim {
+
+namespace mv = mavlink;
+
+namespace {
+
+constexpr std::uint8_t kSeverityInfo = 6;
+
+GeoPoint point_of(const StoredItem& item) {
+    return GeoPoint{item.lat_e7 / 1e7, item.lon_e7 / 1e7};
+}
+
+bool is_manual(RoverMode m) {
+    return m == RoverMode::Manual || m == RoverMode::Learning || m == RoverMode::Steering ||
+           m == RoverMode::Acro;
+}
+
+}  // namespace
+
+DriveLimits RoverSim::limits() const {
+    DriveLimits l;
+    l.lateral_accel = std::max(0.1F, params_.get("TURN_MAX_G", 2)) * 9.80665;
+    return l;
+}
+
+bool RoverSim::physics_active() const {
+    if (vehicle_.speed() != 0) {
+        return true;
+    }
+    if (phase_ != BootPhase::Ready || !armed_) {
+        return false;
+    }
+    if (is_navigating(mode_)) {
+        return target_.has_value();
+    }
+    return is_manual(mode_) &&
+           std::any_of(rc_override_.begin(), rc_override_.end(), [](auto v) { return v != 0; });
+}
+
+bool RoverSim::set_mode(RoverMode mode, const std::string& cause, TimePoint now) {
+    if (mode == RoverMode::Auto && store_.count() <= 1) {
+        text(kSeverityInfo, "No Mission. Can't set AUTO.");
+        return false;
+    }
+    const RoverMode from = mode_;
+    if (from == RoverMode::Auto && mode != RoverMode::Auto) {
+        mission_running_ = false;  // stopped; AUTO again resumes at the current item
+    }
+    mode_ = mode;
+    target_.reset();
+    leg_start_ = vehicle_.position();
+    if (from != mode_) {
+        mode_history_.push_back(ModeChange{now, from, mode_, cause, current_seq_, store_.count()});
+    }
+    // Entering AUTO may end the mission at once (nothing left to drive to), which switches to HOLD.
+    switch (mode) {
+        case RoverMode::Auto:
+            if (mission_complete_ || current_seq_ == 0 || current_seq_ >= store_.count()) {
+                current_seq_ = 1;  // start from the first item after home
+            }
+            mission_complete_ = false;
+            mission_running_ = true;
+            load_item(current_seq_, now);
+            break;
+        case RoverMode::Rtl:
+        case RoverMode::SmartRtl:
+            target_ = home_point();
+            break;
+        case RoverMode::Guided:
+            target_ = guided_target_;
+            break;
+        default:
+            break;
+    }
+    return true;
+}
+
+void RoverSim::load_item(std::uint16_t seq, TimePoint now) {
+    // Commands that are not places (DO_ commands and the like) are passed over at once.
+    while (seq < store_.count() && seq > 0) {
+        const StoredItem& item = store_.at(seq);
+        if (item.is_location() || item.command == kCmdNavReturnToLaunch) {
+            break;
+        }
+        ++seq;
+    }
+    if (seq >= store_.count() || seq == 0) {
+        mission_complete_ = true;
+        mission_running_ = false;
+        target_.reset();
+        text(kSeverityInfo, "Mission Complete");
+        set_mode(RoverMode::Hold, "mission end", now);
+        return;
+    }
+    const bool changed = current_seq_ != seq;
+    current_seq_ = seq;
+    const StoredItem& item = store_.at(seq);
+    target_ = item.command == kCmdNavReturnToLaunch ? home_point() : point_of(item);
+    leg_start_ = vehicle_.position();
+    if (changed) {
+        send_mission_current();
+    }
+}
+
+void RoverSim::physics_step(TimePoint at) {
+    const double dt = std::chrono::duration<double>(config_.physics_step).count();
+    const DriveLimits lim = limits();
+    // The motor's share of the battery (the electronics' share is counted in advance()).
+    consumed_mah_ += 10.0 * std::abs(vehicle_.throttle()) * dt * 1000.0 / 3600.0;
+
+    if (phase_ != BootPhase::Ready || !armed_) {
+        vehicle_.stop(dt, lim);
+        return;
+    }
+    if (is_manual(mode_)) {
+        const auto stick = [&](int ch, std::uint16_t pwm) {
+            const std::string p = "RC" + std::to_string(ch) + "_";
+            const double trim = params_.get(p + "TRIM", 1500);
+            const double span =
+                pwm >= trim ? params_.get(p + "MAX", 1900) - trim : trim - params_.get(p + "MIN", 1100);
+            return span > 0 ? std::clamp((pwm - trim) / span, -1.0, 1.0) : 0.0;
+        };
+        vehicle_.drive_manual(stick(1, rc_input(1, at)), stick(3, rc_input(3, at)), dt, lim);
+        return;
+    }
+    if (!is_navigating(mode_) || !target_) {
+        vehicle_.stop(dt, lim);
+        return;
+    }
+    vehicle_.drive_to(*target_, params_.get("CRUISE_SPEED", 2), dt, lim);
+    const double distance = distance_m(vehicle_.position(), *target_);
+    const double radius = std::max(0.1F, params_.get("WP_RADIUS", 2));
+    if (distance <= radius) {
+        on_target_reached(distance, false, at);
+        return;
+    }
+    // Past the item along the leg (the turn was too wide to get inside WP_RADIUS): it counts as passed.
+    if (leg_start_ && distance_m(*leg_start_, *target_) > radius) {
+        const double leg = bearing_rad(*leg_start_, *target_);
+        const double to_vehicle = bearing_rad(*target_, vehicle_.position());
+        if (std::cos(to_vehicle - leg) > 0 && distance < 4 * radius) {
+            on_target_reached(distance, true, at);
+        }
+    }
+}
+
+void RoverSim::on_target_reached(double distance, bool passed, TimePoint now) {
+    if (mode_ == RoverMode::Rtl || mode_ == RoverMode::SmartRtl) {
+        text(kSeverityInfo, "Reached Destination");
+        set_mode(RoverMode::Hold, "rtl end", now);
+        return;
+    }
+    if (mode_ == RoverMode::Guided) {
+        text(kSeverityInfo, "Reached Destination");
+        guided_target_.reset();
+        target_.reset();
+        return;
+    }
+    const std::uint16_t seq = current_seq_;
+    char line[50];
+    std::snprintf(line, sizeof line, "%s waypoint #%u dist %um", passed ? "Passed" : "Reached",
+                  static_cast<unsigned>(seq), static_cast<unsigned>(std::lround(distance)));
+    text(kSeverityInfo, line);
+    if (config_.reached_style == ReachedStyle::MessageAndText) {
+        mv::MissionItemReached r;
+        r.seq = seq;
+        out_.send(r);
+    }
+    if (reached_.size() >= kMaxReachedLog) {
+        reached_.pop_front();
+    }
+    reached_.push_back(ReachedEvent{now, seq, distance, passed});
+    if (store_.at(seq).command == kCmdNavReturnToLaunch) {
+        load_item(static_cast<std::uint16_t>(store_.count()), now);  // RTL ends the mission
+        return;
+    }
+    load_item(static_cast<std::uint16_t>(seq + 1), now);
+}
+
+bool RoverSim::set_current(std::uint16_t seq, TimePoint now) {
+    if (seq == 0) {
+        seq = 1;  // home is never a target
+    }
+    if (seq >= store_.count()) {
+        return false;
+    }
+    current_seq_ = seq;
+    mission_complete_ = false;
+    if (mode_ == RoverMode::Auto) {
+        mission_running_ = true;
+        load_item(seq, now);  // retarget at once
+    }
+    return true;
+}
+
+bool RoverSim::guided_goto(const StoredItem& item) {
+    if (mode_ != RoverMode::Guided) {
+        return false;
+    }
+    guided_target_ = point_of(item);
+    target_ = guided_target_;
+    leg_start_ = vehicle_.position();
+    return true;
+}
+
+void RoverSim::mission_changed() {
+    params_.set("MIS_TOTAL", static_cast<float>(store_.count()));
+}
+
+bool RoverSim::rc_pilot(RoverMode mode, TimePoint now) {
+    advance(now);
+    if (phase_ != BootPhase::Ready || mode == RoverMode::Initialising) {
+        return false;
+    }
+    return set_mode(mode, "rc pilot", now);
+}
+
+}  // namespace airseg::apmsim
