@@ -2,7 +2,10 @@
 // pause and holds, all in simulated time.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <map>
 #include <numeric>
+#include <random>
 
 #include "tests/unit/flightplan/sim_autopilot.hpp"
 
@@ -397,6 +400,81 @@ TEST(FlightplanFeeder, NewPlanAfterDoneStartsFromTheParkedVehicle) {
         EXPECT_EQ(h.ap.visited()[12 + i], test::SyntheticStream::position_of(42.0, i));
     }
     EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
+}
+
+}  // namespace
+}  // namespace airseg::flightplan
+
+namespace airseg::flightplan {
+namespace {
+
+// Random operator actions and autopilot trouble on top of a lossy link, several seeds. Invariants: the
+// autopilot never completes its mission (never falls into HOLD by itself), the vehicle never drives back
+// into an older plan or to an earlier waypoint of the current one (so never to a stale slot), reached
+// indices are strictly increasing per plan, and once the trouble stops every plan finishes.
+TEST(FlightplanFeeder, ChaosKeepsTheInvariants) {
+    for (unsigned seed = 1; seed <= 6; ++seed) {
+        test::Impairments imp;
+        imp.duplicate_reached = 0.1;
+        imp.delay_reached = 0.1;
+        imp.drop_reached = 0.05;
+        imp.fail_request = 0.05;
+        imp.requests_per_step = 2;
+        test::Harness h({}, imp, seed);
+        std::mt19937 rng(seed * 7919u);
+        int generation = 0;
+        auto base_lat = [](int g) { return 10.0 + g; };
+        h.feeder.replace_plan(test::synthetic(400, base_lat(0)), h.now);
+        for (int step = 0; step < 3000; ++step) {
+            const unsigned dice = rng() % 1000;
+            if (dice < 3) {
+                h.feeder.replace_plan(test::synthetic(300 + rng() % 300, base_lat(++generation)), h.now);
+            } else if (dice < 6) {
+                // Forward skips only: a backward skip legitimately revisits waypoints.
+                if (auto next = h.feeder.progress().next_waypoint)
+                    h.feeder.skip_to(*next + 1 + rng() % 50, h.now);
+            } else if (dice < 9) {
+                h.ap.reboot();
+                h.feeder.on_autopilot_rebooted(h.now);
+            } else if (dice < 15) {
+                h.feeder.pause();
+            } else if (dice < 40) {
+                h.feeder.resume();
+            }
+            h.step();
+        }
+        h.feeder.resume();
+        h.impairments() = test::Impairments{};
+        ASSERT_LT(h.run_until_done(3000), 3000) << "seed " << seed;
+        EXPECT_EQ(h.ap.end_of_mission_holds(), 0) << "seed " << seed;
+        EXPECT_GE(generation, 2) << "seed " << seed;  // the scenario did replace plans
+        EXPECT_GT(h.feeder.progress().retries, 0u) << "seed " << seed;
+        EXPECT_EQ(h.feeder.progress().starvation_holds, 0u) << "seed " << seed;
+        // Visited positions: generation = round(lat) - 10, index from the latitude offset.
+        int last_gen = -1;
+        long last_index = -1;
+        for (const auto& p : h.ap.visited()) {
+            const int g = static_cast<int>(std::floor(p.lat)) - 10;
+            const long index = std::lround((p.lat - std::floor(p.lat)) / 1e-4);
+            ASSERT_EQ(p, test::SyntheticStream::position_of(base_lat(g), static_cast<std::uint64_t>(index)));
+            ASSERT_GE(g, last_gen) << "seed " << seed << ": drove back into an older plan";
+            if (g == last_gen) {
+                ASSERT_GT(index, last_index) << "seed " << seed << ": drove back to an earlier waypoint";
+            }
+            last_gen = g;
+            last_index = index;
+        }
+        std::map<std::uint32_t, std::uint64_t> last_reached;
+        for (const auto& e : h.events) {
+            if (e.kind != FeederEvent::Kind::WaypointReached)
+                continue;
+            auto it = last_reached.find(e.generation);
+            if (it != last_reached.end()) {
+                ASSERT_GT(e.plan_index, it->second) << "seed " << seed;
+            }
+            last_reached[e.generation] = e.plan_index;
+        }
+    }
 }
 
 }  // namespace
