@@ -12,7 +12,7 @@
 //                                 UART space frees up: a driver with a blocked writer retries at its own
 //                                 cadence.
 //   serial_space(from, now)       how many bytes push() would accept now.
-// Calls must use non-decreasing `now`.
+// Calls must use non-decreasing `now`. Poll output regularly: bytes already due wait in memory until polled.
 //
 // What is modelled, in the order a byte meets it:
 //   1. Host UART: bytes leave the host at baud/10 bytes/s (8N1) into the radio; at most host_buffer are
