@@ -20,6 +20,7 @@ struct Sent {
 
 void check_end(const test::Endpoint& rx, const Sent& sent, bool expect_all, std::uint64_t seed) {
     std::array<std::vector<std::uint32_t>, 4> got;
+    std::set<std::uint32_t> fast_seen;
     for (const auto& d : rx.received) {
         ASSERT_GE(d.bytes.size(), 4U) << "seed " << seed;
         const std::uint32_t id = test::id_of(d.bytes);
@@ -28,6 +29,8 @@ void check_end(const test::Endpoint& rx, const Sent& sent, bool expect_all, std:
         ASSERT_EQ(it->second, d.bytes) << "seed " << seed << ": delivered bytes differ from the sent message";
         if (d.cls == MessageClass::safe) {
             got[d.priority].push_back(id);
+        } else {
+            ASSERT_TRUE(fast_seen.insert(id).second) << "seed " << seed << ": Fast message delivered twice";
         }
     }
     for (std::size_t ch = 0; ch < 4; ++ch) {
@@ -59,7 +62,17 @@ void run_seed(std::uint64_t seed) {
     TransportConfig a = test::base_config(1000 + seed, keyed);
     TransportConfig b = test::base_config(2000 + seed, keyed);
     a.link_rate_bytes_per_s = b.link_rate_bytes_per_s = pm.rate;
-    test::SimLink link(a, b, {pm}, seed);
+    // Every fourth seed runs two paths, split or redundant, the second with its own impairments.
+    std::vector<test::PathModel> models{pm};
+    if (seed % 4 == 1) {
+        a.paths = b.paths = 2;
+        a.path_mode = b.path_mode = seed % 8 == 1 ? PathMode::split : PathMode::redundant;
+        b.split_tx_path = 1;
+        test::PathModel second = pm;
+        second.imp.loss = uni(0.0, 0.3);
+        models.push_back(second);
+    }
+    test::SimLink link(a, b, models, seed);
 
     std::array<Sent, 2> sent;
     std::uint32_t next_id = 1;
@@ -84,6 +97,18 @@ void run_seed(std::uint64_t seed) {
         }
         link.run_for(1s);
         ASSERT_FALSE(link.livelocked()) << "seed " << seed;
+        // An attacker on the frequency: replays of frames recorded earlier, and random bytes.
+        for (int to = 0; to < 2; ++to) {
+            const auto& rec = link.recorded(1 - to);
+            for (int k = 0; k < 3 && !rec.empty(); ++k) {
+                link.inject(to, rng() % models.size(), rec[rng() % rec.size()]);
+            }
+            std::vector<std::uint8_t> junk(1 + rng() % 60);
+            for (auto& byte : junk) {
+                byte = static_cast<std::uint8_t>(rng());
+            }
+            link.inject(to, 0, junk);
+        }
         if (::testing::Test::HasFatalFailure()) {
             return;
         }
@@ -91,7 +116,9 @@ void run_seed(std::uint64_t seed) {
     check_end(link.b(), sent[0], false, seed);
     check_end(link.a(), sent[1], false, seed);
     // Then a clean link: everything must arrive.
-    link.path(0).imp = test::Impairments{};
+    for (std::size_t p = 0; p < models.size(); ++p) {
+        link.path(p).imp = test::Impairments{};
+    }
     link.run_until(start + 200s, [&] {
         return link.a().core->safe_pending(0) + link.a().core->safe_pending(1) +
                    link.a().core->safe_pending(2) + link.a().core->safe_pending(3) +
@@ -103,6 +130,9 @@ void run_seed(std::uint64_t seed) {
     check_end(link.b(), sent[0], true, seed);
     check_end(link.a(), sent[1], true, seed);
     EXPECT_EQ(link.a().core->stats().peer_restarts, 0U) << "seed " << seed;
+    EXPECT_EQ(link.b().core->stats().peer_restarts, 0U) << "seed " << seed;
+    const auto& s = link.b().core->stats();  // the impairments and the attacker did reach the core
+    EXPECT_GT(s.replays + s.mac_failures + s.crc_errors + s.framing_errors, 0U) << "seed " << seed;
 }
 
 TEST(TransportProperty, SafeExactlyOnceInOrderUnderRandomImpairments) {
