@@ -192,7 +192,7 @@ TEST(FlightplanPersistence, RestartResumesAtTheFirstUnreachedWaypoint) {
     {
         test::Harness h;
         h.feeder.replace_plan({std::make_unique<Expander>(loaded.plan), "resume"}, h.now);
-        for (int i = 0; i < 137; ++i) {
+        for (int i = 0; i < 61; ++i) {
             h.step();
             ASSERT_FALSE(store.save_progress(SavedProgress::from(h.feeder.progress(), digest)));
         }
@@ -222,6 +222,54 @@ TEST(FlightplanPersistence, RestartResumesAtTheFirstUnreachedWaypoint) {
     ASSERT_EQ(visited.size(), expected.size());
     for (std::size_t i = 0; i < expected.size(); ++i)
         ASSERT_EQ(visited[i], expected[i]) << i;
+}
+
+}  // namespace
+}  // namespace airseg::flightplan
+
+#include "services/flightplan/resume.hpp"
+
+namespace airseg::flightplan {
+namespace {
+
+TEST(FlightplanPersistence, ResumeFromStoredState) {
+    TempDir dir;
+    StateStore store(dir.path(), Durability::NoFsync);
+    EXPECT_FALSE(resume_from(store.load()).resumed.has_value());  // empty store: nothing to resume
+
+    const std::string text = R"(plan:
+  name: r
+  elements:
+    - repeat: {count: 10, elements: [{waypoint: {lat: 41.0, lon: 2.0}}, {waypoint: {lat: 41.001, lon: 2.0}}]}
+)";
+    ASSERT_FALSE(store.save_plan(text, "r.yaml"));
+    auto fresh = resume_from(store.load());
+    ASSERT_TRUE(fresh.resumed.has_value());
+    ASSERT_TRUE(fresh.resumed->stream);
+    EXPECT_EQ(fresh.resumed->stream->next()->index, 0u);  // no progress yet: from the start
+
+    SavedProgress p;
+    p.plan_digest = fresh.resumed->digest;
+    p.state = PlanState::Paused;
+    p.next_index = 13;
+    p.waypoints_reached = 13;
+    ASSERT_FALSE(store.save_progress(p));
+    auto paused = resume_from(store.load());
+    ASSERT_TRUE(paused.resumed && paused.resumed->stream);
+    EXPECT_EQ(paused.resumed->progress.state, PlanState::Paused);
+    const auto w = paused.resumed->stream->next();
+    ASSERT_TRUE(w);
+    EXPECT_EQ(w->index, 13u);
+    EXPECT_DOUBLE_EQ(w->position.lat, 41.001);
+
+    p.state = PlanState::Running;
+    p.next_index = 20;  // past the end
+    ASSERT_FALSE(store.save_progress(p));
+    auto past = resume_from(store.load());
+    ASSERT_TRUE(past.resumed);
+    EXPECT_FALSE(past.resumed->stream);
+    EXPECT_EQ(past.resumed->progress.state, PlanState::Done);
+    EXPECT_EQ(past.problems.size(), 1u);
 }
 
 }  // namespace
