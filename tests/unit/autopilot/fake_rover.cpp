@@ -90,8 +90,10 @@ void FakeRover::handle_timeout(TimePoint now) {
     }
     if (now >= boot_start_ + options_.boot_delay && !boot_texts_sent_) {
         boot_texts_sent_ = true;
-        text(6, "Initialising APM");
-        text(6, "APM:Rover V2.51 (fake)");
+        if (options_.boot_texts) {
+            text(6, "Initialising APM");
+            text(6, "APM:Rover V2.51 (fake)");
+        }
     }
     if (now >= next_heartbeat_) {
         send_heartbeat(now);

@@ -34,6 +34,7 @@ class FakeRover {
         bool send_item_reached = true;
         Duration boot_delay = seconds(2);   // silent (bootloader) after a reset
         Duration calibration = seconds(1);  // heartbeats with MAV_STATE_CALIBRATING
+        bool boot_texts = true;             // "Initialising APM" and the version banner after a boot
         std::size_t params = 40;
         std::size_t max_items = 400;
     };

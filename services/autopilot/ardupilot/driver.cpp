@@ -1,0 +1,661 @@
+#include "services/autopilot/ardupilot/driver.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "services/autopilot/ardupilot/mission_codec.hpp"
+#include "services/autopilot/ardupilot/rover_modes.hpp"
+
+namespace airseg::autopilot::ardupilot {
+
+namespace mav = airseg::mavlink;
+
+namespace {
+constexpr std::uint16_t kCmdDoSetMode = 176;
+constexpr std::uint16_t kCmdSetMessageInterval = 511;
+constexpr std::uint8_t kModeFlagCustomModeEnabled = 1;
+
+double seconds_between(TimePoint a, TimePoint b) {
+    return std::chrono::duration<double>(b - a).count();
+}
+
+RequestResult from_mission(MissionResult r) {
+    switch (r) {
+        case MissionResult::Success:
+            return RequestResult::Ok;
+        case MissionResult::Timeout:
+            return RequestResult::Timeout;
+        case MissionResult::Denied:
+        case MissionResult::NoSpace:
+            return RequestResult::Refused;
+        case MissionResult::InvalidArgument:
+            return RequestResult::Invalid;
+        case MissionResult::Cancelled:
+            return RequestResult::Cancelled;
+        case MissionResult::Busy:
+            return RequestResult::Busy;
+    }
+    return RequestResult::Refused;
+}
+}  // namespace
+
+const char* to_string(Phase p) {
+    switch (p) {
+        case Phase::Closed:
+            return "closed";
+        case Phase::WaitBoot:
+            return "wait_boot";
+        case Phase::Params:
+            return "params";
+        case Phase::Mission:
+            return "mission";
+        case Phase::ApplyParams:
+            return "apply_params";
+        case Phase::Ready:
+            return "ready";
+    }
+    return "?";
+}
+
+Driver::Driver(AutopilotConfig config)
+    : config_(std::move(config)),
+      out_(config_.own_sysid, config_.own_compid,
+           config_.mavlink_version == 1 ? mav::Version::V1 : mav::Version::V2),
+      missions_(out_, config_.target_sysid, config_.target_compid, config_.mission),
+      params_(out_, config_.target_sysid, config_.target_compid,
+              ParamClientConfig{config_.param_timeout, config_.param_retries, config_.param_list_timeout}),
+      rc_(config_.rc_override, config_.target_sysid, config_.target_compid) {
+    if (config_.bauds.empty()) {
+        config_.bauds.push_back(115200);
+    }
+}
+
+// --- port lifecycle ----------------------------------------------------------------------------------------
+
+void Driver::on_port_open(TimePoint now) {
+    port_open_ = true;
+    opened_at_ = now;
+    quiet_since_ = now;
+    heard_frame_ = false;
+    parser_ = mav::Parser{};
+    time_boot_.reset();
+    baud_deadline_ = config_.bauds.size() > 1 ? now + config_.baud_probe : kNever;
+    if (config_.reset_on_open) {
+        // The open rebooted the autopilot: silence is expected until the boot window has passed.
+        quiet_since_ = now + config_.boot_timeout;
+    }
+    enter(Phase::WaitBoot, now);
+}
+
+void Driver::on_port_closed(const std::string& reason, TimePoint now) {
+    port_open_ = false;
+    cancel_everything("autopilot port closed: " + reason, now);
+    if (link_up_) {
+        link_up_ = false;
+        emit(LinkDown{reason});
+    }
+    phase_ = Phase::Closed;
+    phase_deadline_ = kNever;
+    baud_deadline_ = kNever;
+    last_error_ = reason;
+    update_state(now, false);
+}
+
+void Driver::on_reset_pulsed(TimePoint now) {
+    quiet_since_ = now;
+    time_boot_.reset();
+    cancel_everything("autopilot reset", now);
+    enter(Phase::WaitBoot, now);
+}
+
+// --- plumbing ----------------------------------------------------------------------------------------------
+
+void Driver::handle_bytes(std::span<const std::uint8_t> bytes, TimePoint now) {
+    parser_.push(bytes, [&](const mav::Frame& f) {
+        if (!f.checksum_verified) {
+            return;
+        }
+        tap_incoming(f);
+        on_frame(f, now);
+    });
+    drain_clients(now);
+    flush_rc(now);
+}
+
+void Driver::handle_timeout(TimePoint now) {
+    missions_.handle_timeout(now);
+    params_.handle_timeout(now);
+    drain_clients(now);
+
+    if (link_up_ && now >= last_heartbeat_ + config_.heartbeat_timeout) {
+        link_lost(now);
+    }
+    if (mode_request_ && now >= mode_request_->deadline) {
+        if (mode_request_->attempt >= config_.mode_retries) {
+            finish_mode(RequestResult::Timeout,
+                        std::string("no heartbeat in ") + rover_mode_name(mode_request_->mode) + " after " +
+                            std::to_string(mode_request_->attempt + 1) + " attempts",
+                        now);
+        } else {
+            ++mode_request_->attempt;
+            send_mode(mode_request_->mode);
+            mode_request_->deadline = now + config_.mode_timeout;
+        }
+    }
+    if (port_open_ && now >= baud_deadline_ && !heard_frame_) {
+        baud_index_ = (baud_index_ + 1) % config_.bauds.size();
+        actions_.push_back(SwitchBaud{config_.bauds[baud_index_]});
+        baud_deadline_ = now + config_.baud_probe;
+        quiet_since_ = std::max(quiet_since_, now - config_.unresponsive_timeout / 2);
+    }
+    if (port_open_ && !link_up_ && now >= quiet_since_ + config_.unresponsive_timeout) {
+        if (pulses_ < config_.max_reset_pulses) {
+            ++pulses_;
+            ++reset_pulses_;
+            actions_.push_back(PulseReset{pulses_});
+            last_error_ = "autopilot unresponsive, reset pulse " + std::to_string(pulses_);
+        } else {
+            last_error_ = "autopilot unresponsive; reset pulses exhausted";
+        }
+        quiet_since_ = now;  // give the pulse (or the operator) time before the next one
+    }
+    if (now >= phase_deadline_) {
+        phase_deadline_ = kNever;
+        if (phase_ == Phase::WaitBoot) {
+            last_error_ = "autopilot did not finish booting within boot_timeout";
+            if (link_up_ && pulses_ < config_.max_reset_pulses) {
+                ++pulses_;
+                ++reset_pulses_;
+                actions_.push_back(PulseReset{pulses_});
+            }
+        } else if (retry_pending_) {
+            retry_pending_ = false;
+            enter(Phase::Params, now);
+        }
+    }
+    flush_rc(now);
+}
+
+TimePoint Driver::poll_timeout() const {
+    TimePoint t =
+        std::min({missions_.poll_timeout(), params_.poll_timeout(), phase_deadline_, rc_.poll_timeout()});
+    if (link_up_) {
+        t = std::min(t, last_heartbeat_ + config_.heartbeat_timeout);
+    }
+    if (mode_request_) {
+        t = std::min(t, mode_request_->deadline);
+    }
+    if (port_open_) {
+        if (!heard_frame_) {
+            t = std::min(t, baud_deadline_);
+        }
+        if (!link_up_) {
+            t = std::min(t, quiet_since_ + config_.unresponsive_timeout);
+        }
+    }
+    return t;
+}
+
+std::optional<std::vector<std::uint8_t>> Driver::poll_transmit() {
+    auto f = out_.poll_transmit();
+    if (f && tap_) {
+        tap_(true, *f);
+    }
+    return f;
+}
+
+std::optional<Event> Driver::poll_event() {
+    if (events_.empty()) {
+        return std::nullopt;
+    }
+    auto e = std::move(events_.front());
+    events_.pop_front();
+    return e;
+}
+
+std::optional<DriverAction> Driver::poll_action() {
+    if (actions_.empty()) {
+        return std::nullopt;
+    }
+    auto a = actions_.front();
+    actions_.pop_front();
+    return a;
+}
+
+void Driver::flush_rc(TimePoint now) {
+    rc_.set_enabled(state_ == VehicleState::ManualNavigation && link_up_, now);
+    while (auto m = rc_.poll(now)) {
+        out_.send(*m);
+    }
+}
+
+// --- sequencing --------------------------------------------------------------------------------------------
+
+void Driver::enter(Phase p, TimePoint now) {
+    phase_ = p;
+    phase_deadline_ = kNever;
+    retry_pending_ = false;
+    switch (p) {
+        case Phase::Closed:
+            break;
+        case Phase::WaitBoot:
+            sequence_start_ = now;
+            ready_s_.reset();
+            phase_deadline_ = now + config_.boot_timeout;
+            break;
+        case Phase::Params:
+            request_streams();
+            sequence_fetch_ = params_.fetch_all(now);
+            break;
+        case Phase::Mission:
+            sequence_download_ = missions_.download(now);
+            break;
+        case Phase::ApplyParams:
+            start_apply_params(now);
+            break;
+        case Phase::Ready:
+            last_error_.clear();
+            pulses_ = 0;
+            ready_s_ = seconds_between(sequence_start_, now);
+            emit(Ready{*ready_s_});
+            break;
+    }
+    update_state(now, false);
+}
+
+void Driver::request_streams() {
+    if (!config_.use_message_interval) {
+        for (const auto& s : config_.stream_rates) {
+            mav::RequestDataStream m;
+            m.target_system = config_.target_sysid;
+            m.target_component = config_.target_compid;
+            m.req_stream_id = static_cast<std::uint8_t>(s.stream);
+            m.req_message_rate = static_cast<std::uint16_t>(s.hz);
+            m.start_stop = s.hz > 0 ? 1 : 0;
+            out_.send(m);
+        }
+        return;
+    }
+    for (const auto& r : config_.message_rates) {
+        mav::CommandLong m;
+        m.target_system = config_.target_sysid;
+        m.target_component = config_.target_compid;
+        m.command = kCmdSetMessageInterval;
+        m.param1 = static_cast<float>(r.msgid);
+        m.param2 = r.hz > 0 ? static_cast<float>(1e6 / r.hz) : -1.0f;  // -1 disables the message
+        out_.send(m);
+    }
+}
+
+void Driver::start_apply_params(TimePoint now) {
+    sequence_sets_.clear();
+    apply_failures_.clear();
+    for (const auto& p : config_.params) {
+        const auto have = params_.cached(p.name);
+        if (!have) {
+            apply_failures_.push_back(p.name + ": the autopilot has no such parameter");
+            continue;
+        }
+        if (std::fabs(*have - static_cast<float>(p.value)) <= 1e-6f * std::max(1.0f, std::fabs(*have))) {
+            continue;
+        }
+        sequence_sets_[params_.set(p.name, static_cast<float>(p.value), now)] = p.name;
+    }
+    if (sequence_sets_.empty()) {
+        if (apply_failures_.empty()) {
+            enter(Phase::Ready, now);
+        } else {
+            sequence_failed(apply_failures_.front(), now);
+        }
+    }
+}
+
+void Driver::sequence_failed(const std::string& why, TimePoint now) {
+    last_error_ = why;
+    retry_pending_ = true;
+    phase_deadline_ = now + kRetryPause;
+}
+
+void Driver::drain_clients(TimePoint now) {
+    while (auto c = missions_.poll_completion()) {
+        on_mission_done(std::move(*c), now);
+    }
+    while (auto c = params_.poll_completion()) {
+        on_param_done(std::move(*c), now);
+    }
+}
+
+void Driver::on_mission_done(MissionCompletion c, TimePoint now) {
+    if (c.id == sequence_download_) {
+        sequence_download_ = 0;
+        if (c.result != MissionResult::Success) {
+            if (c.result != MissionResult::Cancelled) {
+                sequence_failed("mission download: " + std::string(to_string(c.result)) + " " + c.detail,
+                                now);
+            }
+            return;
+        }
+        mission_.clear();
+        home_slot_.reset();
+        for (std::size_t i = 0; i < c.items.size(); ++i) {
+            if (i == 0) {
+                home_slot_ = c.items[0];
+                if (!telemetry_.home) {
+                    telemetry_.home = Position{c.items[0].x * 1e-7, c.items[0].y * 1e-7, c.items[0].z};
+                }
+            } else {
+                mission_.push_back(decode_item(c.items[i]));
+            }
+        }
+        if (phase_ == Phase::Mission) {
+            enter(Phase::ApplyParams, now);
+        }
+        return;
+    }
+    const auto it = mission_ops_.find(c.id);
+    if (it == mission_ops_.end()) {
+        return;
+    }
+    PendingOp op = std::move(it->second);
+    mission_ops_.erase(it);
+    const RequestResult r = from_mission(c.result);
+    if (r == RequestResult::Ok) {
+        switch (op.kind) {
+            case RequestKind::UploadMission:
+                mission_ = op.items;
+                break;
+            case RequestKind::WriteItems:
+                for (std::size_t i = 0; i < op.items.size(); ++i) {
+                    const std::size_t slot = op.first + i;
+                    if (slot >= 1 && slot - 1 < mission_.size()) {
+                        mission_[slot - 1] = op.items[i];
+                    }
+                }
+                break;
+            case RequestKind::ClearMission:
+                mission_.clear();
+                break;
+            case RequestKind::DownloadMission: {
+                mission_.clear();
+                for (std::size_t i = 1; i < c.items.size(); ++i) {
+                    mission_.push_back(decode_item(c.items[i]));
+                }
+                RequestDone d{op.id, op.kind, r, {}, mission_, std::nullopt};
+                emit(std::move(d));
+                return;
+            }
+            default:
+                break;
+        }
+    }
+    done(op.id, op.kind, r, c.detail);
+}
+
+void Driver::on_param_done(ParamCompletion c, TimePoint now) {
+    if (c.id == sequence_fetch_) {
+        sequence_fetch_ = 0;
+        if (c.result == RequestResult::Ok) {
+            if (phase_ == Phase::Params) {
+                enter(Phase::Mission, now);
+            }
+        } else if (c.result != RequestResult::Cancelled) {
+            sequence_failed(c.detail, now);
+        }
+        return;
+    }
+    if (const auto it = sequence_sets_.find(c.id); it != sequence_sets_.end()) {
+        if (c.result != RequestResult::Ok) {
+            apply_failures_.push_back(c.detail.empty() ? it->second + ": " + to_string(c.result) : c.detail);
+        }
+        sequence_sets_.erase(it);
+        if (sequence_sets_.empty() && phase_ == Phase::ApplyParams) {
+            if (apply_failures_.empty()) {
+                enter(Phase::Ready, now);
+            } else {
+                sequence_failed("parameter " + apply_failures_.front(), now);
+            }
+        }
+        return;
+    }
+    const auto it = param_ops_.find(c.id);
+    if (it == param_ops_.end()) {
+        return;
+    }
+    RequestDone d{it->second.id, it->second.kind, c.result, c.detail, {}, std::nullopt};
+    if (c.value) {
+        d.param_value = *c.value;
+    }
+    param_ops_.erase(it);
+    emit(std::move(d));
+}
+
+void Driver::cancel_everything(const std::string& why, TimePoint now) {
+    missions_.cancel_all(why);
+    params_.cancel_all(why);
+    drain_clients(now);
+    sequence_sets_.clear();
+    if (mode_request_) {
+        finish_mode(RequestResult::Cancelled, why, now);
+    }
+    override_active_ = false;
+}
+
+void Driver::done(std::uint32_t id, RequestKind kind, RequestResult result, std::string detail) {
+    RequestDone d;
+    d.id = id;
+    d.kind = kind;
+    d.result = result;
+    d.detail = std::move(detail);
+    emit(std::move(d));
+}
+
+// --- requests ----------------------------------------------------------------------------------------------
+
+std::uint32_t Driver::reject_if_not_ready(RequestKind kind) {
+    if (ready()) {
+        return 0;
+    }
+    const std::uint32_t id = next_id_++;
+    done(id, kind, RequestResult::NotReady,
+         std::string("autopilot not ready (") + to_string(phase_) + (link_up_ ? "" : ", link down") + ")");
+    return id;
+}
+
+std::uint32_t Driver::upload_mission(std::vector<MissionItem> items, TimePoint now) {
+    if (auto id = reject_if_not_ready(RequestKind::UploadMission)) {
+        return id;
+    }
+    std::vector<mav::MissionItemInt> wire;
+    wire.reserve(items.size() + 1);
+    wire.push_back(home_slot_ ? *home_slot_ : home_item(telemetry_.home.value_or(Position{})));
+    for (const auto& it : items) {
+        wire.push_back(encode_item(it));
+    }
+    const std::uint32_t id = next_id_++;
+    mission_ops_[missions_.upload(std::move(wire), now)] = {id, RequestKind::UploadMission, std::move(items),
+                                                            1};
+    drain_clients(now);
+    return id;
+}
+
+std::uint32_t Driver::write_items(std::uint16_t first_slot, std::vector<MissionItem> items, TimePoint now) {
+    if (auto id = reject_if_not_ready(RequestKind::WriteItems)) {
+        return id;
+    }
+    const std::uint32_t id = next_id_++;
+    if (first_slot == 0) {
+        done(id, RequestKind::WriteItems, RequestResult::Invalid, "slot 0 is home and is not written");
+        return id;
+    }
+    std::vector<mav::MissionItemInt> wire;
+    for (const auto& it : items) {
+        wire.push_back(encode_item(it));
+    }
+    mission_ops_[missions_.write_partial(first_slot, std::move(wire), now)] = {id, RequestKind::WriteItems,
+                                                                               std::move(items), first_slot};
+    drain_clients(now);
+    return id;
+}
+
+std::uint32_t Driver::download_mission(TimePoint now) {
+    if (auto id = reject_if_not_ready(RequestKind::DownloadMission)) {
+        return id;
+    }
+    const std::uint32_t id = next_id_++;
+    mission_ops_[missions_.download(now)] = {id, RequestKind::DownloadMission, {}, 0};
+    drain_clients(now);
+    return id;
+}
+
+std::uint32_t Driver::set_current(std::uint16_t slot, TimePoint now) {
+    if (auto id = reject_if_not_ready(RequestKind::SetCurrent)) {
+        return id;
+    }
+    const std::uint32_t id = next_id_++;
+    mission_ops_[missions_.set_current(slot, now)] = {id, RequestKind::SetCurrent, {}, slot};
+    drain_clients(now);
+    return id;
+}
+
+std::uint32_t Driver::clear_mission(TimePoint now) {
+    if (auto id = reject_if_not_ready(RequestKind::ClearMission)) {
+        return id;
+    }
+    const std::uint32_t id = next_id_++;
+    mission_ops_[missions_.clear(now)] = {id, RequestKind::ClearMission, {}, 0};
+    drain_clients(now);
+    return id;
+}
+
+std::uint32_t Driver::get_param(const std::string& name, TimePoint now) {
+    if (!link_up_) {
+        const std::uint32_t id = next_id_++;
+        done(id, RequestKind::GetParam, RequestResult::NotReady, "autopilot link down");
+        return id;
+    }
+    const std::uint32_t id = next_id_++;
+    param_ops_[params_.get(name, now)] = {id, RequestKind::GetParam, {}, 0};
+    drain_clients(now);
+    return id;
+}
+
+std::uint32_t Driver::set_param(const std::string& name, double value, TimePoint now) {
+    if (auto id = reject_if_not_ready(RequestKind::SetParam)) {
+        return id;
+    }
+    const std::uint32_t id = next_id_++;
+    param_ops_[params_.set(name, static_cast<float>(value), now)] = {id, RequestKind::SetParam, {}, 0};
+    drain_clients(now);
+    return id;
+}
+
+void Driver::joystick(double steering, double throttle, TimePoint now) {
+    rc_.set_input(steering, throttle, now);
+    flush_rc(now);
+}
+
+void Driver::operator_reset(TimePoint now) {
+    if (failsafe_latched_) {
+        failsafe_latched_ = false;
+        update_state(now, true);
+    }
+}
+
+std::uint32_t Driver::request_state(VehicleState target, TimePoint now) {
+    const std::uint32_t id = next_id_++;
+    // The failsafe needs only a live link; everything else needs a READY autopilot.
+    if (!link_up_ || (target != VehicleState::Manual && !ready())) {
+        done(id, RequestKind::SetState, RequestResult::NotReady,
+             link_up_ ? "autopilot not ready" : "autopilot link down");
+        return id;
+    }
+    if (auto why = transition_refusal(state_, target)) {
+        done(id, RequestKind::SetState, RequestResult::Refused,
+             std::string(to_string(state_)) + " -> " + to_string(target) + ": " + *why);
+        return id;
+    }
+    const auto mode = static_cast<std::uint32_t>(*mode_for(target));
+    if (mode_request_) {
+        finish_mode(RequestResult::Cancelled, std::string("superseded by a request for ") + to_string(target),
+                    now);
+    }
+    if (mode_ && *mode_ == mode) {
+        // Same autopilot mode (MANUAL for DIRECTED, MANUAL_NAVIGATION and failsafe MANUAL): only our side
+        // changes.
+        override_active_ = target == VehicleState::ManualNavigation;
+        failsafe_latched_ = failsafe_latched_ || target == VehicleState::Manual;
+        update_state(now, true);
+        flush_rc(now);
+        done(id, RequestKind::SetState, RequestResult::Ok);
+        return id;
+    }
+    mode_request_ = ModeRequest{id, target, mode, 0, now + config_.mode_timeout};
+    send_mode(mode);
+    return id;
+}
+
+void Driver::send_mode(std::uint32_t mode) {
+    if (config_.board == Board::Apm2) {
+        mav::SetMode m;  // ArduRover 2.x does not know MAV_CMD_DO_SET_MODE
+        m.target_system = config_.target_sysid;
+        m.base_mode = kModeFlagCustomModeEnabled;
+        m.custom_mode = mode;
+        out_.send(m);
+        return;
+    }
+    mav::CommandLong m;
+    m.target_system = config_.target_sysid;
+    m.target_component = config_.target_compid;
+    m.command = kCmdDoSetMode;
+    m.param1 = kModeFlagCustomModeEnabled;
+    m.param2 = static_cast<float>(mode);
+    out_.send(m);
+}
+
+void Driver::finish_mode(RequestResult r, std::string detail, TimePoint now) {
+    const ModeRequest req = *mode_request_;
+    mode_request_.reset();
+    if (r == RequestResult::Ok) {
+        override_active_ = req.target == VehicleState::ManualNavigation;
+        failsafe_latched_ = failsafe_latched_ || req.target == VehicleState::Manual;
+        update_state(now, true);
+        flush_rc(now);
+    }
+    done(req.id, RequestKind::SetState, r, std::move(detail));
+}
+
+void Driver::update_state(TimePoint now, bool requested) {
+    VehicleState s = VehicleState::Unknown;
+    if (link_up_ && mode_) {
+        s = state_for(*mode_, phase_ != Phase::Ready, override_active_, failsafe_latched_);
+    }
+    const std::string name = mode_ ? rover_mode_name(*mode_) : std::string();
+    if (s != state_ || name != mode_name_) {
+        ModeChanged e{state_, s, mode_name_, name,
+                      requested ? ModeChangeCause::Requested : ModeChangeCause::External};
+        state_ = s;
+        mode_name_ = name;
+        emit(std::move(e));
+    }
+    telemetry_.state = state_;
+    telemetry_.mode = mode_name_;
+    if (state_ != VehicleState::ManualNavigation) {
+        rc_.set_enabled(false, now);
+    }
+}
+
+AutopilotStatus Driver::status() const {
+    AutopilotStatus s;
+    s.link_up = link_up_;
+    s.ready = ready();
+    s.ready_s = ready_s_;
+    s.state = state_;
+    s.mode = mode_name_;
+    s.position = telemetry_.position;
+    s.mission_current = telemetry_.mission_current;
+    s.reboots = reboots_;
+    s.reset_pulses = reset_pulses_;
+    return s;
+}
+
+}  // namespace airseg::autopilot::ardupilot

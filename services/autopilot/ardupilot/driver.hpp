@@ -1,0 +1,209 @@
+#pragma once
+// Driver: the ArduPilot Rover driver behind the neutral autopilot interface, sans-IO.
+//
+// Connection sequence (Phase): on_port_open() -> WaitBoot (with reset_on_open the open rebooted the
+// autopilot: bootloader noise is ignored and heartbeats must reach STANDBY/ACTIVE within boot_timeout;
+// without it the first running heartbeat will do) -> Params (stream rates requested, parameter table
+// downloaded) -> Mission (mission downloaded; slot 0 is home) -> ApplyParams (configured parameters written
+// where they differ, each read back) -> Ready (Ready event with the seconds since the open). A failed step is
+// retried after retry_pause; last_error() says why the driver is not READY.
+//
+// Afterwards it keeps: telemetry; the vehicle state derived from each heartbeat (mode changes made by the RC
+// pilot or the autopilot itself are published as External ModeChanged events); requested state changes,
+// confirmed by the heartbeat, retried, refused or timed out (never dropped); mission operations through
+// MissionClient; parameters through ParamClient; RC override from joystick input; waypoint-reached events
+// from MISSION_ITEM_REACHED or the "Reached waypoint #N" text; link DOWN after heartbeat_timeout of silence;
+// unexpected reboots (time_boot_ms running slower than our clock, heartbeats saying BOOT/CALIBRATING,
+// boot banners right after a heartbeat gap) trigger a resync of parameters and mission and an
+// AutopilotRebooted event; an autopilot silent for unresponsive_timeout while its port is open makes the
+// driver ask for a reset pulse (at most max_reset_pulses times until it is READY again).
+//
+// Contract (the service, on its strand): on_port_open/on_port_closed/on_reset_pulsed for the port; every byte
+// read to handle_bytes(); handle_timeout(now) when poll_timeout() is due; requests any time. After each call
+// drain poll_transmit() (one frame per call, write in order), poll_event() and poll_action().
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <map>
+#include <optional>
+#include <span>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "services/autopilot/ardupilot/mission_client.hpp"
+#include "services/autopilot/ardupilot/outbox.hpp"
+#include "services/autopilot/ardupilot/param_client.hpp"
+#include "services/autopilot/ardupilot/rc_override.hpp"
+#include "services/autopilot/autopilot.hpp"
+#include "services/autopilot/autopilot_config.hpp"
+#include "services/autopilot/mavlink/parser.hpp"
+#include "services/common/time.hpp"
+
+namespace airseg::autopilot::ardupilot {
+
+/// The service should reconfigure the port to this baud rate (baud probing).
+struct SwitchBaud {
+    unsigned baud = 0;
+};
+/// The service should pulse the autopilot's reset line, then call on_reset_pulsed().
+struct PulseReset {
+    unsigned attempt = 0;
+};
+using DriverAction = std::variant<SwitchBaud, PulseReset>;
+
+enum class Phase : std::uint8_t { Closed, WaitBoot, Params, Mission, ApplyParams, Ready };
+const char* to_string(Phase p);
+
+class Driver {
+  public:
+    /// Called with every frame written to or read from the autopilot (for the flight recorder).
+    using FrameTap = std::function<void(bool outgoing, std::span<const std::uint8_t> frame)>;
+    static constexpr Duration kRetryPause = seconds(5);
+
+    explicit Driver(AutopilotConfig config);
+
+    // --- port lifecycle ---
+    void on_port_open(TimePoint now);
+    void on_port_closed(const std::string& reason, TimePoint now);
+    void on_reset_pulsed(TimePoint now);
+
+    // --- sans-IO plumbing ---
+    void handle_bytes(std::span<const std::uint8_t> bytes, TimePoint now);
+    void handle_timeout(TimePoint now);
+    TimePoint poll_timeout() const;
+    std::optional<std::vector<std::uint8_t>> poll_transmit();
+    std::optional<Event> poll_event();
+    std::optional<DriverAction> poll_action();
+    void set_frame_tap(FrameTap tap) { tap_ = std::move(tap); }
+
+    // --- requests (each ends with exactly one RequestDone event carrying the returned id) ---
+    std::uint32_t request_state(VehicleState state, TimePoint now);
+    /// Replaces the mission with `items` at slots 1..n; slot 0 (home) is kept.
+    std::uint32_t upload_mission(std::vector<MissionItem> items, TimePoint now);
+    std::uint32_t write_items(std::uint16_t first_slot, std::vector<MissionItem> items, TimePoint now);
+    std::uint32_t download_mission(TimePoint now);
+    std::uint32_t set_current(std::uint16_t slot, TimePoint now);
+    std::uint32_t clear_mission(TimePoint now);
+    std::uint32_t get_param(const std::string& name, TimePoint now);
+    std::uint32_t set_param(const std::string& name, double value, TimePoint now);
+    /// Ground joystick, -1..1 each; drives only in MANUAL_NAVIGATION and only while fresh.
+    void joystick(double steering, double throttle, TimePoint now);
+    /// Clears the failsafe MANUAL latch (the operator's explicit reset).
+    void operator_reset(TimePoint now);
+
+    // --- views ---
+    Phase phase() const { return phase_; }
+    const Telemetry& telemetry() const { return telemetry_; }
+    AutopilotStatus status() const;
+    /// Slots 1..n of the mission as last uploaded or downloaded.
+    const std::vector<MissionItem>& mission() const { return mission_; }
+    const ParamClient& params() const { return params_; }
+    const MissionClient& mission_client() const { return missions_; }
+    const RcOverride& rc_override() const { return rc_; }
+    const mavlink::ParserStats& parser_stats() const { return parser_.stats(); }
+    unsigned current_baud() const { return config_.bauds[baud_index_]; }
+    const std::string& last_error() const { return last_error_; }
+    bool link_up() const { return link_up_; }
+    bool ready() const { return phase_ == Phase::Ready && link_up_; }
+
+  private:
+    struct ModeRequest {
+        std::uint32_t id = 0;
+        VehicleState target = VehicleState::Unknown;
+        std::uint32_t mode = 0;
+        unsigned attempt = 0;
+        TimePoint deadline = kNever;
+    };
+    struct PendingOp {
+        std::uint32_t id = 0;  // the requester's id; 0 for the driver's own (sequence) operations
+        RequestKind kind = RequestKind::UploadMission;
+        std::vector<MissionItem> items;  // what an upload/partial write puts in the cache on success
+        std::uint16_t first = 1;
+    };
+
+    // driver.cpp: lifecycle, sequencing, requests
+    void enter(Phase p, TimePoint now);
+    void request_streams();
+    void start_apply_params(TimePoint now);
+    void sequence_failed(const std::string& why, TimePoint now);
+    void drain_clients(TimePoint now);
+    void on_mission_done(MissionCompletion c, TimePoint now);
+    void on_param_done(ParamCompletion c, TimePoint now);
+    void cancel_everything(const std::string& why, TimePoint now);
+    void done(std::uint32_t id, RequestKind kind, RequestResult result, std::string detail = {});
+    std::uint32_t reject_if_not_ready(RequestKind kind);
+    void send_mode(std::uint32_t mode);
+    void finish_mode(RequestResult r, std::string detail, TimePoint now);
+    void update_state(TimePoint now, bool requested);
+    void emit(Event e) { events_.push_back(std::move(e)); }
+    void flush_rc(TimePoint now);
+
+    // driver_frames.cpp: what comes from the autopilot
+    void on_frame(const mavlink::Frame& f, TimePoint now);
+    void on_heartbeat(const mavlink::Heartbeat& hb, TimePoint now);
+    void on_statustext(const mavlink::Statustext& t, TimePoint now);
+    void on_time_boot(std::uint32_t time_boot_ms, TimePoint now);
+    void on_command_ack(const mavlink::CommandAck& ack, TimePoint now);
+    void on_reached(std::uint16_t seq, TimePoint now);
+    void reboot_detected(const std::string& evidence, TimePoint now);
+    void link_lost(TimePoint now);
+    void tap_incoming(const mavlink::Frame& f);
+
+    AutopilotConfig config_;
+    Outbox out_;
+    mavlink::Parser parser_;
+    MissionClient missions_;
+    ParamClient params_;
+    RcOverride rc_;
+    FrameTap tap_;
+
+    Phase phase_ = Phase::Closed;
+    bool port_open_ = false;
+    TimePoint opened_at_{};
+    TimePoint sequence_start_{};
+    TimePoint phase_deadline_ = kNever;  // boot timeout, or the pause before retrying a failed step
+    bool retry_pending_ = false;
+    std::string last_error_;
+    std::optional<double> ready_s_;
+
+    // Link.
+    bool link_up_ = false;
+    TimePoint last_heartbeat_{};
+    TimePoint quiet_since_{};  // reference for the unresponsive timer
+    bool heard_frame_ = false;
+    std::size_t baud_index_ = 0;
+    TimePoint baud_deadline_ = kNever;
+    unsigned pulses_ = 0;
+    TimePoint gap_window_end_{};  // boot banners until then count as reboot evidence
+    std::optional<std::pair<std::uint32_t, TimePoint>> time_boot_;
+
+    // Vehicle.
+    std::optional<std::uint32_t> mode_;
+    std::uint8_t system_status_ = 0;
+    bool override_active_ = false;
+    bool failsafe_latched_ = false;
+    VehicleState state_ = VehicleState::Unknown;
+    std::string mode_name_;
+    std::optional<ModeRequest> mode_request_;
+    Telemetry telemetry_;
+    std::optional<std::pair<std::uint16_t, TimePoint>> last_reached_;
+    unsigned reboots_ = 0;
+    unsigned reset_pulses_ = 0;
+
+    // Mission and parameters.
+    std::vector<MissionItem> mission_;
+    std::optional<mavlink::MissionItemInt> home_slot_;
+    std::map<std::uint32_t, PendingOp> mission_ops_;  // by MissionClient id
+    std::map<std::uint32_t, PendingOp> param_ops_;    // by ParamClient id
+    std::uint32_t sequence_fetch_ = 0;
+    std::uint32_t sequence_download_ = 0;
+    std::map<std::uint32_t, std::string> sequence_sets_;  // ParamClient id -> parameter
+    std::vector<std::string> apply_failures_;
+    std::uint32_t next_id_ = 1;
+
+    std::deque<Event> events_;
+    std::deque<DriverAction> actions_;
+};
+
+}  // namespace airseg::autopilot::ardupilot

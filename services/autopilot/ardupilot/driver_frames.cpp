@@ -1,0 +1,259 @@
+// Driver: what comes from the autopilot (heartbeats, telemetry, texts, reboots, link loss).
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cstdlib>
+
+#include "services/autopilot/ardupilot/driver.hpp"
+#include "services/autopilot/ardupilot/rover_modes.hpp"
+#include "services/autopilot/mavlink/encoder.hpp"
+
+namespace airseg::autopilot::ardupilot {
+
+namespace mav = airseg::mavlink;
+
+namespace {
+constexpr std::uint8_t kMavStateUninit = 0;
+constexpr std::uint8_t kMavStateBoot = 1;
+constexpr std::uint8_t kMavStateCalibrating = 2;
+constexpr std::uint8_t kMavStatePoweroff = 7;
+constexpr std::uint16_t kCmdDoSetMode = 176;
+constexpr Duration kGapWindow = seconds(10);   // boot banners this long after a heartbeat gap mean a reboot
+constexpr Duration kSameReached = seconds(3);  // the item-reached message and the text for the same slot
+constexpr Duration kClockSlack = seconds(2);   // latency jitter allowed when comparing time_boot_ms
+
+std::string lower(std::string_view s) {
+    std::string out(s);
+    std::transform(out.begin(), out.end(), out.begin(),
+                   [](char c) { return static_cast<char>(std::tolower(static_cast<unsigned char>(c))); });
+    return out;
+}
+
+const char* mav_result_name(std::uint8_t r) {
+    static const char* const kNames[] = {"ACCEPTED", "TEMPORARILY_REJECTED", "DENIED",   "UNSUPPORTED",
+                                         "FAILED",   "IN_PROGRESS",          "CANCELLED"};
+    return r < std::size(kNames) ? kNames[r] : "unknown";
+}
+
+bool is_boot_banner(const std::string& text) {
+    return text.starts_with("initialising apm") || text.starts_with("init ardu") ||
+           text.starts_with("ardurover") || text.starts_with("apm:rover");
+}
+}  // namespace
+
+void Driver::tap_incoming(const mav::Frame& f) {
+    if (!tap_) {
+        return;
+    }
+    const mav::MessageInfo* info = mav::find_message(f.msgid);
+    if (!info) {
+        return;
+    }
+    std::array<std::uint8_t, mav::kMaxFrameLength> buf{};
+    const mav::FrameHeader h{f.version, f.seq, f.sysid, f.compid, f.msgid, f.compat_flags};
+    const std::size_t n =
+        mav::encode_frame(h, info->crc_extra, std::span(f.payload).first(f.wire_length), buf);
+    if (n > 0) {
+        tap_(false, std::span<const std::uint8_t>(buf.data(), n));
+    }
+}
+
+void Driver::on_frame(const mav::Frame& f, TimePoint now) {
+    heard_frame_ = true;
+    baud_deadline_ = kNever;
+    if (f.sysid != config_.target_sysid) {
+        return;
+    }
+    missions_.handle_frame(f, now);
+    params_.handle_frame(f, now);
+    const auto p = f.payload_view();
+    switch (f.msgid) {
+        case mav::Heartbeat::kId:
+            if (f.compid == config_.target_compid) {
+                on_heartbeat(mav::decode_payload<mav::Heartbeat>(p), now);
+            }
+            break;
+        case mav::Statustext::kId:
+            on_statustext(mav::decode_payload<mav::Statustext>(p), now);
+            break;
+        case mav::SystemTime::kId:
+            on_time_boot(mav::decode_payload<mav::SystemTime>(p).time_boot_ms, now);
+            break;
+        case mav::GlobalPositionInt::kId: {
+            const auto m = mav::decode_payload<mav::GlobalPositionInt>(p);
+            if (m.lat != 0 || m.lon != 0) {
+                telemetry_.position = Position{m.lat * 1e-7, m.lon * 1e-7, m.alt * 1e-3};
+            }
+            telemetry_.relative_alt = m.relative_alt * 1e-3;
+            if (m.hdg != 65535) {
+                telemetry_.heading = m.hdg * 0.01;
+            }
+            on_time_boot(m.time_boot_ms, now);
+            break;
+        }
+        case mav::Attitude::kId: {
+            const auto m = mav::decode_payload<mav::Attitude>(p);
+            telemetry_.roll = m.roll;
+            telemetry_.pitch = m.pitch;
+            telemetry_.yaw = m.yaw;
+            break;
+        }
+        case mav::VfrHud::kId: {
+            const auto m = mav::decode_payload<mav::VfrHud>(p);
+            telemetry_.ground_speed = m.groundspeed;
+            telemetry_.heading = (m.heading % 360 + 360) % 360;
+            break;
+        }
+        case mav::GpsRawInt::kId: {
+            const auto m = mav::decode_payload<mav::GpsRawInt>(p);
+            telemetry_.gps_fix = m.fix_type <= 6 ? static_cast<GpsFix>(m.fix_type) : GpsFix::RtkFixed;
+            telemetry_.satellites = m.satellites_visible == 255 ? 0 : m.satellites_visible;
+            if (!telemetry_.position && m.fix_type >= 2) {
+                telemetry_.position = Position{m.lat * 1e-7, m.lon * 1e-7, m.alt * 1e-3};
+            }
+            break;
+        }
+        case mav::SysStatus::kId: {
+            const auto m = mav::decode_payload<mav::SysStatus>(p);
+            if (m.voltage_battery != 65535) {
+                telemetry_.battery_voltage = m.voltage_battery * 1e-3;
+            }
+            if (m.current_battery >= 0) {
+                telemetry_.battery_current = m.current_battery * 1e-2;
+            }
+            if (m.battery_remaining >= 0) {
+                telemetry_.battery_remaining = m.battery_remaining;
+            }
+            break;
+        }
+        case mav::HomePosition::kId: {
+            const auto m = mav::decode_payload<mav::HomePosition>(p);
+            telemetry_.home = Position{m.latitude * 1e-7, m.longitude * 1e-7, m.altitude * 1e-3};
+            break;
+        }
+        case mav::MissionCurrent::kId: {
+            const auto seq = mav::decode_payload<mav::MissionCurrent>(p).seq;
+            if (seq != telemetry_.mission_current) {
+                telemetry_.mission_current = seq;
+                emit(MissionCurrentChanged{seq});
+            }
+            break;
+        }
+        case mav::MissionItemReached::kId:
+            on_reached(mav::decode_payload<mav::MissionItemReached>(p).seq, now);
+            break;
+        case mav::CommandAck::kId:
+            on_command_ack(mav::decode_payload<mav::CommandAck>(p), now);
+            break;
+        default:
+            break;
+    }
+}
+
+void Driver::on_heartbeat(const mav::Heartbeat& hb, TimePoint now) {
+    last_heartbeat_ = now;
+    quiet_since_ = now;
+    system_status_ = hb.system_status;
+    const bool booting = hb.system_status == kMavStateUninit || hb.system_status == kMavStateBoot ||
+                         hb.system_status == kMavStateCalibrating ||
+                         hb.custom_mode == static_cast<std::uint32_t>(RoverMode::Initialising);
+    if (!link_up_) {
+        link_up_ = true;
+        gap_window_end_ = now + kGapWindow;
+        emit(LinkUp{});
+        if (phase_ == Phase::Ready) {
+            request_streams();  // the autopilot may have lost them in a reboot we cannot prove
+        }
+    }
+    if (booting && phase_ != Phase::WaitBoot && phase_ != Phase::Closed) {
+        reboot_detected("heartbeat reports the autopilot booting", now);
+    }
+    const bool mode_changed = !mode_ || *mode_ != hb.custom_mode;
+    mode_ = hb.custom_mode;
+    if (mode_request_ && hb.custom_mode == mode_request_->mode) {
+        finish_mode(RequestResult::Ok, {}, now);
+    } else if (mode_changed) {
+        override_active_ = false;  // the RC pilot or the autopilot took over
+    }
+    if (phase_ == Phase::WaitBoot && !booting && hb.system_status != kMavStatePoweroff) {
+        enter(Phase::Params, now);
+    }
+    update_state(now, false);
+}
+
+void Driver::on_statustext(const mav::Statustext& t, TimePoint now) {
+    const std::string text(mav::text_of(t.text));
+    emit(StatusText{t.severity, text});
+    const std::string l = lower(text);
+    if (const auto pos = l.find("reached waypoint #"); pos != std::string::npos) {
+        const char* digits = l.c_str() + pos + 18;
+        char* end = nullptr;
+        const unsigned long seq = std::strtoul(digits, &end, 10);
+        if (end != digits && seq <= 65535) {
+            on_reached(static_cast<std::uint16_t>(seq), now);
+        }
+    }
+    if (is_boot_banner(l) && now < gap_window_end_ && phase_ != Phase::WaitBoot && phase_ != Phase::Closed) {
+        reboot_detected("heartbeat gap with boot messages (\"" + text + "\")", now);
+    }
+}
+
+void Driver::on_time_boot(std::uint32_t time_boot_ms, TimePoint now) {
+    if (time_boot_ && phase_ != Phase::WaitBoot && phase_ != Phase::Closed) {
+        const auto [before, at] = *time_boot_;
+        const auto ours = std::chrono::duration_cast<milliseconds>(now - at).count();
+        const std::int64_t theirs =
+            static_cast<std::int64_t>(time_boot_ms) - static_cast<std::int64_t>(before);
+        const auto slack =
+            std::chrono::duration_cast<milliseconds>(std::max(kClockSlack, config_.heartbeat_timeout));
+        if (theirs + slack.count() < ours) {
+            time_boot_ = std::pair{time_boot_ms, now};
+            reboot_detected(theirs < 0 ? "time_boot_ms went back" : "time_boot_ms restarted during a silence",
+                            now);
+            return;
+        }
+    }
+    time_boot_ = std::pair{time_boot_ms, now};
+}
+
+void Driver::on_command_ack(const mav::CommandAck& ack, TimePoint now) {
+    if (ack.command != kCmdDoSetMode || !mode_request_) {
+        return;
+    }
+    if (ack.result == 0 || ack.result == 5) {
+        return;  // accepted / in progress: the heartbeat confirms
+    }
+    finish_mode(RequestResult::Refused,
+                std::string("autopilot answered MAV_RESULT_") + mav_result_name(ack.result) + " to mode " +
+                    rover_mode_name(mode_request_->mode),
+                now);
+}
+
+void Driver::on_reached(std::uint16_t seq, TimePoint now) {
+    if (last_reached_ && last_reached_->first == seq && now - last_reached_->second < kSameReached) {
+        return;  // the same event by its second route
+    }
+    last_reached_ = std::pair{seq, now};
+    emit(WaypointReached{seq});
+}
+
+void Driver::reboot_detected(const std::string& evidence, TimePoint now) {
+    ++reboots_;
+    emit(AutopilotRebooted{evidence});
+    cancel_everything("autopilot rebooted", now);
+    last_error_ = "autopilot rebooted: " + evidence;
+    enter(Phase::WaitBoot, now);
+}
+
+void Driver::link_lost(TimePoint now) {
+    link_up_ = false;
+    const auto silent = std::chrono::duration<double>(now - last_heartbeat_).count();
+    emit(LinkDown{"no heartbeat for " + std::to_string(static_cast<int>(silent)) + " s"});
+    cancel_everything("autopilot link down", now);
+    if (phase_ != Phase::Ready && phase_ != Phase::Closed) {
+        enter(Phase::WaitBoot, now);  // the sequence starts again when heartbeats return
+    }
+    update_state(now, false);
+}
+
+}  // namespace airseg::autopilot::ardupilot

@@ -1,0 +1,79 @@
+#include "services/autopilot/ardupilot/mission_codec.hpp"
+
+#include <cmath>
+
+namespace airseg::autopilot::ardupilot {
+
+namespace {
+constexpr std::uint16_t kNavWaypoint = 16;
+constexpr std::uint16_t kNavLoiterUnlim = 17;
+constexpr std::uint16_t kDoJump = 177;
+constexpr std::uint8_t kFrameGlobal = 0;
+constexpr std::uint8_t kFrameMission = 2;
+constexpr std::uint8_t kFrameGlobalRelativeAltInt = 6;
+
+std::int32_t to_e7(double degrees) {
+    return static_cast<std::int32_t>(std::llround(degrees * 1e7));
+}
+}  // namespace
+
+mavlink::MissionItemInt encode_item(const MissionItem& item) {
+    mavlink::MissionItemInt m;
+    m.autocontinue = 1;
+    switch (item.kind) {
+        case MissionItem::Kind::Waypoint:
+        case MissionItem::Kind::Stop:
+            m.command = item.kind == MissionItem::Kind::Waypoint ? kNavWaypoint : kNavLoiterUnlim;
+            m.frame = kFrameGlobalRelativeAltInt;
+            m.x = to_e7(item.lat);
+            m.y = to_e7(item.lon);
+            m.z = static_cast<float>(item.alt);
+            if (item.kind == MissionItem::Kind::Waypoint) {
+                m.param1 = static_cast<float>(item.hold_s.value_or(0.0));
+                m.param2 = static_cast<float>(item.radius.value_or(0.0));
+            }
+            break;
+        case MissionItem::Kind::JumpTo:
+            m.command = kDoJump;
+            m.frame = kFrameMission;
+            m.param1 = static_cast<float>(item.jump_slot);
+            m.param2 = -1.0f;
+            break;
+    }
+    return m;
+}
+
+MissionItem decode_item(const mavlink::MissionItemInt& m) {
+    MissionItem item;
+    if (m.command == kDoJump) {
+        item.kind = MissionItem::Kind::JumpTo;
+        item.jump_slot = static_cast<std::uint16_t>(std::lround(m.param1));
+        return item;
+    }
+    item.kind = m.command == kNavLoiterUnlim ? MissionItem::Kind::Stop : MissionItem::Kind::Waypoint;
+    item.lat = static_cast<double>(m.x) * 1e-7;
+    item.lon = static_cast<double>(m.y) * 1e-7;
+    item.alt = m.z;
+    if (m.command == kNavWaypoint) {
+        if (m.param1 > 0) {
+            item.hold_s = m.param1;
+        }
+        if (m.param2 > 0) {
+            item.radius = m.param2;
+        }
+    }
+    return item;
+}
+
+mavlink::MissionItemInt home_item(const Position& home) {
+    mavlink::MissionItemInt m;
+    m.command = kNavWaypoint;
+    m.frame = kFrameGlobal;
+    m.autocontinue = 1;
+    m.x = to_e7(home.lat);
+    m.y = to_e7(home.lon);
+    m.z = static_cast<float>(home.alt);
+    return m;
+}
+
+}  // namespace airseg::autopilot::ardupilot

@@ -1,0 +1,555 @@
+// The ArduPilot driver core against the scripted Rover, in simulated time: connection sequence, vehicle
+// states, pilot mode changes, RC override, reboots, stalls, reset pulses, baud probing, missions.
+#include "services/autopilot/ardupilot/driver.hpp"
+
+#include <gtest/gtest.h>
+
+#include "tests/unit/autopilot/fake_rover.hpp"
+#include "tests/unit/autopilot/sim_harness.hpp"
+
+namespace airseg::autopilot::ardupilot {
+namespace {
+
+using testing::FakeRover;
+using testing::Harness;
+using testing::LinkModel;
+using testing::Party;
+namespace mav = airseg::mavlink;
+
+const TimePoint kStart = TimePoint{} + std::chrono::hours(2);
+
+AutopilotConfig apm2_config() {
+    auto c = AutopilotConfig::defaults_for(Board::Apm2);
+    c.params = {{"CRUISE_SPEED", 3.0}, {"WP_RADIUS", 2.0}};
+    return c;
+}
+
+struct Rig {
+    Rig(AutopilotConfig config, FakeRover::Options opts, LinkModel link = {}, std::uint32_t seed = 1)
+        : driver(std::move(config)),
+          rover(opts, kStart),
+          harness(ground(), vehicle(), link, link, seed, kStart) {}
+
+    Party ground() {
+        Party p;
+        p.receive = [this](std::span<const std::uint8_t> b, TimePoint now) {
+            driver.handle_bytes(b, now);
+            drain();
+        };
+        p.transmit = [this] { return driver.poll_transmit(); };
+        p.on_timeout = [this](TimePoint now) {
+            driver.handle_timeout(now);
+            drain();
+        };
+        p.deadline = [this] { return driver.poll_timeout(); };
+        return p;
+    }
+    Party vehicle() {
+        Party p;
+        p.receive = [this](std::span<const std::uint8_t> b, TimePoint now) { rover.handle_bytes(b, now); };
+        p.transmit = [this] { return rover.poll_transmit(); };
+        p.on_timeout = [this](TimePoint now) { rover.handle_timeout(now); };
+        p.deadline = [this] { return rover.poll_timeout(); };
+        return p;
+    }
+    void drain() {
+        while (auto e = driver.poll_event()) {
+            events.push_back(std::move(*e));
+        }
+        while (auto a = driver.poll_action()) {
+            actions.push_back(*a);
+        }
+    }
+    /// The open of an APM on USB resets it.
+    void open_with_reset() {
+        rover.reboot(now());
+        driver.on_port_open(now());
+        drain();
+    }
+    TimePoint now() const { return harness.now(); }
+
+    template <class E>
+    std::vector<E> all() const {
+        std::vector<E> out;
+        for (const auto& e : events) {
+            if (const auto* x = std::get_if<E>(&e)) {
+                out.push_back(*x);
+            }
+        }
+        return out;
+    }
+    template <class E>
+    bool run_until_event(std::size_t count, Duration limit) {
+        return harness.run_until([&] { return all<E>().size() >= count; }, now() + limit);
+    }
+    std::optional<RequestDone> result_of(std::uint32_t id) const {
+        for (const auto& d : all<RequestDone>()) {
+            if (d.id == id) {
+                return d;
+            }
+        }
+        return std::nullopt;
+    }
+    RequestDone wait_result(std::uint32_t id, Duration limit = seconds(60)) {
+        harness.run_until([&] { return result_of(id).has_value(); }, now() + limit);
+        auto r = result_of(id);
+        return r ? *r
+                 : RequestDone{id, RequestKind::SetState, RequestResult::Cancelled, "no result in time", {},
+                               {}};
+    }
+    void bring_up() {
+        open_with_reset();
+        ASSERT_TRUE(run_until_event<Ready>(1, seconds(40)));
+    }
+
+    Driver driver;
+    FakeRover rover;
+    Harness harness;
+    std::vector<Event> events;
+    std::vector<DriverAction> actions;
+};
+
+FakeRover::Options apm2_rover() {
+    FakeRover::Options o;
+    o.version = mav::Version::V1;
+    o.request_int = false;
+    o.send_item_reached = false;  // ArduRover 2.x announces reached waypoints only as text
+    return o;
+}
+
+TEST(Driver, ReadyWithinBootDelayCalibrationAndOneSecond) {
+    Rig rig(apm2_config(), apm2_rover());
+    rig.open_with_reset();
+    const TimePoint opened = rig.now();
+    ASSERT_TRUE(rig.run_until_event<Ready>(1, seconds(40))) << rig.driver.last_error();
+    const double took = std::chrono::duration<double>(rig.now() - opened).count();
+    EXPECT_LE(took, 2.0 + 1.0 + 1.0);
+    EXPECT_GE(took, 3.0);  // not before the autopilot finished calibrating
+    EXPECT_TRUE(rig.driver.ready());
+    ASSERT_TRUE(rig.driver.status().ready_s);
+    EXPECT_NEAR(*rig.driver.status().ready_s, took, 1e-6);
+    // Configured parameters written and verified; the one already right was not written.
+    EXPECT_FLOAT_EQ(rig.rover.params()["CRUISE_SPEED"], 3.0f);
+    EXPECT_EQ(rig.rover.param_sets(), 1u);
+    EXPECT_EQ(rig.driver.params().table().size(), rig.rover.params().size());
+    ASSERT_TRUE(rig.driver.telemetry().home);
+    EXPECT_NEAR(rig.driver.telemetry().home->lat, 41.39, 1e-6);
+    EXPECT_EQ(rig.driver.status().state, VehicleState::Parking);
+    EXPECT_EQ(rig.driver.status().mode, "HOLD");
+    // Link up was seen, and the state went through CONFIGURE_CHECK on the way.
+    EXPECT_EQ(rig.all<LinkUp>().size(), 1u);
+    bool saw_configure = false;
+    for (const auto& m : rig.all<ModeChanged>()) {
+        saw_configure = saw_configure || m.to == VehicleState::ConfigureCheck;
+    }
+    EXPECT_TRUE(saw_configure);
+    EXPECT_EQ(rig.driver.status().reboots, 0u);
+}
+
+TEST(Driver, RequestsBeforeReadyAreRefusedAsNotReady) {
+    Rig rig(apm2_config(), apm2_rover());
+    rig.open_with_reset();
+    const auto id = rig.driver.upload_mission({MissionItem{}}, rig.now());
+    const auto st = rig.driver.request_state(VehicleState::WaypointNavigation, rig.now());
+    rig.drain();
+    ASSERT_TRUE(rig.result_of(id));
+    EXPECT_EQ(rig.result_of(id)->result, RequestResult::NotReady);
+    EXPECT_EQ(rig.result_of(st)->result, RequestResult::NotReady);
+}
+
+TEST(Driver, EachVehicleStateRequestedAndConfirmed) {
+    for (const Board board : {Board::Apm2, Board::Pixhawk}) {
+        SCOPED_TRACE(to_string(board));
+        auto config = AutopilotConfig::defaults_for(board);
+        config.bauds = {115200};
+        Rig rig(config, board == Board::Apm2 ? apm2_rover() : FakeRover::Options{});
+        rig.bring_up();
+        struct Step {
+            VehicleState state;
+            std::uint32_t mode;
+        };
+        for (const Step s : {Step{VehicleState::WaypointNavigation, testing::kAuto},
+                             Step{VehicleState::Directed, testing::kManual},
+                             Step{VehicleState::ManualNavigation, testing::kManual},
+                             Step{VehicleState::Parking, testing::kHold},
+                             Step{VehicleState::ManualNavigation, testing::kManual},
+                             Step{VehicleState::Manual, testing::kManual}}) {
+            const auto r = rig.wait_result(rig.driver.request_state(s.state, rig.now()));
+            EXPECT_EQ(r.result, RequestResult::Ok) << to_string(s.state) << ": " << r.detail;
+            EXPECT_EQ(rig.driver.status().state, s.state);
+            EXPECT_EQ(rig.rover.mode(), s.mode);
+        }
+        // Failsafe MANUAL holds until the operator resets it.
+        const auto refused = rig.wait_result(rig.driver.request_state(VehicleState::Parking, rig.now()));
+        EXPECT_EQ(refused.result, RequestResult::Refused);
+        EXPECT_NE(refused.detail.find("operator reset"), std::string::npos);
+        EXPECT_EQ(rig.rover.mode(), testing::kManual);
+        rig.driver.operator_reset(rig.now());
+        EXPECT_EQ(rig.driver.status().state, VehicleState::Directed);
+        EXPECT_EQ(rig.wait_result(rig.driver.request_state(VehicleState::Parking, rig.now())).result,
+                  RequestResult::Ok);
+        EXPECT_EQ(rig.rover.mode(), testing::kHold);
+        // CONFIGURE_CHECK is entered by the autopilot, never on request.
+        EXPECT_EQ(rig.wait_result(rig.driver.request_state(VehicleState::ConfigureCheck, rig.now())).result,
+                  RequestResult::Refused);
+    }
+}
+
+TEST(Driver, RefusedModeIsReportedNotDropped) {
+    auto config = AutopilotConfig::defaults_for(Board::Pixhawk);
+    config.bauds = {115200};
+    Rig rig(config, {});
+    rig.rover.refused_modes().insert(testing::kAuto);
+    rig.bring_up();
+    const auto r = rig.wait_result(rig.driver.request_state(VehicleState::WaypointNavigation, rig.now()));
+    EXPECT_EQ(r.result, RequestResult::Refused);
+    EXPECT_NE(r.detail.find("MAV_RESULT_FAILED"), std::string::npos) << r.detail;
+    EXPECT_EQ(rig.driver.status().state, VehicleState::Parking);
+}
+
+TEST(Driver, SilentlyIgnoredModeTimesOutAfterRetries) {
+    auto config = apm2_config();
+    config.mode_retries = 2;
+    Rig rig(config, apm2_rover());
+    rig.rover.refused_modes().insert(testing::kAuto);  // SET_MODE has no answer: only the heartbeat tells
+    rig.bring_up();
+    const TimePoint asked = rig.now();
+    const auto r = rig.wait_result(rig.driver.request_state(VehicleState::WaypointNavigation, rig.now()));
+    EXPECT_EQ(r.result, RequestResult::Timeout);
+    EXPECT_GE(rig.now() - asked, 3 * config.mode_timeout);
+    EXPECT_NE(r.detail.find("AUTO"), std::string::npos);
+}
+
+TEST(Driver, ModeChangeByThePilotIsSeen) {
+    Rig rig(apm2_config(), apm2_rover());
+    rig.bring_up();
+    const auto before = rig.all<ModeChanged>().size();
+    rig.rover.pilot_sets_mode(testing::kManual, rig.now());
+    rig.harness.run_for(milliseconds(100));
+    const auto changes = rig.all<ModeChanged>();
+    ASSERT_EQ(changes.size(), before + 1);
+    EXPECT_EQ(changes.back().from, VehicleState::Parking);
+    EXPECT_EQ(changes.back().to, VehicleState::Directed);
+    EXPECT_EQ(changes.back().to_mode, "MANUAL");
+    EXPECT_EQ(changes.back().cause, ModeChangeCause::External);
+}
+
+TEST(Driver, PilotTakingOverEndsJoystickDriving) {
+    Rig rig(apm2_config(), apm2_rover());
+    rig.bring_up();
+    ASSERT_EQ(rig.wait_result(rig.driver.request_state(VehicleState::ManualNavigation, rig.now())).result,
+              RequestResult::Ok);
+    rig.rover.pilot_sets_mode(testing::kHold, rig.now());
+    rig.harness.run_for(milliseconds(100));
+    rig.rover.pilot_sets_mode(testing::kManual, rig.now());
+    rig.harness.run_for(milliseconds(100));
+    EXPECT_EQ(rig.driver.status().state, VehicleState::Directed);
+}
+
+TEST(Driver, RcOverrideFollowsFreshInputAndIsReleasedWithinTheTimeout) {
+    auto config = apm2_config();
+    config.rc_override.rate_hz = 10;
+    config.rc_override.input_timeout = milliseconds(500);
+    Rig rig(config, apm2_rover());
+    rig.bring_up();
+    ASSERT_EQ(rig.wait_result(rig.driver.request_state(VehicleState::ManualNavigation, rig.now())).result,
+              RequestResult::Ok);
+    // Joystick at 5 Hz for 2 s: full right, half throttle.
+    for (int i = 0; i < 10; ++i) {
+        rig.driver.joystick(1.0, 0.5, rig.now());
+        rig.harness.run_for(milliseconds(200));
+        ASSERT_TRUE(rig.rover.last_override());
+        EXPECT_EQ(rig.rover.last_override()->chan1_raw, 1900);
+        EXPECT_EQ(rig.rover.last_override()->chan3_raw, 1700);
+    }
+    const auto sent_while_driving = rig.rover.overrides_received();
+    EXPECT_GE(sent_while_driving, 18u);  // ~10 Hz
+    EXPECT_LE(sent_while_driving, 22u);
+    // Input stops (ground link lost): released within the timeout (+ one link transit).
+    const TimePoint last_input = rig.now() - milliseconds(200);
+    rig.harness.run_for(seconds(3));
+    ASSERT_TRUE(rig.rover.last_override());
+    EXPECT_EQ(rig.rover.last_override()->chan1_raw, 0);
+    EXPECT_EQ(rig.rover.last_override()->chan3_raw, 0);
+    EXPECT_LE(rig.rover.last_override_at() - last_input,
+              config.rc_override.input_timeout + config.rc_override.release_repeats * milliseconds(100) +
+                  milliseconds(50));
+    const auto after_release = rig.rover.overrides_received();
+    rig.harness.run_for(seconds(3));
+    EXPECT_EQ(rig.rover.overrides_received(), after_release);  // nothing more once released
+    EXPECT_EQ(rig.driver.rc_override().releases(), 1u);
+}
+
+TEST(Driver, JoystickIsIgnoredOutsideManualNavigation) {
+    Rig rig(apm2_config(), apm2_rover());
+    rig.bring_up();
+    rig.driver.joystick(1.0, 1.0, rig.now());
+    rig.harness.run_for(seconds(1));
+    EXPECT_EQ(rig.rover.overrides_received(), 0u);
+}
+
+TEST(Driver, WaypointReachedFromTextAndFromMessageOnce) {
+    FakeRover::Options with_both;
+    with_both.send_item_reached = true;
+    auto config = AutopilotConfig::defaults_for(Board::Pixhawk);
+    config.bauds = {115200};
+    Rig rig(config, with_both);
+    rig.bring_up();
+    rig.rover.reach(1, rig.now());
+    rig.harness.run_for(milliseconds(200));
+    rig.rover.reach(2, rig.now());
+    rig.harness.run_for(milliseconds(200));
+    const auto reached = rig.all<WaypointReached>();
+    ASSERT_EQ(reached.size(), 2u);
+    EXPECT_EQ(reached[0].seq, 1);
+    EXPECT_EQ(reached[1].seq, 2);
+
+    Rig text_only(apm2_config(), apm2_rover());
+    text_only.bring_up();
+    text_only.rover.reach(3, text_only.now());
+    text_only.harness.run_for(milliseconds(200));
+    ASSERT_EQ(text_only.all<WaypointReached>().size(), 1u);
+    EXPECT_EQ(text_only.all<WaypointReached>()[0].seq, 3);
+}
+
+std::vector<MissionItem> plan(std::size_t n) {
+    std::vector<MissionItem> items;
+    for (std::size_t i = 0; i < n; ++i) {
+        MissionItem it;
+        it.lat = 41.39 + 1e-5 * static_cast<double>(i);
+        it.lon = 2.11 - 1e-5 * static_cast<double>(i);
+        it.radius = 1.5;
+        items.push_back(it);
+    }
+    items.back().kind = MissionItem::Kind::Stop;
+    return items;
+}
+
+TEST(Driver, Upload150ItemsOverALossyRadioVerifiedByDownload) {
+    LinkModel radio;
+    radio.baud = 57600;
+    radio.latency = milliseconds(20);
+    radio.frame_drop = 0.10;
+    auto config = AutopilotConfig::defaults_for(Board::Pixhawk);
+    config.bauds = {57600};
+    FakeRover::Options opts;
+    opts.max_items = 200;
+    Rig rig(config, opts, radio, 99);
+    rig.bring_up();
+    const auto items = plan(150);
+    const auto up = rig.wait_result(rig.driver.upload_mission(items, rig.now()), seconds(600));
+    ASSERT_EQ(up.result, RequestResult::Ok) << up.detail;
+    const auto down = rig.wait_result(rig.driver.download_mission(rig.now()), seconds(600));
+    ASSERT_EQ(down.result, RequestResult::Ok) << down.detail;
+    ASSERT_EQ(down.items.size(), items.size());
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        EXPECT_EQ(down.items[i].kind, items[i].kind) << i;
+        EXPECT_NEAR(down.items[i].lat, items[i].lat, 1e-7) << i;
+        EXPECT_NEAR(down.items[i].lon, items[i].lon, 1e-7) << i;
+        ASSERT_TRUE(i + 1 == items.size() || down.items[i].radius) << i;
+    }
+    EXPECT_EQ(rig.driver.mission().size(), 150u);
+}
+
+TEST(Driver, PartialWriteAndSetCurrent) {
+    Rig rig(apm2_config(), apm2_rover());
+    rig.bring_up();
+    ASSERT_EQ(rig.wait_result(rig.driver.upload_mission(plan(6), rig.now())).result, RequestResult::Ok);
+    MissionItem jump;
+    jump.kind = MissionItem::Kind::JumpTo;
+    jump.jump_slot = 1;
+    ASSERT_EQ(rig.wait_result(rig.driver.write_items(6, {jump}, rig.now())).result, RequestResult::Ok);
+    EXPECT_EQ(rig.rover.mission()[6].command, 177);
+    EXPECT_EQ(rig.driver.mission()[5].kind, MissionItem::Kind::JumpTo);
+    ASSERT_EQ(rig.wait_result(rig.driver.set_current(3, rig.now())).result, RequestResult::Ok);
+    EXPECT_EQ(rig.rover.mission_current(), 3);
+    rig.harness.run_for(seconds(2));
+    EXPECT_EQ(rig.driver.status().mission_current, 3);
+    EXPECT_EQ(rig.wait_result(rig.driver.write_items(0, {jump}, rig.now())).result, RequestResult::Invalid);
+}
+
+TEST(Driver, RebootMidMissionIsDetectedAndResynced) {
+    Rig rig(apm2_config(), apm2_rover());
+    rig.bring_up();
+    ASSERT_EQ(rig.wait_result(rig.driver.upload_mission(plan(5), rig.now())).result, RequestResult::Ok);
+    ASSERT_EQ(rig.wait_result(rig.driver.request_state(VehicleState::WaypointNavigation, rig.now())).result,
+              RequestResult::Ok);
+    rig.harness.run_for(seconds(5));
+    rig.rover.params()["CRUISE_SPEED"] = 2.0f;  // the reboot lost an unsaved parameter
+    rig.rover.reboot(rig.now());
+    ASSERT_TRUE(rig.run_until_event<AutopilotRebooted>(1, seconds(20)));
+    ASSERT_TRUE(rig.run_until_event<Ready>(2, seconds(40))) << rig.driver.last_error();
+    EXPECT_EQ(rig.driver.status().reboots, 1u);
+    EXPECT_FLOAT_EQ(rig.rover.params()["CRUISE_SPEED"], 3.0f);  // re-applied
+    EXPECT_EQ(rig.driver.mission().size(), 5u);                 // re-downloaded
+    EXPECT_EQ(rig.driver.status().state, VehicleState::Parking);
+    EXPECT_EQ(rig.all<AutopilotRebooted>().size(), 1u);
+}
+
+TEST(Driver, RebootDuringAHeartbeatSilenceIsDetectedByItsClock) {
+    // A quick boot without calibration heartbeats or banners: only time_boot_ms tells.
+    auto opts = apm2_rover();
+    opts.calibration = Duration::zero();
+    opts.boot_delay = milliseconds(500);
+    opts.boot_texts = false;
+    Rig rig(apm2_config(), opts);
+    rig.bring_up();
+    rig.harness.run_for(seconds(30));
+    // Silent for 6 s, rebooting at the end of it: its clock restarted.
+    rig.rover.stall(rig.now() + seconds(6));
+    rig.harness.run_for(seconds(6));
+    rig.rover.reboot(rig.now());
+    ASSERT_TRUE(rig.run_until_event<AutopilotRebooted>(1, seconds(20)));
+    ASSERT_TRUE(rig.run_until_event<Ready>(2, seconds(40)));
+    EXPECT_EQ(rig.driver.status().reboots, 1u);
+    EXPECT_NE(rig.all<AutopilotRebooted>()[0].evidence.find("time_boot_ms"), std::string::npos);
+}
+
+TEST(Driver, BootBannersRightAfterAGapMeanAReboot) {
+    auto opts = apm2_rover();
+    opts.calibration = Duration::zero();
+    opts.boot_delay = milliseconds(500);
+    Rig rig(apm2_config(), opts);
+    rig.bring_up();
+    rig.harness.run_for(seconds(30));
+    rig.rover.stall(rig.now() + seconds(6));
+    rig.harness.run_for(seconds(6));
+    rig.rover.reboot(rig.now());
+    ASSERT_TRUE(rig.run_until_event<AutopilotRebooted>(1, seconds(20)));
+    EXPECT_EQ(rig.driver.status().reboots, 1u);
+}
+
+TEST(Driver, HeartbeatStallOfTenSecondsIsLinkDownThenUpWithoutReboot) {
+    Rig rig(apm2_config(), apm2_rover());
+    rig.bring_up();
+    const TimePoint stall = rig.now();
+    rig.rover.stall(stall + seconds(10));
+    ASSERT_TRUE(rig.run_until_event<LinkDown>(1, seconds(10)));
+    EXPECT_LE(rig.now() - stall, seconds(3) + seconds(1));  // heartbeat_timeout after the last heartbeat
+    EXPECT_FALSE(rig.driver.status().link_up);
+    EXPECT_EQ(rig.driver.status().state, VehicleState::Unknown);
+    EXPECT_EQ(rig.wait_result(rig.driver.set_current(1, rig.now())).result, RequestResult::NotReady);
+    ASSERT_TRUE(rig.run_until_event<LinkUp>(2, seconds(15)));
+    rig.harness.run_for(seconds(2));
+    EXPECT_TRUE(rig.driver.ready());
+    EXPECT_EQ(rig.driver.status().reboots, 0u);
+    EXPECT_EQ(rig.driver.status().state, VehicleState::Parking);
+}
+
+TEST(Driver, UnresponsiveAutopilotGetsAtMostNResetPulses) {
+    auto config = apm2_config();
+    config.reset_on_open = false;
+    config.unresponsive_timeout = seconds(5);
+    config.max_reset_pulses = 2;
+    Rig rig(config, apm2_rover());
+    rig.rover.stall(kStart + std::chrono::hours(1));
+    rig.driver.on_port_open(rig.now());
+    rig.harness.run_until(
+        [&] {
+            for (auto& a : rig.actions) {
+                if (std::holds_alternative<PulseReset>(a)) {
+                    a = SwitchBaud{0};  // consumed: the service pulsed the line
+                    rig.driver.on_reset_pulsed(rig.now());
+                }
+            }
+            return false;
+        },
+        rig.now() + seconds(60));
+    EXPECT_EQ(rig.driver.status().reset_pulses, 2u);
+    EXPECT_NE(rig.driver.last_error().find("exhausted"), std::string::npos) << rig.driver.last_error();
+}
+
+TEST(Driver, ResetPulseRecoversAStuckAutopilot) {
+    auto config = apm2_config();
+    config.reset_on_open = false;
+    config.unresponsive_timeout = seconds(5);
+    Rig rig(config, apm2_rover());
+    rig.rover.stall(kStart + std::chrono::hours(1));
+    rig.driver.on_port_open(rig.now());
+    const bool ready = rig.harness.run_until(
+        [&] {
+            for (auto& a : rig.actions) {
+                if (std::holds_alternative<PulseReset>(a)) {
+                    a = SwitchBaud{0};
+                    rig.rover.stall(rig.now());  // the reset line reboots it
+                    rig.rover.reboot(rig.now());
+                    rig.driver.on_reset_pulsed(rig.now());
+                }
+            }
+            return !rig.all<Ready>().empty();
+        },
+        rig.now() + seconds(60));
+    EXPECT_TRUE(ready) << rig.driver.last_error();
+    EXPECT_EQ(rig.driver.status().reset_pulses, 1u);
+}
+
+TEST(Driver, BaudProbingMovesToTheNextRateUntilAFrameArrives) {
+    auto config = apm2_config();
+    config.bauds = {57600, 115200};
+    config.baud_probe = seconds(2);
+    Rig rig(config, apm2_rover());
+    rig.rover.stall(kStart + seconds(3));  // nothing readable at first
+    rig.open_with_reset();
+    rig.rover.stall(kStart + seconds(3));
+    ASSERT_TRUE(rig.run_until_event<Ready>(1, seconds(40)));
+    ASSERT_FALSE(rig.actions.empty());
+    ASSERT_TRUE(std::holds_alternative<SwitchBaud>(rig.actions[0]));
+    EXPECT_EQ(std::get<SwitchBaud>(rig.actions[0]).baud, 115200u);
+    EXPECT_EQ(rig.driver.current_baud(), 115200u);
+    rig.harness.run_for(seconds(10));
+    EXPECT_EQ(rig.actions.size(), 1u);  // kept once frames arrived
+}
+
+TEST(Driver, ParameterGetAndSetWithReadBack) {
+    Rig rig(apm2_config(), apm2_rover());
+    rig.bring_up();
+    const auto got = rig.wait_result(rig.driver.get_param("PARAM_7", rig.now()));
+    ASSERT_EQ(got.result, RequestResult::Ok) << got.detail;
+    EXPECT_DOUBLE_EQ(*got.param_value, 7.0);
+    const auto set = rig.wait_result(rig.driver.set_param("PARAM_7", 12.5, rig.now()));
+    ASSERT_EQ(set.result, RequestResult::Ok) << set.detail;
+    EXPECT_FLOAT_EQ(rig.rover.params()["PARAM_7"], 12.5f);
+    EXPECT_FLOAT_EQ(*rig.driver.params().cached("PARAM_7"), 12.5f);
+    const auto missing = rig.wait_result(rig.driver.set_param("NO_SUCH_PARAM", 1, rig.now()));
+    EXPECT_EQ(missing.result, RequestResult::Timeout);
+    const auto bad = rig.wait_result(rig.driver.set_param("A_NAME_LONGER_THAN_16", 1, rig.now()));
+    EXPECT_EQ(bad.result, RequestResult::Invalid);
+}
+
+TEST(Driver, UnknownConfiguredParameterKeepsTheDriverFromReady) {
+    auto config = apm2_config();
+    config.params.push_back({"NOT_A_PARAM", 1});
+    Rig rig(config, apm2_rover());
+    rig.open_with_reset();
+    EXPECT_FALSE(rig.run_until_event<Ready>(1, seconds(20)));
+    EXPECT_NE(rig.driver.last_error().find("NOT_A_PARAM"), std::string::npos) << rig.driver.last_error();
+}
+
+TEST(Driver, PortClosedCancelsAndReportsDown) {
+    Rig rig(apm2_config(), apm2_rover());
+    rig.bring_up();
+    const auto id = rig.driver.download_mission(rig.now());
+    rig.driver.on_port_closed("no /dev/ttyACM0", rig.now());
+    rig.drain();
+    ASSERT_TRUE(rig.result_of(id));
+    EXPECT_EQ(rig.result_of(id)->result, RequestResult::Cancelled);
+    ASSERT_EQ(rig.all<LinkDown>().size(), 1u);
+    EXPECT_EQ(rig.all<LinkDown>()[0].reason, "no /dev/ttyACM0");
+    EXPECT_FALSE(rig.driver.ready());
+}
+
+TEST(Driver, TelemetryFromTheStreams) {
+    Rig rig(apm2_config(), apm2_rover());
+    rig.bring_up();
+    rig.harness.run_for(seconds(2));
+    const auto& t = rig.driver.telemetry();
+    ASSERT_TRUE(t.position);
+    EXPECT_NEAR(t.position->lat, 41.39, 0.01);
+    EXPECT_NEAR(t.position->alt, 12.0, 1e-9);
+    EXPECT_NEAR(t.heading, 90.0, 1e-9);
+    EXPECT_EQ(t.mode, "HOLD");
+    ASSERT_TRUE(rig.driver.status().position);
+}
+
+}  // namespace
+}  // namespace airseg::autopilot::ardupilot
