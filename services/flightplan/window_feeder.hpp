@@ -92,7 +92,6 @@ class WindowFeeder {
     struct Outstanding {
         FeederRequest request;
         TimePoint deadline;
-        std::uint32_t attempt = 0;
     };
     enum class Mode : std::uint8_t { Unknown, Auto, Hold };
 
