@@ -221,8 +221,10 @@ struct LinkStats {
 /// write each frame to that path's port at once; drain poll_message() and poll_event(); (re)arm one timer at
 /// poll_timeout() and call handle_timeout(now) when it fires, then loop again. poll_transmit enforces the
 /// pacing: it returns nothing until the path's byte-time budget (link_rate) allows the next frame, so the
-/// bytes written to a path by time t never exceed link_rate × elapsed + one frame. poll_timeout() then
-/// includes the moment the budget frees up. Protocol errors never throw: they are counted in stats().
+/// bytes written to a path by time t never exceed link_rate × elapsed + one frame (with half_duplex, an end
+/// using 45 % or more of the air also waits for the air budget it shares with the peer; docs/ground-link.md,
+/// "Pacing"). poll_timeout() then includes the moment the budget frees up. Protocol errors never throw: they
+/// are counted in stats().
 class Transport {
   public:
     /// The configuration must be valid (see TransportConfig::validate); an invalid one throws

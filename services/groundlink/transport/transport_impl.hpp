@@ -52,7 +52,7 @@ class Transport::Impl {
     void handle_bytes(std::size_t path, std::span<const std::uint8_t> bytes, TimePoint now);
     void on_plain_frame(std::size_t path, std::span<const std::uint8_t> plain, TimePoint now);
     void on_hello(std::size_t path, const frame::Hello& h, TimePoint now);
-    void on_data_frame(std::size_t path, std::span<const std::uint8_t> frame, TimePoint now);
+    void on_data_frame(std::span<const std::uint8_t> frame, TimePoint now);
     void on_authentic(std::size_t path, std::uint8_t peer_heard_mask, TimePoint now);
     void on_safe(const frame::SafeChunk& c, TimePoint now);
     void on_fast(const frame::FastChunk& c, TimePoint now);

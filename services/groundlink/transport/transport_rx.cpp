@@ -99,7 +99,7 @@ void Transport::Impl::on_plain_frame(std::size_t path, std::span<const std::uint
     if (!confirmed) {
         confirmed = true;
     }
-    on_data_frame(path, frame_bytes, now);
+    on_data_frame(frame_bytes, now);
 }
 
 void Transport::Impl::on_authentic(std::size_t path, std::uint8_t peer_heard_mask, TimePoint now) {
@@ -121,9 +121,7 @@ void Transport::Impl::on_authentic(std::size_t path, std::uint8_t peer_heard_mas
     peer_mask_known = true;
 }
 
-void Transport::Impl::on_data_frame(std::size_t path, std::span<const std::uint8_t> frame_bytes,
-                                    TimePoint now) {
-    (void)path;
+void Transport::Impl::on_data_frame(std::span<const std::uint8_t> frame_bytes, TimePoint now) {
     const auto chunks = frame::decode_chunks(frame_bytes);
     if (!chunks) {
         ++stats.malformed;

@@ -1,0 +1,283 @@
+#include "services/groundlink/groundlink_service.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <random>
+
+#include "services/groundlink/link/key_file.hpp"
+#include "services/groundlink/protocol/ground_protocol.hpp"
+#include "services/status/status_messages.hpp"
+
+namespace airseg::groundlink {
+
+namespace {
+
+std::uint64_t random_nonce() {
+    std::random_device rd;
+    std::uint64_t v = 0;
+    while (v == 0) {
+        v = (static_cast<std::uint64_t>(rd()) << 32) ^ rd();
+    }
+    return v;
+}
+
+nlohmann::json class_json(const ClassStats& s) {
+    return {{"messages", s.messages},   {"bytes", s.bytes}, {"retransmissions", s.retransmissions},
+            {"drops", s.drops},         {"replaced", s.replaced}, {"queue_depth", s.queue_depth}};
+}
+
+}  // namespace
+
+TransportConfig transport_config_for(const GroundlinkServiceConfig& config) {
+    TransportConfig t = config.transport;
+    if (config.mode == "udp") {
+        t.paths = 1;
+        t.path_mode = PathMode::single;
+        t.half_duplex = false;
+    } else {
+        t.link_rate_bytes_per_s = config.baud / 10.0;
+        t.paths = config.ports.size();
+        t.path_mode = config.mode == "split"       ? PathMode::split
+                      : config.mode == "redundant" ? PathMode::redundant
+                                                   : PathMode::single;
+    }
+    return t;
+}
+
+GroundlinkService::GroundlinkService(ServiceContext& ctx, GroundlinkServiceConfig config)
+    : Service("groundlink", ctx), config_(std::move(config)), stats_timer_(strand()) {}
+
+GroundlinkService::~GroundlinkService() = default;
+
+void GroundlinkService::on_start() {
+    TransportConfig transport = transport_config_for(config_);
+    transport.boot_nonce = random_nonce();
+    if (!config_.key_file.empty()) {
+        auto key = read_key_file(config_.key_file);
+        if (!key.key) {
+            // Running unauthenticated when a key was asked for would be worse than not running the link.
+            fatal_ = key.error;
+            spdlog::error("groundlink: {}; the ground link stays down", fatal_);
+            update_health();
+            publish_status();
+            return;
+        }
+        transport.key = key.key;
+    } else {
+        spdlog::warn("groundlink: no key_file configured: frames are not authenticated");
+    }
+    if (auto problems = transport.validate(); !problems.empty()) {
+        fatal_ = problems.front();
+        update_health();
+        return;
+    }
+    driver_ = std::make_unique<LinkDriver>(strand(), transport,
+                                           LinkDriver::Handlers{[this](Delivered m) { on_message(std::move(m)); },
+                                                                [this](const TransportEvent& e) { on_event(e); }});
+    if (config_.mode == "udp") {
+        udp_ = std::make_unique<hal::UdpSocket>(strand());
+        auto r = udp_->open(config_.udp);
+        if (!r.ok()) {
+            fatal_ = r.message;
+            spdlog::error("groundlink[udp]: {}", r.message);
+        } else {
+            udp_->start_receiving(
+                [this](std::span<const std::uint8_t> d, const hal::UdpSocket::Endpoint&) {
+                    driver_->handle_bytes(0, d);
+                },
+                [](std::error_code, const std::string& what) { spdlog::warn("groundlink[udp]: {}", what); });
+            driver_->set_writer(0, [this](std::vector<std::uint8_t> frame) {
+                return udp_->send(std::move(frame)) == hal::WriteResult::Queued;
+            });
+        }
+    } else {
+        for (std::size_t i = 0; i < config_.ports.size(); ++i) {
+            PortKeeperConfig pc;
+            pc.serial.path = config_.ports[i];
+            pc.serial.baud = config_.baud;
+            pc.reconnect_min = config_.reconnect_min;
+            pc.reconnect_max = config_.reconnect_max;
+            keepers_.push_back(std::make_unique<PortKeeper>(
+                strand(), pc,
+                PortKeeper::Handlers{
+                    [this, i] {
+                        driver_->set_writer(i, [this, i](std::vector<std::uint8_t> frame) {
+                            return keepers_[i]->write(std::move(frame)) == hal::WriteResult::Queued;
+                        });
+                        update_health();
+                    },
+                    [this, i](std::span<const std::uint8_t> b) { driver_->handle_bytes(i, b); },
+                    [this, i](const std::string&) {
+                        driver_->set_writer(i, {});
+                        update_health();
+                    }}));
+        }
+        for (auto& k : keepers_) {
+            k->start();
+        }
+    }
+    last_stats_at_ = SteadyClock::now();
+    update_health();
+    do_stats();
+}
+
+void GroundlinkService::on_stop() {
+    stats_timer_.cancel();
+    if (driver_) {
+        driver_->stop();
+    }
+    for (auto& k : keepers_) {
+        k->stop();
+    }
+    if (udp_) {
+        udp_->close();
+    }
+}
+
+void GroundlinkService::on_message(Delivered message) {
+    auto decoded = protocol::decode(message.bytes);
+    if (!decoded.message) {
+        ++bad_messages_;
+        spdlog::warn("groundlink: dropped a ground message: {}", decoded.error);
+        return;
+    }
+    if (auto* command = std::get_if<protocol::Command>(&*decoded.message)) {
+        ++commands_;
+        const std::uint32_t id = command->request_id;
+        ctx_.commands.dispatch(command->request, Role::Control, [this, id](CommandResult result) {
+            asio::dispatch(strand(), [this, id, answer = result.to_json()] {
+                if (!driver_) {
+                    return;
+                }
+                const auto bytes = protocol::encode(protocol::Result{id, answer});
+                const auto r = driver_->send_safe(protocol::kPriorityControl, bytes);
+                if (r != SendResult::accepted) {
+                    spdlog::warn("groundlink: could not queue the answer to request {}", id);
+                }
+            });
+        });
+    }
+    // Other types from the ground are not expected yet; unknown types are skipped by design.
+}
+
+void GroundlinkService::on_event(const TransportEvent& event) {
+    switch (event.kind) {
+        case TransportEvent::Kind::link_up:
+            spdlog::info("groundlink: link up");
+            break;
+        case TransportEvent::Kind::link_down:
+            spdlog::warn("groundlink: link down");
+            break;
+        case TransportEvent::Kind::peer_restarted:
+            spdlog::info("groundlink: the ground end restarted; session resynchronised");
+            break;
+        case TransportEvent::Kind::path_up:
+            spdlog::info("groundlink: path {} up", event.path);
+            break;
+        case TransportEvent::Kind::path_down:
+            spdlog::warn("groundlink: path {} silent", event.path);
+            break;
+        default:
+            break;
+    }
+    update_health();
+}
+
+void GroundlinkService::do_stats() {
+    const TimePoint now = SteadyClock::now();
+    if (driver_) {
+        const auto& s = driver_->stats();
+        const auto rx = s.rx_safe.bytes + s.rx_fast.bytes;
+        const double dt = std::chrono::duration<double>(now - last_stats_at_).count();
+        if (dt > 0) {
+            goodput_bps_ = static_cast<double>(rx - last_rx_bytes_) / dt;
+        }
+        last_rx_bytes_ = rx;
+        last_stats_at_ = now;
+        if (driver_->link_up()) {
+            protocol::LinkStatsReport report;
+            report.rtt_ms = static_cast<std::uint16_t>(std::min(65535.0, s.srtt_ms));
+            report.loss_permille = static_cast<std::uint16_t>(std::min(1000.0, s.frame_loss * 1000));
+            report.goodput_bps = static_cast<std::uint32_t>(goodput_bps_);
+            report.retransmissions = static_cast<std::uint32_t>(s.tx_safe.retransmissions);
+            report.mac_failures = static_cast<std::uint32_t>(s.mac_failures);
+            driver_->send_fast(protocol::kPriorityStatus, protocol::kTopicLinkStats, protocol::encode(report));
+        }
+    }
+    update_health();
+    publish_status();
+    stats_timer_.expires_after(config_.stats_interval);
+    stats_timer_.async_wait([this](boost::system::error_code ec) {
+        if (!ec) {
+            do_stats();
+        }
+    });
+}
+
+void GroundlinkService::update_health() {
+    if (!fatal_.empty()) {
+        set_health(Health::Down, fatal_);
+        return;
+    }
+    std::size_t open = 0;
+    std::string missing;
+    for (const auto& k : keepers_) {
+        if (k->is_open()) {
+            ++open;
+        } else {
+            missing += (missing.empty() ? "" : ", ") + (k->last_error().empty() ? "opening" : k->last_error());
+        }
+    }
+    if (udp_ && udp_->is_open()) {
+        ++open;
+    }
+    if (open == 0) {
+        set_health(Health::Down, missing.empty() ? "no port open" : missing);
+    } else if (!driver_ || !driver_->link_up()) {
+        set_health(Health::Degraded, missing.empty() ? "no ground station heard" : missing);
+    } else if (!missing.empty()) {
+        set_health(Health::Degraded, missing);
+    } else {
+        set_health(Health::Up);
+    }
+}
+
+void GroundlinkService::publish_status() {
+    nlohmann::json g;
+    g["mode"] = config_.mode;
+    if (!driver_) {
+        g["link"] = "down";
+        g["error"] = fatal_;
+        ctx_.bus.publish(status::StatusSection{"groundlink", std::move(g)});
+        return;
+    }
+    const auto& s = driver_->stats();
+    g["link"] = driver_->link_up() ? "up" : "down";
+    g["authenticated"] = s.authenticated;
+    g["rtt_ms"] = std::round(s.srtt_ms);
+    g["loss"] = std::round(s.frame_loss * 1000) / 1000;
+    g["goodput_bps"] = std::round(goodput_bps_);
+    g["frame_payload"] = s.frame_payload;
+    g["frames_sent"] = s.frames_sent;
+    g["frames_received"] = s.frames_received;
+    g["crc_errors"] = s.crc_errors;
+    g["framing_errors"] = s.framing_errors;
+    g["mac_failures"] = s.mac_failures;
+    g["replays"] = s.replays;
+    g["peer_restarts"] = s.peer_restarts;
+    g["commands"] = commands_;
+    g["bad_messages"] = bad_messages_;
+    g["tx"] = {{"safe", class_json(s.tx_safe)}, {"fast", class_json(s.tx_fast)}};
+    g["rx"] = {{"safe", class_json(s.rx_safe)}, {"fast", class_json(s.rx_fast)}};
+    auto& paths = g["paths"] = nlohmann::json::array();
+    for (std::size_t i = 0; i < driver_->core().config().paths; ++i) {
+        const auto& p = s.path[i];
+        paths.push_back({{"port", config_.mode == "udp" ? "udp" : config_.ports[i]},
+                         {"alive", p.alive},
+                         {"frames_sent", p.frames_sent},
+                         {"frames_received", p.frames_received}});
+    }
+    ctx_.bus.publish(status::StatusSection{"groundlink", std::move(g)});
+}
+
+}  // namespace airseg::groundlink

@@ -1,0 +1,60 @@
+#pragma once
+// The ground-link service: the transport core on one or two serial radio pairs (or UDP), the ground protocol
+// on top, commands from the ground through the shared dispatcher, and link statistics in the status document.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "hal/udp_socket.hpp"
+#include "services/common/port_keeper.hpp"
+#include "services/common/service.hpp"
+#include "services/groundlink/link/link_driver.hpp"
+
+namespace airseg::groundlink {
+
+struct GroundlinkServiceConfig {
+    std::string mode = "single";  // single | split | redundant | udp
+    std::vector<std::string> ports{"/dev/ttyUSB0"};
+    unsigned baud = 57600;
+    Duration reconnect_min = std::chrono::milliseconds(500);
+    Duration reconnect_max = std::chrono::seconds(10);
+    std::string key_file;  // empty: frames are not authenticated (status says so)
+    hal::UdpConfig udp;
+    TransportConfig transport;  // paths, path_mode, link rate, key and boot nonce are set by the service
+    Duration stats_interval = std::chrono::seconds(1);
+};
+
+class GroundlinkService : public Service {
+public:
+    GroundlinkService(ServiceContext& ctx, GroundlinkServiceConfig config);
+    ~GroundlinkService() override;
+
+protected:
+    void on_start() override;
+    void on_stop() override;
+
+private:
+    void on_message(Delivered message);
+    void on_event(const TransportEvent& event);
+    void do_stats();
+    void update_health();
+    void publish_status();
+
+    GroundlinkServiceConfig config_;
+    std::unique_ptr<LinkDriver> driver_;
+    std::vector<std::unique_ptr<PortKeeper>> keepers_;
+    std::unique_ptr<hal::UdpSocket> udp_;
+    asio::steady_timer stats_timer_;
+    std::string fatal_;  // a configuration problem found at start (bad key file): the link stays down
+    std::uint64_t last_rx_bytes_ = 0;
+    TimePoint last_stats_at_{};
+    double goodput_bps_ = 0;
+    std::uint64_t commands_ = 0;
+    std::uint64_t bad_messages_ = 0;
+};
+
+/// The transport configuration for a service configuration: paths and mode from `mode` and `ports`, the link
+/// rate from the baud rate (8N1: baud/10 bytes per second).
+TransportConfig transport_config_for(const GroundlinkServiceConfig& config);
+
+}  // namespace airseg::groundlink

@@ -1,0 +1,103 @@
+#pragma once
+// The ground protocol: what airsegd and airsegctl say to each other inside ground-link transport messages.
+// Compact binary, explicit little-endian, versioned; an unknown message type is skipped, not an error.
+// Layouts are in docs/ground-protocol.md.
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace airseg::groundlink::protocol {
+
+inline constexpr std::uint8_t kVersion = 1;
+
+/// Transport priorities (Safe channels) and Fast topics used by the protocol.
+inline constexpr std::uint8_t kPriorityControl = 0;    // commands and their results
+inline constexpr std::uint8_t kPriorityTelemetry = 1;  // vehicle state
+inline constexpr std::uint8_t kPriorityStatus = 2;     // link statistics, events
+inline constexpr std::uint8_t kPriorityBulk = 3;       // flight plans, parameter lists
+inline constexpr std::uint16_t kTopicTelemetry = 1;
+inline constexpr std::uint16_t kTopicLinkStats = 2;
+
+enum class MessageType : std::uint8_t {
+    telemetry = 0x01,
+    link_stats = 0x02,
+    event = 0x04,
+    command = 0x10,
+    result = 0x11,
+};
+
+/// One vehicle telemetry sample. Units are chosen so the whole message fits 29 bytes.
+struct Telemetry {
+    double lat_deg = 0;             // 1e-7 degree resolution
+    double lon_deg = 0;
+    double alt_m = 0;               // 0.1 m resolution, ±3276 m
+    double ground_speed_mps = 0;    // 0.01 m/s, up to 655 m/s
+    double heading_deg = 0;         // 0.01 degree, 0..360
+    int roll_deg = 0;               // whole degrees, ±127
+    int pitch_deg = 0;
+    double battery_v = 0;           // 1 mV
+    std::optional<int> battery_pct; // 0..100; absent when unknown
+    std::uint8_t gps_fix = 0;       // 0..15 (MAV_GPS_FIX_TYPE values)
+    std::uint8_t satellites = 0;    // capped at 15
+    std::uint8_t vehicle_state = 0; // autopilot-neutral vehicle state (0..15)
+    std::uint8_t mode = 0;          // autopilot mode number (0..255)
+    std::uint8_t plan_state = 0;    // 0 none, 1 running, 2 paused, 3 done
+    std::uint16_t plan_element = 0; // capped at 16383
+    std::uint32_t next_waypoint = 0;  // index in the expanded plan, capped at 2^24-1
+
+    bool operator==(const Telemetry&) const = default;
+};
+
+struct LinkStatsReport {
+    std::uint16_t rtt_ms = 0;
+    std::uint16_t loss_permille = 0;
+    std::uint32_t goodput_bps = 0;  // delivered message bytes per second, both classes
+    std::uint32_t retransmissions = 0;
+    std::uint32_t mac_failures = 0;
+    bool operator==(const LinkStatsReport&) const = default;
+};
+
+struct Event {
+    enum class Severity : std::uint8_t { info = 0, warning = 1, error = 2 };
+    Severity severity = Severity::info;
+    std::string text;  // at most kMaxEventText bytes
+    bool operator==(const Event&) const = default;
+};
+inline constexpr std::size_t kMaxEventText = 200;
+
+/// A command request: the same JSON object the local socket takes ({"cmd": ...}), carried as CBOR.
+struct Command {
+    std::uint32_t request_id = 0;
+    nlohmann::json request;
+    bool operator==(const Command&) const = default;
+};
+
+/// The answer to one Command: the dispatcher's {"ok":..} object, carried as CBOR.
+struct Result {
+    std::uint32_t request_id = 0;
+    nlohmann::json answer;
+    bool operator==(const Result&) const = default;
+};
+
+struct Unknown {
+    std::uint8_t type = 0;
+    bool operator==(const Unknown&) const = default;
+};
+
+using Message = std::variant<Telemetry, LinkStatsReport, Event, Command, Result, Unknown>;
+
+std::vector<std::uint8_t> encode(const Message& message);
+
+struct DecodeResult {
+    std::optional<Message> message;
+    std::string error;  // set when the bytes are not a valid message of a known type and version
+};
+
+DecodeResult decode(std::span<const std::uint8_t> bytes);
+
+}  // namespace airseg::groundlink::protocol
