@@ -1,0 +1,190 @@
+#include "tools/apmsim/control.hpp"
+
+#include <sstream>
+#include <vector>
+
+#include "tools/common/cli.hpp"
+
+namespace airseg::apmsim {
+
+namespace {
+
+std::vector<std::string> words(std::string_view text) {
+    std::istringstream in{std::string(text)};
+    std::vector<std::string> out;
+    for (std::string w; in >> w;) {
+        out.push_back(w);
+    }
+    return out;
+}
+
+double seconds_since(TimePoint start, TimePoint t) {
+    return std::chrono::duration<double>(t - start).count();
+}
+
+}  // namespace
+
+nlohmann::json state_json(const RoverSim& sim, TimePoint now) {
+    const SimState s = sim.state();
+    nlohmann::json j{
+        {"t", seconds_since(sim.started(), now)},
+        {"phase", phase_name(s.phase)},
+        {"mode", mode_name(s.mode)},
+        {"armed", s.armed},
+        {"lat", s.position.lat},
+        {"lon", s.position.lon},
+        {"heading", s.heading_deg},
+        {"speed", s.speed},
+        {"current_seq", s.current_seq},
+        {"mission_count", s.mission_count},
+        {"time_boot_ms", s.time_boot_ms},
+        {"boots", s.boots},
+        {"battery_remaining", s.battery_remaining},
+        {"odometer", s.odometer},
+        {"reached", sim.reached().size()},
+    };
+    if (s.target) {
+        j["target"] = {{"lat", s.target->lat}, {"lon", s.target->lon}, {"distance", s.target_distance}};
+    } else {
+        j["target"] = nullptr;
+    }
+    return j;
+}
+
+nlohmann::json modes_json(const RoverSim& sim) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const ModeChange& m : sim.mode_history()) {
+        list.push_back({{"t", seconds_since(sim.started(), m.at)},
+                        {"from", mode_name(m.from)},
+                        {"to", mode_name(m.to)},
+                        {"cause", m.cause},
+                        {"seq", m.current_seq},
+                        {"count", m.mission_count}});
+    }
+    return list;
+}
+
+nlohmann::json stats_json(const RoverSim& sim) {
+    const SimCounters& c = sim.counters();
+    const MissionServerStats& m = sim.mission_stats();
+    return {{"bytes_in", c.bytes_in},
+            {"bytes_out", c.bytes_out},
+            {"bytes_lost", c.bytes_lost},
+            {"bytes_corrupted", c.bytes_corrupted},
+            {"frames_in", c.frames_in},
+            {"frames_ignored", c.frames_ignored},
+            {"heartbeats_sent", c.heartbeats_sent},
+            {"heartbeats_stalled", c.heartbeats_stalled},
+            {"uploads_completed", m.uploads_completed},
+            {"uploads_cancelled", m.uploads_cancelled},
+            {"mission_rerequests", m.rerequests},
+            {"mission_items_sent", m.items_sent},
+            {"mission_items_received", m.items_received},
+            {"mission_denied", m.denied}};
+}
+
+std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now, const LinkControl& link) {
+    const auto w = words(command);
+    if (w.empty()) {
+        return "error: empty command";
+    }
+    const std::string& verb = w[0];
+    const auto need = [&](std::size_t n, const char* form) {
+        if (w.size() != n) {
+            throw toolcommon::UsageError(std::string("usage: ") + form);
+        }
+    };
+    try {
+        if (verb == "state") {
+            return state_json(sim, now).dump();
+        }
+        if (verb == "modes") {
+            return modes_json(sim).dump();
+        }
+        if (verb == "stats") {
+            return stats_json(sim).dump();
+        }
+        if (verb == "rcpilot") {
+            need(2, "rcpilot MODE");
+            const auto mode = parse_mode(w[1]);
+            if (!mode || *mode == RoverMode::Initialising) {
+                return "error: rcpilot: unknown mode '" + w[1] + "'";
+            }
+            if (!sim.rc_pilot(*mode, now)) {
+                return "error: rcpilot: " + std::string(mode_name(*mode)) + " refused (" +
+                       std::string(phase_name(sim.state().phase)) + ")";
+            }
+            return "ok mode " + std::string(mode_name(*mode));
+        }
+        if (verb == "reboot") {
+            if (w.size() == 1) {
+                sim.reboot(now);
+                return "ok rebooting";
+            }
+            need(2, "reboot [SECONDS]");
+            sim.schedule_reboot(now + toolcommon::parse_seconds(verb, w[1]));
+            return "ok reboot in " + w[1] + " s";
+        }
+        if (verb == "unplug") {
+            need(1, "unplug");
+            return link.unplug ? link.unplug() : "error: unplug: no link";
+        }
+        if (verb == "replug") {
+            need(1, "replug");
+            return link.replug ? link.replug() : "error: replug: no link";
+        }
+        if (verb == "hbstall") {
+            need(2, "hbstall SECONDS");
+            sim.stall_heartbeats(toolcommon::parse_seconds(verb, w[1]), now);
+            return "ok no heartbeats for " + w[1] + " s";
+        }
+        if (verb == "loss") {
+            need(2, "loss P");
+            sim.faults().loss = toolcommon::parse_probability(verb, w[1]);
+            return "ok loss " + w[1];
+        }
+        if (verb == "corrupt") {
+            need(2, "corrupt P");
+            sim.faults().corrupt = toolcommon::parse_probability(verb, w[1]);
+            return "ok corrupt " + w[1];
+        }
+        if (verb == "ignore-mission") {
+            need(2, "ignore-mission on|off");
+            if (w[1] != "on" && w[1] != "off") {
+                return "error: ignore-mission: expected on or off, got '" + w[1] + "'";
+            }
+            sim.faults().ignore_mission = w[1] == "on";
+            return "ok ignore-mission " + w[1];
+        }
+        if (verb == "slow") {
+            need(2, "slow MS");
+            sim.faults().slow = toolcommon::parse_milliseconds(verb, w[1]);
+            return "ok slow " + w[1] + " ms";
+        }
+        if (verb == "param") {
+            if (w.size() == 2) {
+                const auto i = sim.params().index_of(w[1]);
+                if (!i) {
+                    return "error: param: unknown parameter '" + w[1] + "'";
+                }
+                return nlohmann::json{{"name", w[1]}, {"value", sim.params().at(*i).value}}.dump();
+            }
+            need(3, "param NAME [VALUE]");
+            const double v = toolcommon::parse_double(verb, w[2], -1e9, 1e9);
+            if (!sim.params().set(w[1], static_cast<float>(v))) {
+                return "error: param: unknown parameter '" + w[1] + "'";
+            }
+            return "ok param " + w[1] + " " + w[2];
+        }
+        if (verb == "help") {
+            return "ok commands: state, modes, stats, rcpilot MODE, reboot [S], unplug, replug, hbstall S, "
+                   "loss P, "
+                   "corrupt P, ignore-mission on|off, slow MS, param NAME [VALUE]";
+        }
+        return "error: unknown command '" + verb + "' (try help)";
+    } catch (const toolcommon::UsageError& e) {
+        return std::string("error: ") + e.what();
+    }
+}
+
+}  // namespace airseg::apmsim

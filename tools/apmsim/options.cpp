@@ -1,0 +1,163 @@
+#include "tools/apmsim/options.hpp"
+
+namespace airseg::apmsim {
+
+using toolcommon::UsageError;
+
+const char* usage() {
+    return R"(usage: airseg-apmsim --link PATH [options]
+
+Simulates an ArduPilot APM:Rover board (APM 2.x, Rover 2.x firmware) on a pseudo-terminal. PATH becomes a
+symlink to the pty slave; open it as you would open /dev/ttyACM0. The board speaks MAVLink as system 1,
+component 1 (MAV_TYPE_GROUND_ROVER, MAV_AUTOPILOT_ARDUPILOTMEGA) to any ground station.
+
+Like an APM on USB, the board reboots when a program opens the port (DTR): it goes silent for the boot
+delay, then sends "Initialising APM..." and heartbeats in MAV_STATE_BOOT/CALIBRATING (mode INITIALISING)
+for the calibration time, then "Ready to drive." in STANDBY/ACTIVE and mode INITIAL_MODE (MANUAL).
+
+Board:
+  --link PATH              symlink to the pty slave (required)
+  --boot-delay S           silence after a reset                                  [2]
+  --calib-time S           calibration time after the silence                     [3]
+  --no-reset-on-open       do not reboot when the port is opened (Pixhawk-style boards)
+  --home LAT,LON           start and home position, degrees                       [41.2756,1.9866]
+  --home-alt M             home altitude above mean sea level                     [5]
+  --mission-capacity N     mission items the board holds, home included           [150]
+  --reached-style STYLE    both: MISSION_ITEM_REACHED and the STATUSTEXT
+                           "Reached waypoint #N dist Mm"; text: the text only,
+                           as APM:Rover 2.x firmware does                          [both]
+  --mavlink1               speak MAVLink 1 (default MAVLink 2)
+  --param NAME=VALUE       set a parameter before boot (repeatable), e.g. WP_RADIUS=3
+  --seed N                 seed of the fault generators (deterministic)          [1]
+  --speedup N              simulated time runs N times faster than real time      [1]
+Faults (times are simulated seconds after start):
+  --loss P                 probability each byte (either direction) is lost
+  --corrupt P              probability each byte (either direction) gets a bit flipped
+  --hb-stall START:DUR     no heartbeats from START for DUR seconds (repeatable)
+  --reboot-at S            reboot at S
+  --unplug START:DUR       remove the pty at START, plug a new one in after DUR (repeatable)
+  --ignore-mission         ignore every mission protocol message
+  --slow MS                answer every request MS milliseconds late
+Control and output:
+  --control PATH           Unix datagram socket taking run-time commands (below)
+  --quiet                  no event lines on standard error
+  --help
+
+On exit (SIGINT, SIGTERM) the mode history is printed on standard output as one JSON object. SIGUSR1
+reboots the board.
+
+Control commands (one per datagram; the reply goes to the sender's bound address):
+  state                    position, mode, armed, current item, mission count... as JSON
+  modes                    mode history as JSON: [{"t":s,"from":..,"to":..,"cause":..,"seq":..,"count":..}]
+                           causes: power on, reboot, command, rc pilot, mission end, rtl end
+  stats                    byte, frame and mission counters as JSON
+  rcpilot MODE             the RC pilot flips the mode switch (MANUAL, HOLD, AUTO, ... or a number)
+  reboot [S]               reboot now, or in S simulated seconds
+  unplug | replug          remove the pty (the link is gone) / create a new one at PATH
+  hbstall S                no heartbeats for S seconds
+  loss P | corrupt P       set byte loss / corruption
+  ignore-mission on|off    ignore mission protocol messages
+  slow MS                  answer requests MS milliseconds late (0: at once)
+  param NAME [VALUE]       read or set a parameter
+  help
+)";
+}
+
+namespace {
+
+GeoPoint parse_lat_lon(std::string_view option, std::string_view text) {
+    const auto comma = text.find(',');
+    if (comma == std::string_view::npos) {
+        throw UsageError(std::string(option) + ": expected LAT,LON, got '" + std::string(text) + "'");
+    }
+    return GeoPoint{toolcommon::parse_double(option, text.substr(0, comma), -89, 89),
+                    toolcommon::parse_double(option, text.substr(comma + 1), -180, 180)};
+}
+
+}  // namespace
+
+std::optional<ApmSimOptions> parse_options(const std::vector<std::string>& args) {
+    using namespace toolcommon;
+    ApmSimOptions o;
+    for (std::size_t i = 0; i < args.size(); ++i) {
+        const std::string& arg = args[i];
+        auto value = [&]() -> std::string_view {
+            if (i + 1 >= args.size()) {
+                throw UsageError(arg + ": missing value");
+            }
+            return args[++i];
+        };
+        if (arg == "--help" || arg == "-h") {
+            return std::nullopt;
+        } else if (arg == "--link") {
+            o.link_path = value();
+        } else if (arg == "--control") {
+            o.control_path = value();
+        } else if (arg == "--boot-delay") {
+            o.sim.boot_delay = parse_seconds(arg, value());
+        } else if (arg == "--calib-time") {
+            o.sim.calib_time = parse_seconds(arg, value());
+        } else if (arg == "--no-reset-on-open") {
+            o.sim.reset_on_open = false;
+        } else if (arg == "--home") {
+            o.sim.home = parse_lat_lon(arg, value());
+        } else if (arg == "--home-alt") {
+            o.sim.home_alt = static_cast<float>(parse_double(arg, value(), -1000, 10000));
+        } else if (arg == "--mission-capacity") {
+            o.sim.mission_capacity = parse_unsigned(arg, value(), 1, 65535);
+        } else if (arg == "--reached-style") {
+            const std::string_view v = value();
+            if (v == "both") {
+                o.sim.reached_style = ReachedStyle::MessageAndText;
+            } else if (v == "text") {
+                o.sim.reached_style = ReachedStyle::TextOnly;
+            } else {
+                throw UsageError(arg + ": expected both or text, got '" + std::string(v) + "'");
+            }
+        } else if (arg == "--mavlink1") {
+            o.sim.version = mavlink::Version::V1;
+        } else if (arg == "--param") {
+            const std::string v(value());
+            const auto eq = v.find('=');
+            if (eq == std::string::npos || eq == 0) {
+                throw UsageError(arg + ": expected NAME=VALUE, got '" + v + "'");
+            }
+            const std::string name = v.substr(0, eq);
+            if (!ParamTable::rover_defaults().index_of(name)) {
+                throw UsageError(arg + ": unknown parameter '" + name + "'");
+            }
+            o.params.emplace_back(name, static_cast<float>(parse_double(arg, v.substr(eq + 1), -1e9, 1e9)));
+        } else if (arg == "--seed") {
+            o.sim.seed = parse_unsigned(arg, value(), 0, UINT64_MAX);
+        } else if (arg == "--speedup") {
+            o.speedup = parse_double(arg, value(), 0.01, 10000);
+        } else if (arg == "--loss") {
+            o.faults.loss = parse_probability(arg, value());
+        } else if (arg == "--corrupt") {
+            o.faults.corrupt = parse_probability(arg, value());
+        } else if (arg == "--hb-stall") {
+            o.hb_stalls.push_back(parse_window(arg, value()));
+        } else if (arg == "--reboot-at") {
+            o.reboot_at = parse_seconds(arg, value());
+        } else if (arg == "--unplug") {
+            o.unplugs.push_back(parse_window(arg, value()));
+        } else if (arg == "--ignore-mission") {
+            o.faults.ignore_mission = true;
+        } else if (arg == "--slow") {
+            o.faults.slow = parse_milliseconds(arg, value());
+        } else if (arg == "--quiet") {
+            o.quiet = true;
+        } else {
+            throw UsageError(arg + ": unknown option (see --help)");
+        }
+    }
+    if (o.link_path.empty()) {
+        throw UsageError("--link PATH is required");
+    }
+    if (const auto errors = RoverSimConfig::validate(o.sim); !errors.empty()) {
+        throw UsageError(errors.front());
+    }
+    return o;
+}
+
+}  // namespace airseg::apmsim

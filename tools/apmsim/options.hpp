@@ -1,0 +1,30 @@
+#pragma once
+// Command line of airseg-apmsim.
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "tools/apmsim/rover_sim.hpp"
+#include "tools/common/cli.hpp"
+
+namespace airseg::apmsim {
+
+struct ApmSimOptions {
+    std::string link_path;     // --link
+    std::string control_path;  // --control
+    double speedup = 1.0;      // --speedup
+    RoverSimConfig sim;
+    Faults faults;
+    std::vector<std::pair<std::string, float>> params;  // --param NAME=VALUE
+    std::optional<Duration> reboot_at;                  // --reboot-at S (simulated seconds after start)
+    std::vector<toolcommon::Window> hb_stalls;          // --hb-stall START:DUR
+    std::vector<toolcommon::Window> unplugs;            // --unplug START:DUR
+    bool quiet = false;                                 // --quiet
+};
+
+const char* usage();
+/// Parses the arguments (without argv[0]). nullopt for --help; throws toolcommon::UsageError.
+std::optional<ApmSimOptions> parse_options(const std::vector<std::string>& args);
+
+}  // namespace airseg::apmsim

@@ -1,0 +1,214 @@
+#include "tools/apmsim/sim_driver.hpp"
+
+#include <iostream>
+
+#include "tools/apmsim/control.hpp"
+
+namespace airseg::apmsim {
+
+namespace {
+
+// Waking more often than this costs more than it shows: the core catches up whole physics steps.
+constexpr Duration kMinWake = std::chrono::milliseconds(1);
+
+}  // namespace
+
+SimDriver::SimDriver(boost::asio::io_context& io, ApmSimOptions options)
+    : options_(std::move(options)),
+      strand_(boost::asio::make_strand(io)),
+      real_origin_(SteadyClock::now()),
+      timer_(strand_) {
+    RoverSimConfig config = options_.sim;
+    config.unix_time_at_start_us = static_cast<std::uint64_t>(
+        std::chrono::duration_cast<microseconds>(std::chrono::system_clock::now().time_since_epoch())
+            .count());
+    // Simulated time starts equal to the real clock, so both share one origin.
+    sim_ = std::make_unique<RoverSim>(config, real_origin_);
+    for (const auto& [name, value] : options_.params) {
+        sim_->params().set(name, value);
+    }
+    sim_->faults() = options_.faults;
+    if (options_.reboot_at) {
+        sim_->schedule_reboot(real_origin_ + *options_.reboot_at);
+    }
+    hal::PtyConfig pc;
+    pc.link_path = options_.link_path;
+    pty_ = std::make_unique<hal::Pty>(strand_, pc);
+}
+
+SimDriver::~SimDriver() {
+    stop();
+}
+
+TimePoint SimDriver::sim_now() const {
+    const auto real = SteadyClock::now() - real_origin_;
+    return real_origin_ + std::chrono::duration_cast<Duration>(real * options_.speedup);
+}
+
+TimePoint SimDriver::to_real(TimePoint sim_time) const {
+    if (sim_time == kNever) {
+        return kNever;
+    }
+    return real_origin_ + std::chrono::duration_cast<Duration>((sim_time - real_origin_) / options_.speedup);
+}
+
+std::string SimDriver::start() {
+    if (auto r = pty_->open(); !r.ok()) {
+        return r.message;
+    }
+    pty_->on_peer_open([this] {
+        log("port opened" + std::string(options_.sim.reset_on_open ? ": rebooting" : ""));
+        sim_->port_opened(sim_now());
+        pump();
+    });
+    pty_->on_peer_close([this] { log("port closed"); });
+    pty_->start_reading([this](std::span<const std::uint8_t> bytes) {
+        sim_->handle_bytes(bytes, sim_now());
+        pump();
+    });
+    if (!options_.control_path.empty()) {
+        control_ = std::make_unique<toolcommon::ControlSocket>(
+            strand_, options_.control_path, [this](const std::string& c) { return on_command(c); });
+        std::string message;
+        if (control_->open(message)) {
+            return message;
+        }
+    }
+    schedule_faults();
+    boost::asio::dispatch(strand_, [this] { pump(); });
+    return {};
+}
+
+void SimDriver::stop() {
+    if (stopped_) {
+        return;
+    }
+    stopped_ = true;
+    timer_.cancel();
+    for (auto& t : fault_timers_) {
+        t->cancel();
+    }
+    control_.reset();
+    pty_->unplug();
+}
+
+void SimDriver::reboot() {
+    boost::asio::dispatch(strand_, [this] {
+        log("reboot by signal");
+        sim_->reboot(sim_now());
+        pump();
+    });
+}
+
+void SimDriver::pump() {
+    if (stopped_) {
+        return;
+    }
+    const TimePoint now = sim_now();
+    if (sim_->poll_timeout() <= now) {
+        sim_->handle_timeout(now);
+    }
+    auto bytes = sim_->poll_transmit();
+    if (!bytes.empty() && pty_->is_open() && pty_->peer_connected()) {
+        pty_->write(std::move(bytes));
+    }
+    log_new_events();
+    arm();
+}
+
+void SimDriver::arm() {
+    const TimePoint next_sim = sim_->poll_timeout();
+    if (next_sim == kNever) {
+        return;
+    }
+    const TimePoint next = std::max(to_real(next_sim), SteadyClock::now() + kMinWake);
+    if (armed_ != kNever && armed_ <= next) {
+        return;  // an earlier or equal wake-up is already set
+    }
+    armed_ = next;
+    timer_.expires_at(next);
+    timer_.async_wait([this](const boost::system::error_code& ec) {
+        if (ec == boost::asio::error::operation_aborted) {
+            return;  // re-armed earlier, or stopping
+        }
+        armed_ = kNever;
+        pump();
+    });
+}
+
+void SimDriver::at_sim_time(Duration after_start, std::function<void()> action) {
+    auto t = std::make_unique<boost::asio::steady_timer>(strand_);
+    t->expires_at(to_real(real_origin_ + after_start));
+    t->async_wait([this, action = std::move(action)](const boost::system::error_code& ec) {
+        if (!ec && !stopped_) {
+            action();
+            pump();
+        }
+    });
+    fault_timers_.push_back(std::move(t));
+}
+
+void SimDriver::schedule_faults() {
+    for (const auto& w : options_.hb_stalls) {
+        at_sim_time(w.start, [this, w] { sim_->stall_heartbeats(w.length, sim_now()); });
+    }
+    for (const auto& w : options_.unplugs) {
+        at_sim_time(w.start, [this] { log(unplug()); });
+        at_sim_time(w.start + w.length, [this] { log(replug()); });
+    }
+}
+
+std::string SimDriver::unplug() {
+    if (!pty_->is_open()) {
+        return "error: unplug: already unplugged";
+    }
+    pty_->unplug();
+    return "ok unplugged " + options_.link_path;
+}
+
+std::string SimDriver::replug() {
+    if (pty_->is_open()) {
+        return "error: replug: still plugged in";
+    }
+    if (auto r = pty_->replug(); !r.ok()) {
+        return "error: replug: " + r.message;
+    }
+    return "ok replugged " + options_.link_path + " -> " + pty_->slave_path();
+}
+
+std::string SimDriver::on_command(const std::string& command) {
+    const TimePoint now = sim_now();
+    if (sim_->poll_timeout() <= now) {
+        sim_->handle_timeout(now);  // the answer describes the present
+    }
+    std::string reply = apply_control(*sim_, command, now,
+                                      LinkControl{[this] { return unplug(); }, [this] { return replug(); }});
+    if (command.rfind("state", 0) != 0 && command.rfind("modes", 0) != 0 && command.rfind("stats", 0) != 0) {
+        log("control: " + command + " -> " + reply);
+    }
+    pump();
+    return reply;
+}
+
+void SimDriver::log(const std::string& line) const {
+    if (!options_.quiet) {
+        const double t = std::chrono::duration<double>(sim_now() - real_origin_).count();
+        std::cerr << "airseg-apmsim[" << options_.link_path << "] t=" << t << ": " << line << std::endl;
+    }
+}
+
+void SimDriver::log_new_events() {
+    const auto& modes = sim_->mode_history();
+    for (; modes_logged_ < modes.size(); ++modes_logged_) {
+        const ModeChange& m = modes[modes_logged_];
+        log(std::string("mode ") + std::string(mode_name(m.from)) + " -> " + std::string(mode_name(m.to)) +
+            " (" + m.cause + ")");
+    }
+    const auto& reached = sim_->reached();
+    reached_logged_ = std::min(reached_logged_, reached.size());  // the log is bounded and may drop old ones
+    for (; reached_logged_ < reached.size(); ++reached_logged_) {
+        log("reached item " + std::to_string(reached[reached_logged_].seq));
+    }
+}
+
+}  // namespace airseg::apmsim
