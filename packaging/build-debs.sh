@@ -86,9 +86,11 @@ build_one() {
     # ctest's closing lines, for whoever reads this output.
     grep -E '^[0-9]+% tests passed|^Total Test time' "$work/build.log" | sed "s/^/$arch: /" || true
   fi
-  rm -f "$AIRSEG_ROOT"/dist/airseg*_"$arch".deb "$AIRSEG_ROOT"/dist/airseg*_"$arch".ddeb
-  cp "$work"/airseg*_"$version"_"$arch".deb "$AIRSEG_ROOT/dist/"
-  cp "$work"/airseg*_"$version"_"$arch".ddeb "$AIRSEG_ROOT/dist/" 2>/dev/null || true
+  rm -f "$AIRSEG_ROOT"/dist/airseg_*_"$arch".deb "$AIRSEG_ROOT"/dist/debug/airseg-dbgsym_*_"$arch".*deb
+  cp "$work/airseg_${version}_$arch.deb" "$AIRSEG_ROOT/dist/"
+  # Debug symbols (for crash analysis on the vehicle) apart from the packages to install.
+  mkdir -p "$AIRSEG_ROOT/dist/debug"
+  cp "$work"/airseg-dbgsym_"$version"_"$arch".*deb "$AIRSEG_ROOT/dist/debug/" 2>/dev/null || true
   "$AIRSEG_ROOT/packaging/check-deb.sh" "$arch" "$AIRSEG_ROOT/dist/airseg_${version}_$arch.deb"
 }
 

@@ -18,10 +18,10 @@ bad() { log "FAIL ($arch): $*"; fail=1; }
 field() { dpkg-deb --field "$deb" "$1"; }
 [ "$(field Architecture)" = "$arch" ] || bad "Architecture is '$(field Architecture)'"
 depends=$(field Depends)
-for lib in libc6 libstdc++6; do
-  [[ "$depends" =~ (^|[ ,])$lib\ \(\>=\  ]] || bad "Depends lacks a versioned $lib: $depends"
+has_dep() { tr ',' '\n' <<<"$depends" | sed 's/^ *//' | grep -qF -- "$1"; }
+for lib in "libc6 (>= " "libstdc++6 (>= " "adduser" "procps"; do
+  has_dep "$lib" || bad "Depends lacks '$lib': $depends"
 done
-[[ "$depends" =~ (^|[ ,])adduser([ ,]|$) ]] || bad "Depends lacks adduser: $depends"
 
 dpkg-deb --ctrl-tarfile "$deb" | tar -xOf - ./conffiles 2>/dev/null | grep -qx /etc/airseg/airseg.yaml \
   || bad "/etc/airseg/airseg.yaml is not a conffile"
@@ -46,6 +46,11 @@ for f in "$tmp"/usr/bin/* "$tmp"/usr/sbin/*; do
   [[ "$desc" == *"interpreter $want_ld,"* ]] || bad "$(basename "$f") is not linked against $want_ld: $desc"
 done
 [ "$programs" -gt 0 ] || bad "no programs in the package"
+
+# The hand-written manual pages must name every option and command the programs' --help names.
+if [ "$arch" = "$(dpkg --print-architecture)" ]; then
+  "$AIRSEG_ROOT/packaging/check-manpages.sh" "$tmp/usr" "$AIRSEG_ROOT/packaging/man" || bad "manual pages behind --help"
+fi
 
 if ! lintian --display-info --fail-on error,warning "$deb" >"$tmp/lintian.txt" 2>&1; then
   bad "lintian:"; cat "$tmp/lintian.txt" >&2

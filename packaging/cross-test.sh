@@ -8,7 +8,8 @@
 # qemu-arm, and QEMU_LD_PREFIX (set here) points it at the sysroot.
 #
 # Build directory: build-pkg-cross-ARCH (AIRSEG_BUILD_DIR to change). AIRSEG_SOURCE_DIR builds
-# another source tree (default: this one). Extra arguments go to ctest.
+# another source tree (default: this one). AIRSEG_TARGETS="a b" builds only those targets (then
+# pick their tests with ctest -R / -L). Extra arguments go to ctest.
 set -euo pipefail
 . "$(dirname "$0")/lib.sh"
 
@@ -36,7 +37,8 @@ cmake -S "$src" -B "$build" -G Ninja \
   -DCMAKE_TOOLCHAIN_FILE="$AIRSEG_ROOT/packaging/toolchain-$arch.cmake" -DAIRSEG_SYSROOT="$sysroot" \
   -DAIRSEG_BUILD_FUZZ=OFF $(ccache_launcher_args) >"$build.configure.log" \
   || { cat "$build.configure.log"; die "configure failed"; }
-cmake --build "$build" -j "$jobs"
+# shellcheck disable=SC2086
+cmake --build "$build" -j "$jobs" ${AIRSEG_TARGETS:+--target $AIRSEG_TARGETS}
 built=$SECONDS
 export QEMU_LD_PREFIX=$sysroot
 ctest --test-dir "$build" --output-on-failure --parallel "$jobs" "$@"

@@ -3,7 +3,7 @@
 #
 # Installs the amd64 package in a throwaway Debian 12 chroot (mmdebstrap, discarded afterwards)
 # and checks what the package promises: `dpkg -i` creates the system user airseg (in dialout,
-# and in gpio when that group exists), installs /etc/airseg/airseg.yaml as a conffile and the
+# and in gpio, which the chroot has), installs /etc/airseg/airseg.yaml as a conffile and the
 # unit, `systemd-analyze verify` accepts the installed unit, `dpkg -r` keeps the conffile and
 # `dpkg -P` removes it. The host is not touched. Default DEB: dist/airseg_*_amd64.deb.
 set -euo pipefail
@@ -25,9 +25,11 @@ set -eu
 fail=0
 ok()  { echo "  ok: $*"; }
 bad() { echo "  FAIL: $*"; fail=1; }
+addgroup --quiet --system gpio   # a board whose GPIO chips belong to group gpio
 dpkg -i /tmp/airseg.deb
 getent passwd airseg >/dev/null && ok "user airseg exists" || bad "no user airseg"
 id -nG airseg | tr ' ' '\n' | grep -qx dialout && ok "airseg is in dialout" || bad "airseg not in dialout"
+id -nG airseg | tr ' ' '\n' | grep -qx gpio && ok "airseg is in gpio" || bad "airseg not in gpio"
 grep -qx /etc/airseg/airseg.yaml /var/lib/dpkg/info/airseg.conffiles && ok "conffile registered" || bad "no conffile"
 [ -f /etc/airseg/airseg.yaml ] && ok "conffile installed" || bad "conffile missing"
 [ -f /lib/systemd/system/airsegd.service ] && ok "unit installed" || bad "unit missing"
