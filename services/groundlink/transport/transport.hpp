@@ -62,9 +62,12 @@ struct TransportConfig {
     /// latency_frame_payload: frame ceiling while Fast or non-bulk traffic is active (or frame loss is
     /// heavy), so a frame already on the air holds an urgent message back by at most this many bytes of air
     /// time.
-    std::size_t latency_frame_payload = 192;
+    std::size_t latency_frame_payload = 128;
     /// latency_hold: how long that ceiling stays after such traffic.
     Duration latency_hold = std::chrono::seconds(2);
+    /// urgent_pacing: fraction of link_rate used while urgent traffic is active (either end), so the radios'
+    /// buffers drain and an urgent message does not queue behind bytes already handed to the radio.
+    double urgent_pacing = 0.93;
 
     /// priorities: levels 0 (highest: control) .. priorities-1 (bulk). Safe channel = priority.
     std::size_t priorities = 4;
@@ -81,9 +84,9 @@ struct TransportConfig {
     /// retransmit_share: link share Safe retransmissions may take while Fast traffic waits.
     double retransmit_share = 0.3;
     /// ack_delay: longest wait before acknowledging Safe segments.
-    Duration ack_delay = std::chrono::milliseconds(100);
+    Duration ack_delay = std::chrono::milliseconds(200);
     /// ack_every: acknowledge at once after this many new segments.
-    std::size_t ack_every = 4;
+    std::size_t ack_every = 8;
     /// rto_initial: retransmission timeout before the first round-trip sample.
     Duration rto_initial = std::chrono::milliseconds(1000);
     /// rto_min, rto_max: bounds of the retransmission timeout; rto_max also caps the backoff.

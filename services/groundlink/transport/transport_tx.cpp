@@ -9,8 +9,10 @@ namespace {
 
 constexpr std::size_t kMinUsefulSafe = 16;  // do not top up a frame with a Safe sliver smaller than this
 constexpr std::size_t kMaxDataChunks = 64;
-constexpr double kFairShare = 0.45;      // of link_rate, below which an end is not held back on shared air
-constexpr double kLossyFraction = 0.15;  // declared-lost share of Safe segments above which frames stay small
+constexpr double kFairShare = 0.45;  // of link_rate, below which an end is not held back on shared air
+// Share of recent Safe segments declared lost above which frames stay at most kLossyFramePayload.
+constexpr double kLossyFraction = 0.15;
+constexpr std::size_t kLossyFramePayload = 192;
 
 }  // namespace
 
@@ -84,12 +86,14 @@ std::size_t Transport::Impl::payload_cap() const {
     if (cfg.adaptive_frame_size && peer_suggested > 0) {
         cap = std::clamp(peer_suggested, cfg.min_frame_payload, cfg.max_frame_payload);
     }
-    // Under heavy frame loss small frames shorten each repair round trip, which bounds stalls; under urgent
-    // traffic they bound how long a frame already on the air holds the urgent message back.
-    const bool lossy = sent_window >= 20.0 && lost_window > kLossyFraction * sent_window;
-    // The peer's urgent traffic waits for this end's frame on shared air, so it counts as well.
+    // Under heavy frame loss small frames shorten each repair round trip, which bounds stalls.
+    if (sent_window >= 20.0 && lost_window > kLossyFraction * sent_window) {
+        cap = std::min(cap, kLossyFramePayload);
+    }
+    // Under urgent traffic they bound how long a frame already on its way holds the urgent message back; the
+    // peer's urgent traffic waits for this end's frames on shared air, so it counts as well.
     const bool peer_waiting = cfg.half_duplex && peer_urgent && peer_mask_fresh();
-    if (now_ < urgent_until || lossy || peer_waiting) {
+    if (now_ < urgent_until || peer_waiting) {
         cap = std::min(cap, cfg.latency_frame_payload);
     }
     return std::max(cap, cfg.min_frame_payload);
@@ -184,8 +188,10 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::poll_transmit(std::siz
 
 void Transport::Impl::account_sent(std::size_t path, std::size_t bytes, TimePoint now) {
     Path& ps = paths[path];
+    const bool urgent = now < urgent_until || (peer_urgent && peer_mask_fresh());
+    const double rate = cfg.link_rate_bytes_per_s * (urgent ? cfg.urgent_pacing : 1.0);
     const auto air = std::chrono::duration_cast<Duration>(
-        std::chrono::duration<double>(static_cast<double>(bytes) / cfg.link_rate_bytes_per_s));
+        std::chrono::duration<double>(static_cast<double>(bytes) / rate));
     ps.next_free = std::max(ps.next_free, now) + air;
     ps.air_debt = std::max(ps.air_debt, now) + air;  // the shared-air budget counts both ends
     ps.tx_rate = decayed_rate(ps.tx_rate, ps.tx_rate_time, now) + static_cast<double>(bytes);
