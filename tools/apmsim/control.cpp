@@ -99,7 +99,14 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
             return state_json(sim, now).dump();
         }
         if (verb == "modes") {
-            return modes_json(sim).dump();
+            if (w.size() == 1) {
+                return modes_json(sim).dump();
+            }
+            need(2, "modes [LAST_N]");
+            const auto n = toolcommon::parse_unsigned(verb, w[1], 1, UINT32_MAX);
+            auto all = modes_json(sim);
+            const auto skip = all.size() > n ? all.size() - n : 0;
+            return nlohmann::json(all.begin() + static_cast<std::ptrdiff_t>(skip), all.end()).dump();
         }
         if (verb == "stats") {
             return stats_json(sim).dump();
@@ -177,7 +184,8 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
             return "ok param " + w[1] + " " + w[2];
         }
         if (verb == "help") {
-            return "ok commands: state, modes, stats, rcpilot MODE, reboot [S], unplug, replug, hbstall S, "
+            return "ok commands: state, modes [N], stats, rcpilot MODE, reboot [S], unplug, replug, hbstall "
+                   "S, "
                    "loss P, "
                    "corrupt P, ignore-mission on|off, slow MS, param NAME [VALUE]";
         }

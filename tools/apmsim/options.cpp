@@ -48,7 +48,7 @@ reboots the board.
 
 Control commands (one per datagram; the reply goes to the sender's bound address):
   state                    position, mode, armed, current item, mission count... as JSON
-  modes                    mode history as JSON: [{"t":s,"from":..,"to":..,"cause":..,"seq":..,"count":..}]
+  modes [N]                mode history (the last N changes) as JSON: [{"t":s,"from":..,"to":..,"cause":..,"seq":..,"count":..}]
                            causes: power on, reboot, command, rc pilot, mission end, rtl end
   stats                    byte, frame and mission counters as JSON
   rcpilot MODE             the RC pilot flips the mode switch (MANUAL, HOLD, AUTO, ... or a number)

@@ -146,8 +146,8 @@ class SimHarness {
                             wanted = r->seq;
                         } else if (auto r2 = mv::decode<mv::MissionRequestInt>(f)) {
                             wanted = r2->seq;
-                        } else if (auto a = mv::decode<mv::MissionAck>(f)) {
-                            acked = a->type;
+                        } else if (auto a = mv::decode<mv::MissionAck>(f); a && a->type != 13) {
+                            acked = a->type;  // INVALID_SEQUENCE answers a duplicate; the transfer goes on
                         }
                         if (wanted || acked) {
                             ++scan;
