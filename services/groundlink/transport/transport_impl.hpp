@@ -69,6 +69,8 @@ class Transport::Impl {
     [[nodiscard]] std::uint8_t heard_mask() const;
     [[nodiscard]] std::uint8_t header_flags() const;
     [[nodiscard]] bool may_borrow(std::size_t path) const;
+    /// Split mode: `path` is the peer's transmit pair, used for bulk while the own pair works.
+    [[nodiscard]] bool borrowed(std::size_t path) const;
     [[nodiscard]] Duration reorder_slack() const;
     /// Any Safe or Fast traffic ready; `bulk`: include the lowest priority.
     [[nodiscard]] bool data_ready(bool bulk) const;
@@ -150,6 +152,7 @@ class Transport::Impl {
     std::array<bool, kMaxPriorities> fast_turn{};
     TimePoint urgent_until{};
     bool bulk_blocked = false;  // while filling a frame through an urgent_only gate
+    bool bulk_only = false;     // while filling a frame for a borrowed path
     double sent_window = 0.0;
     double lost_window = 0.0;
 

@@ -34,6 +34,10 @@ std::uint8_t Transport::Impl::header_flags() const {
     return static_cast<std::uint8_t>(heard_mask() | (now_ < urgent_until ? frame::kUrgentFlag : 0));
 }
 
+bool Transport::Impl::borrowed(std::size_t path) const {
+    return cfg.path_mode == PathMode::split && path != cfg.split_tx_path && carries_data(cfg.split_tx_path);
+}
+
 bool Transport::Impl::may_borrow(std::size_t path) const {
     const Path& ps = paths[path];
     return cfg.split_borrow && ps.alive && !(peer_mask_fresh() && peer_urgent) &&
@@ -100,7 +104,7 @@ std::size_t Transport::Impl::payload_cap() const {
 }
 
 bool Transport::Impl::level_ready(std::size_t level, bool retx_ok) const {
-    if (bulk_blocked && level + 1 == senders.size()) {
+    if ((bulk_blocked && level + 1 == senders.size()) || (bulk_only && level + 1 < senders.size())) {
         return false;
     }
     return !fast[level].empty() || (retx_ok && senders[level].has_lost()) || senders[level].can_send_new();
@@ -154,11 +158,15 @@ TimePoint Transport::Impl::content_due(std::size_t path) const {
     }
     if (carries_data(path)) {
         const AirGate gate = air_gate(path);
-        if (!ps.mirror.empty() || (gate == AirGate::open && data_ready(true)) ||
-            (gate == AirGate::urgent_only && data_ready(false))) {
+        if (borrowed(path)) {
+            // A borrowed path carries bulk only: urgent traffic keeps to this end's own pair.
+            if (level_ready(senders.size() - 1, true)) {
+                t = std::min(t, gate == AirGate::open ? now_ : ps.air_debt);
+            }
+        } else if (!ps.mirror.empty() || (gate == AirGate::open && data_ready(true)) ||
+                   (gate == AirGate::urgent_only && data_ready(false))) {
             return std::min(t, now_);
-        }
-        if (data_ready(true)) {
+        } else if (data_ready(true)) {
             t = std::min(t, ps.air_debt);
         }
         t = std::min(t, ack_due());
@@ -363,6 +371,7 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
     std::size_t data_chunks = 0;
     const AirGate gate = air_gate(path);  // closed: only acknowledgements and keepalives go out
     bulk_blocked = gate == AirGate::urgent_only;
+    bulk_only = borrowed(path);
     while (gate != AirGate::closed && data_chunks < kMaxDataChunks &&
            add_data_chunk(chunks, storage, room, data_chunks == 0, now)) {
         ++data_chunks;
@@ -372,6 +381,7 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
     }
 
     bulk_blocked = false;
+    bulk_only = false;
     if (data_chunks == 0 && !ack_is_due && !keepalive_due) {
         return std::nullopt;  // only opportunistic content: wait for a frame worth sending
     }
