@@ -138,3 +138,68 @@ TEST(ApmsimLossy, CorruptedFramesAreDroppedNotMisread) {
 
 }  // namespace
 }  // namespace airseg::apmsim::test
+
+namespace airseg::apmsim::test {
+namespace {
+
+TEST(ApmsimCommands, HomeVersionArmRebootAndUnknown) {
+    SimHarness h;
+    h.boot();
+    mv::CommandLong c;
+    c.command = 512;  // MAV_CMD_REQUEST_MESSAGE
+    c.param1 = static_cast<float>(mv::HomePosition::kId);
+    std::size_t from = h.received.size();
+    h.send(c);
+    const auto home = h.last<mv::HomePosition>(from);
+    ASSERT_TRUE(home);
+    EXPECT_EQ(home->latitude, static_cast<std::int32_t>(std::lround(h.sim.config().home.lat * 1e7)));
+    EXPECT_EQ(home->altitude, 5000);
+    EXPECT_EQ(h.last<mv::CommandAck>(from)->result, 0);
+
+    c.command = 520;  // MAV_CMD_REQUEST_AUTOPILOT_CAPABILITIES
+    from = h.received.size();
+    h.send(c);
+    const auto version = h.last<mv::AutopilotVersion>(from);
+    ASSERT_TRUE(version);
+    EXPECT_TRUE(version->capabilities & 0x4) << "MISSION_INT";
+
+    c.command = 400;  // disarm
+    c.param1 = 0;
+    h.send(c);
+    EXPECT_FALSE(h.sim.state().armed);
+    auto hb = h.wait_for<mv::Heartbeat>(seconds(2));
+    ASSERT_TRUE(hb);
+    EXPECT_EQ(hb->base_mode & 128, 0);
+    EXPECT_EQ(hb->system_status, 3) << "STANDBY when disarmed";
+
+    c.command = 31000;
+    from = h.received.size();
+    h.send(c);
+    EXPECT_EQ(h.last<mv::CommandAck>(from)->result, 3) << "UNSUPPORTED";
+
+    c.command = 246;  // MAV_CMD_PREFLIGHT_REBOOT_SHUTDOWN
+    c.param1 = 1;
+    from = h.received.size();
+    h.send(c);
+    ASSERT_TRUE(h.last<mv::CommandAck>(from));
+    EXPECT_EQ(h.last<mv::CommandAck>(from)->command, 246);
+    EXPECT_EQ(h.sim.state().phase, BootPhase::Silent);
+    EXPECT_EQ(h.sim.state().boots, 2u);
+}
+
+TEST(ApmsimCommands, MessagesForAnotherSystemAreIgnored) {
+    SimHarness h;
+    h.boot();
+    mv::CommandLong c;
+    c.target_system = 7;
+    c.command = 176;
+    c.param1 = 1;
+    c.param2 = 4;
+    const std::size_t from = h.received.size();
+    h.send(c);
+    EXPECT_FALSE(h.last<mv::CommandAck>(from));
+    EXPECT_EQ(h.sim.state().mode, RoverMode::Manual);
+}
+
+}  // namespace
+}  // namespace airseg::apmsim::test

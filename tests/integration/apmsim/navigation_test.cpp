@@ -176,3 +176,49 @@ TEST(ApmsimNav, ScheduledReboot) {
 
 }  // namespace
 }  // namespace airseg::apmsim::test
+
+namespace airseg::apmsim::test {
+namespace {
+
+// A client feeding the mission while the rover drives it (the rolling window of the seed's navigation loop):
+// each reached event appends one more item with a partial write; the rover never stops until the feed does.
+TEST(ApmsimNav, FeedingItemsWhileDrivingNeverHoldsEarly) {
+    SimHarness h;
+    h.boot();
+    const GeoPoint home = h.sim.config().home;
+    ASSERT_EQ(h.upload(line_mission(home, 3, 15)), 0);
+    h.set_mode(RoverMode::Auto);
+    int appended = 0;
+    std::size_t seen = 0;
+    while (h.sim.state().mode == RoverMode::Auto) {
+        ASSERT_TRUE(h.run_until(
+            [&] { return h.sim.reached().size() > seen || h.sim.state().mode != RoverMode::Auto; },
+            seconds(60)));
+        seen = h.sim.reached().size();
+        if (appended < 7 && h.sim.state().mode == RoverMode::Auto) {
+            const auto next = static_cast<std::int16_t>(h.sim.mission().count());
+            mv::MissionWritePartialList p;
+            p.start_index = next;
+            p.end_index = next;
+            h.send(p);
+            auto item = waypoint(home, 15.0 * next, 0);
+            item.seq = static_cast<std::uint16_t>(next);
+            h.send(item);
+            ++appended;
+        }
+    }
+    ASSERT_EQ(h.sim.reached().size(), 10u);
+    for (std::size_t i = 0; i < 10; ++i) {
+        EXPECT_EQ(h.sim.reached()[i].seq, i + 1);
+    }
+    int holds = 0;
+    for (const auto& m : h.sim.mode_history()) {
+        holds += m.to == RoverMode::Hold ? 1 : 0;
+    }
+    EXPECT_EQ(holds, 1);
+    EXPECT_EQ(h.sim.mode_history().back().cause, "mission end");
+    EXPECT_EQ(h.sim.mode_history().back().current_seq, 10);
+}
+
+}  // namespace
+}  // namespace airseg::apmsim::test
