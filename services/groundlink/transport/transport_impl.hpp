@@ -69,6 +69,8 @@ class Transport::Impl {
     [[nodiscard]] std::uint8_t heard_mask() const;
     [[nodiscard]] std::uint8_t header_flags() const;
     [[nodiscard]] bool may_borrow(std::size_t path) const;
+    /// More than kLossyFraction of the recent Safe segments were declared lost.
+    [[nodiscard]] bool lossy() const;
     /// Split mode: `path` is the peer's transmit pair, used for bulk while the own pair works.
     [[nodiscard]] bool borrowed(std::size_t path) const;
     [[nodiscard]] Duration reorder_slack() const;

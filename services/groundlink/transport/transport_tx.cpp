@@ -40,7 +40,8 @@ bool Transport::Impl::borrowed(std::size_t path) const {
 
 bool Transport::Impl::may_borrow(std::size_t path) const {
     const Path& ps = paths[path];
-    return cfg.split_borrow && ps.alive && !(peer_mask_fresh() && peer_urgent) &&
+    // Not under heavy loss: the peer's acknowledgements on that pair matter more then.
+    return cfg.split_borrow && ps.alive && !(peer_mask_fresh() && peer_urgent) && !lossy() &&
            decayed_rate(ps.rx_rate, ps.rx_rate_time, now_) < 0.25 * cfg.link_rate_bytes_per_s;
 }
 
@@ -85,13 +86,17 @@ bool Transport::Impl::keeps_alive(std::size_t path) const {
     return false;
 }
 
+bool Transport::Impl::lossy() const {
+    return sent_window >= 20.0 && lost_window > kLossyFraction * sent_window;
+}
+
 std::size_t Transport::Impl::payload_cap() const {
     std::size_t cap = cfg.max_frame_payload;
     if (cfg.adaptive_frame_size && peer_suggested > 0) {
         cap = std::clamp(peer_suggested, cfg.min_frame_payload, cfg.max_frame_payload);
     }
     // Under heavy frame loss small frames shorten each repair round trip, which bounds stalls.
-    if (sent_window >= 20.0 && lost_window > kLossyFraction * sent_window) {
+    if (lossy()) {
         cap = std::min(cap, kLossyFramePayload);
     }
     // Under urgent traffic they bound how long a frame already on its way holds the urgent message back; the
