@@ -57,12 +57,17 @@ std::string SimDriver::start() {
         return r.message;
     }
     pty_->on_peer_open([this] {
-        log("port opened" + std::string(options_.sim.reset_on_open ? ": rebooting" : ""));
-        sim_->port_opened(sim_now());
+        on_port_opened();
         pump();
     });
-    pty_->on_peer_close([this] { log("port closed"); });
+    pty_->on_peer_close([this] {
+        peer_present_ = false;
+        log("port closed");
+    });
     pty_->start_reading([this](std::span<const std::uint8_t> bytes) {
+        // The open is sampled, so a fast writer's first bytes can arrive before it is seen; on the board the
+        // DTR reset comes first and those bytes meet the boot loader.
+        on_port_opened();
         sim_->handle_bytes(bytes, sim_now());
         pump();
     });
@@ -158,11 +163,21 @@ void SimDriver::schedule_faults() {
     }
 }
 
+void SimDriver::on_port_opened() {
+    if (peer_present_) {
+        return;
+    }
+    peer_present_ = true;
+    log("port opened" + std::string(options_.sim.reset_on_open ? ": rebooting" : ""));
+    sim_->port_opened(sim_now());
+}
+
 std::string SimDriver::unplug() {
     if (!pty_->is_open()) {
         return "error: unplug: already unplugged";
     }
     pty_->unplug();
+    peer_present_ = false;
     return "ok unplugged " + options_.link_path;
 }
 

@@ -36,6 +36,7 @@ class SimDriver {
     void arm();
     void schedule_faults();
     void at_sim_time(Duration after_start, std::function<void()> action);
+    void on_port_opened();
     std::string unplug();
     std::string replug();
     std::string on_command(const std::string& command);
@@ -53,6 +54,7 @@ class SimDriver {
     std::vector<std::unique_ptr<boost::asio::steady_timer>> fault_timers_;
     std::size_t modes_logged_ = 0;
     std::size_t reached_logged_ = 0;
+    bool peer_present_ = false;  // as the board sees it (DTR)
     bool stopped_ = false;
 };
 
