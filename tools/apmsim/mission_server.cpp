@@ -72,9 +72,14 @@ bool MissionServer::handle(const mv::Frame& f, TimePoint now) {
     switch (f.msgid) {
         case mv::MissionRequestList::kId: {
             const auto m = mv::decode_payload<mv::MissionRequestList>(f.payload_view());
-            if (for_us(m.target_system)) {
-                on_request_list(f);
+            if (!for_us(m.target_system)) {
+                return true;
             }
+            if (m.mission_type != kMissionTypeMission) {
+                ack(f, MissionResult::Unsupported);  // no fence or rally points on this board
+                return true;
+            }
+            on_request_list(f);
             return true;
         }
         case mv::MissionRequest::kId: {
@@ -126,9 +131,14 @@ bool MissionServer::handle(const mv::Frame& f, TimePoint now) {
         }
         case mv::MissionClearAll::kId: {
             const auto m = mv::decode_payload<mv::MissionClearAll>(f.payload_view());
-            if (for_us(m.target_system)) {
-                on_clear(f);
+            if (!for_us(m.target_system)) {
+                return true;
             }
+            if (m.mission_type != kMissionTypeMission) {
+                ack(f, MissionResult::Unsupported);
+                return true;
+            }
+            on_clear(f);
             return true;
         }
         case mv::MissionSetCurrent::kId: {

@@ -224,3 +224,27 @@ TEST_F(ApmsimMission, MissionSurvivesReboot) {
 
 }  // namespace
 }  // namespace airseg::apmsim::test
+
+namespace airseg::apmsim::test {
+namespace {
+
+TEST(ApmsimMissionTypes, FenceAndRallyAreUnsupported) {
+    SimHarness h;
+    h.boot();
+    mv::MissionRequestList list;
+    list.mission_type = 1;  // MAV_MISSION_TYPE_FENCE
+    std::size_t from = h.received.size();
+    h.send(list);
+    EXPECT_FALSE(h.last<mv::MissionCount>(from));
+    EXPECT_EQ(h.last<mv::MissionAck>(from)->type, 3);
+    mv::MissionCount count;
+    count.count = 4;
+    count.mission_type = 2;  // MAV_MISSION_TYPE_RALLY
+    from = h.received.size();
+    h.send(count);
+    EXPECT_EQ(h.last<mv::MissionAck>(from)->type, 3);
+    EXPECT_FALSE(h.sim.mission_stats().uploads_completed);
+}
+
+}  // namespace
+}  // namespace airseg::apmsim::test
