@@ -54,23 +54,26 @@ struct MissionConfig {
     Duration initial_timeout = milliseconds(1500);  // autopilot.mission.initial_timeout, before RTT is known
     Duration min_timeout = milliseconds(400);       // autopilot.mission.min_timeout
     Duration max_timeout = seconds(6);              // autopilot.mission.max_timeout
-    unsigned retries = 5;           // autopilot.mission.retries (per step, refreshed on progress)
+    unsigned retries = 5;  // autopilot.mission.retries: per step, refreshed on progress...
+    Duration give_up_after =
+        seconds(15);                // autopilot.mission.give_up_after: ...and this long without progress
     bool use_int = true;            // autopilot.mission.use_int: MISSION_REQUEST_INT / ITEM_INT
     std::uint16_t max_items = 700;  // autopilot.mission.max_items
 };
 
 struct AutopilotConfig {
-    Board board = Board::Apm2;                    // autopilot.board: apm2 | pixhawk
-    std::vector<unsigned> bauds = {115200};       // autopilot.baud (one) or autopilot.bauds (tried in turn)
-    Duration baud_probe = seconds(3);             // autopilot.baud_probe: time for a valid frame at one baud
-    bool reset_on_open = true;                    // autopilot.reset_on_open (default: board == apm2)
-    Duration boot_timeout = seconds(30);          // autopilot.boot_timeout (1..120 s)
-    Duration heartbeat_timeout = seconds(3);      // autopilot.heartbeat_timeout (0.5..30 s)
-    std::uint8_t own_sysid = 255;                 // autopilot.own_sysid
-    std::uint8_t own_compid = 190;                // autopilot.own_compid (MAV_COMP_ID_MISSIONPLANNER)
-    std::uint8_t target_sysid = 1;                // autopilot.target_sysid
-    std::uint8_t target_compid = 1;               // autopilot.target_compid
-    int mavlink_version = 1;                      // autopilot.mavlink_version: 1 | 2 (default per board)
+    Board board = Board::Apm2;                // autopilot.board: apm2 | pixhawk
+    std::vector<unsigned> bauds = {115200};   // autopilot.baud (one) or autopilot.bauds (tried in turn)
+    Duration baud_probe = seconds(3);         // autopilot.baud_probe: time for a valid frame at one baud
+    bool reset_on_open = true;                // autopilot.reset_on_open (default: board == apm2)
+    Duration boot_timeout = seconds(30);      // autopilot.boot_timeout (1..120 s)
+    Duration heartbeat_timeout = seconds(3);  // autopilot.heartbeat_timeout (0.5..30 s)
+    std::uint8_t own_sysid = 255;             // autopilot.own_sysid
+    std::uint8_t own_compid = 190;            // autopilot.own_compid (MAV_COMP_ID_MISSIONPLANNER)
+    std::uint8_t target_sysid = 1;            // autopilot.target_sysid
+    std::uint8_t target_compid = 1;           // autopilot.target_compid
+    bool gcs_heartbeat = true;  // autopilot.gcs_heartbeat: send our 1 Hz HEARTBEAT (ArduPilot's GCS failsafe)
+    int mavlink_version = 1;    // autopilot.mavlink_version: 1 | 2 (default per board)
     bool use_message_interval = false;            // autopilot.use_message_interval (default per board)
     std::vector<StreamRate> stream_rates;         // autopilot.streams: {position: 4, extra1: 4, ...}
     std::vector<MessageRate> message_rates;       // autopilot.message_rates: {GLOBAL_POSITION_INT: 4, ...}

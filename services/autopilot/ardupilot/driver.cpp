@@ -79,6 +79,7 @@ void Driver::on_port_open(TimePoint now) {
     heard_frame_ = false;
     parser_ = mav::Parser{};
     time_boot_.reset();
+    next_gcs_heartbeat_ = config_.gcs_heartbeat ? now : kNever;
     baud_deadline_ = config_.bauds.size() > 1 ? now + config_.baud_probe : kNever;
     if (config_.reset_on_open) {
         // The open rebooted the autopilot: silence is expected until the boot window has passed.
@@ -97,6 +98,7 @@ void Driver::on_port_closed(const std::string& reason, TimePoint now) {
     phase_ = Phase::Closed;
     phase_deadline_ = kNever;
     baud_deadline_ = kNever;
+    next_gcs_heartbeat_ = kNever;
     last_error_ = reason;
     update_state(now, false);
 }
@@ -158,6 +160,14 @@ void Driver::handle_timeout(TimePoint now) {
             last_error_ = "autopilot unresponsive; reset pulses exhausted";
         }
         quiet_since_ = now;  // give the pulse (or the operator) time before the next one
+    }
+    if (now >= next_gcs_heartbeat_) {
+        mav::Heartbeat hb;
+        hb.type = 6;           // MAV_TYPE_GCS
+        hb.autopilot = 8;      // MAV_AUTOPILOT_INVALID
+        hb.system_status = 4;  // MAV_STATE_ACTIVE
+        out_.send(hb);
+        next_gcs_heartbeat_ = now + seconds(1);
     }
     if (now >= phase_deadline_) {
         phase_deadline_ = kNever;
@@ -240,6 +250,7 @@ void Driver::enter(Phase p, TimePoint now) {
             break;
         case Phase::WaitBoot:
             sequence_start_ = now;
+            time_boot_.reset();  // the clock of the boot being waited for starts again
             ready_s_.reset();
             phase_deadline_ = now + config_.boot_timeout;
             break;

@@ -174,6 +174,7 @@ class Driver {
     bool heard_frame_ = false;
     std::size_t baud_index_ = 0;
     TimePoint baud_deadline_ = kNever;
+    TimePoint next_gcs_heartbeat_ = kNever;
     unsigned pulses_ = 0;
     TimePoint gap_window_end_{};  // boot banners until then count as reboot evidence
     std::optional<std::pair<std::uint32_t, TimePoint>> time_boot_;

@@ -249,10 +249,8 @@ void Driver::link_lost(TimePoint now) {
     link_up_ = false;
     const auto silent = std::chrono::duration<double>(now - last_heartbeat_).count();
     emit(LinkDown{"no heartbeat for " + std::to_string(static_cast<int>(silent)) + " s"});
-    cancel_everything("autopilot link down", now);
-    if (phase_ != Phase::Ready && phase_ != Phase::Closed) {
-        enter(Phase::WaitBoot, now);  // the sequence starts again when heartbeats return
-    }
+    // Transfers in progress are left to their own timeouts: a few lost heartbeats on a noisy radio must not
+    // throw away a long upload that is still making progress.
     update_state(now, false);
 }
 

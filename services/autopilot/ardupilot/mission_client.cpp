@@ -12,6 +12,8 @@ namespace {
 constexpr std::uint8_t kAccepted = 0;
 constexpr std::uint8_t kNoSpace = 4;
 constexpr std::uint8_t kInvalidSequence = 13;
+constexpr std::uint8_t kOperationCancelled = 15;
+constexpr std::uint8_t kError = 1;
 constexpr std::uint8_t kMissionTypeMission = 0;
 
 const char* mission_result_name(std::uint8_t type) {
@@ -246,6 +248,7 @@ void MissionClient::start_front(TimePoint now) {
                 w.step = Step::WaitAck;
                 break;
         }
+        w.last_progress = now;
         transmit(w, now, false);
     }
 }
@@ -337,17 +340,22 @@ void MissionClient::transmit(WorkItem& w, TimePoint now, bool retry) {
     }
     if (retry) {
         ++stats_.retransmissions;
-        backoff_ = std::min(backoff_ * 2, 16u);
+        if (!srtt_) {
+            backoff_ = std::min(backoff_ * 2, 16u);
+        }
     }
     w.retransmitted = retry;
     w.sent_at = now;
-    w.deadline = now + current_timeout();
+    w.deadline = now + current_timeout(w);
 }
 
-// Karn's rule: after a retransmission the timeout stays backed off until an unambiguous RTT sample arrives,
-// otherwise a link slower than the initial guess would never yield one.
-Duration MissionClient::current_timeout() const {
-    return std::min<Duration>(base_timeout() * backoff_, config_.max_timeout);
+// Until the first RTT sample, Karn's rule: the timeout doubles with each retransmission, otherwise a link
+// slower than the initial guess would never yield an unambiguous sample. Once the RTT is known a lost frame
+// is taken for what it is on a serial radio, random loss, not congestion: a retry waits twice the timeout,
+// no more, so a lossy link gets many quick attempts (ArduPilot abandons an upload after 8 s without an item).
+Duration MissionClient::current_timeout(const WorkItem& w) const {
+    const unsigned factor = srtt_ ? (w.attempt > 0 ? 2u : 1u) : backoff_;
+    return std::min<Duration>(base_timeout() * factor, config_.max_timeout);
 }
 
 // The vehicle answered something sent with the current step: take an RTT sample and refresh the budget.
@@ -365,6 +373,7 @@ void MissionClient::progress(WorkItem& w, TimePoint now) {
         backoff_ = 1;
     }
     w.attempt = 0;
+    w.last_progress = now;
 }
 
 // The one exit point of a running work item.
@@ -384,7 +393,9 @@ void MissionClient::handle_timeout(TimePoint now) {
         return;
     }
     WorkItem& w = work_.front();
-    if (w.attempt >= config_.retries) {
+    // Out of budget only when both the attempts and the time since the last progress are spent: on a fast,
+    // lossy link the attempts come quickly, and the vehicle is still there.
+    if (w.attempt >= config_.retries && now - w.last_progress >= config_.give_up_after) {
         std::string where;
         switch (w.step) {
             case Step::WaitRequest:
@@ -510,16 +521,18 @@ void MissionClient::on_request(std::uint16_t seq, bool as_int, TimePoint now) {
     w.any_request = true;
     w.highest_sent = std::max(w.highest_sent, seq);
     w.next_seq = seq;
-    w.answer_int = as_int;
+    // With use_int the item goes as MISSION_ITEM_INT even to a MISSION_REQUEST: float degrees would cost
+    // decimetres of position (ArduPilot accepts either form). Without it, the form asked for.
+    w.answer_int = as_int || config_.use_int;
     w.step = (seq + 1u == end) ? Step::WaitAck : Step::WaitRequest;
     // Answer every request, a repeated one too: the vehicle asks again when our item was lost.
-    send_item(w, seq, as_int);
+    send_item(w, seq, w.answer_int);
     w.retransmitted = !fresh;
     w.sent_at = now;
     if (!fresh) {
         ++stats_.retransmissions;
     }
-    w.deadline = now + current_timeout();
+    w.deadline = now + current_timeout(w);
 }
 
 void MissionClient::on_ack(std::uint8_t type, TimePoint now) {
@@ -546,6 +559,25 @@ void MissionClient::on_ack(std::uint8_t type, TimePoint now) {
     }
     if (type == kInvalidSequence && uploading) {
         ++stats_.invalid_sequence_acks;
+        return;
+    }
+    // The vehicle gave up waiting (ArduPilot: 8 s without an item on a bad link, OPERATION_CANCELLED), or it
+    // is no longer receiving when one of our items arrives (ERROR: its cancel, or its final acceptance, was
+    // lost). Either way the mission on board is not known to be ours: start the transfer again. An error
+    // before any item was asked for is the vehicle's verdict on the request itself and is final.
+    if (type == kError && !w.any_request && w.restarts > 0) {
+        ++stats_.ignored_frames;  // the answer to an item of the abandoned attempt, still on the link
+        return;
+    }
+    const bool vehicle_lost_track = type == kOperationCancelled || (type == kError && w.any_request);
+    if (uploading && vehicle_lost_track && w.restarts < config_.retries) {
+        ++w.restarts;
+        ++stats_.restarts;
+        w.any_request = false;
+        w.highest_sent = 0;
+        w.next_seq = w.first;
+        w.step = Step::WaitRequest;
+        transmit(w, now, true);
         return;
     }
     const std::string detail = std::string("autopilot answered MAV_MISSION_") + mission_result_name(type);

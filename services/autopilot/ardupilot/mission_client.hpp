@@ -8,14 +8,17 @@
 // one at a time, in the order they were queued.
 //
 // Timeouts follow the link: every answered first transmission is an RTT sample; the timeout is
-// SRTT + 4 RTTVAR (RFC 6298), kept between min_timeout and max_timeout, doubled on each retransmission and
-// kept doubled until an unambiguous sample arrives (Karn's rule). A fixed half-second timeout fails over a
+// SRTT + 4 RTTVAR (RFC 6298), kept between min_timeout and max_timeout; before the first sample it doubles
+// with each retransmission (Karn's rule), afterwards a retry waits twice the timeout (random loss, not
+// congestion, is what a serial radio has). A fixed half-second timeout fails over a
 // loaded 57600 radio; this one does not.
 //
-// The vehicle may ask for an item with MISSION_REQUEST (answered with MISSION_ITEM, float degrees) or
-// MISSION_REQUEST_INT (answered with MISSION_ITEM_INT); a download accepts either item form.
+// The vehicle may ask for an item with MISSION_REQUEST or MISSION_REQUEST_INT. With use_int the answer is
+// always MISSION_ITEM_INT (float degrees would cost decimetres); without it (APM 2.x), MISSION_ITEM to a
+// MISSION_REQUEST. A download accepts either item form.
 // MAV_MISSION_INVALID_SEQUENCE during an upload means a duplicate item crossed a request on the link; it is
-// counted and the transfer goes on.
+// counted and the transfer goes on. MAV_MISSION_OPERATION_CANCELLED during an upload (the vehicle gave up on
+// a bad link) starts the upload again, up to `retries` times.
 //
 // Contract: enqueue with upload()/download()/write_partial()/set_current()/clear(); feed every frame from the
 // autopilot to handle_frame(); call handle_timeout(now) when poll_timeout() is due; after each input drain
@@ -63,6 +66,7 @@ struct MissionClientStats {
     std::uint64_t duplicate_requests = 0;  // the vehicle asked again for an item already sent
     std::uint64_t invalid_sequence_acks = 0;
     std::uint64_t ignored_frames = 0;  // mission frames that matched no running operation
+    std::uint64_t restarts = 0;        // uploads started again after the vehicle cancelled them
 };
 
 class MissionClient {
@@ -90,8 +94,7 @@ class MissionClient {
     bool idle() const { return work_.empty(); }
     /// The timeout from the RTT estimate alone.
     Duration base_timeout() const;
-    /// The timeout a transmission gets now: base_timeout() times the backoff left by retransmissions.
-    Duration current_timeout() const;
+
     std::optional<Duration> smoothed_rtt() const { return srtt_; }
     const MissionClientStats& stats() const { return stats_; }
 
@@ -119,8 +122,11 @@ class MissionClient {
         bool retransmitted = false;  // Karn's rule: no RTT sample from a retransmission
         bool answer_int = true;      // reply form for the last request
         std::uint16_t highest_sent = 0;
+        unsigned restarts = 0;
+        TimePoint last_progress{};  // upload / partial: started again after the vehicle cancelled it
     };
 
+    Duration current_timeout(const WorkItem& w) const;
     std::uint32_t enqueue(WorkItem item, TimePoint now);
     void start_front(TimePoint now);
     void transmit(WorkItem& w, TimePoint now, bool retry);

@@ -246,7 +246,11 @@ void FakeRover::on_frame(const mav::Frame& f, TimePoint now) {
                 item.z = fi.z;
                 item.autocontinue = fi.autocontinue;
             }
-            if (!receiving_ || item.seq != request_i_) {
+            if (!receiving_) {
+                send_ack(1);  // MAV_MISSION_ERROR: not receiving
+                return;
+            }
+            if (item.seq != request_i_) {
                 send_ack(13);
                 return;
             }

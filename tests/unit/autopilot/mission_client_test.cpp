@@ -176,8 +176,10 @@ TEST(MissionClient, TimeoutAdaptsToASlowLinkInsteadOfFailing) {
     EXPECT_LE(fx.ground.client.stats().retransmissions, 2u);
 }
 
-TEST(MissionClient, AnswersMissionRequestWithFloatItems) {
-    Fixture fx({}, 5, {.request_int = false});
+TEST(MissionClient, AnswersMissionRequestWithFloatItemsWithoutUseInt) {
+    MissionConfig config;
+    config.use_int = false;
+    Fixture fx({}, 5, {.request_int = false}, config);
     auto items = make_items(5);
     fx.ground.client.upload(items, fx.harness.now());
     ASSERT_TRUE(fx.run_until_done(1));
@@ -187,6 +189,16 @@ TEST(MissionClient, AnswersMissionRequestWithFloatItems) {
         EXPECT_NEAR(fx.rover.mission()[i].x, items[i].x, 20);
         EXPECT_NEAR(fx.rover.mission()[i].y, items[i].y, 20);
     }
+}
+
+TEST(MissionClient, AnswersMissionRequestWithIntItemsWithUseInt) {
+    Fixture fx({}, 5, {.request_int = false});
+    auto items = make_items(5);
+    items[3].x = 412756789;  // needs more digits than a float carries
+    fx.ground.client.upload(items, fx.harness.now());
+    ASSERT_TRUE(fx.run_until_done(1));
+    ASSERT_EQ(fx.ground.completions[0].result, MissionResult::Success);
+    EXPECT_EQ(fx.rover.mission()[3].x, 412756789);
 }
 
 TEST(MissionClient, PartialWriteReplacesOnlyItsSlots) {

@@ -1,0 +1,305 @@
+// The driver core against the simulated APM:Rover board (tools/apmsim), both in-process, bytes between them,
+// in simulated time: the acceptance scenarios of the autopilot layer.
+#include <gtest/gtest.h>
+
+#include "services/autopilot/ardupilot/driver.hpp"
+#include "tests/unit/autopilot/sim_harness.hpp"
+#include "tools/apmsim/rover_sim.hpp"
+
+namespace airseg::autopilot::ardupilot {
+namespace {
+
+using testing::Harness;
+using testing::LinkModel;
+using testing::Party;
+namespace mav = airseg::mavlink;
+
+const TimePoint kStart = TimePoint{} + std::chrono::hours(3);
+
+apmsim::RoverSimConfig sim_config(Board board) {
+    apmsim::RoverSimConfig c;
+    c.version = board == Board::Apm2 ? mav::Version::V1 : mav::Version::V2;
+    c.reached_style =
+        board == Board::Apm2 ? apmsim::ReachedStyle::TextOnly : apmsim::ReachedStyle::MessageAndText;
+    c.mission_capacity = 300;
+    c.reset_on_open = board == Board::Apm2;
+    return c;
+}
+
+AutopilotConfig driver_config(Board board) {
+    auto c = AutopilotConfig::defaults_for(board);
+    c.bauds = {115200};
+    return c;
+}
+
+struct SimRig {
+    SimRig(Board board, LinkModel up = {}, LinkModel down = {}, std::uint32_t seed = 5)
+        : SimRig(driver_config(board), sim_config(board), up, down, seed) {}
+    SimRig(AutopilotConfig config, apmsim::RoverSimConfig sc, LinkModel up, LinkModel down,
+           std::uint32_t seed)
+        : driver(std::move(config)), sim(sc, kStart), harness(ground(), board(), up, down, seed, kStart) {}
+
+    Party ground() {
+        Party p;
+        p.receive = [this](std::span<const std::uint8_t> b, TimePoint now) {
+            driver.handle_bytes(b, now);
+            drain();
+        };
+        p.transmit = [this] { return driver.poll_transmit(); };
+        p.on_timeout = [this](TimePoint now) {
+            driver.handle_timeout(now);
+            drain();
+        };
+        p.deadline = [this] { return driver.poll_timeout(); };
+        return p;
+    }
+    Party board() {
+        Party p;
+        p.receive = [this](std::span<const std::uint8_t> b, TimePoint now) { sim.handle_bytes(b, now); };
+        p.transmit = [this]() -> std::optional<std::vector<std::uint8_t>> {
+            auto bytes = sim.poll_transmit();
+            if (bytes.empty()) {
+                return std::nullopt;
+            }
+            return bytes;
+        };
+        p.on_timeout = [this](TimePoint now) { sim.handle_timeout(now); };
+        p.deadline = [this] { return sim.poll_timeout(); };
+        return p;
+    }
+    void drain() {
+        while (auto e = driver.poll_event()) {
+            events.push_back(std::move(*e));
+        }
+    }
+    TimePoint now() const { return harness.now(); }
+    template <class E>
+    std::vector<E> all() const {
+        std::vector<E> out;
+        for (const auto& e : events) {
+            if (const auto* x = std::get_if<E>(&e)) {
+                out.push_back(*x);
+            }
+        }
+        return out;
+    }
+    template <class E>
+    bool run_until_event(std::size_t count, Duration limit) {
+        return harness.run_until([&] { return all<E>().size() >= count; }, now() + limit);
+    }
+    RequestDone wait_result(std::uint32_t id, Duration limit = seconds(120)) {
+        std::optional<RequestDone> found;
+        harness.run_until(
+            [&] {
+                for (const auto& d : all<RequestDone>()) {
+                    if (d.id == id) {
+                        found = d;
+                    }
+                }
+                return found.has_value();
+            },
+            now() + limit);
+        return found ? *found
+                     : RequestDone{id, RequestKind::SetState, RequestResult::Cancelled, "no result", {}, {}};
+    }
+    /// The port opens: the board sees DTR (and reboots when it is an APM on USB).
+    bool open_and_wait_ready() {
+        sim.port_opened(now());
+        driver.on_port_open(now());
+        return run_until_event<Ready>(1, seconds(60));
+    }
+
+    Driver driver;
+    apmsim::RoverSim sim;
+    Harness harness;
+    std::vector<Event> events;
+};
+
+std::vector<MissionItem> square(std::size_t n, double step_deg = 2e-4) {
+    std::vector<MissionItem> items;
+    for (std::size_t i = 0; i < n; ++i) {
+        MissionItem it;
+        it.lat = 41.2756 + step_deg * static_cast<double>((i + 1) % 4 < 2 ? 1 : 0);
+        it.lon = 1.9866 + step_deg * static_cast<double>((i + 1) % 4 >= 1 && (i + 1) % 4 <= 2 ? 1 : 0);
+        items.push_back(it);
+    }
+    return items;
+}
+
+TEST(DriverWithApmSim, ReadyWithinBootDelayCalibrationAndOneSecond) {
+    for (const Board board : {Board::Apm2, Board::Pixhawk}) {
+        SCOPED_TRACE(to_string(board));
+        SimRig rig(board);
+        const TimePoint opened = rig.now();
+        ASSERT_TRUE(rig.open_and_wait_ready()) << rig.driver.last_error();
+        const auto& sc = rig.sim.config();
+        const Duration budget =
+            (board == Board::Apm2 ? sc.boot_delay + sc.calib_time : Duration{}) + seconds(1);
+        EXPECT_LE(rig.now() - opened,
+                  board == Board::Apm2 ? budget : sc.boot_delay + sc.calib_time + seconds(1));
+        EXPECT_EQ(rig.driver.params().table().size(), rig.sim.params().size());
+        // The board starts in its INITIAL_MODE, MANUAL: the RC pilot drives.
+        EXPECT_EQ(rig.driver.status().state, VehicleState::Directed) << rig.driver.status().mode;
+        ASSERT_TRUE(rig.driver.telemetry().home);
+        EXPECT_NEAR(rig.driver.telemetry().home->lat, sc.home.lat, 1e-6);
+    }
+}
+
+TEST(DriverWithApmSim, EachVehicleStateRequestedAndConfirmed) {
+    for (const Board board : {Board::Apm2, Board::Pixhawk}) {
+        SCOPED_TRACE(to_string(board));
+        SimRig rig(board);
+        ASSERT_TRUE(rig.open_and_wait_ready());
+        ASSERT_EQ(rig.wait_result(rig.driver.upload_mission(square(4), rig.now())).result, RequestResult::Ok);
+        struct Step {
+            VehicleState state;
+            apmsim::RoverMode mode;
+        };
+        for (const Step s : {Step{VehicleState::WaypointNavigation, apmsim::RoverMode::Auto},
+                             Step{VehicleState::Parking, apmsim::RoverMode::Hold},
+                             Step{VehicleState::Directed, apmsim::RoverMode::Manual},
+                             Step{VehicleState::ManualNavigation, apmsim::RoverMode::Manual},
+                             Step{VehicleState::Manual, apmsim::RoverMode::Manual}}) {
+            const auto r = rig.wait_result(rig.driver.request_state(s.state, rig.now()));
+            EXPECT_EQ(r.result, RequestResult::Ok) << to_string(s.state) << ": " << r.detail;
+            EXPECT_EQ(rig.driver.status().state, s.state);
+            EXPECT_EQ(rig.sim.state().mode, s.mode);
+        }
+    }
+}
+
+TEST(DriverWithApmSim, ModeChangeByTheSimulatedRcPilotIsSeen) {
+    SimRig rig(Board::Apm2);
+    ASSERT_TRUE(rig.open_and_wait_ready());
+    ASSERT_TRUE(rig.sim.rc_pilot(apmsim::RoverMode::Manual, rig.now()));
+    rig.harness.run_for(seconds(2));
+    const auto changes = rig.all<ModeChanged>();
+    ASSERT_FALSE(changes.empty());
+    EXPECT_EQ(changes.back().to, VehicleState::Directed);
+    EXPECT_EQ(changes.back().cause, ModeChangeCause::External);
+    EXPECT_EQ(rig.driver.status().mode, "MANUAL");
+}
+
+TEST(DriverWithApmSim, Upload150ItemsOverALossyLinkVerifiedByDownload) {
+    // Ten percent of the frames to the board are lost, and the board's serial line loses one byte in a
+    // hundred both ways (about a third of the mission items).
+    LinkModel up;
+    up.baud = 57600;
+    up.latency = milliseconds(20);
+    up.frame_drop = 0.10;
+    LinkModel down = up;
+    down.frame_drop = 0;
+    SimRig rig(driver_config(Board::Pixhawk), sim_config(Board::Pixhawk), up, down, 21);
+    ASSERT_TRUE(rig.open_and_wait_ready()) << rig.driver.last_error();
+    rig.sim.faults().loss = 0.01;
+    const auto items = square(150);
+    const auto r = rig.wait_result(rig.driver.upload_mission(items, rig.now()), seconds(900));
+    const auto& st = rig.driver.mission_client().stats();
+    ASSERT_EQ(r.result, RequestResult::Ok)
+        << r.detail << " restarts " << st.restarts << " retransmissions " << st.retransmissions << " srtt "
+        << (rig.driver.mission_client().smoothed_rtt()
+                ? rig.driver.mission_client().smoothed_rtt()->count() / 1e6
+                : -1.0)
+        << " ms, t " << (rig.now() - kStart).count() / 1e9 << " s, down bytes "
+        << rig.sim.counters().bytes_out << " mstats rx " << rig.sim.mission_stats().items_received;
+    ASSERT_EQ(rig.sim.mission().count(), 151u);
+    const auto down_r = rig.wait_result(rig.driver.download_mission(rig.now()), seconds(900));
+    ASSERT_EQ(down_r.result, RequestResult::Ok)
+        << down_r.detail << " ignored " << st.ignored_frames << " sent by sim "
+        << rig.sim.mission_stats().items_sent << " parser bad " << rig.driver.parser_stats().bad_checksum
+        << " ok " << rig.driver.parser_stats().frames_ok << " link " << rig.driver.link_up()
+        << " sim frames in " << rig.sim.counters().frames_in << " ignored "
+        << rig.sim.counters().frames_ignored << " bytes in " << rig.sim.counters().bytes_in << " sent "
+        << rig.harness.to_vehicle().frames() << " dropped " << rig.harness.to_vehicle().dropped_frames();
+    ASSERT_EQ(down_r.items.size(), 150u);
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        EXPECT_NEAR(down_r.items[i].lat, items[i].lat, 1e-7) << i;
+        EXPECT_NEAR(down_r.items[i].lon, items[i].lon, 1e-7) << i;
+    }
+    EXPECT_GT(rig.sim.counters().bytes_lost, 0u);
+    EXPECT_GT(rig.driver.mission_client().stats().retransmissions, 0u);
+}
+
+TEST(DriverWithApmSim, DrivesTheMissionAndReportsReachedWaypoints) {
+    for (const Board board : {Board::Apm2, Board::Pixhawk}) {
+        SCOPED_TRACE(to_string(board));
+        SimRig rig(board);
+        ASSERT_TRUE(rig.open_and_wait_ready());
+        ASSERT_EQ(rig.wait_result(rig.driver.upload_mission(square(4), rig.now())).result, RequestResult::Ok);
+        ASSERT_EQ(
+            rig.wait_result(rig.driver.request_state(VehicleState::WaypointNavigation, rig.now())).result,
+            RequestResult::Ok);
+        ASSERT_TRUE(rig.run_until_event<WaypointReached>(4, seconds(600)));
+        const auto reached = rig.all<WaypointReached>();
+        for (std::size_t i = 0; i < 4; ++i) {
+            EXPECT_EQ(reached[i].seq, i + 1);
+        }
+        EXPECT_EQ(rig.sim.reached().size(), 4u);  // one event per reach, not two
+        // The mission ends in HOLD, by the autopilot's own decision.
+        rig.harness.run_for(seconds(5));
+        EXPECT_EQ(rig.driver.status().state, VehicleState::Parking);
+        EXPECT_EQ(rig.all<ModeChanged>().back().cause, ModeChangeCause::External);
+    }
+}
+
+TEST(DriverWithApmSim, RebootMidMissionIsDetectedAndResynced) {
+    SimRig rig(Board::Apm2);
+    ASSERT_TRUE(rig.open_and_wait_ready());
+    ASSERT_EQ(rig.wait_result(rig.driver.upload_mission(square(8), rig.now())).result, RequestResult::Ok);
+    ASSERT_EQ(rig.wait_result(rig.driver.request_state(VehicleState::WaypointNavigation, rig.now())).result,
+              RequestResult::Ok);
+    ASSERT_TRUE(rig.run_until_event<WaypointReached>(1, seconds(300)));
+    rig.sim.schedule_reboot(rig.now() + seconds(1));
+    ASSERT_TRUE(rig.run_until_event<AutopilotRebooted>(1, seconds(30)));
+    ASSERT_TRUE(rig.run_until_event<Ready>(2, seconds(60))) << rig.driver.last_error();
+    EXPECT_EQ(rig.driver.status().reboots, 1u);
+    EXPECT_EQ(rig.driver.mission().size(), rig.sim.mission().count() - 1);
+    EXPECT_TRUE(rig.driver.ready());
+}
+
+TEST(DriverWithApmSim, TenSecondHeartbeatStallIsDetectedAndRecovered) {
+    SimRig rig(Board::Apm2);
+    ASSERT_TRUE(rig.open_and_wait_ready());
+    const TimePoint stall = rig.now();
+    rig.sim.stall_heartbeats(seconds(10), rig.now());
+    ASSERT_TRUE(rig.run_until_event<LinkDown>(1, seconds(10)));
+    EXPECT_LE(rig.now() - stall, seconds(4));
+    ASSERT_TRUE(rig.run_until_event<LinkUp>(2, seconds(15)));
+    EXPECT_GE(rig.now() - stall, seconds(9));
+    EXPECT_TRUE(rig.driver.ready());
+    EXPECT_EQ(rig.driver.status().reboots, 0u);
+    EXPECT_EQ(rig.driver.status().state, VehicleState::Directed);
+}
+
+TEST(DriverWithApmSim, RcOverrideDrivesAndIsReleasedWhenTheJoystickStops) {
+    auto config = driver_config(Board::Apm2);
+    config.rc_override.input_timeout = milliseconds(500);
+    SimRig rig(config, sim_config(Board::Apm2), {}, {}, 3);
+    ASSERT_TRUE(rig.open_and_wait_ready());
+    ASSERT_EQ(rig.wait_result(rig.driver.request_state(VehicleState::ManualNavigation, rig.now())).result,
+              RequestResult::Ok);
+    for (int i = 0; i < 25; ++i) {
+        rig.driver.joystick(0.0, 0.8, rig.now());
+        rig.harness.run_for(milliseconds(200));
+    }
+    const double driving_speed = rig.sim.state().speed;
+    EXPECT_GT(driving_speed, 0.5);
+    // The ground link is lost: no more input. The board's own override timeout is 3 s; ours releases first,
+    // and the car starts slowing down within the input timeout (plus a physics step and a link transit).
+    const TimePoint last_input = rig.now() - milliseconds(200);
+    std::optional<Duration> slowing_after;
+    for (int i = 0; i < 60 && !slowing_after; ++i) {
+        rig.harness.run_for(milliseconds(50));
+        if (rig.sim.state().speed < driving_speed - 0.05) {
+            slowing_after = rig.now() - last_input;
+        }
+    }
+    ASSERT_TRUE(slowing_after) << "still driving on a stale command";
+    EXPECT_LE(*slowing_after, config.rc_override.input_timeout + milliseconds(150));
+    EXPECT_EQ(rig.driver.rc_override().releases(), 1u);
+    rig.harness.run_for(seconds(10));
+    EXPECT_EQ(rig.sim.state().speed, 0.0);
+}
+
+}  // namespace
+}  // namespace airseg::autopilot::ardupilot
