@@ -25,6 +25,8 @@ std::vector<std::string> TransportConfig::validate() const {
     need(latency_frame_payload >= min_frame_payload && latency_frame_payload <= max_frame_payload,
          "latency_frame_payload must be min_frame_payload..max_frame_payload");
     need(latency_hold >= Duration::zero(), "latency_hold must not be negative");
+    need(air_turnaround >= Duration::zero() && air_turnaround <= std::chrono::milliseconds(100),
+         "air_turnaround must be 0..100 ms");
     need(urgent_pacing >= 0.5 && urgent_pacing <= 1.0, "urgent_pacing must be 0.5..1");
     need(priorities >= 1 && priorities <= kMaxPriorities, "priorities must be 1..8");
     double shares = 0.0;

@@ -29,16 +29,23 @@ std::size_t SafeSender::lost_size() const {
     return 0;
 }
 
-SafeSender::Segment SafeSender::take_lost(TimePoint now) {
+SafeSender::Segment SafeSender::take_lost(TimePoint now, bool repeat_twice_lost) {
     for (std::size_t i = 0; i < inflight_.size(); ++i) {
         InFlight& s = inflight_[i];
         if (!s.lost) {
             continue;
         }
-        s.lost = false;
-        --lost_count_;
         ++s.transmissions;
         s.last_sent = now;
+        if (repeat_twice_lost && s.transmissions >= 3 && !s.repeated) {
+            // Lost twice already on a link losing many frames: it goes out twice in a row (stays marked lost
+            // for the next frame), which shortens the longest stalls at a small cost.
+            s.repeated = true;
+        } else {
+            s.repeated = false;
+            s.lost = false;
+            --lost_count_;
+        }
         return Segment{static_cast<std::uint16_t>(una_ + i), s.end, s.data, true};
     }
     return Segment{};

@@ -34,8 +34,9 @@ class SafeSender {
     [[nodiscard]] bool can_send_new() const;
     /// Size of the data of the lowest lost segment (it is resent as it was cut).
     [[nodiscard]] std::size_t lost_size() const;
-    /// Resends the lowest lost segment.
-    Segment take_lost(TimePoint now);
+    /// Resends the lowest lost segment; with `repeat_twice_lost`, a segment already lost twice is sent in two
+    /// consecutive frames.
+    Segment take_lost(TimePoint now, bool repeat_twice_lost = false);
     /// Cuts the next segment with at most `max_data` bytes; nullopt when the window is closed, nothing is
     /// queued, or `max_data` is too small to keep the message within 255 fragments (`force`: then cut the
     /// smallest segment that does).
@@ -70,6 +71,7 @@ class SafeSender {
         bool acked = false;
         bool lost = false;
         std::uint32_t transmissions = 0;
+        bool repeated = false;  // the second copy of a repeat is still due
         TimePoint last_sent{};
     };
     void mark_acked(InFlight& s, AckResult& r, TimePoint now, TimePoint& newest_acked_send);

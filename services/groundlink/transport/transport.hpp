@@ -49,9 +49,11 @@ struct TransportConfig {
     /// split_borrow: in split mode, also send on the peer's transmit path while the peer leaves it mostly
     /// idle (under a quarter of link_rate) and has no urgent traffic, so one-way bulk uses both pairs.
     bool split_borrow = true;
-    /// half_duplex: bytes received on a path while this end's budget is running push that budget back (the
-    /// radios of a pair share their air time).
+    /// half_duplex: both ends share one air budget per path (the radios of a pair share their air time).
     bool half_duplex = true;
+    /// air_turnaround: air time a half-duplex radio pair loses when the sending side changes; every frame
+    /// heard costs the air budget two of them.
+    Duration air_turnaround = std::chrono::milliseconds(1);
 
     /// max_frame_payload: chunk bytes per frame on a clean link.
     std::size_t max_frame_payload = 1024;

@@ -28,9 +28,20 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
             std::chrono::duration<double>(static_cast<double>(bytes.size()) / cfg.link_rate_bytes_per_s));
         ps.air_debt = std::max(ps.air_debt, now_ - air) + (peer_urgent ? air + air / 2 : air + air / 4);
     }
+    // Each frame heard also cost the radios a change of sender and back.
+    const auto turnaround = [&] {
+        if (cfg.half_duplex) {
+            ps.air_debt = std::max(ps.air_debt, now_) + 2 * cfg.air_turnaround;
+        }
+    };
     ps.deframer.feed(
-        bytes, [&](std::vector<std::uint8_t>&& plain) { on_plain_frame(path, plain, now_); },
+        bytes,
+        [&](std::vector<std::uint8_t>&& plain) {
+            turnaround();
+            on_plain_frame(path, plain, now_);
+        },
         [&] {
+            turnaround();
             ++stats.framing_errors;
             meter.on_bad_frame();
         });

@@ -13,6 +13,8 @@ constexpr double kFairShare = 0.45;  // of link_rate, below which an end is not 
 // Share of recent Safe segments declared lost above which frames stay at most kLossyFramePayload.
 constexpr double kLossyFraction = 0.15;
 constexpr std::size_t kLossyFramePayload = 192;
+// Share of recent Safe segments declared lost above which a segment lost twice is sent twice in a row.
+constexpr double kRepeatFraction = 0.25;
 
 }  // namespace
 
@@ -270,7 +272,7 @@ bool Transport::Impl::add_data_chunk(std::vector<frame::Chunk>& chunks,
         const auto level = static_cast<std::uint8_t>(l);
         std::size_t used = 0;
         if (retx_ok && tx.has_lost() && (first || tx.lost_size() + frame::safe_chunk_overhead() <= room)) {
-            auto seg = tx.take_lost(now);
+            auto seg = tx.take_lost(now, lost_window > kRepeatFraction * sent_window);
             storage.push_back(std::move(seg.data));
             chunks.emplace_back(frame::SafeChunk{level, seg.end, seg.seq, storage.back()});
             used = frame::safe_chunk_overhead() + storage.back().size();

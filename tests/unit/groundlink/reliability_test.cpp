@@ -238,3 +238,23 @@ TEST(RttEstimator, AdaptsToSamplesAndBacksOffToTheCap) {
 
 }  // namespace
 }  // namespace airseg::groundlink
+
+namespace airseg::groundlink {
+namespace {
+
+TEST(SafeSender, SegmentLostTwiceIsRepeatedOnALossyLink) {
+    SafeSender tx(8, 1 << 20, 100000);
+    tx.enqueue(seq_bytes(10));
+    ASSERT_TRUE(tx.take_new(100, false, t0).has_value());
+    ASSERT_EQ(tx.on_timeout(t0 + milliseconds(500), milliseconds(500)), 1U);
+    EXPECT_EQ(tx.take_lost(t0 + milliseconds(500), true).seq, 0);  // second transmission: once
+    EXPECT_FALSE(tx.has_lost());
+    ASSERT_EQ(tx.on_timeout(t0 + milliseconds(1000), milliseconds(500)), 1U);
+    EXPECT_EQ(tx.take_lost(t0 + milliseconds(1000), true).seq, 0);  // third: twice in a row
+    ASSERT_TRUE(tx.has_lost());
+    EXPECT_EQ(tx.take_lost(t0 + milliseconds(1010), true).seq, 0);
+    EXPECT_FALSE(tx.has_lost());
+}
+
+}  // namespace
+}  // namespace airseg::groundlink
