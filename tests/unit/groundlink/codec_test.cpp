@@ -17,7 +17,7 @@ std::vector<std::uint8_t> bytes(std::string_view s) {
     return {s.begin(), s.end()};
 }
 
-TEST(Crc32, KnownVectors) {
+TEST(GroundlinkCrc32, KnownVectors) {
     EXPECT_EQ(crc32(bytes("123456789")), 0xCBF43926U);
     EXPECT_EQ(crc32(bytes("")), 0x00000000U);
     EXPECT_EQ(crc32(bytes("a")), 0xE8B7BE43U);
@@ -28,7 +28,7 @@ TEST(Crc32, KnownVectors) {
     EXPECT_EQ(split.value(), 0xCBF43926U);
 }
 
-TEST(Cobs, KnownVectors) {
+TEST(GroundlinkCobs, KnownVectors) {
     auto enc = [](std::vector<std::uint8_t> in) {
         std::vector<std::uint8_t> out;
         cobs_encode(in, out);
@@ -48,7 +48,7 @@ TEST(Cobs, KnownVectors) {
     EXPECT_EQ(e[255], 0x01);
 }
 
-TEST(Cobs, RoundTripAndWorstCaseOverheadUnderOnePercent) {
+TEST(GroundlinkCobs, RoundTripAndWorstCaseOverheadUnderOnePercent) {
     std::mt19937 rng(7);
     for (std::size_t n : {0U, 1U, 253U, 254U, 255U, 508U, 1000U, 4000U}) {
         std::vector<std::uint8_t> in(n);
@@ -72,7 +72,7 @@ TEST(Cobs, RoundTripAndWorstCaseOverheadUnderOnePercent) {
     }
 }
 
-TEST(Cobs, RejectsInvalidEncodings) {
+TEST(GroundlinkCobs, RejectsInvalidEncodings) {
     EXPECT_FALSE(cobs_decode(std::vector<std::uint8_t>{0x05, 0x11}).has_value());  // run past the end
     EXPECT_FALSE(cobs_decode(std::vector<std::uint8_t>{0x03, 0x11, 0x00}).has_value());
 }
@@ -85,7 +85,7 @@ std::vector<std::vector<std::uint8_t>> deframe(const std::vector<std::uint8_t>& 
     return frames;
 }
 
-TEST(CobsDeframer, ResynchronizesWithinOneFrameAfterLostInsertedOrCorruptedBytes) {
+TEST(GroundlinkCobsDeframer, ResynchronizesWithinOneFrameAfterLostInsertedOrCorruptedBytes) {
     std::vector<std::vector<std::uint8_t>> sent;
     for (int i = 0; i < 5; ++i) {
         sent.push_back(std::vector<std::uint8_t>(40, static_cast<std::uint8_t>(i + 1)));
@@ -136,7 +136,7 @@ TEST(CobsDeframer, ResynchronizesWithinOneFrameAfterLostInsertedOrCorruptedBytes
     }
 }
 
-TEST(CobsDeframer, DiscardsOversizeFramesAndRecovers) {
+TEST(GroundlinkCobsDeframer, DiscardsOversizeFramesAndRecovers) {
     std::vector<std::uint8_t> stream(2000, 0x33);  // a run with no delimiter
     stream.push_back(0);
     std::vector<std::uint8_t> good;
@@ -149,7 +149,7 @@ TEST(CobsDeframer, DiscardsOversizeFramesAndRecovers) {
     EXPECT_EQ(got[0], (std::vector<std::uint8_t>{1, 2, 3}));
 }
 
-TEST(FrameMac, TagDependsOnKeyContextAndBytes) {
+TEST(GroundlinkFrameMac, TagDependsOnKeyContextAndBytes) {
     std::array<std::uint8_t, kKeyBytes> k1{};
     std::array<std::uint8_t, kKeyBytes> k2{};
     k2[0] = 1;
@@ -168,7 +168,7 @@ TEST(FrameMac, TagDependsOnKeyContextAndBytes) {
     EXPECT_GE(t.size() * 8, 48U);
 }
 
-TEST(Frame, ChunksRoundTripAndTheLastOmitsItsLength) {
+TEST(GroundlinkFrame, ChunksRoundTripAndTheLastOmitsItsLength) {
     const std::vector<std::uint8_t> d1{1, 2, 3};
     const std::vector<std::uint8_t> d2{9, 8};
     std::vector<frame::Chunk> chunks;
@@ -204,7 +204,7 @@ TEST(Frame, ChunksRoundTripAndTheLastOmitsItsLength) {
     EXPECT_EQ(std::vector<std::uint8_t>(s.data.begin(), s.data.end()), d2);
 }
 
-TEST(Frame, MalformedChunksAreRejectedNotTrusted) {
+TEST(GroundlinkFrame, MalformedChunksAreRejectedNotTrusted) {
     auto plain = frame::encode_data(0, 1, {});
     plain.push_back(0xE0);  // unknown chunk type 7
     EXPECT_FALSE(frame::decode_chunks(plain).has_value());
@@ -219,7 +219,7 @@ TEST(Frame, MalformedChunksAreRejectedNotTrusted) {
     EXPECT_FALSE(frame::decode_chunks(bad_len).has_value());
 }
 
-TEST(Frame, SealedFrameChecksCrcAndUnkeyedCrcBindsTheSession) {
+TEST(GroundlinkFrame, SealedFrameChecksCrcAndUnkeyedCrcBindsTheSession) {
     const auto plain = frame::encode_data(1, 5, {});
     const MacContext ctx{11, 22, 5};
     auto sealed = frame::seal(plain, nullptr, ctx);
@@ -231,7 +231,7 @@ TEST(Frame, SealedFrameChecksCrcAndUnkeyedCrcBindsTheSession) {
     EXPECT_FALSE(frame::check_crc(*decoded, false, ctx).has_value());
 }
 
-TEST(ReplayWindow, RejectsDuplicatesAndTooOldAndReconstructsAcrossTheWrap) {
+TEST(GroundlinkReplayWindow, RejectsDuplicatesAndTooOldAndReconstructsAcrossTheWrap) {
     ReplayWindow w;
     EXPECT_EQ(w.check(0), ReplayWindow::Check::fresh);
     w.accept(0);

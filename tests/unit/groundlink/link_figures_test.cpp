@@ -97,13 +97,13 @@ Figures measure(std::size_t paths, test::Impairments imp, FastFrom fast_from, Du
     return f;
 }
 
-TEST(LinkFigures, CleanLinkBulkGoodput) {
+TEST(GroundlinkLinkFigures, CleanLinkBulkGoodput) {
     const auto f = measure(1, {}, FastFrom::none, 60s, 1);
     EXPECT_GT(f.goodput, 0.94);       // target 0.95
     EXPECT_LT(f.max_backlog, 400ms);  // pacing keeps the radio queue to about a frame
 }
 
-TEST(LinkFigures, BulkGoodputUnderByteCorruption) {
+TEST(GroundlinkLinkFigures, BulkGoodputUnderByteCorruption) {
     test::Impairments light;
     light.byte_corrupt = 1e-4;
     EXPECT_GT(measure(1, light, FastFrom::none, 90s, 2).goodput, 0.82);  // target 0.85
@@ -112,7 +112,7 @@ TEST(LinkFigures, BulkGoodputUnderByteCorruption) {
     EXPECT_GT(measure(1, heavy, FastFrom::none, 90s, 3).goodput, 0.63);  // target 0.65
 }
 
-TEST(LinkFigures, ThirtyPercentFrameLossNeverStallsFiveSeconds) {
+TEST(GroundlinkLinkFigures, ThirtyPercentFrameLossNeverStallsFiveSeconds) {
     test::Impairments lossy;
     lossy.loss = 0.3;
     for (std::uint64_t seed : {4U, 5U}) {
@@ -122,7 +122,7 @@ TEST(LinkFigures, ThirtyPercentFrameLossNeverStallsFiveSeconds) {
     }
 }
 
-TEST(LinkFigures, FastLatencyWhileBulkSaturates) {
+TEST(GroundlinkLinkFigures, FastLatencyWhileBulkSaturates) {
     const auto same = measure(1, {}, FastFrom::sender, 60s, 6);
     EXPECT_GT(same.fast_received, 1700U);
     EXPECT_LT(same.fast_p99_ms, 150.0);
@@ -134,13 +134,13 @@ TEST(LinkFigures, FastLatencyWhileBulkSaturates) {
     EXPECT_LT(reverse.max_backlog, 600ms);  // the bulk end yields the air
 }
 
-TEST(LinkFigures, SplitCarriesNearlyTwiceSingle) {
+TEST(GroundlinkLinkFigures, SplitCarriesNearlyTwiceSingle) {
     const auto single = measure(1, {}, FastFrom::none, 60s, 8);
     const auto split = measure(2, {}, FastFrom::none, 60s, 8);
     EXPECT_GT(split.goodput, 1.85 * single.goodput);  // target 1.9
 }
 
-TEST(LinkFigures, BothEndsSaturatingShareTheAirWithoutAQueue) {
+TEST(GroundlinkLinkFigures, BothEndsSaturatingShareTheAirWithoutAQueue) {
     test::SimLink link(test::base_config(1), test::base_config(2), {test::PathModel{}}, 9);
     std::array<std::uint32_t, 2> next{};
     std::array<std::uint64_t, 2> bytes{};

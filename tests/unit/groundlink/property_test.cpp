@@ -135,7 +135,7 @@ void run_seed(std::uint64_t seed) {
     EXPECT_GT(s.replays + s.mac_failures + s.crc_errors + s.framing_errors, 0U) << "seed " << seed;
 }
 
-TEST(TransportProperty, SafeExactlyOnceInOrderUnderRandomImpairments) {
+TEST(GroundlinkTransportProperty, SafeExactlyOnceInOrderUnderRandomImpairments) {
     // AIRSEG_PROPERTY_SEEDS=n runs more seeds (the default keeps the suite fast).
     const char* env = std::getenv("AIRSEG_PROPERTY_SEEDS");
     const std::uint64_t seeds = env != nullptr ? std::strtoull(env, nullptr, 10) : 24;

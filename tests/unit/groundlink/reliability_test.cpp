@@ -26,7 +26,7 @@ frame::SafeChunk chunk_of(const SafeSender::Segment& s) {
     return frame::SafeChunk{0, s.end, s.seq, s.data};
 }
 
-TEST(SafeSender, FragmentsLazilyAndReassemblesInOrder) {
+TEST(GroundlinkSafeSender, FragmentsLazilyAndReassemblesInOrder) {
     SafeSender tx(64, 1 << 20, 100000);
     SafeReceiver rx(64, 100000);
     const auto msg = seq_bytes(1000);
@@ -49,7 +49,7 @@ TEST(SafeSender, FragmentsLazilyAndReassemblesInOrder) {
     EXPECT_EQ(rx.on_segment(chunk_of(segs[2])), SafeReceiver::Accept::duplicate);
 }
 
-TEST(SafeSender, KeepsEveryMessageWithin255Fragments) {
+TEST(GroundlinkSafeSender, KeepsEveryMessageWithin255Fragments) {
     SafeSender tx(128, 1 << 20, 255 * 64);
     ASSERT_EQ(tx.enqueue(seq_bytes(255 * 64)), SendResult::accepted);
     EXPECT_FALSE(tx.take_new(10, false, t0).has_value());  // 10-byte pieces would need 1632 fragments
@@ -58,7 +58,7 @@ TEST(SafeSender, KeepsEveryMessageWithin255Fragments) {
     EXPECT_EQ(forced->data.size(), 64U);
 }
 
-TEST(SafeSender, BoundedQueueRefusesWhenFullAndTooLarge) {
+TEST(GroundlinkSafeSender, BoundedQueueRefusesWhenFullAndTooLarge) {
     SafeSender tx(4, 1000, 600);
     EXPECT_EQ(tx.enqueue(seq_bytes(601)), SendResult::too_large);
     EXPECT_EQ(tx.enqueue(seq_bytes(600)), SendResult::accepted);
@@ -66,7 +66,7 @@ TEST(SafeSender, BoundedQueueRefusesWhenFullAndTooLarge) {
     EXPECT_EQ(tx.enqueue(seq_bytes(400)), SendResult::accepted);
 }
 
-TEST(SafeSender, SelectiveAckResendsOnlyTheHoleAndWindowBounds) {
+TEST(GroundlinkSafeSender, SelectiveAckResendsOnlyTheHoleAndWindowBounds) {
     SafeSender tx(8, 1 << 20, 100000);
     for (int i = 0; i < 20; ++i) {
         ASSERT_EQ(tx.enqueue(seq_bytes(10)), SendResult::accepted);
@@ -103,7 +103,7 @@ TEST(SafeSender, SelectiveAckResendsOnlyTheHoleAndWindowBounds) {
     EXPECT_TRUE(tx.can_send_new());
 }
 
-TEST(SafeSender, TimeoutDeclaresOutstandingLostAndKarnSkipsRetransmittedSamples) {
+TEST(GroundlinkSafeSender, TimeoutDeclaresOutstandingLostAndKarnSkipsRetransmittedSamples) {
     SafeSender tx(8, 1 << 20, 100000);
     tx.enqueue(seq_bytes(10));
     auto s = tx.take_new(100, false, t0);
@@ -119,7 +119,7 @@ TEST(SafeSender, TimeoutDeclaresOutstandingLostAndKarnSkipsRetransmittedSamples)
     EXPECT_TRUE(r.progress);
 }
 
-TEST(SafeSender, ResetRequeuesUnacknowledgedMessagesInOrder) {
+TEST(GroundlinkSafeSender, ResetRequeuesUnacknowledgedMessagesInOrder) {
     SafeSender tx(8, 1 << 20, 100000);
     tx.enqueue(seq_bytes(100));
     tx.enqueue(seq_bytes(100));
@@ -137,7 +137,7 @@ TEST(SafeSender, ResetRequeuesUnacknowledgedMessagesInOrder) {
     }
 }
 
-TEST(SafeReceiver, WindowBoundsHeldSegments) {
+TEST(GroundlinkSafeReceiver, WindowBoundsHeldSegments) {
     SafeReceiver rx(4, 1000);
     const std::vector<std::uint8_t> d{1};
     EXPECT_EQ(rx.on_segment(frame::SafeChunk{0, true, 4, d}), SafeReceiver::Accept::out_of_window);
@@ -145,7 +145,7 @@ TEST(SafeReceiver, WindowBoundsHeldSegments) {
     EXPECT_EQ(rx.on_segment(frame::SafeChunk{0, true, 0xFFFF, d}), SafeReceiver::Accept::duplicate);
 }
 
-TEST(FastQueue, FreshestValueWinsAndCapDropsOldest) {
+TEST(GroundlinkFastQueue, FreshestValueWinsAndCapDropsOldest) {
     FastQueue q(3);
     const std::vector<std::uint8_t> v1{1};
     const std::vector<std::uint8_t> v2{2};
@@ -162,7 +162,7 @@ TEST(FastQueue, FreshestValueWinsAndCapDropsOldest) {
     EXPECT_EQ(topics, (std::vector<std::uint16_t>{11, 12, 13}));
 }
 
-TEST(FastQueue, ReplacedValueKeepsItsPlace) {
+TEST(GroundlinkFastQueue, ReplacedValueKeepsItsPlace) {
     FastQueue q(8);
     const std::vector<std::uint8_t> old_v{1};
     const std::vector<std::uint8_t> new_v{9};
@@ -175,7 +175,7 @@ TEST(FastQueue, ReplacedValueKeepsItsPlace) {
     EXPECT_EQ(first->data, new_v);
 }
 
-TEST(FastQueue, FragmentsAndReassemblesAndTimesOut) {
+TEST(GroundlinkFastQueue, FragmentsAndReassemblesAndTimesOut) {
     FastQueue q(4);
     const auto msg = seq_bytes(500);
     q.push(7, msg);
@@ -206,7 +206,7 @@ TEST(FastQueue, FragmentsAndReassemblesAndTimesOut) {
     EXPECT_EQ(r.next_deadline(), kNever);
 }
 
-TEST(FastQueue, LargeMessageStaysWithin255Fragments) {
+TEST(GroundlinkFastQueue, LargeMessageStaysWithin255Fragments) {
     FastQueue q(4);
     q.push(1, seq_bytes(255 * 40));
     std::size_t n = 0;
@@ -217,7 +217,7 @@ TEST(FastQueue, LargeMessageStaysWithin255Fragments) {
     EXPECT_EQ(n, 255U);
 }
 
-TEST(RttEstimator, AdaptsToSamplesAndBacksOffToTheCap) {
+TEST(GroundlinkRttEstimator, AdaptsToSamplesAndBacksOffToTheCap) {
     RttEstimator r(milliseconds(1000), milliseconds(100), milliseconds(3000), milliseconds(20));
     EXPECT_EQ(r.rto(), milliseconds(1000));
     for (int i = 0; i < 50; ++i) {
@@ -242,7 +242,7 @@ TEST(RttEstimator, AdaptsToSamplesAndBacksOffToTheCap) {
 namespace airseg::groundlink {
 namespace {
 
-TEST(SafeSender, SegmentLostTwiceIsRepeatedOnALossyLink) {
+TEST(GroundlinkSafeSender, SegmentLostTwiceIsRepeatedOnALossyLink) {
     SafeSender tx(8, 1 << 20, 100000);
     tx.enqueue(seq_bytes(10));
     ASSERT_TRUE(tx.take_new(100, false, t0).has_value());

@@ -28,7 +28,7 @@ std::size_t count_safe(const test::Endpoint& e, std::uint8_t prio) {
         [prio](const Delivered& d) { return d.cls == MessageClass::safe && d.priority == prio; }));
 }
 
-TEST(TransportConfig, ValidateNamesEachProblem) {
+TEST(GroundlinkTransportConfig, ValidateNamesEachProblem) {
     EXPECT_TRUE(base_config(1).validate().empty());
     TransportConfig c = base_config(1);
     c.paths = 3;
@@ -45,7 +45,7 @@ TEST(TransportConfig, ValidateNamesEachProblem) {
     EXPECT_TRUE(split.validate().empty());
 }
 
-TEST(Transport, HandshakeThenSafeBothWaysAuthenticated) {
+TEST(GroundlinkTransport, HandshakeThenSafeBothWaysAuthenticated) {
     SimLink link(base_config(0x1111), base_config(0x2222), one_path(), 1);
     const auto m1 = pattern(300, 1);
     const auto m2 = pattern(3000, 2);
@@ -70,7 +70,7 @@ TEST(Transport, HandshakeThenSafeBothWaysAuthenticated) {
     EXPECT_GT(link.a().core->stats().rtt_samples, 0U);
 }
 
-TEST(Transport, WithoutKeyStatsSayUnauthenticated) {
+TEST(GroundlinkTransport, WithoutKeyStatsSayUnauthenticated) {
     SimLink link(base_config(5, false), base_config(6, false), one_path(), 2);
     link.a().core->send_safe(1, pattern(50, 9), link.now());
     link.run_for(3s);
@@ -79,7 +79,7 @@ TEST(Transport, WithoutKeyStatsSayUnauthenticated) {
     EXPECT_FALSE(link.b().core->stats().authenticated);
 }
 
-TEST(Transport, PacingNeverExceedsRateTimesElapsedPlusOneFrame) {
+TEST(GroundlinkTransport, PacingNeverExceedsRateTimesElapsedPlusOneFrame) {
     SimLink link(base_config(1), base_config(2), one_path(), 3);
     for (std::uint32_t i = 0; i < 60; ++i) {
         link.a().core->send_safe(3, pattern(1000, i), link.now());
@@ -98,7 +98,7 @@ TEST(Transport, PacingNeverExceedsRateTimesElapsedPlusOneFrame) {
     EXPECT_GT(link.written(0, 0), 5760U * 10U * 8U / 10U);  // and it does use the link
 }
 
-TEST(Transport, UrgentMessageOvertakesBulkWithinAFewFrameTimes) {
+TEST(GroundlinkTransport, UrgentMessageOvertakesBulkWithinAFewFrameTimes) {
     SimLink link(base_config(1), base_config(2), one_path(), 4);
     link.run_for(2s);  // handshake
     for (std::uint32_t i = 0; i < 40; ++i) {
@@ -122,7 +122,7 @@ TEST(Transport, UrgentMessageOvertakesBulkWithinAFewFrameTimes) {
     EXPECT_LT(count_safe(link.b(), 3), 40U);  // bulk was still going
 }
 
-TEST(Transport, LowerPriorityGetsItsMinimumShare) {
+TEST(GroundlinkTransport, LowerPriorityGetsItsMinimumShare) {
     TransportConfig a = base_config(1);
     a.min_share = {0.0, 0.0, 0.0, 0.1, 0, 0, 0, 0};
     SimLink link(a, base_config(2), one_path(), 5);
@@ -140,7 +140,7 @@ TEST(Transport, LowerPriorityGetsItsMinimumShare) {
     EXPECT_LT(low_share, 0.2);
 }
 
-TEST(Transport, FastFreshestWinsEndToEnd) {
+TEST(GroundlinkTransport, FastFreshestWinsEndToEnd) {
     SimLink link(base_config(1), base_config(2), one_path(), 6);
     link.run_for(2s);
     for (std::uint32_t v = 0; v < 50; ++v) {
@@ -159,7 +159,7 @@ TEST(Transport, FastFreshestWinsEndToEnd) {
     EXPECT_EQ(link.a().core->stats().tx_fast.replaced, 49U);
 }
 
-TEST(Transport, RttAndRtoFollowTheLinkLatency) {
+TEST(GroundlinkTransport, RttAndRtoFollowTheLinkLatency) {
     test::Impairments slow;
     slow.latency = 150ms;
     SimLink link(base_config(1), base_config(2), one_path(slow), 7);
@@ -177,7 +177,7 @@ TEST(Transport, RttAndRtoFollowTheLinkLatency) {
     EXPECT_EQ(count_safe(link.b(), 1), 100U);
 }
 
-TEST(Transport, PeerRestartIsDetectedAndBothResynchronize) {
+TEST(GroundlinkTransport, PeerRestartIsDetectedAndBothResynchronize) {
     SimLink link(base_config(0xA), base_config(0xB), one_path(), 8);
     for (std::uint32_t i = 0; i < 5; ++i) {
         link.a().core->send_safe(0, pattern(100, i), link.now());
@@ -204,7 +204,7 @@ TEST(Transport, PeerRestartIsDetectedAndBothResynchronize) {
     EXPECT_TRUE(link.b().core->link_up());
 }
 
-TEST(Transport, ForgedAndReplayedFramesAreNeverDelivered) {
+TEST(GroundlinkTransport, ForgedAndReplayedFramesAreNeverDelivered) {
     SimLink link(base_config(0x10), base_config(0x20), one_path(), 9);
     for (std::uint32_t i = 0; i < 20; ++i) {
         link.a().core->send_safe(0, pattern(200, i), link.now());
@@ -283,14 +283,14 @@ std::uint64_t bulk_bytes_delivered(PathMode mode, std::size_t paths, Duration ru
     return bytes;
 }
 
-TEST(Transport, SplitModeNearlyDoublesThroughput) {
+TEST(GroundlinkTransport, SplitModeNearlyDoublesThroughput) {
     const auto single = bulk_bytes_delivered(PathMode::single, 1, 30s, 11);
     const auto split = bulk_bytes_delivered(PathMode::split, 2, 30s, 11);
     EXPECT_GT(static_cast<double>(single), 0.9 * 5760.0 * 28.0);
     EXPECT_GT(static_cast<double>(split), 1.9 * static_cast<double>(single));
 }
 
-TEST(Transport, SplitFallsBackWhenAPairGoesSilentAndReturns) {
+TEST(GroundlinkTransport, SplitFallsBackWhenAPairGoesSilentAndReturns) {
     TransportConfig a = dual(1, PathMode::split, 0);
     TransportConfig b = dual(2, PathMode::split, 1);
     a.split_borrow = b.split_borrow = false;  // so path 1 carries A's data only while falling back
@@ -317,7 +317,7 @@ TEST(Transport, SplitFallsBackWhenAPairGoesSilentAndReturns) {
     EXPECT_TRUE(link.a().core->stats().path[0].peer_hears);
 }
 
-TEST(Transport, RedundantModeDropsDuplicatesAndSurvivesOnePathDying) {
+TEST(GroundlinkTransport, RedundantModeDropsDuplicatesAndSurvivesOnePathDying) {
     SimLink link(dual(1, PathMode::redundant, 0), dual(2, PathMode::redundant, 0),
                  {clean_path(), clean_path()}, 13);
     for (std::uint32_t i = 0; i < 20; ++i) {
@@ -336,7 +336,7 @@ TEST(Transport, RedundantModeDropsDuplicatesAndSurvivesOnePathDying) {
     EXPECT_TRUE(link.a().core->link_up());
 }
 
-TEST(Transport, FrameSizeShrinksUnderCorruption) {
+TEST(GroundlinkTransport, FrameSizeShrinksUnderCorruption) {
     test::Impairments noisy;
     noisy.byte_corrupt = 1e-3;
     SimLink link(base_config(1), base_config(2), one_path(noisy), 14);
@@ -351,7 +351,7 @@ TEST(Transport, FrameSizeShrinksUnderCorruption) {
     EXPECT_GT(count_safe(link.b(), 3), 50U);
 }
 
-TEST(Transport, LinkGoesDownAfterSilenceAndComesBack) {
+TEST(GroundlinkTransport, LinkGoesDownAfterSilenceAndComesBack) {
     SimLink link(base_config(1), base_config(2), one_path(), 15);
     link.run_for(3s);
     ASSERT_TRUE(link.a().core->link_up());
