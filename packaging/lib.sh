@@ -35,11 +35,13 @@ ensure_packages() {
 
 # The -dev packages the project builds against, read from Build-Depends in debian/control so the
 # host, every sysroot and the Debian package agree.
+# shellcheck disable=SC2034  # used by the scripts that source this file
 mapfile -t AIRSEG_DEV_PACKAGES < <(sed -n '/^Build-Depends:/,/^[A-Z][A-Za-z-]*:/p' \
   "$AIRSEG_ROOT/packaging/debian/control" | sed -e 's/^Build-Depends://' \
   | grep -oE '^[[:space:]]*[a-z0-9][a-z0-9.+-]*-dev\b' | sed 's/^[[:space:]]*//' | sort -u)
 
 # Tools to build .debs natively.
+# shellcheck disable=SC2034
 AIRSEG_NATIVE_TOOLS=(build-essential cmake ninja-build pkgconf debhelper dpkg-dev fakeroot lintian file)
 
 # Tools to cross-build for ARCH and run the results under qemu-user.

@@ -37,6 +37,9 @@ if ! attempt "deb $mirror bookworm main" "deb $mirror bookworm-updates main" \
   attempt "deb $mirror bookworm main" "deb $mirror bookworm-updates main" \
     || die "mmdebstrap failed for $arch"
 fi
+# qemu-arm -L SYSROOT looks up every absolute path in the sysroot first: device nodes there
+# (mmdebstrap's /dev) would shadow the host's, and /dev/ptmx would fail with ENODEV.
+rm -rf "$dir.tmp/dev" "$dir.tmp/tmp" "$dir.tmp/run" "$dir.tmp/proc" "$dir.tmp/sys"
 rm -rf "$dir"
 mv "$dir.tmp" "$dir"
 # The recorded file lists name the directory the sysroot was built in; keep them true.
