@@ -143,6 +143,43 @@ struct RequestDone {
 using Event = std::variant<WaypointReached, MissionCurrentChanged, ModeChanged, LinkUp, LinkDown,
                            AutopilotRebooted, Ready, StatusText, RequestDone>;
 
+// --- bus requests to the autopilot service (answered by a RequestDone event with the same id) -------------
+struct RequestStateChange {
+    VehicleState state = VehicleState::Parking;
+};
+struct UploadMission {
+    std::vector<MissionItem> items;  // slots 1..n; slot 0 (home) is the driver's
+};
+struct WriteMissionItems {
+    std::uint16_t first_slot = 1;
+    std::vector<MissionItem> items;
+};
+struct DownloadMission {};
+struct SetMissionCurrent {
+    std::uint16_t slot = 1;
+};
+struct ClearMission {};
+struct GetParam {
+    std::string name;
+};
+struct SetParam {
+    std::string name;
+    double value = 0.0;
+};
+struct AutopilotRequest {
+    std::uint32_t id = 0;  // chosen by the requester, echoed in RequestDone::id
+    std::variant<RequestStateChange, UploadMission, WriteMissionItems, DownloadMission, SetMissionCurrent,
+                 ClearMission, GetParam, SetParam>
+        op;
+};
+/// Ground joystick input, -1..1 each; it drives only in MANUAL_NAVIGATION and only while it keeps coming.
+struct JoystickInput {
+    double steering = 0.0;
+    double throttle = 0.0;
+};
+/// The operator's explicit reset out of failsafe MANUAL.
+struct OperatorReset {};
+
 /// What status shows as autopilot.* keys.
 struct AutopilotStatus {
     bool link_up = false;                        // autopilot.link

@@ -1,0 +1,246 @@
+#include "services/autopilot/autopilot_service.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include "hal/gpio_pulse.hpp"
+
+namespace airseg::autopilot {
+
+namespace {
+PortKeeperConfig port_config(AutopilotServiceConfig& c) {
+    PortKeeperConfig p = c.port;
+    if (!c.autopilot.bauds.empty()) {
+        p.serial.baud = c.autopilot.bauds.front();
+    }
+    return p;
+}
+}  // namespace
+
+AutopilotService::AutopilotService(ServiceContext& ctx, AutopilotServiceConfig config, hal::GpioFactory* gpio)
+    : Service("autopilot", ctx),
+      config_(std::move(config)),
+      gpio_(gpio),
+      driver_(config_.autopilot),
+      keeper_(strand(), port_config(config_),
+              PortKeeper::Handlers{[this] {
+                                       driver_.on_port_open(SteadyClock::now());
+                                       pump();
+                                   },
+                                   [this](std::span<const std::uint8_t> bytes) {
+                                       driver_.handle_bytes(bytes, SteadyClock::now());
+                                       pump();
+                                   },
+                                   [this](const std::string& reason) {
+                                       driver_.on_port_closed(reason, SteadyClock::now());
+                                       pump();
+                                   }}),
+      tlog_(config_.tlog),
+      timer_(strand()),
+      status_timer_(strand()),
+      prefix_("autopilot[" + config_.port.serial.path + "]: ") {
+    if (config_.tlog.enabled) {
+        driver_.set_frame_tap([this](bool, std::span<const std::uint8_t> frame) {
+            tlog_.record(frame, std::chrono::system_clock::now());
+        });
+    }
+}
+
+AutopilotService::~AutopilotService() = default;
+
+void AutopilotService::on_start() {
+    running_ = true;
+    if (config_.reset_line) {
+        if (!gpio_) {
+            spdlog::warn("{}reset line configured but no GPIO backend; reset pulses disabled", prefix_);
+        } else if (auto r = gpio_->request(*config_.reset_line); r.ok()) {
+            reset_line_ = r.line;
+        } else {
+            spdlog::warn("{}reset line: {}; reset pulses disabled", prefix_, r.message);
+        }
+    }
+    auto& bus = ctx_.bus;
+    subscriptions_.push_back(
+        bus.subscribe<AutopilotRequest>(strand(), [this](const AutopilotRequest& r) { on_request(r); }));
+    subscriptions_.push_back(bus.subscribe<JoystickInput>(strand(), [this](const JoystickInput& j) {
+        driver_.joystick(j.steering, j.throttle, SteadyClock::now());
+        pump();
+    }));
+    subscriptions_.push_back(bus.subscribe<OperatorReset>(strand(), [this](const OperatorReset&) {
+        driver_.operator_reset(SteadyClock::now());
+        pump();
+    }));
+    keeper_.start();
+    publish_status();
+    update_health();
+    schedule_status();
+}
+
+void AutopilotService::on_stop() {
+    running_ = false;
+    subscriptions_.clear();
+    timer_.cancel();
+    status_timer_.cancel();
+    keeper_.stop();
+    tlog_.flush();
+}
+
+void AutopilotService::on_request(const AutopilotRequest& r) {
+    const TimePoint now = SteadyClock::now();
+    const std::uint32_t id = std::visit(
+        [&](const auto& op) -> std::uint32_t {
+            using T = std::decay_t<decltype(op)>;
+            if constexpr (std::is_same_v<T, RequestStateChange>) {
+                return driver_.request_state(op.state, now);
+            } else if constexpr (std::is_same_v<T, UploadMission>) {
+                return driver_.upload_mission(op.items, now);
+            } else if constexpr (std::is_same_v<T, WriteMissionItems>) {
+                return driver_.write_items(op.first_slot, op.items, now);
+            } else if constexpr (std::is_same_v<T, DownloadMission>) {
+                return driver_.download_mission(now);
+            } else if constexpr (std::is_same_v<T, SetMissionCurrent>) {
+                return driver_.set_current(op.slot, now);
+            } else if constexpr (std::is_same_v<T, ClearMission>) {
+                return driver_.clear_mission(now);
+            } else if constexpr (std::is_same_v<T, GetParam>) {
+                return driver_.get_param(op.name, now);
+            } else {
+                return driver_.set_param(op.name, op.value, now);
+            }
+        },
+        r.op);
+    requester_ids_[id] = r.id;
+    pump();
+}
+
+// Everything the driver has for the outside world, then the timer for its next deadline.
+void AutopilotService::pump() {
+    if (!running_) {
+        return;
+    }
+    while (auto frame = driver_.poll_transmit()) {
+        if (keeper_.is_open()) {
+            keeper_.write(std::move(*frame));
+        }
+    }
+    bool changed = false;
+    while (auto e = driver_.poll_event()) {
+        changed = true;
+        publish(std::move(*e));
+    }
+    while (auto a = driver_.poll_action()) {
+        if (const auto* p = std::get_if<ardupilot::PulseReset>(&*a)) {
+            pulse_reset(p->attempt);
+        } else if (const auto* b = std::get_if<ardupilot::SwitchBaud>(&*a)) {
+            // PortKeeper cannot reopen at another rate yet: the first configured rate stays in use.
+            spdlog::warn("{}no valid frame yet; would try {} baud, which needs PortKeeper support", prefix_,
+                         b->baud);
+        }
+    }
+    if (changed) {
+        publish_status();
+        update_health();
+    }
+    arm_timer();
+}
+
+void AutopilotService::publish(Event e) {
+    std::visit(
+        [&](auto& ev) {
+            using T = std::decay_t<decltype(ev)>;
+            if constexpr (std::is_same_v<T, RequestDone>) {
+                if (auto it = requester_ids_.find(ev.id); it != requester_ids_.end()) {
+                    ev.id = it->second;
+                    requester_ids_.erase(it);
+                }
+                if (ev.result != RequestResult::Ok) {
+                    spdlog::info("{}{} #{}: {} {}", prefix_, to_string(ev.kind), ev.id, to_string(ev.result),
+                                 ev.detail);
+                }
+            } else if constexpr (std::is_same_v<T, LinkDown>) {
+                spdlog::warn("{}link down: {}", prefix_, ev.reason);
+            } else if constexpr (std::is_same_v<T, AutopilotRebooted>) {
+                spdlog::warn("{}autopilot rebooted ({})", prefix_, ev.evidence);
+            } else if constexpr (std::is_same_v<T, Ready>) {
+                spdlog::info("{}ready {:.1f} s after the open", prefix_, ev.seconds_from_open);
+            } else if constexpr (std::is_same_v<T, ModeChanged>) {
+                spdlog::info("{}{} -> {} ({})", prefix_, to_string(ev.from), to_string(ev.to), ev.to_mode);
+            }
+            ctx_.bus.publish(std::move(ev));
+        },
+        e);
+}
+
+void AutopilotService::arm_timer() {
+    const TimePoint next = driver_.poll_timeout();
+    if (next == timer_at_) {
+        return;
+    }
+    timer_at_ = next;
+    if (next == kNever) {
+        timer_.cancel();
+        return;
+    }
+    timer_.expires_at(next);
+    timer_.async_wait([this](const boost::system::error_code& ec) { on_timer(ec); });
+}
+
+void AutopilotService::schedule_status() {
+    status_timer_.expires_after(config_.status_period);
+    status_timer_.async_wait([this](const boost::system::error_code& ec) {
+        if (ec || !running_) {
+            return;
+        }
+        publish_status();
+        update_health();
+        schedule_status();
+    });
+}
+
+void AutopilotService::on_timer(const boost::system::error_code& ec) {
+    if (ec == asio::error::operation_aborted || !running_) {
+        return;
+    }
+    timer_at_ = kNever;
+    driver_.handle_timeout(SteadyClock::now());
+    pump();
+}
+
+void AutopilotService::publish_status() {
+    AutopilotStatus s = driver_.status();
+    s.reconnects = keeper_.reconnects();
+    ctx_.bus.publish_latest(s);
+    ctx_.bus.publish_latest(driver_.telemetry());
+}
+
+void AutopilotService::update_health() {
+    if (driver_.ready()) {
+        set_health(Health::Up);
+    } else if (driver_.link_up()) {
+        set_health(Health::Degraded, driver_.last_error().empty()
+                                         ? std::string("connecting: ") + ardupilot::to_string(driver_.phase())
+                                         : driver_.last_error());
+    } else {
+        set_health(Health::Down, keeper_.is_open() ? (driver_.last_error().empty() ? "waiting for heartbeats"
+                                                                                   : driver_.last_error())
+                                                   : keeper_.last_error());
+    }
+}
+
+void AutopilotService::pulse_reset(unsigned attempt) {
+    if (!reset_line_) {
+        spdlog::warn("{}autopilot unresponsive; no reset line to pulse (attempt {})", prefix_, attempt);
+        return;
+    }
+    spdlog::warn("{}autopilot unresponsive: pulsing {} (attempt {})", prefix_, reset_line_->name(), attempt);
+    hal::pulse(strand(), reset_line_, config_.reset_pulse_width, [this](std::error_code ec) {
+        if (ec) {
+            spdlog::warn("{}reset pulse failed: {}", prefix_, ec.message());
+        }
+        if (running_) {
+            driver_.on_reset_pulsed(SteadyClock::now());
+            pump();
+        }
+    });
+}
+
+}  // namespace airseg::autopilot

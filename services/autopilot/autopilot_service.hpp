@@ -1,0 +1,72 @@
+#pragma once
+// AutopilotService: the asio side of the ArduPilot driver. It keeps the autopilot's serial port open
+// (PortKeeper: reopen with backoff), feeds the port's bytes and a steady_timer to the sans-IO Driver, writes
+// what the driver sends, publishes the driver's events and the autopilot status and telemetry on the bus,
+// pulses the reset line when the driver asks, and records every frame in the .tlog when enabled.
+//
+// Bus: subscribes AutopilotRequest, JoystickInput, OperatorReset; publishes the autopilot::Event types
+// (RequestDone with the requester's id) as events, and AutopilotStatus and Telemetry as variables.
+// Log prefix: autopilot[<device>]: .
+#include <map>
+#include <memory>
+#include <optional>
+
+#include "hal/gpio.hpp"
+#include "services/autopilot/ardupilot/driver.hpp"
+#include "services/autopilot/autopilot.hpp"
+#include "services/autopilot/autopilot_config.hpp"
+#include "services/autopilot/tlog_writer.hpp"
+#include "services/common/port_keeper.hpp"
+#include "services/common/service.hpp"
+
+namespace airseg::autopilot {
+
+struct AutopilotServiceConfig {
+    AutopilotConfig autopilot;
+    PortKeeperConfig port;  // its serial.baud is replaced by autopilot.bauds[0]
+    TlogConfig tlog;
+    std::optional<hal::GpioLineRequest> reset_line;  // autopilot.reset.line
+    Duration reset_pulse_width = milliseconds(200);  // autopilot.reset.pulse_width
+    Duration status_period = milliseconds(200);      // how often status and telemetry are published
+};
+
+class AutopilotService : public Service {
+  public:
+    /// `gpio` may be null when no reset line is configured.
+    AutopilotService(ServiceContext& ctx, AutopilotServiceConfig config, hal::GpioFactory* gpio);
+    ~AutopilotService() override;
+
+    /// The driver, for tests and the status service; touch only on strand().
+    const ardupilot::Driver& driver() const { return driver_; }
+
+  protected:
+    void on_start() override;
+    void on_stop() override;
+
+  private:
+    void on_request(const AutopilotRequest& r);
+    void pump();
+    void arm_timer();
+    void on_timer(const boost::system::error_code& ec);
+    void publish_status();
+    void schedule_status();
+    void publish(Event e);
+    void pulse_reset(unsigned attempt);
+    void update_health();
+
+    AutopilotServiceConfig config_;
+    hal::GpioFactory* gpio_;
+    std::shared_ptr<hal::GpioLine> reset_line_;
+    ardupilot::Driver driver_;
+    PortKeeper keeper_;
+    TlogWriter tlog_;
+    asio::steady_timer timer_;
+    TimePoint timer_at_ = kNever;
+    asio::steady_timer status_timer_;
+    std::map<std::uint32_t, std::uint32_t> requester_ids_;  // driver id -> requester id
+    std::vector<Subscription> subscriptions_;
+    bool running_ = false;
+    std::string prefix_;
+};
+
+}  // namespace airseg::autopilot
