@@ -77,6 +77,8 @@ build_one() {
   stage_source "$src"
   rm -f "$work"/airseg*_"$arch".* "$work"/airseg*_"$arch".*deb
   local start=$SECONDS
+  # debhelper gives the build a HOME of its own inside debian/, which would start ccache empty.
+  export CCACHE_DIR=${CCACHE_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/ccache}
   (cd "$src" && AIRSEG_SYSROOT="$sysroot" DEB_BUILD_OPTIONS="$opts" \
      AIRSEG_CMAKE_ARGS="$(ccache_launcher_args)" dpkg-buildpackage "${dpkg_args[@]}") \
      >"$work/build.log" 2>&1 || { tail -n 60 "$work/build.log"; die "build for $arch failed (log: $work/build.log)"; }
