@@ -172,7 +172,8 @@ void Driver::handle_timeout(TimePoint now) {
     if (now >= phase_deadline_) {
         phase_deadline_ = kNever;
         if (phase_ == Phase::WaitBoot) {
-            last_error_ = "autopilot did not finish booting within boot_timeout";
+            last_error_ = link_up_ ? "autopilot did not finish booting within boot_timeout"
+                                   : "no heartbeat from the autopilot within boot_timeout";
             if (link_up_ && pulses_ < config_.max_reset_pulses) {
                 ++pulses_;
                 ++reset_pulses_;

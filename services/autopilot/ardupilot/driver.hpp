@@ -6,7 +6,7 @@
 // without it the first running heartbeat will do) -> Params (stream rates requested, parameter table
 // downloaded) -> Mission (mission downloaded; slot 0 is home) -> ApplyParams (configured parameters written
 // where they differ, each read back) -> Ready (Ready event with the seconds since the open). A failed step is
-// retried after retry_pause; last_error() says why the driver is not READY.
+// retried after kRetryPause; last_error() says why the driver is not READY.
 //
 // Afterwards it keeps: telemetry; the vehicle state derived from each heartbeat (mode changes made by the RC
 // pilot or the autopilot itself are published as External ModeChanged events); requested state changes,
