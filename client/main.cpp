@@ -1,14 +1,21 @@
 // airsegctl: the thin ground client of airseg. All state lives in airsegd; this program asks and shows.
 #include <fmt/format.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
 
+#include <unistd.h>
+#include <csignal>
 #include <cstdlib>
 #include <functional>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "client/local_client.hpp"
+#include "client/radio_client.hpp"
 #include "client/status_view.hpp"
 
 namespace {
@@ -20,14 +27,20 @@ constexpr int kUsage = 2;
 constexpr int kNoLink = 3;
 
 const char* kUsageText =
-    "Usage: airsegctl [--local] [--socket PATH] [--json] [--timeout MS] COMMAND [ARGS]\n"
+    "Usage: airsegctl [CONNECTION] [--json] [--timeout MS] COMMAND [ARGS]\n"
     "\n"
     "Talks to airsegd, the on-board daemon, and shows what it says. Nothing is shown as done before\n"
     "the vehicle has acknowledged it.\n"
     "\n"
-    "Connection:\n"
+    "Connection (one of):\n"
     "  --local            through airsegd's local socket on the board (the default)\n"
     "  --socket PATH      local socket path (default /run/airseg/status.sock)\n"
+    "  --link PATH[,PATH2]  over the ground radio(s) on these serial devices; with two, list them in the\n"
+    "                     same radio-pair order as the vehicle's groundlink.ports\n"
+    "  --baud N           radio port baud rate (default 57600)\n"
+    "  --mode MODE        single (one device), split or redundant (two devices)\n"
+    "  --udp HOST:PORT    over UDP to the vehicle's ground-link socket\n"
+    "  --key FILE         pre-shared key file (mode 0600), the same as the vehicle's groundlink.key_file\n"
     "  --timeout MS       how long to wait for an answer (default 5000)\n"
     "\n"
     "Output:\n"
@@ -35,12 +48,15 @@ const char* kUsageText =
     "\n"
     "Commands:\n"
     "  status             health of every service and the vehicle's state\n"
+    "  watch [--interval MS]  a live view refreshed in place until Ctrl-C (default every 1000 ms)\n"
     "  request JSON       send one raw request object, e.g. '{\"cmd\":\"status\"}', print the answer\n"
     "\n"
     "Exit codes: 0 done, 1 refused by the vehicle, 2 usage, 3 no link (no answer in time).\n";
 
 struct Options {
     std::string socket = "/run/airseg/status.sock";
+    airseg::client::RadioOptions radio;
+    bool use_radio = false;
     bool json = false;
     long timeout_ms = 5000;
     std::vector<std::string> positional;
@@ -68,7 +84,7 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
             std::cout << "airsegctl " << AIRSEG_VERSION << "\n";
             return kDone;
         } else if (a == "--local") {
-            // The only connection this build offers; accepted for scripts that name it.
+            o.use_radio = false;  // the default; named for scripts that want to be explicit
         } else if (a == "--json") {
             o.json = true;
         } else if (a == "--socket") {
@@ -77,6 +93,44 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
                 return usage_error("--socket needs a PATH");
             }
             o.socket = *v;
+        } else if (a == "--link") {
+            auto v = value("--link");
+            if (!v || v->empty()) {
+                return usage_error("--link needs PATH[,PATH2]");
+            }
+            o.radio.ports.clear();
+            std::size_t start = 0;
+            for (std::size_t comma; (comma = v->find(',', start)) != std::string::npos; start = comma + 1) {
+                o.radio.ports.push_back(v->substr(start, comma - start));
+            }
+            o.radio.ports.push_back(v->substr(start));
+            if (o.radio.ports.size() == 2 && o.radio.mode == "single") {
+                o.radio.mode = "split";
+            }
+            o.use_radio = true;
+        } else if (a == "--udp") {
+            auto v = value("--udp");
+            if (!v) {
+                return usage_error("--udp needs HOST:PORT");
+            }
+            o.radio.udp = *v;
+            o.use_radio = true;
+        } else if (a == "--baud" || a == "--mode" || a == "--key") {
+            auto v = value(a.c_str());
+            if (!v) {
+                return usage_error(a + " needs a value");
+            }
+            if (a == "--baud") {
+                char* end = nullptr;
+                o.radio.baud = static_cast<unsigned>(std::strtoul(v->c_str(), &end, 10));
+                if (*end != '\0') {
+                    return usage_error("--baud needs a number");
+                }
+            } else if (a == "--mode") {
+                o.radio.mode = *v;
+            } else {
+                o.radio.key_file = *v;
+            }
         } else if (a == "--timeout") {
             auto v = value("--timeout");
             char* end = nullptr;
@@ -93,6 +147,11 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
     }
     if (o.positional.empty()) {
         return usage_error("no command given");
+    }
+    if (o.use_radio) {
+        if (auto problem = airseg::client::validate(o.radio); !problem.empty()) {
+            return usage_error(problem);
+        }
     }
     return std::nullopt;
 }
@@ -120,20 +179,95 @@ int show_answer(const Options& o, const airseg::client::LocalAnswer& a,
     return ok ? kDone : kRefused;
 }
 
+volatile std::sig_atomic_t g_stop = 0;
+
+/// The live view: the status document redrawn in place on a terminal, appended otherwise (for logs).
+int watch(const Options& o, const std::function<airseg::client::LocalAnswer(const nlohmann::json&)>& request,
+          airseg::client::RadioClient* radio, std::chrono::milliseconds interval) {
+    std::signal(SIGINT, [](int) { g_stop = 1; });
+    std::signal(SIGTERM, [](int) { g_stop = 1; });
+    const bool tty = ::isatty(STDOUT_FILENO) == 1;
+    while (g_stop == 0) {
+        const auto started = std::chrono::steady_clock::now();
+        auto answer = request({{"cmd", "status"}});
+        std::string screen;
+        if (answer.answer && answer.answer->value("ok", false)) {
+            const auto& doc = (*answer.answer)["result"];
+            screen = o.json ? doc.dump() + "\n" : airseg::client::render_status(doc);
+        } else {
+            screen = "airsegctl: " +
+                     (answer.answer ? answer.answer->value("error", std::string("refused")) : answer.error) +
+                     "\n";
+        }
+        if (radio != nullptr && !o.json) {
+            screen += "ground end of the link:\n";
+            const auto stats = radio->link_stats();
+            for (const auto& [key, value] : stats.items()) {
+                screen += "  " + key + std::string(key.size() < 28 ? 28 - key.size() : 1, ' ') + " " +
+                          value.dump() + "\n";
+            }
+        }
+        std::cout << (tty ? "\x1b[H\x1b[2J" : "") << screen << std::flush;
+        // Wait out the rest of the interval; over the radio keep the link serviced meanwhile.
+        while (g_stop == 0 && std::chrono::steady_clock::now() - started < interval) {
+            if (radio != nullptr) {
+                radio->run_for(std::chrono::milliseconds(50), [](const auto&) {});
+            } else {
+                std::this_thread::sleep_for(std::chrono::milliseconds(50));
+            }
+        }
+    }
+    return kDone;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+    // stdout carries answers (JSON for scripts); the libraries' log lines go to stderr, warnings only.
+    spdlog::set_default_logger(spdlog::stderr_color_st("airsegctl"));
+    spdlog::set_level(spdlog::level::warn);
     Options o;
     if (auto exit_code = parse(argc, argv, o)) {
         return *exit_code;
     }
-    airseg::client::LocalClient client(o.socket, std::chrono::milliseconds(o.timeout_ms));
+    const auto timeout = std::chrono::milliseconds(o.timeout_ms);
+    airseg::client::LocalClient local(o.socket, timeout);
+    std::unique_ptr<airseg::client::RadioClient> radio;
+    if (o.use_radio) {
+        radio = std::make_unique<airseg::client::RadioClient>(o.radio);
+        if (auto error = radio->open(); !error.empty()) {
+            std::cerr << "airsegctl: " << error << "\n";
+            return kNoLink;
+        }
+    }
+    struct Requester {
+        airseg::client::LocalClient& local;
+        airseg::client::RadioClient* radio;
+        std::chrono::milliseconds timeout;
+        airseg::client::LocalAnswer request(const nlohmann::json& r) {
+            return radio ? radio->request(r, timeout) : local.request(r);
+        }
+    } client{local, radio.get(), timeout};
     const auto& cmd = o.positional[0];
     if (cmd == "status") {
         if (o.positional.size() != 1) {
             return usage_error("status takes no arguments");
         }
         return show_answer(o, client.request({{"cmd", "status"}}), airseg::client::render_status);
+    }
+    if (cmd == "watch") {
+        long interval_ms = 1000;
+        if (o.positional.size() == 3 && o.positional[1] == "--interval") {
+            interval_ms = std::strtol(o.positional[2].c_str(), nullptr, 10);
+        } else if (o.positional.size() != 1) {
+            return usage_error("watch takes only --interval MS");
+        }
+        if (interval_ms < 100) {
+            return usage_error("watch --interval must be at least 100 ms");
+        }
+        return watch(
+            o, [&](const nlohmann::json& r) { return client.request(r); }, radio.get(),
+            std::chrono::milliseconds(interval_ms));
     }
     if (cmd == "request") {
         if (o.positional.size() != 2) {

@@ -13,6 +13,7 @@
 #include "daemon/logging.hpp"
 #include "daemon/systemd_notifier.hpp"
 #include "services/common/port_service.hpp"
+#include "services/groundlink/groundlink_service.hpp"
 #include "services/status/status_messages.hpp"
 #include "services/status/status_service.hpp"
 
@@ -101,13 +102,18 @@ class App::Impl {
             std::vector{port_config(ap.port, ap.bauds.empty() ? ap.baud : ap.bauds.front(), ap.reconnect_min,
                                     ap.reconnect_max)}));
         const auto& gl = config_.groundlink;
-        std::vector<PortKeeperConfig> radios;
-        if (gl.mode != "udp") {
-            for (const auto& port : gl.ports) {
-                radios.push_back(port_config(port, gl.baud, gl.reconnect_min, gl.reconnect_max));
-            }
-        }
-        services_.push_back(std::make_unique<PortService>("groundlink", context_, std::move(radios)));
+        groundlink::GroundlinkServiceConfig g;
+        g.mode = gl.mode;
+        g.ports = gl.ports;
+        g.baud = static_cast<unsigned>(gl.baud);
+        g.reconnect_min = gl.reconnect_min;
+        g.reconnect_max = gl.reconnect_max;
+        g.key_file = gl.key_file;
+        g.udp.bind_address = gl.udp_bind;
+        g.udp.bind_port = static_cast<std::uint16_t>(gl.udp_port);
+        g.udp.remote_address = gl.udp_remote;
+        g.udp.remote_port = static_cast<std::uint16_t>(gl.udp_remote_port);
+        services_.push_back(std::make_unique<groundlink::GroundlinkService>(context_, std::move(g)));
     }
 
     void start_services() {

@@ -33,6 +33,10 @@ struct GroundlinkConfig {
     std::string key_file;                            // groundlink.key_file: empty = no authentication
     milliseconds reconnect_min{500};                 // groundlink.reconnect_min
     milliseconds reconnect_max{10'000};              // groundlink.reconnect_max
+    std::string udp_bind = "0.0.0.0";                // groundlink.udp.bind
+    int udp_port = 14650;                            // groundlink.udp.port
+    std::string udp_remote;                          // groundlink.udp.remote: empty = answer the last sender
+    int udp_remote_port = 0;                         // groundlink.udp.remote_port
 };
 
 struct Config {

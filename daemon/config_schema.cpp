@@ -296,6 +296,18 @@ std::vector<KeySpec> build_schema() {
     s.push_back(duration(
         "groundlink.reconnect_max", [](Config& c) -> milliseconds& { return c.groundlink.reconnect_max; },
         milliseconds(10), hours(1), "longest retry delay for the radio ports"));
+    s.push_back(string(
+        "groundlink.udp.bind", [](Config& c) -> std::string& { return c.groundlink.udp_bind; },
+        "local address of the UDP ground link (mode udp)", false));
+    s.push_back(integer(
+        "groundlink.udp.port", [](Config& c) -> int& { return c.groundlink.udp_port; }, 1, 65535,
+        "local UDP port of the ground link"));
+    s.push_back(string(
+        "groundlink.udp.remote", [](Config& c) -> std::string& { return c.groundlink.udp_remote; },
+        "fixed ground station address; empty = answer whoever sent last", true));
+    s.push_back(integer(
+        "groundlink.udp.remote_port", [](Config& c) -> int& { return c.groundlink.udp_remote_port; }, 0,
+        65535, "UDP port of the fixed ground station (with udp.remote)"));
     return s;
 }
 

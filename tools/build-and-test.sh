@@ -9,4 +9,6 @@ if command -v ccache >/dev/null; then
 fi
 cmake -S . -B "$build" -G Ninja "${launcher[@]}"
 cmake --build "$build" -j"$(nproc)"
+# The MAVLink interoperability test needs node-mavlink (pinned by its lock file) in the build directory.
+tests/integration/mavlink_interop/setup.sh "$build"
 ctest --test-dir "$build" -j"$(nproc)" --output-on-failure --timeout 300

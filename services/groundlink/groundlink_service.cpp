@@ -22,8 +22,8 @@ std::uint64_t random_nonce() {
 }
 
 nlohmann::json class_json(const ClassStats& s) {
-    return {{"messages", s.messages},   {"bytes", s.bytes}, {"retransmissions", s.retransmissions},
-            {"drops", s.drops},         {"replaced", s.replaced}, {"queue_depth", s.queue_depth}};
+    return {{"messages", s.messages}, {"bytes", s.bytes},       {"retransmissions", s.retransmissions},
+            {"drops", s.drops},       {"replaced", s.replaced}, {"queue_depth", s.queue_depth}};
 }
 
 }  // namespace
@@ -71,9 +71,10 @@ void GroundlinkService::on_start() {
         update_health();
         return;
     }
-    driver_ = std::make_unique<LinkDriver>(strand(), transport,
-                                           LinkDriver::Handlers{[this](Delivered m) { on_message(std::move(m)); },
-                                                                [this](const TransportEvent& e) { on_event(e); }});
+    driver_ =
+        std::make_unique<LinkDriver>(strand(), transport,
+                                     LinkDriver::Handlers{[this](Delivered m) { on_message(std::move(m)); },
+                                                          [this](const TransportEvent& e) { on_event(e); }});
     if (config_.mode == "udp") {
         udp_ = std::make_unique<hal::UdpSocket>(strand());
         auto r = udp_->open(config_.udp);
@@ -181,6 +182,7 @@ void GroundlinkService::on_event(const TransportEvent& event) {
             break;
     }
     update_health();
+    publish_status();  // the status document shows a link change at once, not at the next statistics tick
 }
 
 void GroundlinkService::do_stats() {
@@ -201,7 +203,8 @@ void GroundlinkService::do_stats() {
             report.goodput_bps = static_cast<std::uint32_t>(goodput_bps_);
             report.retransmissions = static_cast<std::uint32_t>(s.tx_safe.retransmissions);
             report.mac_failures = static_cast<std::uint32_t>(s.mac_failures);
-            driver_->send_fast(protocol::kPriorityStatus, protocol::kTopicLinkStats, protocol::encode(report));
+            driver_->send_fast(protocol::kPriorityStatus, protocol::kTopicLinkStats,
+                               protocol::encode(report));
         }
     }
     update_health();
@@ -225,7 +228,8 @@ void GroundlinkService::update_health() {
         if (k->is_open()) {
             ++open;
         } else {
-            missing += (missing.empty() ? "" : ", ") + (k->last_error().empty() ? "opening" : k->last_error());
+            missing +=
+                (missing.empty() ? "" : ", ") + (k->last_error().empty() ? "opening" : k->last_error());
         }
     }
     if (udp_ && udp_->is_open()) {

@@ -25,15 +25,15 @@ struct GroundlinkServiceConfig {
 };
 
 class GroundlinkService : public Service {
-public:
+  public:
     GroundlinkService(ServiceContext& ctx, GroundlinkServiceConfig config);
     ~GroundlinkService() override;
 
-protected:
+  protected:
     void on_start() override;
     void on_stop() override;
 
-private:
+  private:
     void on_message(Delivered message);
     void on_event(const TransportEvent& event);
     void do_stats();

@@ -17,8 +17,9 @@ KeyFileResult read_key_file(const std::string& path) {
         return out;
     }
     if ((st.st_mode & 077) != 0) {
-        out.error = fmt::format("key file {} has mode {:04o}; it must be readable by its owner only (chmod 600 {})",
-                                path, st.st_mode & 07777, path);
+        out.error =
+            fmt::format("key file {} has mode {:04o}; it must be readable by its owner only (chmod 600 {})",
+                        path, st.st_mode & 07777, path);
         return out;
     }
     std::ifstream in(path, std::ios::binary);

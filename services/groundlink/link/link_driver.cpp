@@ -26,7 +26,8 @@ SendResult LinkDriver::send_safe(std::uint8_t priority, std::span<const std::uin
     return r;
 }
 
-SendResult LinkDriver::send_fast(std::uint8_t priority, std::uint16_t topic, std::span<const std::uint8_t> msg) {
+SendResult LinkDriver::send_fast(std::uint8_t priority, std::uint16_t topic,
+                                 std::span<const std::uint8_t> msg) {
     const auto r = core_.send_fast(priority, topic, msg, SteadyClock::now());
     pump();
     return r;

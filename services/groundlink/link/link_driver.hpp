@@ -13,7 +13,7 @@
 namespace airseg::groundlink {
 
 class LinkDriver {
-public:
+  public:
     /// Writes one frame to a path now; returns false when the path cannot take it (port closed, queue full).
     using Writer = std::function<bool(std::vector<std::uint8_t> frame)>;
     struct Handlers {
@@ -40,7 +40,7 @@ public:
     /// Frames the core released that a path refused to take.
     std::uint64_t write_refusals() const { return write_refusals_; }
 
-private:
+  private:
     void pump();
     void arm_timer();
 

@@ -7,7 +7,7 @@ namespace airseg::groundlink::protocol {
 namespace {
 
 class Writer {
-public:
+  public:
     void u8(std::uint64_t v) { out.push_back(static_cast<std::uint8_t>(v & 0xff)); }
     void le(std::uint64_t v, int bytes) {
         for (int i = 0; i < bytes; ++i) {
@@ -19,7 +19,7 @@ public:
 };
 
 class Reader {
-public:
+  public:
     explicit Reader(std::span<const std::uint8_t> b) : b_(b) {}
     bool has(std::size_t n) const { return pos_ + n <= b_.size(); }
     std::uint64_t le(int bytes) {
@@ -40,7 +40,7 @@ public:
         return r;
     }
 
-private:
+  private:
     std::span<const std::uint8_t> b_;
     std::size_t pos_ = 0;
 };

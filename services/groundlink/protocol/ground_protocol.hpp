@@ -33,21 +33,21 @@ enum class MessageType : std::uint8_t {
 
 /// One vehicle telemetry sample. Units are chosen so the whole message fits 29 bytes.
 struct Telemetry {
-    double lat_deg = 0;             // 1e-7 degree resolution
+    double lat_deg = 0;  // 1e-7 degree resolution
     double lon_deg = 0;
-    double alt_m = 0;               // 0.1 m resolution, ±3276 m
-    double ground_speed_mps = 0;    // 0.01 m/s, up to 655 m/s
-    double heading_deg = 0;         // 0.01 degree, 0..360
-    int roll_deg = 0;               // whole degrees, ±127
+    double alt_m = 0;             // 0.1 m resolution, ±3276 m
+    double ground_speed_mps = 0;  // 0.01 m/s, up to 655 m/s
+    double heading_deg = 0;       // 0.01 degree, 0..360
+    int roll_deg = 0;             // whole degrees, ±127
     int pitch_deg = 0;
-    double battery_v = 0;           // 1 mV
-    std::optional<int> battery_pct; // 0..100; absent when unknown
-    std::uint8_t gps_fix = 0;       // 0..15 (MAV_GPS_FIX_TYPE values)
-    std::uint8_t satellites = 0;    // capped at 15
-    std::uint8_t vehicle_state = 0; // autopilot-neutral vehicle state (0..15)
-    std::uint8_t mode = 0;          // autopilot mode number (0..255)
-    std::uint8_t plan_state = 0;    // 0 none, 1 running, 2 paused, 3 done
-    std::uint16_t plan_element = 0; // capped at 16383
+    double battery_v = 0;             // 1 mV
+    std::optional<int> battery_pct;   // 0..100; absent when unknown
+    std::uint8_t gps_fix = 0;         // 0..15 (MAV_GPS_FIX_TYPE values)
+    std::uint8_t satellites = 0;      // capped at 15
+    std::uint8_t vehicle_state = 0;   // autopilot-neutral vehicle state (0..15)
+    std::uint8_t mode = 0;            // autopilot mode number (0..255)
+    std::uint8_t plan_state = 0;      // 0 none, 1 running, 2 paused, 3 done
+    std::uint16_t plan_element = 0;   // capped at 16383
     std::uint32_t next_waypoint = 0;  // index in the expanded plan, capped at 2^24-1
 
     bool operator==(const Telemetry&) const = default;

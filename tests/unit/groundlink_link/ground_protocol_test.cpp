@@ -1,0 +1,145 @@
+#include "services/groundlink/protocol/ground_protocol.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace airseg::groundlink::protocol {
+namespace {
+
+Telemetry sample() {
+    Telemetry t;
+    t.lat_deg = 41.2756789;
+    t.lon_deg = 1.9871234;
+    t.alt_m = 12.3;
+    t.ground_speed_mps = 2.54;
+    t.heading_deg = 271.25;
+    t.roll_deg = -5;
+    t.pitch_deg = 3;
+    t.battery_v = 12.345;
+    t.battery_pct = 87;
+    t.gps_fix = 3;
+    t.satellites = 11;
+    t.vehicle_state = 4;
+    t.mode = 10;
+    t.plan_state = 1;
+    t.plan_element = 7;
+    t.next_waypoint = 123456;
+    return t;
+}
+
+TEST(GroundProtocol, TelemetryIsTwentyNineBytesAndRoundTrips) {
+    const auto bytes = encode(sample());
+    EXPECT_EQ(bytes.size(), 29u);
+    EXPECT_EQ(bytes[0], kVersion);
+    EXPECT_EQ(bytes[1], 0x01);
+    // Explicit little-endian: latitude 412756789 = 0x189A2D35.
+    EXPECT_EQ(bytes[2], 0x35);
+    EXPECT_EQ(bytes[5], 0x18);
+    auto decoded = decode(bytes);
+    ASSERT_TRUE(decoded.message) << decoded.error;
+    const auto& t = std::get<Telemetry>(*decoded.message);
+    EXPECT_NEAR(t.lat_deg, 41.2756789, 1e-7);
+    EXPECT_NEAR(t.lon_deg, 1.9871234, 1e-7);
+    EXPECT_NEAR(t.alt_m, 12.3, 0.05);
+    EXPECT_NEAR(t.ground_speed_mps, 2.54, 0.005);
+    EXPECT_NEAR(t.heading_deg, 271.25, 0.005);
+    EXPECT_EQ(t.roll_deg, -5);
+    EXPECT_EQ(t.pitch_deg, 3);
+    EXPECT_NEAR(t.battery_v, 12.345, 0.0005);
+    EXPECT_EQ(t.battery_pct, 87);
+    EXPECT_EQ(t.gps_fix, 3);
+    EXPECT_EQ(t.satellites, 11);
+    EXPECT_EQ(t.vehicle_state, 4);
+    EXPECT_EQ(t.mode, 10);
+    EXPECT_EQ(t.plan_state, 1);
+    EXPECT_EQ(t.plan_element, 7);
+    EXPECT_EQ(t.next_waypoint, 123456u);
+}
+
+TEST(GroundProtocol, TelemetryClampsOutOfRangeValues) {
+    Telemetry t;
+    t.lat_deg = -33.9;
+    t.lon_deg = -151.2;
+    t.alt_m = 99999;
+    t.heading_deg = -90;
+    t.roll_deg = 400;
+    t.satellites = 40;
+    t.battery_pct.reset();
+    t.next_waypoint = 50'000'000;
+    auto d = decode(encode(t));
+    ASSERT_TRUE(d.message);
+    const auto& back = std::get<Telemetry>(*d.message);
+    EXPECT_NEAR(back.lat_deg, -33.9, 1e-7);
+    EXPECT_NEAR(back.lon_deg, -151.2, 1e-7);
+    EXPECT_NEAR(back.alt_m, 3276.7, 0.01);
+    EXPECT_NEAR(back.heading_deg, 270.0, 0.01);
+    EXPECT_EQ(back.roll_deg, 127);
+    EXPECT_EQ(back.satellites, 15);
+    EXPECT_FALSE(back.battery_pct.has_value());
+    EXPECT_EQ(back.next_waypoint, 0xffffffu);
+}
+
+TEST(GroundProtocol, OtherMessagesRoundTrip) {
+    std::vector<Message> messages{
+        LinkStatsReport{180, 52, 4800, 17, 2},
+        Event{Event::Severity::warning, "autopilot rebooted"},
+        Command{42, {{"cmd", "param.set"}, {"name", "WP_RADIUS"}, {"value", 2.5}}},
+        Result{42, {{"ok", true}, {"result", {{"value", 2.5}}}}},
+    };
+    for (const auto& m : messages) {
+        auto d = decode(encode(m));
+        ASSERT_TRUE(d.message) << d.error;
+        EXPECT_EQ(*d.message, m);
+    }
+}
+
+TEST(GroundProtocol, UnknownTypesAreSkippedNotErrors) {
+    std::vector<std::uint8_t> bytes{kVersion, 0x7e, 1, 2, 3};
+    auto d = decode(bytes);
+    ASSERT_TRUE(d.message);
+    EXPECT_EQ(std::get<Unknown>(*d.message).type, 0x7e);
+}
+
+TEST(GroundProtocol, BadInputIsNamed) {
+    EXPECT_NE(decode(std::vector<std::uint8_t>{1}).error.find("shorter"), std::string::npos);
+    EXPECT_NE(decode(std::vector<std::uint8_t>{9, 1}).error.find("version 9"), std::string::npos);
+    auto telemetry = encode(sample());
+    telemetry.pop_back();
+    EXPECT_FALSE(decode(telemetry).message);
+    std::vector<std::uint8_t> bad_cbor{kVersion, 0x10, 1, 0, 0, 0, 0xff};
+    EXPECT_FALSE(decode(bad_cbor).message);
+}
+
+TEST(GroundProtocol, DeeplyNestedPayloadIsRefusedWithoutRecursion) {
+    std::vector<std::uint8_t> bytes{kVersion, 0x10, 1, 0, 0, 0};
+    bytes.insert(bytes.end(), 100000, 0x81);  // arrays of one element, nested 100000 deep
+    bytes.push_back(0x00);
+    auto d = decode(bytes);
+    EXPECT_FALSE(d.message);
+    EXPECT_NE(d.error.find("nested"), std::string::npos);
+
+    // 20 levels is fine.
+    std::vector<std::uint8_t> ok{kVersion, 0x10, 1, 0, 0, 0};
+    ok.insert(ok.end(), 20, 0x81);
+    ok.push_back(0x00);
+    EXPECT_TRUE(decode(ok).message) << decode(ok).error;
+}
+
+TEST(GroundProtocol, RandomBytesNeverCrash) {
+    std::mt19937 rng(7);
+    for (int i = 0; i < 20000; ++i) {
+        std::vector<std::uint8_t> bytes(rng() % 64);
+        for (auto& b : bytes) {
+            b = static_cast<std::uint8_t>(rng());
+        }
+        if (!bytes.empty()) {
+            bytes[0] = kVersion;
+        }
+        auto d = decode(bytes);
+        EXPECT_TRUE(d.message.has_value() != !d.error.empty());
+    }
+}
+
+}  // namespace
+}  // namespace airseg::groundlink::protocol
