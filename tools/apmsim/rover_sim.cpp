@@ -84,7 +84,11 @@ void RoverSim::reboot(TimePoint now) {
     out_.drop_held();
     server_.reset();
     streams_.clear();
-    parser_ = std::make_unique<mv::Parser>();
+    if (parsing_) {
+        reboot_during_parse_ = true;  // the parser is mid-push: replaced when the push returns
+    } else {
+        parser_ = std::make_unique<mv::Parser>();
+    }
     ++boots_;
     boot_started_ = now;
     reboot_at_ = kNever;
@@ -195,11 +199,20 @@ void RoverSim::handle_bytes(std::span<const std::uint8_t> bytes, TimePoint now) 
     if (phase_ == BootPhase::Silent) {
         return;  // the bootloader and the early start-up do not read MAVLink
     }
+    parsing_ = true;
     parser_->push(in, [&](const mv::Frame& f) {
+        if (reboot_during_parse_) {
+            return;  // the board went down: the rest of this input meets the boot loader
+        }
         ++counters_.frames_in;
         out_.set_reply_context(now, faults_.slow);
         dispatch(f, now);
     });
+    parsing_ = false;
+    if (reboot_during_parse_) {
+        reboot_during_parse_ = false;
+        parser_ = std::make_unique<mv::Parser>();
+    }
     out_.release(now);
 }
 

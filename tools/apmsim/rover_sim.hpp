@@ -205,6 +205,8 @@ class RoverSim {
     MissionServer server_;
     StreamScheduler streams_;
     std::unique_ptr<mavlink::Parser> parser_;
+    bool parsing_ = false;
+    bool reboot_during_parse_ = false;
     VehicleModel vehicle_;
 
     BootPhase phase_ = BootPhase::Silent;

@@ -135,7 +135,8 @@ void RoverSim::physics_step(TimePoint at) {
         vehicle_.stop(dt, lim);
         return;
     }
-    vehicle_.drive_to(*target_, params_.get("CRUISE_SPEED", 2), dt, lim);
+    // A parameter set to nonsense must not fling the car off the planet.
+    vehicle_.drive_to(*target_, std::clamp(params_.get("CRUISE_SPEED", 2), 0.0F, 50.0F), dt, lim);
     const double distance = distance_m(vehicle_.position(), *target_);
     const double radius = std::max(0.1F, params_.get("WP_RADIUS", 2));
     if (distance <= radius) {
