@@ -6,11 +6,13 @@
 #include <limits>
 #include <span>
 #include <system_error>
+#include <utility>
+
+#include <nlohmann/json.hpp>
 
 #include "services/autopilot/mavlink/encoder.hpp"
 #include "services/autopilot/mavlink/field_value.hpp"
 #include "services/autopilot/mavlink/message_table.hpp"
-#include "tools/mavdump/json.hpp"
 
 namespace airseg::mavdump {
 namespace {
@@ -25,6 +27,26 @@ void append_hex(std::string& out, std::span<const std::uint8_t> bytes) {
         out += kDigits[b >> 4];
         out += kDigits[b & 0xF];
     }
+}
+
+void append_json_string(std::string& out, std::string_view text) {
+    out += '"';
+    for (const char c : text) {
+        const auto b = static_cast<unsigned char>(c);
+        if (c == '"' || c == '\\') {
+            out += '\\';
+            out += c;
+        } else if (b < 0x20 || b >= 0x7F) {
+            // A char[] field holds bytes, not text: byte 0xNN becomes \u00NN (field_bytes reads it back).
+            static constexpr char kDigits[] = "0123456789abcdef";
+            out += "\\u00";
+            out += kDigits[b >> 4];
+            out += kDigits[b & 0xF];
+        } else {
+            out += c;
+        }
+    }
+    out += '"';
 }
 
 template <class T>
@@ -77,69 +99,131 @@ void append_field(std::string& out, const FieldInfo& field, std::span<const std:
 
 // ---- encoding ----
 
+using Json = nlohmann::json;
+
+// Enough for any frame document (three levels) and for keys a reader ignores; bounds the parser's work and
+// memory on a hostile line.
+constexpr int kMaxJsonNesting = 32;
+
+struct NestingTooDeep {};
+
+// The text of a parse error without its "[json.exception...] parse error at line 1, column N: " prefix and
+// without the token it quotes ("; last read: '...'"), which can be long and hold raw input bytes; the caller
+// names the byte instead.
+std::string parse_error_text(const Json::parse_error& e) {
+    std::string text = e.what();
+    if (const auto colon = text.find(": "); colon != std::string::npos) {
+        text.erase(0, colon + 2);
+    }
+    static constexpr std::string_view kLastRead = "; last read: '";
+    if (const auto from = text.find(kLastRead); from != std::string::npos) {
+        const auto expected = text.rfind("'; expected ");
+        text.erase(from, expected != std::string::npos && expected >= from + kLastRead.size()
+                             ? expected + 1 - from
+                             : std::string::npos);
+    }
+    return text;
+}
+
+std::optional<Json> parse_line(std::string_view line, std::string& error) {
+    const Json::parser_callback_t refuse_deep_nesting = [](int depth, Json::parse_event_t event, Json&) {
+        if ((event == Json::parse_event_t::object_start || event == Json::parse_event_t::array_start) &&
+            depth >= kMaxJsonNesting) {
+            throw NestingTooDeep{};
+        }
+        return true;
+    };
+    try {
+        return Json::parse(line, refuse_deep_nesting);
+    } catch (const Json::parse_error& e) {
+        // e.byte counts from 1 and points at the last byte read.
+        error = parse_error_text(e) + " at byte " + std::to_string(e.byte > 0 ? e.byte - 1 : 0);
+    } catch (const Json::out_of_range&) {
+        error = "number out of range";
+    } catch (const NestingTooDeep&) {
+        error = "nested deeper than " + std::to_string(kMaxJsonNesting) + " levels";
+    }
+    return std::nullopt;
+}
+
+const Json* member(const Json& object, const char* key) {
+    const auto it = object.find(key);
+    return it == object.end() ? nullptr : &*it;
+}
+
+// Integers of any field width convert exactly: nlohmann::json keeps them as int64_t or uint64_t.
 template <class T>
-std::optional<T> integer_of(const JsonValue* v) {
-    if (v == nullptr) {
-        return std::nullopt;
+std::optional<T> integer_of(const Json* v) {
+    if (v != nullptr && v->is_number_unsigned()) {
+        const auto u = v->get<std::uint64_t>();
+        if (std::in_range<T>(u)) {
+            return static_cast<T>(u);
+        }
+    } else if (v != nullptr && v->is_number_integer()) {
+        const auto i = v->get<std::int64_t>();
+        if (std::in_range<T>(i)) {
+            return static_cast<T>(i);
+        }
     }
-    const JsonNumber* n = v->as_number();
-    if (n == nullptr || !n->is_integer()) {
-        return std::nullopt;
-    }
-    T out{};
-    const auto res = std::from_chars(n->text.data(), n->text.data() + n->text.size(), out);
-    if (res.ec != std::errc{} || res.ptr != n->text.data() + n->text.size()) {
-        return std::nullopt;
+    return std::nullopt;
+}
+
+// JSON text is Unicode; a char[] field holds bytes. Code points up to U+00FF (what append_json_string writes
+// for bytes 0x80-0xFF) become one byte each; higher code points keep their UTF-8 bytes.
+std::string field_bytes(const std::string& utf8) {
+    std::string out;
+    for (std::size_t i = 0; i < utf8.size(); ++i) {
+        const auto lead = static_cast<unsigned char>(utf8[i]);
+        if ((lead == 0xC2 || lead == 0xC3) && i + 1 < utf8.size()) {
+            const auto next = static_cast<unsigned char>(utf8[++i]);
+            out += static_cast<char>(((lead & 0x03) << 6) | (next & 0x3F));
+        } else {
+            out += utf8[i];
+        }
     }
     return out;
 }
 
-std::optional<FieldValue> element_value(const JsonValue& v, const FieldInfo& field, std::string& error) {
+std::optional<FieldValue> element_value(const Json& v, const FieldInfo& field, std::string& error) {
     const bool is_float = field.type == FieldType::Float || field.type == FieldType::Double;
-    if (const std::string* s = v.as_string(); s != nullptr && is_float) {
-        if (*s == "nan") {
+    if (v.is_string() && is_float) {
+        const auto& s = v.get_ref<const std::string&>();
+        if (s == "nan") {
             return std::numeric_limits<double>::quiet_NaN();
         }
-        if (*s == "inf") {
+        if (s == "inf") {
             return std::numeric_limits<double>::infinity();
         }
-        if (*s == "-inf") {
+        if (s == "-inf") {
             return -std::numeric_limits<double>::infinity();
         }
     }
-    const JsonNumber* n = v.as_number();
-    if (n == nullptr) {
+    if (v.is_number_unsigned()) {
+        return FieldValue{v.get<std::uint64_t>()};
+    }
+    if (v.is_number_integer()) {
+        return FieldValue{v.get<std::int64_t>()};
+    }
+    if (!v.is_number_float()) {
         error = is_float ? "expects a number or \"nan\", \"inf\", \"-inf\"" : "expects an integer";
         return std::nullopt;
     }
-    if (n->is_integer()) {
-        if (n->text.front() == '-') {
-            if (auto i = integer_of<std::int64_t>(&v)) {
-                return FieldValue{*i};
-            }
-        } else if (auto u = integer_of<std::uint64_t>(&v)) {
-            return FieldValue{*u};
-        }
-        if (!is_float) {
-            error = "integer out of range";
-            return std::nullopt;
-        }
+    const double d = v.get<double>();
+    if (is_float) {
+        return FieldValue{d};
     }
-    if (!is_float) {
-        error = "expects an integer, got " + n->text;
-        return std::nullopt;
+    // Integers beyond 64 bits reach here as doubles.
+    constexpr double kTwoTo63 = 9223372036854775808.0;
+    if (std::trunc(d) == d && (d <= -kTwoTo63 || d >= 2 * kTwoTo63)) {
+        error = "integer out of range";
+    } else {
+        error = "expects an integer, got " + v.dump();
     }
-    double d = 0;
-    const auto res = std::from_chars(n->text.data(), n->text.data() + n->text.size(), d);
-    if (res.ec != std::errc{}) {
-        error = "number out of range: " + n->text;
-        return std::nullopt;
-    }
-    return FieldValue{d};
+    return std::nullopt;
 }
 
-bool store_element(const JsonValue& v, const FieldInfo& field, std::span<std::uint8_t> payload,
-                   std::size_t index, std::string& error) {
+bool store_element(const Json& v, const FieldInfo& field, std::span<std::uint8_t> payload, std::size_t index,
+                   std::string& error) {
     const auto value = element_value(v, field, error);
     if (!value) {
         return false;
@@ -157,33 +241,31 @@ bool store_element(const JsonValue& v, const FieldInfo& field, std::span<std::ui
     return false;
 }
 
-bool store_field(const JsonValue& v, const FieldInfo& field, std::span<std::uint8_t> payload,
-                 std::string& error) {
+bool store_field(const Json& v, const FieldInfo& field, std::span<std::uint8_t> payload, std::string& error) {
     if (field.type == FieldType::Char && field.array_length > 0) {
-        const std::string* s = v.as_string();
-        if (s == nullptr) {
+        if (!v.is_string()) {
             error = "expects a string";
             return false;
         }
-        if (s->size() > field.array_length) {
+        const std::string bytes = field_bytes(v.get_ref<const std::string&>());
+        if (bytes.size() > field.array_length) {
             error = "string longer than " + std::to_string(field.array_length) + " bytes";
             return false;
         }
-        std::copy(s->begin(), s->end(), payload.begin() + field.offset);
+        std::copy(bytes.begin(), bytes.end(), payload.begin() + field.offset);
         return true;
     }
     if (field.array_length > 0) {
-        const JsonArray* a = v.as_array();
-        if (a == nullptr) {
+        if (!v.is_array()) {
             error = "expects an array";
             return false;
         }
-        if (a->size() > field.array_length) {
+        if (v.size() > field.array_length) {
             error = "array longer than " + std::to_string(field.array_length) + " elements";
             return false;
         }
-        for (std::size_t i = 0; i < a->size(); ++i) {
-            if (!store_element((*a)[i], field, payload, i, error)) {
+        for (std::size_t i = 0; i < v.size(); ++i) {
+            if (!store_element(v[i], field, payload, i, error)) {
                 error = "element " + std::to_string(i) + ": " + error;
                 return false;
             }
@@ -266,28 +348,30 @@ std::string frame_to_json(const mavlink::Frame& frame, std::optional<std::uint64
 
 JsonFrameEncoder::Result JsonFrameEncoder::encode_line(std::string_view line) {
     Result r;
-    const JsonParseResult parsed = parse_json(line);
-    if (!parsed.value) {
-        r.error = "invalid JSON: " + parsed.error;
+    std::string json_error;
+    const std::optional<Json> parsed = parse_line(line, json_error);
+    if (!parsed) {
+        r.error = "invalid JSON: " + json_error;
         return r;
     }
-    const JsonValue& doc = *parsed.value;
-    if (doc.as_object() == nullptr) {
+    const Json& doc = *parsed;
+    if (!doc.is_object()) {
         r.error = "expected a JSON object";
         return r;
     }
-    const JsonValue* name = doc.member("name");
-    const JsonValue* msgid_value = doc.member("msgid");
+    const Json* name = member(doc, "name");
+    const Json* msgid_value = member(doc, "msgid");
     const mavlink::MessageInfo* info = nullptr;
     std::uint32_t msgid = 0;
     if (name != nullptr) {
-        if (name->as_string() == nullptr) {
+        if (!name->is_string()) {
             r.error = "\"name\" must be a string";
             return r;
         }
-        info = mavlink::find_message(*name->as_string());
+        const auto& name_text = name->get_ref<const std::string&>();
+        info = mavlink::find_message(name_text);
         if (info == nullptr && msgid_value == nullptr) {
-            r.error = "unknown message name \"" + *name->as_string() + "\" (give \"msgid\" to send it raw)";
+            r.error = "unknown message name \"" + name_text + "\" (give \"msgid\" to send it raw)";
             return r;
         }
     }
@@ -315,7 +399,8 @@ JsonFrameEncoder::Result JsonFrameEncoder::encode_line(std::string_view line) {
 
     mavlink::FrameHeader header;
     header.msgid = msgid;
-    const auto version = doc.member("v") ? integer_of<int>(doc.member("v")) : std::optional<int>(2);
+    const Json* version_value = member(doc, "v");
+    const auto version = version_value ? integer_of<int>(version_value) : std::optional<int>(2);
     if (!version || (*version != 1 && *version != 2)) {
         r.error = "\"v\" must be 1 or 2";
         return r;
@@ -323,7 +408,7 @@ JsonFrameEncoder::Result JsonFrameEncoder::encode_line(std::string_view line) {
     header.version = *version == 1 ? mavlink::Version::V1 : mavlink::Version::V2;
     for (auto [key, target, fallback] : {std::tuple{"sysid", &header.sysid, std::uint8_t{255}},
                                          std::tuple{"compid", &header.compid, std::uint8_t{190}}}) {
-        const JsonValue* v = doc.member(key);
+        const Json* v = member(doc, key);
         const auto value = v ? integer_of<std::uint8_t>(v) : std::optional<std::uint8_t>(fallback);
         if (!value) {
             r.error = std::string("\"") + key + "\" must be an integer from 0 to 255";
@@ -332,7 +417,7 @@ JsonFrameEncoder::Result JsonFrameEncoder::encode_line(std::string_view line) {
         *target = *value;
     }
     std::uint8_t& next = next_seq_[{header.sysid, header.compid}];
-    if (const JsonValue* v = doc.member("seq")) {
+    if (const Json* v = member(doc, "seq")) {
         const auto seq = integer_of<std::uint8_t>(v);
         if (!seq) {
             r.error = "\"seq\" must be an integer from 0 to 255";
@@ -345,14 +430,14 @@ JsonFrameEncoder::Result JsonFrameEncoder::encode_line(std::string_view line) {
     std::array<std::uint8_t, mavlink::kMaxFrameLength> out{};
     std::size_t size = 0;
     if (info == nullptr) {
-        const JsonValue* payload = doc.member("payload");
-        const auto crc_extra = integer_of<std::uint8_t>(doc.member("crc_extra"));
-        if (payload == nullptr || payload->as_string() == nullptr || !crc_extra) {
+        const Json* payload = member(doc, "payload");
+        const auto crc_extra = integer_of<std::uint8_t>(member(doc, "crc_extra"));
+        if (payload == nullptr || !payload->is_string() || !crc_extra) {
             r.error = "message id " + std::to_string(msgid) +
                       " is not known: give its raw \"payload\" (hex) and its \"crc_extra\"";
             return r;
         }
-        const auto bytes = hex_bytes(*payload->as_string());
+        const auto bytes = hex_bytes(payload->get_ref<const std::string&>());
         if (!bytes) {
             r.error = "\"payload\" must be an even number of hex digits, at most 255 bytes";
             return r;
@@ -365,12 +450,12 @@ JsonFrameEncoder::Result JsonFrameEncoder::encode_line(std::string_view line) {
             mavlink::write_element(*info->find_field("mavlink_version"), payload, 0,
                                    std::uint64_t{mavlink::kMavlinkDialectVersion});
         }
-        if (const JsonValue* fields = doc.member("fields")) {
-            if (fields->as_object() == nullptr) {
+        if (const Json* fields = member(doc, "fields")) {
+            if (!fields->is_object()) {
                 r.error = "\"fields\" must be an object";
                 return r;
             }
-            for (const auto& [key, value] : *fields->as_object()) {
+            for (const auto& [key, value] : fields->items()) {
                 const FieldInfo* field = info->find_field(key);
                 if (field == nullptr) {
                     r.error = std::string(info->name) + " has no field \"" + key + "\"";

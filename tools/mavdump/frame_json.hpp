@@ -2,7 +2,8 @@
 // MAVLink frames to JSON lines and back, the format of airseg-mavdump:
 //   {"name":"HEARTBEAT","msgid":0,"sysid":1,"compid":1,"seq":7,"v":2,"fields":{"type":10,...}}
 // Field names are the specification's, in declaration order; char[] fields are strings (up to the first
-// NUL), other arrays JSON arrays; float NaN and infinities are the strings "nan", "inf", "-inf".
+// NUL) whose bytes 0x80-0xFF are written \u0080-\u00FF and read back as single bytes, other arrays JSON
+// arrays; float NaN and infinities are the strings "nan", "inf", "-inf".
 // A message id without a declaration comes out as {"name":"UNKNOWN_<id>",...,"payload":"<hex>"}.
 #include <cstdint>
 #include <map>
@@ -24,7 +25,8 @@ std::string frame_to_json(const mavlink::Frame& frame,
 /// "v" (1 or 2, default 2), "sysid" (default 255), "compid" (default 190), "seq" (default: the next number of
 /// that sysid/compid, starting at 0), "fields" (missing fields are 0, except HEARTBEAT's mavlink_version: 3).
 /// Unknown ids need "payload" (hex) and "crc_extra". Other keys, such as "timestamp_us", are ignored so that
-/// decoder output can be fed back.
+/// decoder output can be fed back. A line is one JSON document (nlohmann::json), nested at most 32 levels
+/// deep; a malformed one is refused with the byte offset of the fault.
 class JsonFrameEncoder {
   public:
     struct Result {

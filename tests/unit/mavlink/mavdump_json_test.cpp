@@ -1,4 +1,4 @@
-// The JSON side of airseg-mavdump: frame -> JSON line -> frame, errors, and the JSON reader itself.
+// The JSON side of airseg-mavdump: frame -> JSON line -> frame, errors, and how malformed lines are refused.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,7 +9,6 @@
 #include "services/autopilot/mavlink/parser.hpp"
 #include "tests/unit/mavlink/golden_frames.hpp"
 #include "tools/mavdump/frame_json.hpp"
-#include "tools/mavdump/json.hpp"
 #include "tools/mavdump/tlog_reader.hpp"
 
 namespace airseg::mavdump {
@@ -130,22 +129,85 @@ TEST(MavdumpJson, ErrorsNameWhatIsWrong) {
               "message id 70000 is not known: give its raw \"payload\" (hex) and its \"crc_extra\"");
     EXPECT_EQ(error_of(R"({"msgid":300,"payload":"00","crc_extra":1,"v":1})"),
               "message id 300 cannot be sent as MAVLink 1 (ids above 255 need v2)");
-    EXPECT_EQ(error_of(R"({"name":"HEARTBEAT",)"), "invalid JSON: expected a string key at byte 20");
+    EXPECT_EQ(
+        error_of(R"({"name":"HEARTBEAT",)"),
+        "invalid JSON: syntax error while parsing object key - unexpected end of input; expected string "
+        "literal at byte 20");
+    EXPECT_EQ(error_of(R"({"name":"HEARTBEAT","fields":{"type":-1}})"),
+              "HEARTBEAT.type: value out of range for uint8_t");
+    EXPECT_EQ(error_of(R"({"name":"HEARTBEAT","fields":{"type":"1"}})"),
+              "HEARTBEAT.type: expects an integer");
+    EXPECT_EQ(error_of(R"({"name":"HEARTBEAT","fields":{"type":1e2}})"),
+              "HEARTBEAT.type: expects an integer, got 100.0");
+    EXPECT_EQ(error_of(R"({"name":"HOME_POSITION","fields":{"time_usec":18446744073709551616}})"),
+              "HOME_POSITION.time_usec: integer out of range");
+    EXPECT_EQ(error_of(R"({"name":"HOME_POSITION","fields":{"latitude":-9223372036854775809}})"),
+              "HOME_POSITION.latitude: integer out of range");
+    EXPECT_EQ(error_of(R"({"name":"HOME_POSITION","fields":{"time_usec":-1}})"),
+              "HOME_POSITION.time_usec: value out of range for uint64_t");
+    EXPECT_EQ(error_of(R"({"name":"HOME_POSITION","fields":{"x":1e400}})"),
+              "invalid JSON: number out of range");
+    EXPECT_EQ(error_of(R"({"name":"HEARTBEAT","sysid":256})"), "\"sysid\" must be an integer from 0 to 255");
+    EXPECT_EQ(error_of(R"({"name":"HEARTBEAT","seq":1.0})"), "\"seq\" must be an integer from 0 to 255");
     EXPECT_EQ(error_of("[1,2]"), "expected a JSON object");
 }
 
-TEST(MavdumpJson, ReaderRejectsMalformedDocuments) {
+TEST(MavdumpJson, MalformedLinesAreRefusedWithTheirByteOffset) {
+    JsonFrameEncoder encoder;
     for (const char* bad : {"", "{", "{\"a\":}", "[1,]", "\"unterminated", "01x", "{\"a\":1} trailing", "-",
-                            "1.", "\"\\ud800\"", "\"\\q\""}) {
-        EXPECT_FALSE(parse_json(bad).value.has_value()) << bad;
+                            "1.", "\"\\ud800\"", "\"\\q\"", "{\"text\":\"\xff\"}"}) {
+        const auto r = encoder.encode_line(bad);
+        EXPECT_EQ(r.error.rfind("invalid JSON: ", 0), 0u) << bad;
+        EXPECT_NE(r.error.find(" at byte "), std::string::npos) << r.error;
+        EXPECT_TRUE(r.frame.empty());
     }
-    std::string deep(100, '[');
-    EXPECT_FALSE(parse_json(deep).value.has_value());
-    const auto ok = parse_json(R"( {"a":[true,false,null,-1.5e3,"x\u20ac\ud83d\ude00"]} )");
-    ASSERT_TRUE(ok.value.has_value());
-    const auto* arr = ok.value->member("a")->as_array();
-    ASSERT_NE(arr, nullptr);
-    EXPECT_EQ(*(*arr)[4].as_string(), "x\xe2\x82\xac\xf0\x9f\x98\x80");
+    EXPECT_EQ(encoder.encode_line(R"({"name":"HEARTBEAT","fields":{"type":1,}})").error,
+              "invalid JSON: syntax error while parsing object key - unexpected '}'; expected string literal "
+              "at byte 39");
+    // The error names the place, not the input: a long or binary token is not echoed.
+    const std::string long_token = R"({"name":")" + std::string(10000, 'x') + "\x01\"}";
+    const std::string error = encoder.encode_line(long_token).error;
+    EXPECT_LT(error.size(), 200u) << error;
+    EXPECT_NE(error.find("at byte 10009"), std::string::npos) << error;
+    EXPECT_EQ(error.find('\x01'), std::string::npos);
+}
+
+TEST(MavdumpJson, NestingIsBounded) {
+    JsonFrameEncoder encoder;
+    auto nested = [](int levels) {  // the frame object itself is the first level
+        return R"({"name":"HEARTBEAT","ignored":)" + std::string(levels - 1, '[') +
+               std::string(levels - 1, ']') + "}";
+    };
+    EXPECT_EQ(encoder.encode_line(nested(32)).error, "");
+    EXPECT_EQ(encoder.encode_line(nested(33)).error, "invalid JSON: nested deeper than 32 levels");
+    // Refused as soon as the limit is crossed, whatever follows.
+    EXPECT_EQ(encoder.encode_line(std::string(1000000, '[')).error,
+              "invalid JSON: nested deeper than 32 levels");
+}
+
+TEST(MavdumpJson, TextFieldsTakeUnicodeEscapesAndUtf8) {
+    JsonFrameEncoder encoder;
+    auto text_of_line = [&](const std::string& line) {
+        const auto r = encoder.encode_line(line);
+        EXPECT_EQ(r.error, "") << line;
+        const auto st = mavlink::decode<mavlink::Statustext>(parse(r.frame).at(0));
+        return mavlink::text_of(st->text);
+    };
+    // Above U+00FF a code point keeps its UTF-8 bytes, whether escaped or written as is.
+    EXPECT_EQ(text_of_line(R"({"name":"STATUSTEXT","fields":{"text":"x\u20ac\ud83d\ude00"}})"),
+              "x\xe2\x82\xac\xf0\x9f\x98\x80");
+    EXPECT_EQ(text_of_line("{\"name\":\"STATUSTEXT\",\"fields\":{\"text\":\"x\xe2\x82\xac\"}}"),
+              "x\xe2\x82\xac");
+    // Up to U+00FF a code point is one byte (the printer's \u00NN), written as is or escaped.
+    EXPECT_EQ(text_of_line("{\"name\":\"STATUSTEXT\",\"fields\":{\"text\":\"\xc3\xa9\\u00ff\"}}"),
+              "\xe9\xff");
+    // The length limit counts bytes of the field, so 50 such code points fit.
+    std::string fifty;
+    for (int i = 0; i < 50; ++i) {
+        fifty += "\\u00e9";
+    }
+    EXPECT_EQ(text_of_line(R"({"name":"STATUSTEXT","fields":{"text":")" + fifty + "\"}}"),
+              std::string(50, '\xe9'));
 }
 
 TEST(MavdumpTlog, SplitsRecordsAndResynchronises) {
