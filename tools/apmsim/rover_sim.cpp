@@ -196,8 +196,8 @@ void RoverSim::handle_bytes(std::span<const std::uint8_t> bytes, TimePoint now) 
     counters_.bytes_in += bytes.size();
     std::vector<std::uint8_t> in(bytes.begin(), bytes.end());
     impair(in);
-    if (phase_ == BootPhase::Silent) {
-        return;  // the bootloader and the early start-up do not read MAVLink
+    if (phase_ == BootPhase::Silent || in.empty()) {
+        return;  // the boot loader and the early start-up do not read MAVLink
     }
     parsing_ = true;
     parser_->push(in, [&](const mv::Frame& f) {
