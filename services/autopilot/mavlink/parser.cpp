@@ -74,7 +74,9 @@ void Parser::push(std::span<const std::uint8_t> bytes, Sink sink) {
             const std::size_t need = required_length();
             if (len_ < need) {
                 const std::size_t n = std::min(need - len_, bytes.size() - pos);
-                std::memcpy(buf_.data() + len_, bytes.data() + pos, n);
+                if (n > 0) {  // an empty span may carry a null pointer, which memcpy must not get
+                    std::memcpy(buf_.data() + len_, bytes.data() + pos, n);
+                }
                 len_ += n;
                 pos += n;
                 if (len_ < need && pos == bytes.size()) {
