@@ -1,8 +1,11 @@
 // End to end on real ptys: airsegd ⇄ airseg-linksim (57600 baud radio pair) ⇄ airsegctl.
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
 #include <signal.h>
 #include <sys/socket.h>
 #include <sys/un.h>
+#include <unistd.h>
 
 #include <cstring>
 #include <filesystem>
@@ -36,14 +39,22 @@ class GroundlinkEndToEnd : public ::testing::Test {
         })) << linksim->err();
     }
 
-    void start_daemon() {
+    void start_daemon(std::vector<std::string> link = {}) {
+        if (link.empty()) {
+            link = {"--set", "groundlink.ports=[" + air() + "]"};
+        }
+        std::vector<std::string> args{binary("daemon/airsegd"),
+                                      "--config",
+                                      source_path("config/airseg.yaml"),
+                                      "--set",
+                                      "status.socket=" + dir.file("status.sock"),
+                                      "--set",
+                                      "state_dir=" + dir.file("state"),
+                                      "--set",
+                                      "autopilot.port=" + dir.file("ttyACM0")};
+        args.insert(args.end(), link.begin(), link.end());
         daemon = std::make_unique<Subprocess>(
-            std::vector<std::string>{binary("daemon/airsegd"), "--config", source_path("config/airseg.yaml"),
-                                     "--set", "status.socket=" + dir.file("status.sock"), "--set",
-                                     "state_dir=" + dir.file("state"), "--set",
-                                     "autopilot.port=" + dir.file("ttyACM0"), "--set",
-                                     "groundlink.ports=[" + air() + "]"},
-            std::map<std::string, std::string>{{"NOTIFY_SOCKET", notify.path()}}, dir.path());
+            args, std::map<std::string, std::string>{{"NOTIFY_SOCKET", notify.path()}}, dir.path());
         ASSERT_TRUE(notify.wait_for("READY=1", 10s, notify.messages().size())) << daemon->err();
     }
 
@@ -113,6 +124,62 @@ TEST_F(GroundlinkEndToEnd, ASessionSurvivesASixtySecondOutageAndADaemonRestart) 
     auto again = status(30'000);
     ASSERT_EQ(again.exit_code, 0) << again.err;
     EXPECT_EQ(nlohmann::json::parse(again.out)["groundlink"]["link"], "up");
+}
+
+TEST_F(GroundlinkEndToEnd, SplitModeOverTwoRadioPairsKeepsWorkingWhenOnePairDies) {
+    // Pair A carries air→ground, pair B ground→air; each is its own airseg-linksim.
+    start_link({});
+    const std::string air_b = dir.file("air_b"), ground_b = dir.file("ground_b"),
+                      control_b = dir.file("b.ctl");
+    Subprocess pair_b({binary("tools/linksim/airseg-linksim"), "--a", air_b, "--b", ground_b, "--baud",
+                       "57600", "--seed", "8", "--control", control_b},
+                      {}, dir.path());
+    ASSERT_TRUE(
+        wait_until([&] { return std::filesystem::exists(air_b) && std::filesystem::exists(ground_b); }));
+    start_daemon(
+        {"--set", "groundlink.mode=split", "--set", "groundlink.ports=[" + air() + "," + air_b + "]"});
+    auto split_status = [&] {
+        return run({binary("client/airsegctl"), "--link", ground() + "," + ground_b, "--mode", "split",
+                    "--timeout", "30000", "status", "--json"},
+                   {}, 40s);
+    };
+    auto both = split_status();
+    ASSERT_EQ(both.exit_code, 0) << both.err << "\ndaemon:\n" << daemon->err();
+    auto doc = nlohmann::json::parse(both.out);
+    EXPECT_EQ(doc["groundlink"]["mode"], "split");
+    ASSERT_EQ(doc["groundlink"]["paths"].size(), 2u);
+
+    // Pair A dies: traffic falls back to pair B in both directions.
+    control_command("down a");
+    control_command("down b");
+    auto one = split_status();
+    ASSERT_EQ(one.exit_code, 0) << one.err << "\ndaemon:\n" << daemon->err();
+}
+
+/// A UDP port free at the moment of asking (the kernel picks it).
+int free_udp_port() {
+    const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
+    socklen_t len = sizeof addr;
+    ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+    ::close(fd);
+    return ntohs(addr.sin_port);
+}
+
+TEST_F(GroundlinkEndToEnd, UdpModeServesTheSameCommands) {
+    const int port = free_udp_port();
+    start_daemon({"--set", "groundlink.mode=udp", "--set", "groundlink.udp.bind=127.0.0.1", "--set",
+                  "groundlink.udp.port=" + std::to_string(port)});
+    auto r = run({binary("client/airsegctl"), "--udp", "127.0.0.1:" + std::to_string(port), "--timeout",
+                  "10000", "status", "--json"},
+                 {}, 20s);
+    ASSERT_EQ(r.exit_code, 0) << r.err << "\ndaemon:\n" << daemon->err();
+    auto doc = nlohmann::json::parse(r.out);
+    EXPECT_EQ(doc["groundlink"]["mode"], "udp");
+    EXPECT_EQ(doc["services"]["groundlink"]["health"].get<std::string>() != "down", true);
 }
 
 TEST_F(GroundlinkEndToEnd, NoLinkIsExitCodeThree) {
