@@ -9,29 +9,19 @@
 #include <thread>
 #include <vector>
 
+#include "daemon/autopilot_commands.hpp"
+#include "daemon/autopilot_setup.hpp"
+#include "daemon/autopilot_status.hpp"
 #include "daemon/config_loader.hpp"
 #include "daemon/logging.hpp"
 #include "daemon/systemd_notifier.hpp"
-#include "services/common/port_service.hpp"
+#include "hal/gpio_libgpiod.hpp"
+#include "services/autopilot/autopilot_service.hpp"
 #include "services/groundlink/groundlink_service.hpp"
 #include "services/status/status_messages.hpp"
 #include "services/status/status_service.hpp"
 
 namespace airseg::daemon {
-
-namespace {
-
-PortKeeperConfig port_config(const std::string& path, int baud, std::chrono::milliseconds min,
-                             std::chrono::milliseconds max) {
-    PortKeeperConfig c;
-    c.serial.path = path;
-    c.serial.baud = static_cast<unsigned>(baud);
-    c.reconnect_min = min;
-    c.reconnect_max = max;
-    return c;
-}
-
-}  // namespace
 
 class App::Impl {
   public:
@@ -96,11 +86,11 @@ class App::Impl {
     void build_services() {
         services_.push_back(std::make_unique<status::StatusService>(
             context_, status::StatusServiceConfig{config_.status.socket, config_.status.socket_mode}));
-        const auto& ap = config_.autopilot;
-        services_.push_back(std::make_unique<PortService>(
-            "autopilot", context_,
-            std::vector{port_config(ap.port, ap.bauds.empty() ? ap.baud : ap.bauds.front(), ap.reconnect_min,
-                                    ap.reconnect_max)}));
+        auto ap = autopilot_setup(config_);  // already validated by the loader
+        hal::GpioFactory* gpio = ap.service.reset_line ? &gpio_ : nullptr;
+        services_.push_back(
+            std::make_unique<autopilot::AutopilotService>(context_, std::move(ap.service), gpio));
+        autopilot_commands_ = std::make_unique<AutopilotCommands>(bus_, commands_, asio::make_strand(io_));
         const auto& gl = config_.groundlink;
         groundlink::GroundlinkServiceConfig g;
         g.mode = gl.mode;
@@ -122,6 +112,8 @@ class App::Impl {
             s->start([this, remaining] {
                 asio::post(strand_, [this, remaining] {
                     if (--*remaining == 0) {
+                        // The status service now listens: sections published from here on are kept.
+                        autopilot_section_ = std::make_unique<AutopilotStatusSection>(bus_, strand_);
                         spdlog::info("airsegd {}: all {} services started", AIRSEG_VERSION, services_.size());
                         notifier_.ready();
                     }
@@ -155,6 +147,7 @@ class App::Impl {
         boost::system::error_code ignored;
         signals_.cancel(ignored);
         line_sub_.reset();
+        autopilot_section_.reset();
         auto remaining = std::make_shared<std::size_t>(services_.size());
         for (auto& s : services_) {
             s->stop([this, remaining] {
@@ -255,7 +248,10 @@ class App::Impl {
     HealthRegistry health_;
     CommandDispatcher commands_;
     ServiceContext context_;
+    hal::LibgpiodFactory gpio_;
     std::vector<std::unique_ptr<Service>> services_;
+    std::unique_ptr<AutopilotStatusSection> autopilot_section_;
+    std::unique_ptr<AutopilotCommands> autopilot_commands_;
     Subscription line_sub_;
     bool stopping_ = false;
     bool watchdog_complained_ = false;

@@ -17,13 +17,27 @@ struct StatusConfig {
 };
 
 struct AutopilotConfig {
-    std::string board = "apm2";          // autopilot.board: apm2 | pixhawk
-    std::string port = "/dev/ttyACM0";   // autopilot.port
-    int baud = 115200;                   // autopilot.baud
-    std::vector<int> bauds;              // autopilot.bauds: tried in turn when non-empty
-    bool reset_on_open = true;           // autopilot.reset_on_open
-    milliseconds reconnect_min{500};     // autopilot.reconnect_min
-    milliseconds reconnect_max{10'000};  // autopilot.reconnect_max
+    std::string board = "apm2";             // autopilot.board: apm2 | pixhawk
+    std::string port = "/dev/ttyACM0";      // autopilot.port
+    int baud = 115200;                      // autopilot.baud
+    std::vector<int> bauds;                 // autopilot.bauds: tried in turn when non-empty
+    std::string reset_on_open = "auto";     // autopilot.reset_on_open: auto (= board is apm2) | true | false
+    milliseconds reconnect_min{500};        // autopilot.reconnect_min
+    milliseconds reconnect_max{10'000};     // autopilot.reconnect_max
+    milliseconds boot_timeout{30'000};      // autopilot.boot_timeout
+    milliseconds heartbeat_timeout{3'000};  // autopilot.heartbeat_timeout
+    milliseconds mode_timeout{1'500};       // autopilot.mode_timeout
+    std::map<std::string, double> params;   // autopilot.params: {NAME: value}
+    std::map<std::string, double> streams;  // autopilot.streams: {position: 4, ...}; empty = board's
+    double rc_override_rate_hz = 10.0;      // autopilot.rc_override.rate_hz
+    milliseconds rc_override_input_timeout{500};               // autopilot.rc_override.input_timeout
+    bool tlog_enabled = false;                                 // autopilot.tlog.enabled
+    std::string tlog_path = "/var/log/airseg/autopilot.tlog";  // autopilot.tlog.path
+    long long tlog_max_bytes = 64ll << 20;                     // autopilot.tlog.max_bytes
+    int tlog_keep = 4;                                         // autopilot.tlog.keep
+    std::string reset_line;                           // autopilot.reset.line: name or chip:offset; "" = none
+    milliseconds reset_unresponsive_timeout{20'000};  // autopilot.reset.unresponsive_timeout
+    int reset_max_pulses = 3;                         // autopilot.reset.max_pulses
 };
 
 struct GroundlinkConfig {

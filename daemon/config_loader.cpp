@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "daemon/autopilot_setup.hpp"
 #include "daemon/config_schema.hpp"
 
 namespace airseg::daemon {
@@ -164,6 +165,15 @@ void check_consistency(const Config& c, const std::string& source,
     if (g.reconnect_min > g.reconnect_max) {
         errors.push_back({at("groundlink.reconnect_min"), "groundlink.reconnect_min",
                           "must not be longer than groundlink.reconnect_max"});
+    }
+    // The autopilot layer's own rules, reported at the key they name.
+    for (const auto& problem : autopilot_setup(c).problems) {
+        const std::string key = problem_key(problem);
+        if (key.empty()) {
+            errors.push_back({at("autopilot", "autopilot.board"), "autopilot", problem});
+        } else {
+            errors.push_back({at(key), key, problem.substr(key.size() + 2)});
+        }
     }
 }
 

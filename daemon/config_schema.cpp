@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
+#include <map>
 
 #include "daemon/duration.hpp"
 
@@ -172,6 +174,79 @@ KeySpec string_list(std::string path, Ref ref, std::size_t min_items, std::size_
     return spec;
 }
 
+template <class Ref>
+KeySpec number(std::string path, Ref ref, double min, double max, std::string doc) {
+    KeySpec spec;
+    spec.path = std::move(path);
+    spec.type_name = fmt::format("number {}..{}", min, max);
+    spec.doc = std::move(doc);
+    spec.apply = [ref, min, max](const YAML::Node& node, Config& c) -> std::optional<std::string> {
+        double v = 0;
+        if (!node.IsScalar() || !YAML::convert<double>::decode(node, v)) {
+            return fmt::format("expected a number, got '{}'", scalar_text(node));
+        }
+        if (!(v >= min && v <= max)) {
+            return fmt::format("{} is out of range {}..{}", v, min, max);
+        }
+        ref(c) = v;
+        return std::nullopt;
+    };
+    spec.show = [ref](const Config& c) { return fmt::format("{}", ref(const_cast<Config&>(c))); };
+    return spec;
+}
+
+/// A mapping of names to numbers, e.g. {WP_RADIUS: 2, CRUISE_SPEED: 1.5}. `names` empty = any name;
+/// otherwise only those. `whole` requires whole numbers >= 0.
+template <class Ref>
+KeySpec number_map(std::string path, Ref ref, std::vector<std::string> names, bool whole, std::string doc) {
+    KeySpec spec;
+    spec.path = std::move(path);
+    spec.type_name = names.empty() ? "mapping NAME: number"
+                                   : fmt::format("mapping of {} to {}", fmt::join(names, " | "),
+                                                 whole ? "whole numbers >= 0" : "numbers");
+    spec.doc = std::move(doc);
+    spec.apply = [ref, names, whole](const YAML::Node& node, Config& c) -> std::optional<std::string> {
+        if (node.IsNull()) {
+            ref(c).clear();
+            return std::nullopt;
+        }
+        if (!node.IsMap()) {
+            return "expected a mapping, e.g. {NAME: 1.5}";
+        }
+        std::map<std::string, double> out;
+        for (const auto& entry : node) {
+            if (!entry.first.IsScalar() || entry.first.Scalar().empty()) {
+                return "every name must be a non-empty plain string";
+            }
+            const std::string name = entry.first.Scalar();
+            if (!names.empty() && std::find(names.begin(), names.end(), name) == names.end()) {
+                return fmt::format("unknown name '{}' (one of {})", name, fmt::join(names, ", "));
+            }
+            double v = 0;
+            if (!entry.second.IsScalar() || !YAML::convert<double>::decode(entry.second, v) ||
+                !std::isfinite(v)) {
+                return fmt::format("{}: expected a number, got '{}'", name, scalar_text(entry.second));
+            }
+            if (whole && (v < 0 || v != std::floor(v))) {
+                return fmt::format("{}: expected a whole number >= 0, got {}", name, v);
+            }
+            if (!out.emplace(name, v).second) {
+                return fmt::format("{} is given twice", name);
+            }
+        }
+        ref(c) = std::move(out);
+        return std::nullopt;
+    };
+    spec.show = [ref](const Config& c) {
+        std::vector<std::string> parts;
+        for (const auto& [name, value] : ref(const_cast<Config&>(c))) {
+            parts.push_back(fmt::format("{}: {}", name, value));
+        }
+        return fmt::format("{{{}}}", fmt::join(parts, ", "));
+    };
+    return spec;
+}
+
 const std::vector<int> kStandardBauds{9600, 19200, 38400, 57600, 115200, 230400, 460800, 500000, 921600};
 
 std::optional<std::string> check_baud(long long v) {
@@ -267,15 +342,65 @@ std::vector<KeySpec> build_schema() {
     s.push_back(baud_list(
         "autopilot.bauds", [](Config& c) -> std::vector<int>& { return c.autopilot.bauds; },
         "baud rates tried in turn (the first that yields a valid frame is kept); empty = baud"));
-    s.push_back(boolean(
-        "autopilot.reset_on_open", [](Config& c) -> bool& { return c.autopilot.reset_on_open; },
-        "the board reboots when its port is opened (APM 2.x on USB)"));
+    s.push_back(choice(
+        "autopilot.reset_on_open", [](Config& c) -> std::string& { return c.autopilot.reset_on_open; },
+        {"auto", "true", "false"},
+        "the board reboots when its port is opened; auto = true for apm2 (USB), false for pixhawk"));
     s.push_back(duration(
         "autopilot.reconnect_min", [](Config& c) -> milliseconds& { return c.autopilot.reconnect_min; },
         milliseconds(10), seconds(60), "first retry delay after the port could not be opened or was lost"));
     s.push_back(duration(
         "autopilot.reconnect_max", [](Config& c) -> milliseconds& { return c.autopilot.reconnect_max; },
         milliseconds(10), hours(1), "longest retry delay (the delay doubles up to this)"));
+    // Wide ranges here: AutopilotConfig::validate() owns the limits and reports them with the key.
+    s.push_back(duration(
+        "autopilot.boot_timeout", [](Config& c) -> milliseconds& { return c.autopilot.boot_timeout; },
+        milliseconds(0), hours(1), "longest time from the open to READY before the link is reported failed"));
+    s.push_back(duration(
+        "autopilot.heartbeat_timeout",
+        [](Config& c) -> milliseconds& { return c.autopilot.heartbeat_timeout; }, milliseconds(0), hours(1),
+        "the link is down after this long without a heartbeat"));
+    s.push_back(duration(
+        "autopilot.mode_timeout", [](Config& c) -> milliseconds& { return c.autopilot.mode_timeout; },
+        milliseconds(0), hours(1), "wait for the autopilot to confirm a mode change, per attempt"));
+    s.push_back(number_map(
+        "autopilot.params", [](Config& c) -> std::map<std::string, double>& { return c.autopilot.params; },
+        {}, false, "autopilot parameters written (and read back) on every connection"));
+    s.push_back(number_map(
+        "autopilot.streams", [](Config& c) -> std::map<std::string, double>& { return c.autopilot.streams; },
+        {"raw_sensors", "extended_status", "rc_channels", "position", "extra1", "extra2", "extra3"}, true,
+        "telemetry stream rates in Hz (REQUEST_DATA_STREAM boards); empty = the board's defaults"));
+    s.push_back(number(
+        "autopilot.rc_override.rate_hz", [](Config& c) -> double& { return c.autopilot.rc_override_rate_hz; },
+        0, 1000, "rate of RC override frames while the ground joystick drives"));
+    s.push_back(duration(
+        "autopilot.rc_override.input_timeout",
+        [](Config& c) -> milliseconds& { return c.autopilot.rc_override_input_timeout; }, milliseconds(0),
+        hours(1), "joystick input older than this releases the override (the vehicle stops)"));
+    s.push_back(boolean(
+        "autopilot.tlog.enabled", [](Config& c) -> bool& { return c.autopilot.tlog_enabled; },
+        "record every MAVLink frame to a .tlog flight recorder"));
+    s.push_back(string(
+        "autopilot.tlog.path", [](Config& c) -> std::string& { return c.autopilot.tlog_path; },
+        "the .tlog file; rotated files are PATH.1, PATH.2, ...", false));
+    s.push_back(integer(
+        "autopilot.tlog.max_bytes", [](Config& c) -> long long& { return c.autopilot.tlog_max_bytes; },
+        64 * 1024, 1ll << 40, "size at which the .tlog is rotated"));
+    s.push_back(integer(
+        "autopilot.tlog.keep", [](Config& c) -> int& { return c.autopilot.tlog_keep; }, 0, 100,
+        "rotated .tlog files kept"));
+    s.push_back(string(
+        "autopilot.reset.line", [](Config& c) -> std::string& { return c.autopilot.reset_line; },
+        "GPIO line pulsed to reset an unresponsive autopilot: a line name or CHIP:OFFSET; empty = none",
+        true));
+    s.push_back(duration(
+        "autopilot.reset.unresponsive_timeout",
+        [](Config& c) -> milliseconds& { return c.autopilot.reset_unresponsive_timeout; }, milliseconds(0),
+        hours(1),
+        "the autopilot counts as unresponsive after this long with the port open and no heartbeat"));
+    s.push_back(integer(
+        "autopilot.reset.max_pulses", [](Config& c) -> int& { return c.autopilot.reset_max_pulses; }, 0, 1000,
+        "reset pulses tried before giving up (0 = never pulse)"));
     // Ground link
     s.push_back(choice(
         "groundlink.mode", [](Config& c) -> std::string& { return c.groundlink.mode; },

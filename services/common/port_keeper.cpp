@@ -40,6 +40,19 @@ void PortKeeper::retry_now() {
     }
 }
 
+void PortKeeper::reopen_at(unsigned baud) {
+    config_.serial.baud = baud;
+    if (!running_ || !port_.is_open()) {
+        return;
+    }
+    spdlog::info("port[{}]: switching to {} baud", config_.serial.path, baud);
+    port_.close();
+    const bool counted = was_open_;
+    was_open_ = false;  // the same device, opened again on purpose: not a reconnect
+    do_open();
+    was_open_ = was_open_ || counted;
+}
+
 void PortKeeper::do_open() {
     if (!running_) {
         return;

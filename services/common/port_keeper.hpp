@@ -34,6 +34,12 @@ class PortKeeper {
     /// Tries to open the port now instead of waiting for the backoff (e.g. on an operator request).
     void retry_now();
 
+    /// Uses `baud` from now on (probing a device whose rate is unknown). An open port is closed and opened
+    /// again at once at the new rate: on_open runs again, on_down does not (the device did not go away) and
+    /// it does not count as a reconnect. A closed port takes the rate at its next attempt.
+    void reopen_at(unsigned baud);
+    unsigned baud() const { return config_.serial.baud; }
+
     bool is_open() const { return port_.is_open(); }
     hal::WriteResult write(std::vector<std::uint8_t> bytes) { return port_.write(std::move(bytes)); }
     std::size_t queued_bytes() const { return port_.queued_bytes(); }

@@ -1,6 +1,9 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include "daemon/autopilot_commands.hpp"
+#include "daemon/autopilot_setup.hpp"
+#include "daemon/autopilot_status.hpp"
 #include "daemon/cli.hpp"
 #include "daemon/config_loader.hpp"
 #include "daemon/config_schema.hpp"
@@ -144,6 +147,151 @@ TEST(Config, DiffNamesRuntimeChanges) {
     EXPECT_TRUE(changes[0].runtime);
     EXPECT_EQ(changes[1].key, "autopilot.port");
     EXPECT_FALSE(changes[1].runtime);
+}
+
+TEST(AutopilotConfig, KeysReachTheServiceConfiguration) {
+    auto r = load_config_text(
+        "autopilot:\n"
+        "  board: apm2\n"
+        "  port: /dev/ttyS4\n"
+        "  bauds: [57600, 115200]\n"
+        "  boot_timeout: 12s\n"
+        "  heartbeat_timeout: 2s\n"
+        "  mode_timeout: 800ms\n"
+        "  params: {WP_RADIUS: 2.5, CRUISE_SPEED: 1}\n"
+        "  streams: {position: 5, extra1: 2}\n"
+        "  rc_override: {rate_hz: 20, input_timeout: 300ms}\n"
+        "  tlog: {enabled: true, path: /tmp/a.tlog, max_bytes: 100000, keep: 2}\n"
+        "  reset: {line: \"gpiochip1:17\", unresponsive_timeout: 9s, max_pulses: 5}\n",
+        "k.yaml");
+    ASSERT_TRUE(r.ok()) << r.errors[0].to_string();
+    const auto setup = autopilot_setup(r.config);
+    ASSERT_TRUE(setup.problems.empty());
+    const auto& s = setup.service;
+    EXPECT_EQ(s.port.serial.path, "/dev/ttyS4");
+    EXPECT_EQ(s.port.serial.baud, 57600u);
+    EXPECT_EQ(s.autopilot.bauds, (std::vector<unsigned>{57600, 115200}));
+    EXPECT_TRUE(s.autopilot.reset_on_open);  // auto on apm2
+    EXPECT_EQ(s.autopilot.boot_timeout, std::chrono::seconds(12));
+    EXPECT_EQ(s.autopilot.heartbeat_timeout, std::chrono::seconds(2));
+    EXPECT_EQ(s.autopilot.mode_timeout, std::chrono::milliseconds(800));
+    ASSERT_EQ(s.autopilot.params.size(), 2u);
+    EXPECT_EQ(s.autopilot.params[1].name, "WP_RADIUS");
+    EXPECT_EQ(s.autopilot.params[1].value, 2.5);
+    ASSERT_EQ(s.autopilot.stream_rates.size(), 2u);
+    EXPECT_EQ(s.autopilot.stream_rates[0].stream, autopilot::DataStream::Extra1);
+    EXPECT_EQ(s.autopilot.stream_rates[1].hz, 5u);
+    EXPECT_EQ(s.autopilot.rc_override.rate_hz, 20.0);
+    EXPECT_EQ(s.autopilot.rc_override.input_timeout, std::chrono::milliseconds(300));
+    EXPECT_TRUE(s.tlog.enabled);
+    EXPECT_EQ(s.tlog.path, "/tmp/a.tlog");
+    EXPECT_EQ(s.tlog.max_bytes, 100000u);
+    EXPECT_EQ(s.tlog.keep, 2u);
+    ASSERT_TRUE(s.reset_line);
+    EXPECT_EQ(s.reset_line->chip, "gpiochip1");
+    EXPECT_EQ(s.reset_line->offset, 17u);
+    EXPECT_EQ(s.autopilot.unresponsive_timeout, std::chrono::seconds(9));
+    EXPECT_EQ(s.autopilot.max_reset_pulses, 5u);
+}
+
+TEST(AutopilotConfig, BoardDefaultsApplyUnlessGiven) {
+    auto pix = load_config_text("autopilot:\n  board: pixhawk\n  reset:\n    line: APM_RESET\n", "p");
+    ASSERT_TRUE(pix.ok());
+    const auto s = autopilot_setup(pix.config).service;
+    EXPECT_FALSE(s.autopilot.reset_on_open);
+    EXPECT_EQ(s.autopilot.mavlink_version, 2);
+    ASSERT_TRUE(s.reset_line);
+    EXPECT_EQ(s.reset_line->line_name, "APM_RESET");
+    EXPECT_TRUE(s.reset_line->chip.empty());
+
+    auto forced = load_config_text("autopilot:\n  board: pixhawk\n  reset_on_open: \"true\"\n", "p");
+    ASSERT_TRUE(forced.ok());
+    EXPECT_TRUE(autopilot_setup(forced.config).service.autopilot.reset_on_open);
+    EXPECT_FALSE(autopilot_setup(Config{}).service.reset_line) << "no reset line by default";
+}
+
+TEST(AutopilotConfig, AutopilotRulesAreReportedAtTheirKeyAndLine) {
+    auto r = load_config_text(
+        "autopilot:\n"
+        "  boot_timeout: 200s\n"
+        "  rc_override:\n"
+        "    rate_hz: 80\n"
+        "  params: {THIS_NAME_IS_TOO_LONG: 1}\n",
+        "v.yaml");
+    ASSERT_EQ(r.errors.size(), 3u) << r.errors[0].to_string();
+    EXPECT_EQ(r.errors[0].key, "autopilot.boot_timeout");
+    EXPECT_EQ(r.errors[0].where, "v.yaml:2:3");
+    EXPECT_NE(r.errors[0].message.find("outside 1..120"), std::string::npos) << r.errors[0].message;
+    EXPECT_EQ(r.errors[1].key, "autopilot.params");
+    EXPECT_EQ(r.errors[1].where, "v.yaml:5:3");
+    EXPECT_EQ(r.errors[2].key, "autopilot.rc_override.rate_hz");
+    EXPECT_EQ(r.errors[2].where, "v.yaml:4:5");
+
+    auto set = load_config_text("", "x", {"autopilot.reset.max_pulses=30"});
+    ASSERT_EQ(set.errors.size(), 1u);
+    EXPECT_EQ(set.errors[0].where, "--set autopilot.reset.max_pulses");
+}
+
+TEST(AutopilotConfig, MapsAreCheckedEntryByEntry) {
+    auto bad_stream = load_config_text("autopilot:\n  streams: {positon: 4}\n", "m");
+    ASSERT_EQ(bad_stream.errors.size(), 1u);
+    EXPECT_NE(bad_stream.errors[0].message.find("unknown name 'positon'"), std::string::npos);
+    EXPECT_FALSE(load_config_text("autopilot:\n  streams: {position: 2.5}\n", "m").ok());
+    EXPECT_FALSE(load_config_text("autopilot:\n  params: {WP_RADIUS: wide}\n", "m").ok());
+    EXPECT_FALSE(load_config_text("autopilot:\n  params: [WP_RADIUS]\n", "m").ok());
+    auto over = load_config_text("", "m", {"autopilot.params={WP_RADIUS: 3}"});
+    ASSERT_TRUE(over.ok());
+    EXPECT_EQ(over.config.autopilot.params.at("WP_RADIUS"), 3.0);
+    Config changed;
+    changed.autopilot.params["WP_RADIUS"] = 3;
+    const auto d = diff_config(Config{}, changed);
+    ASSERT_EQ(d.size(), 1u);
+    EXPECT_EQ(d[0].to, "{WP_RADIUS: 3}");
+}
+
+TEST(AutopilotStatus, SectionCarriesTheDocumentedKeys) {
+    autopilot::AutopilotStatus s;
+    s.link_up = true;
+    s.ready = true;
+    s.ready_s = 4.26;
+    s.state = autopilot::VehicleState::Parking;
+    s.mode = "HOLD";
+    s.position = autopilot::Position{41.3, 2.1, 10};
+    s.mission_current = 3;
+    s.reboots = 1;
+    s.reconnects = 2;
+    const auto j = autopilot_status_json(s);
+    EXPECT_EQ(j["link"], "up");
+    EXPECT_EQ(j["ready"], true);
+    EXPECT_DOUBLE_EQ(j["ready_s"].get<double>(), 4.3);
+    EXPECT_EQ(j["state"], "PARKING");
+    EXPECT_EQ(j["mode"], "HOLD");
+    EXPECT_DOUBLE_EQ(j["position"]["lat"].get<double>(), 41.3);
+    EXPECT_DOUBLE_EQ(j["position"]["lon"].get<double>(), 2.1);
+    EXPECT_EQ(j["mission_current"], 3);
+    EXPECT_EQ(j["reboots"], 1);
+    EXPECT_EQ(j["reconnects"], 2);
+    const auto down = autopilot_status_json(autopilot::AutopilotStatus{});
+    EXPECT_EQ(down["link"], "down");
+    EXPECT_TRUE(down["ready_s"].is_null());
+    EXPECT_TRUE(down["position"].is_null());
+}
+
+TEST(AutopilotCommands, ResultsMapToCommandStatuses) {
+    autopilot::RequestDone done;
+    done.result = autopilot::RequestResult::Ok;
+    auto ok = command_result(done, {{"state", "PARKING"}});
+    EXPECT_EQ(ok.status, CommandStatus::Ok);
+    EXPECT_EQ(ok.result["state"], "PARKING");
+    done.result = autopilot::RequestResult::Refused;
+    done.detail = "not allowed from MANUAL";
+    auto refused = command_result(done, {});
+    EXPECT_EQ(refused.status, CommandStatus::Refused);
+    EXPECT_NE(refused.error.find("not allowed from MANUAL"), std::string::npos);
+    done.result = autopilot::RequestResult::Timeout;
+    EXPECT_EQ(command_result(done, {}).status, CommandStatus::Failed);
+    done.result = autopilot::RequestResult::Invalid;
+    EXPECT_EQ(command_result(done, {}).status, CommandStatus::BadRequest);
 }
 
 TEST(Cli, BadArgumentsExitTwoWithUsage) {

@@ -1,0 +1,115 @@
+#include "daemon/autopilot_commands.hpp"
+
+#include <cmath>
+
+#include "daemon/autopilot_status.hpp"
+
+namespace airseg::daemon {
+
+namespace {
+
+using autopilot::RequestResult;
+
+bool valid_param_name(const Json& name) {
+    return name.is_string() && !name.get_ref<const std::string&>().empty() &&
+           name.get_ref<const std::string&>().size() <= 16;
+}
+
+}  // namespace
+
+CommandResult command_result(const autopilot::RequestDone& done, Json result) {
+    const std::string why = done.detail.empty()
+                                ? autopilot::to_string(done.result)
+                                : std::string(autopilot::to_string(done.result)) + ": " + done.detail;
+    switch (done.result) {
+        case RequestResult::Ok:
+            return CommandResult::ok(std::move(result));
+        case RequestResult::Invalid:
+            return CommandResult::fail(CommandStatus::BadRequest, why);
+        case RequestResult::Refused:
+        case RequestResult::NotReady:
+        case RequestResult::Busy:
+            return CommandResult::fail(CommandStatus::Refused, why);
+        case RequestResult::Timeout:
+        case RequestResult::Cancelled:
+            break;
+    }
+    return CommandResult::fail(CommandStatus::Failed, why);
+}
+
+AutopilotCommands::AutopilotCommands(Bus& bus, CommandDispatcher& commands, Strand strand)
+    : bus_(bus), strand_(strand) {
+    done_subscription_ = bus_.subscribe<autopilot::RequestDone>(
+        strand_, [this](const autopilot::RequestDone& done) { on_done(done); });
+
+    commands.add("state", strand_, Role::Control, [this](const Json& req, CommandDispatcher::Reply reply) {
+        const auto it = req.find("state");
+        const auto state = it != req.end() && it->is_string()
+                               ? parse_state_name(it->get_ref<const std::string&>())
+                               : std::nullopt;
+        if (!state) {
+            reply(CommandResult::fail(CommandStatus::BadRequest,
+                                      "\"state\" must be one of PARKING, DIRECTED, MANUAL_NAVIGATION, "
+                                      "WAYPOINT_NAVIGATION"));
+            return;
+        }
+        request({0, autopilot::RequestStateChange{*state}}, {{"state", state_name(*state)}},
+                std::move(reply));
+    });
+    commands.add(
+        "param.get", strand_, Role::Monitor, [this](const Json& req, CommandDispatcher::Reply reply) {
+            const auto name = req.value("name", Json());
+            if (!valid_param_name(name)) {
+                reply(CommandResult::fail(CommandStatus::BadRequest,
+                                          "\"name\" must be a parameter name (1..16)"));
+                return;
+            }
+            request({0, autopilot::GetParam{name.get<std::string>()}}, {{"name", name}}, std::move(reply));
+        });
+    commands.add("param.set", strand_, Role::Control,
+                 [this](const Json& req, CommandDispatcher::Reply reply) {
+                     const auto name = req.value("name", Json());
+                     const auto value = req.value("value", Json());
+                     if (!valid_param_name(name)) {
+                         reply(CommandResult::fail(CommandStatus::BadRequest,
+                                                   "\"name\" must be a parameter name (1..16)"));
+                         return;
+                     }
+                     if (!value.is_number() || !std::isfinite(value.get<double>())) {
+                         reply(CommandResult::fail(CommandStatus::BadRequest, "\"value\" must be a number"));
+                         return;
+                     }
+                     request({0, autopilot::SetParam{name.get<std::string>(), value.get<double>()}},
+                             {{"name", name}}, std::move(reply));
+                 });
+}
+
+void AutopilotCommands::request(autopilot::AutopilotRequest r, Json result, CommandDispatcher::Reply reply) {
+    r.id = next_id_;
+    next_id_ = next_id_ == UINT32_MAX ? kFirstId : next_id_ + 1;
+    pending_[r.id] = Pending{std::move(result), std::move(reply)};
+    bus_.publish(std::move(r));
+}
+
+void AutopilotCommands::on_done(const autopilot::RequestDone& done) {
+    const auto it = pending_.find(done.id);
+    if (it == pending_.end()) {
+        return;  // another requester's
+    }
+    auto reply = std::move(it->second.reply);
+    Json result = std::move(it->second.result);
+    pending_.erase(it);
+    switch (done.kind) {
+        case autopilot::RequestKind::GetParam:
+        case autopilot::RequestKind::SetParam:
+            if (done.param_value) {
+                result["value"] = *done.param_value;
+            }
+            break;
+        default:
+            break;
+    }
+    reply(command_result(done, std::move(result)));
+}
+
+}  // namespace airseg::daemon

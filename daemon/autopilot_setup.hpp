@@ -1,0 +1,24 @@
+#pragma once
+// Turns the autopilot.* keys of the daemon's configuration into the AutopilotService's configuration,
+// starting from the board's defaults, and lists every problem the autopilot layer finds in the result (each
+// message starts with the key it is about, "autopilot.boot_timeout: ...").
+#include <string>
+#include <vector>
+
+#include "daemon/config.hpp"
+#include "services/autopilot/autopilot_service.hpp"
+
+namespace airseg::daemon {
+
+struct AutopilotSetup {
+    autopilot::AutopilotServiceConfig service;
+    std::vector<std::string> problems;
+};
+
+AutopilotSetup autopilot_setup(const Config& config);
+
+/// "autopilot.boot_timeout" from "autopilot.boot_timeout: 200 s is outside ..."; empty when the message does
+/// not start with a key.
+std::string problem_key(const std::string& problem);
+
+}  // namespace airseg::daemon

@@ -1,0 +1,60 @@
+#include "daemon/autopilot_status.hpp"
+
+#include <cctype>
+#include <cmath>
+
+#include "services/status/status_messages.hpp"
+
+namespace airseg::daemon {
+
+std::string state_name(autopilot::VehicleState s) {
+    std::string name = autopilot::to_string(s);
+    for (char& c : name) {
+        c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    }
+    return name;
+}
+
+std::optional<autopilot::VehicleState> parse_state_name(std::string_view text) {
+    if (text.size() > 32) {
+        return std::nullopt;
+    }
+    std::string lower(text);
+    for (char& c : lower) {
+        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    }
+    return autopilot::vehicle_state_from_string(lower);
+}
+
+nlohmann::json autopilot_status_json(const autopilot::AutopilotStatus& s) {
+    nlohmann::json j;
+    j["link"] = s.link_up ? "up" : "down";
+    j["ready"] = s.ready;
+    // Tenths of a second are all a person or a script needs, and they keep the section from churning.
+    j["ready_s"] = s.ready_s ? nlohmann::json(std::round(*s.ready_s * 10.0) / 10.0) : nlohmann::json(nullptr);
+    j["state"] = state_name(s.state);
+    j["mode"] = s.mode;
+    if (s.position) {
+        j["position"] = {{"lat", s.position->lat}, {"lon", s.position->lon}, {"alt", s.position->alt}};
+    } else {
+        j["position"] = nullptr;
+    }
+    j["mission_current"] = s.mission_current;
+    j["reboots"] = s.reboots;
+    j["reconnects"] = s.reconnects;
+    j["reset_pulses"] = s.reset_pulses;
+    return j;
+}
+
+AutopilotStatusSection::AutopilotStatusSection(Bus& bus, Strand strand) : bus_(bus) {
+    subscription_ =
+        bus_.subscribe<autopilot::AutopilotStatus>(strand, [this](const autopilot::AutopilotStatus& s) {
+            auto j = autopilot_status_json(s);
+            if (j != last_) {
+                last_ = j;
+                bus_.publish(status::StatusSection{"autopilot", std::move(j)});
+            }
+        });
+}
+
+}  // namespace airseg::daemon

@@ -1,0 +1,226 @@
+// airsegd and the simulated APM:Rover (airseg-apmsim), both real binaries, joined by a pseudo-terminal; the
+// operator's side is airsegctl on the local socket. The simulator's control socket says what the board
+// really did. Simulated time runs faster than real time on the board's side (--speedup); every wait is on a
+// condition with a generous deadline.
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstring>
+#include <nlohmann/json.hpp>
+
+#include "tests/support/process.hpp"
+
+namespace airseg::test {
+namespace {
+
+using Json = nlohmann::json;
+
+constexpr auto kGenerous = 30s;
+constexpr auto kPoll = 100ms;  // each poll of the status runs airsegctl
+constexpr double kHomeLat = 41.2756;
+constexpr double kHomeLon = 1.9866;
+
+bool exists(const std::string& path) {
+    struct stat st {};
+    return ::stat(path.c_str(), &st) == 0;
+}
+
+/// The simulator's control socket: one datagram per command, the reply comes back to our bound address.
+class SimControl {
+  public:
+    SimControl(std::string own, std::string server) : own_(std::move(own)), server_(std::move(server)) {
+        fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+        sockaddr_un a = address(own_);
+        ::unlink(own_.c_str());
+        if (::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
+            ADD_FAILURE() << "cannot bind " << own_ << ": " << std::strerror(errno);
+        }
+    }
+    ~SimControl() {
+        ::close(fd_);
+        ::unlink(own_.c_str());
+    }
+    SimControl(const SimControl&) = delete;
+    SimControl& operator=(const SimControl&) = delete;
+
+    std::string command(const std::string& text) {
+        sockaddr_un a = address(server_);
+        if (::sendto(fd_, text.data(), text.size(), 0, reinterpret_cast<sockaddr*>(&a), sizeof a) < 0) {
+            return {};
+        }
+        pollfd p{fd_, POLLIN, 0};
+        if (::poll(&p, 1, 5000) <= 0) {
+            return {};
+        }
+        char buf[65536];
+        const auto n = ::recv(fd_, buf, sizeof buf, 0);
+        return n > 0 ? std::string(buf, static_cast<std::size_t>(n)) : std::string();
+    }
+    Json json(const std::string& text) {
+        const auto reply = command(text);
+        auto j = Json::parse(reply, nullptr, false);
+        if (j.is_discarded()) {
+            ADD_FAILURE() << "simulator: no JSON reply to '" << text << "': " << reply;
+            return Json::object();
+        }
+        return j;
+    }
+
+  private:
+    static sockaddr_un address(const std::string& path) {
+        sockaddr_un a{};
+        a.sun_family = AF_UNIX;
+        std::strncpy(a.sun_path, path.c_str(), sizeof a.sun_path - 1);
+        return a;
+    }
+    std::string own_, server_;
+    int fd_ = -1;
+};
+
+struct Answer {
+    int exit_code = -1;
+    Json json;
+};
+
+class AutopilotE2e : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        sim_ = std::make_unique<Subprocess>(
+            std::vector<std::string>{binary("tools/apmsim/airseg-apmsim"), "--link", dir_.file("ttyACM0"),
+                                     "--control", dir_.file("ctl"), "--home",
+                                     std::to_string(kHomeLat) + "," + std::to_string(kHomeLon), "--speedup",
+                                     "10", "--boot-delay", "0.5", "--calib-time", "0.5"},
+            std::map<std::string, std::string>{}, dir_.path());
+        ASSERT_TRUE(wait_until([&] { return exists(dir_.file("ttyACM0")) && exists(dir_.file("ctl")); },
+                               kGenerous, kPoll))
+            << sim_->err();
+        control_ = std::make_unique<SimControl>(dir_.file("me"), dir_.file("ctl"));
+        daemon_ = std::make_unique<Subprocess>(
+            std::vector<std::string>{
+                binary("daemon/airsegd"), "--config", source_path("config/airseg.yaml"), "--set",
+                "status.socket=" + dir_.file("status.sock"), "--set", "state_dir=" + dir_.file("state"),
+                "--set", "autopilot.port=" + dir_.file("ttyACM0"), "--set", "autopilot.reconnect_max=500ms",
+                "--set", "groundlink.ports=[" + dir_.file("ttyUSB0") + "]"},
+            std::map<std::string, std::string>{}, dir_.path());
+    }
+
+    void TearDown() override {
+        if (daemon_ && daemon_->running()) {
+            daemon_->signal(SIGTERM);
+            EXPECT_EQ(daemon_->wait_exit(10s), 0) << daemon_->err();
+        }
+    }
+
+    Answer ctl(std::vector<std::string> args) {
+        std::vector<std::string> argv{binary("client/airsegctl"),
+                                      "--local",
+                                      "--socket",
+                                      dir_.file("status.sock"),
+                                      "--json",
+                                      "--timeout",
+                                      "15000"};
+        argv.insert(argv.end(), args.begin(), args.end());
+        const auto r = run(argv, {}, 30s);
+        Answer a;
+        a.exit_code = r.exit_code;
+        a.json = Json::parse(r.out, nullptr, false);
+        return a;
+    }
+    Answer request(const Json& r) { return ctl({"request", r.dump()}); }
+    Json autopilot_section() {
+        auto a = ctl({"status"});
+        return a.exit_code == 0 && a.json.is_object() ? a.json.value("autopilot", Json()) : Json();
+    }
+    bool ready() {
+        const auto ap = autopilot_section();
+        return ap.is_object() && ap.value("ready", false);
+    }
+
+    TempDir dir_;
+    std::unique_ptr<Subprocess> sim_;
+    std::unique_ptr<SimControl> control_;
+    std::unique_ptr<Subprocess> daemon_;
+};
+
+TEST_F(AutopilotE2e, ReadyStatusStateChangesAndParameters) {
+    ASSERT_TRUE(wait_until([&] { return ready(); }, kGenerous, kPoll)) << daemon_->err();
+    const auto ap = autopilot_section();
+    EXPECT_EQ(ap["link"], "up");
+    ASSERT_TRUE(ap["ready_s"].is_number()) << ap.dump();
+    EXPECT_GT(ap["ready_s"].get<double>(), 0.0);
+    EXPECT_TRUE(ap["mode"].is_string() && !ap["mode"].get<std::string>().empty()) << ap.dump();
+    EXPECT_TRUE(ap["state"].is_string()) << ap.dump();
+    EXPECT_TRUE(ap.contains("mission_current") && ap.contains("reboots") && ap.contains("reconnects"));
+    ASSERT_TRUE(wait_until([&] { return autopilot_section()["position"].is_object(); }, kGenerous, kPoll));
+    const auto pos = autopilot_section()["position"];
+    EXPECT_NEAR(pos["lat"].get<double>(), kHomeLat, 1e-3);
+    EXPECT_NEAR(pos["lon"].get<double>(), kHomeLon, 1e-3);
+
+    // PARKING is HOLD on a Rover: answered only once the board has switched.
+    auto parked = request({{"cmd", "state"}, {"state", "PARKING"}});
+    ASSERT_EQ(parked.exit_code, 0) << parked.json.dump();
+    EXPECT_EQ(parked.json["state"], "PARKING");
+    EXPECT_EQ(control_->json("state")["mode"], "HOLD");
+    const auto modes = control_->json("modes 1");
+    ASSERT_TRUE(modes.is_array() && !modes.empty()) << modes.dump();
+    EXPECT_EQ(modes.back()["to"], "HOLD");
+    EXPECT_EQ(modes.back()["cause"], "command");
+    ASSERT_TRUE(wait_until([&] { return autopilot_section()["state"] == "PARKING"; }, kGenerous, kPoll));
+    EXPECT_EQ(autopilot_section()["mode"], "HOLD");
+
+    // WAYPOINT_NAVIGATION needs a mission; the board has none, so the request is refused, not "ok".
+    auto auto_mode = request({{"cmd", "state"}, {"state", "WAYPOINT_NAVIGATION"}});
+    EXPECT_EQ(auto_mode.exit_code, 1) << auto_mode.json.dump();
+    EXPECT_EQ(auto_mode.json.value("ok", true), false) << auto_mode.json.dump();
+    EXPECT_EQ(control_->json("state")["mode"], "HOLD");
+    EXPECT_EQ(autopilot_section()["state"], "PARKING");
+
+    // DIRECTED hands the rover to the RC pilot: MANUAL on the board.
+    auto directed = request({{"cmd", "state"}, {"state", "directed"}});
+    ASSERT_EQ(directed.exit_code, 0) << directed.json.dump();
+    EXPECT_EQ(directed.json["state"], "DIRECTED");
+    EXPECT_EQ(control_->json("state")["mode"], "MANUAL");
+
+    auto bad = request({{"cmd", "state"}, {"state", "FLYING"}});
+    EXPECT_EQ(bad.exit_code, 1);
+    EXPECT_EQ(bad.json.value("status", ""), "bad_request") << bad.json.dump();
+
+    // Parameters: read, write, read back, and the board agrees.
+    auto before = request({{"cmd", "param.get"}, {"name", "WP_RADIUS"}});
+    ASSERT_EQ(before.exit_code, 0) << before.json.dump();
+    ASSERT_TRUE(before.json["value"].is_number()) << before.json.dump();
+    const double wanted = before.json["value"].get<double>() + 1.0;
+    auto set = request({{"cmd", "param.set"}, {"name", "WP_RADIUS"}, {"value", wanted}});
+    ASSERT_EQ(set.exit_code, 0) << set.json.dump();
+    EXPECT_NEAR(set.json["value"].get<double>(), wanted, 1e-4);
+    auto after = request({{"cmd", "param.get"}, {"name", "WP_RADIUS"}});
+    ASSERT_EQ(after.exit_code, 0) << after.json.dump();
+    EXPECT_NEAR(after.json["value"].get<double>(), wanted, 1e-4);
+
+    auto unknown = request({{"cmd", "param.get"}, {"name", "NO_SUCH_PARAM"}});
+    EXPECT_NE(unknown.exit_code, 0) << unknown.json.dump();
+}
+
+TEST_F(AutopilotE2e, UnplugShowsTheLinkDownAndReplugRecoversWithoutARestart) {
+    ASSERT_TRUE(wait_until([&] { return ready(); }, kGenerous, kPoll)) << daemon_->err();
+    const auto reconnects = autopilot_section()["reconnects"].get<unsigned>();
+
+    control_->command("unplug");
+    ASSERT_TRUE(wait_until([&] { return autopilot_section()["link"] == "down"; }, kGenerous, kPoll));
+    EXPECT_FALSE(autopilot_section()["ready"].get<bool>());
+
+    control_->command("replug");
+    ASSERT_TRUE(wait_until([&] { return ready(); }, kGenerous, kPoll)) << daemon_->err();
+    EXPECT_EQ(autopilot_section()["link"], "up");
+    EXPECT_GT(autopilot_section()["reconnects"].get<unsigned>(), reconnects);
+    EXPECT_TRUE(daemon_->running());
+}
+
+}  // namespace
+}  // namespace airseg::test
