@@ -123,5 +123,26 @@ TEST_F(PortKeeperTest, UnplugIsReportedAndTheReplacementDeviceIsReopened) {
     keeper->stop();
 }
 
+TEST_F(PortKeeperTest, ReopenAtAnotherBaudIsNotAReconnect) {
+    Pty pty;
+    std::filesystem::create_symlink(pty.path, link);
+    auto keeper = make_keeper();
+    keeper->start();
+    ASSERT_TRUE(run_until([&] { return opens == 1; }));
+    const int downs_before = downs;
+
+    keeper->reopen_at(115200);
+    ASSERT_TRUE(run_until([&] { return opens == 2; }));
+    EXPECT_TRUE(keeper->is_open());
+    EXPECT_EQ(keeper->baud(), 115200u);
+    EXPECT_EQ(keeper->reconnects(), 0u);
+    EXPECT_EQ(downs, downs_before) << "a deliberate reopen is not the device going away";
+
+    const std::string hello = "at 115200";
+    ASSERT_EQ(::write(pty.master, hello.data(), hello.size()), ssize_t(hello.size()));
+    ASSERT_TRUE(run_until([&] { return received == hello; }));
+    keeper->stop();
+}
+
 }  // namespace
 }  // namespace airseg
