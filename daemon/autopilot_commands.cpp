@@ -82,6 +82,13 @@ AutopilotCommands::AutopilotCommands(Bus& bus, CommandDispatcher& commands, Stra
                      request({0, autopilot::SetParam{name.get<std::string>(), value.get<double>()}},
                              {{"name", name}}, std::move(reply));
                  });
+    add_param_list(commands);
+}
+
+void AutopilotCommands::add_param_list(CommandDispatcher& commands) {
+    commands.add("param.list", strand_, Role::Monitor, [this](const Json&, CommandDispatcher::Reply reply) {
+        request({0, autopilot::ListParams{}}, Json::object(), std::move(reply));
+    });
 }
 
 void AutopilotCommands::request(autopilot::AutopilotRequest r, Json result, CommandDispatcher::Reply reply) {
@@ -106,6 +113,14 @@ void AutopilotCommands::on_done(const autopilot::RequestDone& done) {
                 result["value"] = *done.param_value;
             }
             break;
+        case autopilot::RequestKind::ListParams: {
+            auto& params = result["params"] = Json::object();
+            for (const auto& [name, value] : done.params) {
+                params[name] = value;
+            }
+            result["count"] = done.params.size();
+            break;
+        }
         default:
             break;
     }

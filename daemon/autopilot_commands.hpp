@@ -26,6 +26,7 @@ class AutopilotCommands {
         Json result;  // what an ok reply carries, completed from the RequestDone
         CommandDispatcher::Reply reply;
     };
+    void add_param_list(CommandDispatcher& commands);
     void request(autopilot::AutopilotRequest r, Json result, CommandDispatcher::Reply reply);
     void on_done(const autopilot::RequestDone& done);
 

@@ -81,6 +81,8 @@ const char* to_string(RequestKind k) {
             return "get_param";
         case RequestKind::SetParam:
             return "set_param";
+        case RequestKind::ListParams:
+            return "list_params";
     }
     return "?";
 }

@@ -128,6 +128,7 @@ enum class RequestKind : std::uint8_t {
     ClearMission,
     GetParam,
     SetParam,
+    ListParams,
 };
 const char* to_string(RequestKind k);
 
@@ -135,9 +136,10 @@ struct RequestDone {
     std::uint32_t id = 0;
     RequestKind kind = RequestKind::SetState;
     RequestResult result = RequestResult::Ok;
-    std::string detail;                 // for people, when not ok
-    std::vector<MissionItem> items;     // DownloadMission
-    std::optional<double> param_value;  // GetParam / SetParam (the value read back)
+    std::string detail;                                  // for people, when not ok
+    std::vector<MissionItem> items;                      // DownloadMission
+    std::optional<double> param_value;                   // GetParam / SetParam (the value read back)
+    std::vector<std::pair<std::string, double>> params;  // ListParams: the cached table, by name
 };
 
 using Event = std::variant<WaypointReached, MissionCurrentChanged, ModeChanged, LinkUp, LinkDown,
@@ -166,10 +168,12 @@ struct SetParam {
     std::string name;
     double value = 0.0;
 };
+/// The parameter table as downloaded at connection (and kept current by every set and PARAM_VALUE).
+struct ListParams {};
 struct AutopilotRequest {
     std::uint32_t id = 0;  // chosen by the requester, echoed in RequestDone::id
     std::variant<RequestStateChange, UploadMission, WriteMissionItems, DownloadMission, SetMissionCurrent,
-                 ClearMission, GetParam, SetParam>
+                 ClearMission, GetParam, SetParam, ListParams>
         op;
 };
 /// Ground joystick input, -1..1 each; it drives only in MANUAL_NAVIGATION and only while it keeps coming.

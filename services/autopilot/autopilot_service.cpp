@@ -86,6 +86,21 @@ void AutopilotService::on_stop() {
 
 void AutopilotService::on_request(const AutopilotRequest& r) {
     const TimePoint now = SteadyClock::now();
+    if (std::holds_alternative<ListParams>(r.op)) {
+        // Answered from the cached table: no traffic to the autopilot, so no driver request.
+        RequestDone done;
+        done.id = r.id;
+        done.kind = RequestKind::ListParams;
+        for (const auto& [name, entry] : driver_.params().table()) {
+            done.params.emplace_back(name, static_cast<double>(entry.value));
+        }
+        if (done.params.empty()) {
+            done.result = RequestResult::Refused;
+            done.detail = "the parameters have not been downloaded yet (autopilot not ready)";
+        }
+        ctx_.bus.publish(std::move(done));
+        return;
+    }
     const std::uint32_t id = std::visit(
         [&](const auto& op) -> std::uint32_t {
             using T = std::decay_t<decltype(op)>;
@@ -103,6 +118,8 @@ void AutopilotService::on_request(const AutopilotRequest& r) {
                 return driver_.clear_mission(now);
             } else if constexpr (std::is_same_v<T, GetParam>) {
                 return driver_.get_param(op.name, now);
+            } else if constexpr (std::is_same_v<T, ListParams>) {
+                return 0;  // answered above
             } else {
                 return driver_.set_param(op.name, op.value, now);
             }

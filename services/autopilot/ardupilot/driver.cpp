@@ -392,7 +392,7 @@ void Driver::on_mission_done(MissionCompletion c, TimePoint now) {
                 for (std::size_t i = 1; i < c.items.size(); ++i) {
                     mission_.push_back(decode_item(c.items[i]));
                 }
-                RequestDone d{op.id, op.kind, r, {}, mission_, std::nullopt};
+                RequestDone d{op.id, op.kind, r, {}, mission_, std::nullopt, {}};
                 emit(std::move(d));
                 return;
             }
@@ -433,7 +433,7 @@ void Driver::on_param_done(ParamCompletion c, TimePoint now) {
     if (it == param_ops_.end()) {
         return;
     }
-    RequestDone d{it->second.id, it->second.kind, c.result, c.detail, {}, std::nullopt};
+    RequestDone d{it->second.id, it->second.kind, c.result, c.detail, {}, std::nullopt, {}};
     if (c.value) {
         d.param_value = *c.value;
     }

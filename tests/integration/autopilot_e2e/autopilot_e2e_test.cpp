@@ -205,6 +205,13 @@ TEST_F(AutopilotE2e, ReadyStatusStateChangesAndParameters) {
 
     auto unknown = request({{"cmd", "param.get"}, {"name", "NO_SUCH_PARAM"}});
     EXPECT_NE(unknown.exit_code, 0) << unknown.json.dump();
+
+    // The whole table, as cached since the connection, includes the value just set.
+    auto list = request({{"cmd", "param.list"}});
+    ASSERT_EQ(list.exit_code, 0) << list.json.dump();
+    EXPECT_GE(list.json["count"].get<int>(), 200);
+    ASSERT_TRUE(list.json["params"].contains("WP_RADIUS")) << list.json.dump().substr(0, 300);
+    EXPECT_NEAR(list.json["params"]["WP_RADIUS"].get<double>(), wanted, 1e-4);
 }
 
 TEST_F(AutopilotE2e, UnplugShowsTheLinkDownAndReplugRecoversWithoutARestart) {

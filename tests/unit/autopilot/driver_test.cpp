@@ -94,8 +94,8 @@ struct Rig {
         harness.run_until([&] { return result_of(id).has_value(); }, now() + limit);
         auto r = result_of(id);
         return r ? *r
-                 : RequestDone{id, RequestKind::SetState, RequestResult::Cancelled, "no result in time", {},
-                               {}};
+                 : RequestDone{
+                       id, RequestKind::SetState, RequestResult::Cancelled, "no result in time", {}, {}, {}};
     }
     void bring_up() {
         open_with_reset();
