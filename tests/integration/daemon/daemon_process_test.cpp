@@ -1,6 +1,7 @@
 // airsegd as systemd runs it: a real NOTIFY_SOCKET, signals, the status socket and airsegctl.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/stat.h>
 
 #include <nlohmann/json.hpp>
 
@@ -164,6 +165,29 @@ TEST_F(DaemonProcess, SighupAppliesRuntimeKeysAndKeepsTheRunningConfigOnErrors) 
     auto status = ctl({"status", "--socket", socket(), "--json"});
     EXPECT_EQ(status.exit_code, 0);
 
+    daemon.signal(SIGTERM);
+    EXPECT_EQ(daemon.wait_exit(5s), 0);
+}
+
+TEST_F(DaemonProcess, UnderSystemdEachLogLineCarriesItsSyslogPriority) {
+    // journald hands the daemon a stream and names it in JOURNAL_STREAM (device:inode of stderr).
+    const std::string log = dir.file("journal.log");
+    write_file(log, "");
+    struct stat st {};
+    ASSERT_EQ(::stat(log.c_str(), &st), 0);
+    auto e = env();
+    e["JOURNAL_STREAM"] = std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino);
+    std::string command = "exec";
+    for (const auto& a : daemon_args()) {
+        command += " '" + a + "'";
+    }
+    command += " 2>>'" + log + "'";
+    Subprocess daemon({"/bin/sh", "-c", command}, e, dir.path());
+    ASSERT_TRUE(notify.wait_for("READY=1", 10s));
+    EXPECT_TRUE(wait_until([&] { return read_file(log).find("<6>status: up") != std::string::npos; }))
+        << read_file(log);
+    EXPECT_TRUE(wait_until([&] { return read_file(log).find("<4>autopilot:") != std::string::npos; }))
+        << read_file(log);
     daemon.signal(SIGTERM);
     EXPECT_EQ(daemon.wait_exit(5s), 0);
 }
