@@ -44,6 +44,13 @@ class SerialPort::Impl : public std::enable_shared_from_this<Impl> {
             return result;
         }
         result.warnings = termios_setup::apply_optional(fd, config);
+        // Two openers of one serial line each get part of the bytes and both see garbage; exclusive mode
+        // makes a second open (ModemManager probing, a second daemon, a stray terminal) fail with EBUSY
+        // instead.
+        if (::ioctl(fd, TIOCEXCL) != 0) {
+            result.warnings.push_back("cannot take exclusive use of the line (TIOCEXCL): " +
+                                      std::error_code(errno, std::system_category()).message());
+        }
         for (auto& w : result.warnings) {
             w = prefix_ + w;
             spdlog::warn("{}", w);

@@ -153,7 +153,10 @@ TEST_F(GroundlinkEndToEnd, SplitModeOverTwoRadioPairsKeepsWorkingWhenOnePairDies
     control_command("down a");
     control_command("down b");
     auto one = split_status();
-    ASSERT_EQ(one.exit_code, 0) << one.err << "\ndaemon:\n" << daemon->err();
+    EXPECT_EQ(one.exit_code, 0) << one.err << "\ndaemon:\n" << daemon->err();
+    // The daemon goes before pair B's emulator: a daemon outliving its ports would keep reopening their paths,
+    // and a pty number freed by the emulator is soon another test's line.
+    daemon.reset();
 }
 
 /// A UDP port free at the moment of asking (the kernel picks it).

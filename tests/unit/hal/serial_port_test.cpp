@@ -2,8 +2,15 @@
 
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 
 #include "tests/unit/hal/run_until.hpp"
@@ -94,6 +101,39 @@ TEST_F(HalSerialPortTest, NonexistentPathErrorNamesThePath) {
     EXPECT_EQ(result.error, std::error_code(ENOENT, std::system_category()));
     EXPECT_NE(result.message.find("/nonexistent/ttyAIRSEG0"), std::string::npos) << result.message;
     EXPECT_FALSE(port.is_open());
+}
+
+// A second opener would steal part of the bytes; the port takes the line for itself (TIOCEXCL). Root ignores
+// exclusive mode, so under root the second open is tried as the unprivileged user `nobody`.
+TEST_F(HalSerialPortTest, SecondOpenOfTheLineIsRefusedWhileThePortHoldsIt) {
+    SerialPort port(io_.get_executor());
+    ASSERT_TRUE(port.open(config_for(pty_)).ok());
+    const std::string path = pty_.slave_path();
+    int second_open_errno = 0;
+    if (::geteuid() != 0) {
+        const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
+        second_open_errno = fd < 0 ? errno : 0;
+        if (fd >= 0) {
+            ::close(fd);
+        }
+    } else {
+        ASSERT_EQ(::chmod(path.c_str(), 0666), 0);
+        const pid_t child = ::fork();
+        ASSERT_GE(child, 0);
+        if (child == 0) {
+            if (::setgid(65534) != 0 || ::setuid(65534) != 0) {
+                ::_exit(100);
+            }
+            const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
+            ::_exit(fd < 0 ? (errno & 0x7f) : 0);
+        }
+        int status = 0;
+        ASSERT_EQ(::waitpid(child, &status, 0), child);
+        ASSERT_TRUE(WIFEXITED(status));
+        ASSERT_NE(WEXITSTATUS(status), 100) << "cannot become nobody";
+        second_open_errno = WEXITSTATUS(status);
+    }
+    EXPECT_EQ(second_open_errno, EBUSY) << std::strerror(second_open_errno);
 }
 
 TEST_F(HalSerialPortTest, RegularFileIsNotATerminal) {

@@ -262,7 +262,7 @@ TEST(LinkSimBinary, CarriesBytesBothWaysAtTheSerialRateAndReportsOnExit) {
         b.drain_into(got);
         return got.size() >= sent.size();
     })) << "received "
-        << got.size();
+        << got.size() << "; emulator: " << control.stats().dump();
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     EXPECT_EQ(got, sent);
     // 480 bytes at 960 bytes/s cannot take less than half a second.
