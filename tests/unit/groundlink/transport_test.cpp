@@ -1,6 +1,8 @@
 // The core end to end, two instances in simulated time (sim_link.hpp).
 #include <gtest/gtest.h>
 
+#include "services/groundlink/transport/cobs.hpp"
+#include "services/groundlink/transport/frame.hpp"
 #include "tests/unit/groundlink/sim_link.hpp"
 
 namespace airseg::groundlink {
@@ -202,6 +204,38 @@ TEST(GroundlinkTransport, PeerRestartIsDetectedAndBothResynchronize) {
     EXPECT_EQ(count_safe(link.a(), 0), 5U);
     EXPECT_TRUE(link.a().core->link_up());
     EXPECT_TRUE(link.b().core->link_up());
+}
+
+// A restarted peer may hear the survivor's session hello (still in the air, or a reply to its previous
+// incarnation) before anything else, and then echo the survivor's session nonce in its own hellos. The
+// survivor must still challenge it, or the new incarnation is never heard while the survivor keeps talking
+// to the one that died (found by fuzz_groundlink_transport).
+TEST(GroundlinkTransport, RestartedPeerThatHeardTheOldSessionsHelloFirstIsStillAccepted) {
+    SimLink link(base_config(0xA), base_config(0xB), one_path(), 9);
+    link.run_for(3s);
+    ASSERT_TRUE(link.a().core->session_established() && link.b().core->session_established());
+    // B's latest hello: its session reply to A's old incarnation.
+    std::vector<std::uint8_t> session_hello;
+    for (const auto& wire : link.recorded(1)) {
+        const auto plain = cobs_decode(std::span(wire).first(wire.size() - 1));
+        if (plain && frame::kind_of(*plain) == frame::Kind::hello) {
+            session_hello = wire;
+        }
+    }
+    ASSERT_FALSE(session_hello.empty());
+
+    link.restart(0, base_config(0xAA));
+    link.a().received.clear();
+    link.inject(0, 0, session_hello);  // the first thing the new incarnation hears
+    for (std::uint32_t i = 0; i < 3; ++i) {
+        link.b().core->send_safe(0, pattern(100, i), link.now());
+        link.a().core->send_safe(0, pattern(100, 10 + i), link.now());
+    }
+    link.run_for(10s);
+    EXPECT_TRUE(link.a().core->session_established());
+    EXPECT_EQ(link.b().core->stats().peer_restarts, 1U);
+    EXPECT_EQ(count_safe(link.a(), 0), 3U) << "the survivor's messages reach the new incarnation";
+    EXPECT_EQ(count_safe(link.b(), 0), 3U);
 }
 
 TEST(GroundlinkTransport, ForgedAndReplayedFramesAreNeverDelivered) {
