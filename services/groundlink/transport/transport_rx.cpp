@@ -269,11 +269,13 @@ void Transport::Impl::on_hello(std::size_t path, const frame::Hello& h, TimePoin
         queue_hello_reply(frame::Hello{0, my_nonce, peer_nonce, true});
         return;
     }
-    if (!established || h.sender_nonce != peer_nonce) {
+    if (!established || (h.sender_nonce != peer_nonce && (h.echo_nonce == 0 || h.echo_nonce == my_nonce))) {
         // A peer that is not the session's (it started, or it is a replay): challenge it with a fresh nonce;
-        // the session changes only if the answer echoes it. This holds even when it echoes this end's session
-        // nonce: a restarted peer learns that nonce from the first hello it hears, and ignoring it then would
-        // leave it unheard for good while this end keeps talking to the incarnation that died.
+        // the session changes only if the answer echoes it. A restarted peer may echo this end's session
+        // nonce, learnt from the first hello it heard; ignoring it then would leave it unheard for good while
+        // this end keeps talking to the incarnation that died. A hello echoing any other nonce is someone
+        // else's challenge (or a recording of one): answering it would let a replay renegotiate a live
+        // session.
         last_seen_peer = h.sender_nonce;
         queue_hello_reply(frame::Hello{0, candidate, h.sender_nonce, false});
     }
