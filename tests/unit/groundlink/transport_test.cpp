@@ -238,6 +238,41 @@ TEST(GroundlinkTransport, RestartedPeerThatHeardTheOldSessionsHelloFirstIsStillA
     EXPECT_EQ(count_safe(link.b(), 0), 3U);
 }
 
+// A hello recorded from an incarnation that has since restarted, replayed to the survivor, draws a challenge
+// that the live incarnation must ignore: answering it would renegotiate the live session and deliver the
+// survivor's in-flight messages a second time (found by fuzz_groundlink_transport).
+TEST(GroundlinkTransport, ReplayedHelloOfADeadIncarnationLeavesTheLiveSessionAlone) {
+    SimLink link(base_config(0xA), base_config(0xB), one_path(), 10);
+    link.run_for(3s);
+    std::vector<std::vector<std::uint8_t>> old_hellos;
+    for (const auto& wire : link.recorded(0)) {
+        const auto plain = cobs_decode(std::span(wire).first(wire.size() - 1));
+        if (plain && frame::kind_of(*plain) == frame::Kind::hello) {
+            old_hellos.push_back(wire);
+        }
+    }
+    ASSERT_FALSE(old_hellos.empty());
+    link.restart(0, base_config(0xAA));
+    link.a().received.clear();
+    link.run_for(5s);
+    ASSERT_TRUE(link.a().core->session_established() && link.b().core->session_established());
+    ASSERT_EQ(link.b().core->stats().peer_restarts, 1U);
+
+    for (std::uint32_t i = 0; i < 20; ++i) {
+        link.b().core->send_safe(0, pattern(100, i), link.now());
+    }
+    for (const auto& hello : old_hellos) {
+        link.inject(1, 0, hello);
+        link.run_for(200ms);
+    }
+    link.run_for(10s);
+    EXPECT_EQ(link.b().core->stats().peer_restarts, 1U) << "the replay renegotiated the session";
+    ASSERT_EQ(count_safe(link.a(), 0), 20U);
+    for (std::uint32_t i = 0; i < 20; ++i) {
+        EXPECT_EQ(test::id_of(link.a().received[i].bytes), i);
+    }
+}
+
 TEST(GroundlinkTransport, ForgedAndReplayedFramesAreNeverDelivered) {
     SimLink link(base_config(0x10), base_config(0x20), one_path(), 9);
     for (std::uint32_t i = 0; i < 20; ++i) {
