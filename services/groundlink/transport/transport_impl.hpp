@@ -104,6 +104,10 @@ class Transport::Impl {
     std::uint64_t my_nonce = 0;
     std::uint64_t peer_nonce = 0;
     std::uint64_t last_seen_peer = 0;
+    // Hellos sent without a session since last_seen_peer was learnt. A nonce learnt from a recording, or one
+    // the peer has since replaced, is never answered; after a few tries the hellos echo nothing instead,
+    // which any peer answers with a challenge.
+    unsigned unanswered_hellos = 0;
     std::optional<frame::Hello> hello_reply;
     std::uint8_t hello_reply_paths = 0;
     std::uint64_t next_frame_number = 0;

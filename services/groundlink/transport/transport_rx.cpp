@@ -277,6 +277,7 @@ void Transport::Impl::on_hello(std::size_t path, const frame::Hello& h, TimePoin
         // else's challenge (or a recording of one): answering it would let a replay renegotiate a live
         // session.
         last_seen_peer = h.sender_nonce;
+        unanswered_hellos = 0;
         queue_hello_reply(frame::Hello{0, candidate, h.sender_nonce, false});
     }
 }

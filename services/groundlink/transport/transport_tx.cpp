@@ -15,6 +15,7 @@ constexpr double kLossyFraction = 0.15;
 constexpr std::size_t kLossyFramePayload = 192;
 // Share of recent Safe segments declared lost above which a segment lost twice is sent twice in a row.
 constexpr double kRepeatFraction = 0.25;
+constexpr unsigned kUnansweredHellosBeforeEchoingNothing = 3;
 
 }  // namespace
 
@@ -231,6 +232,10 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_hello(std::size_
             hello_reply.reset();
         }
     } else if (!confirmed && now >= ps.next_hello) {
+        if (!established && last_seen_peer != 0 &&
+            ++unanswered_hellos > kUnansweredHellosBeforeEchoingNothing) {
+            last_seen_peer = 0;
+        }
         h = established ? frame::Hello{0, my_nonce, peer_nonce, true}
                         : frame::Hello{0, candidate, last_seen_peer, false};
     } else {

@@ -273,6 +273,36 @@ TEST(GroundlinkTransport, ReplayedHelloOfADeadIncarnationLeavesTheLiveSessionAlo
     }
 }
 
+// A fresh incarnation that first hears a recording of the survivor's hello from an older session echoes a
+// nonce the survivor no longer uses, and the survivor rightly ignores it; after a few unanswered hellos the
+// fresh end echoes nothing and is challenged (found by fuzz_groundlink_transport).
+TEST(GroundlinkTransport, FreshPeerMisledByAnOldRecordingStillGetsASession) {
+    SimLink link(base_config(0xA), base_config(0xB), one_path(), 11);
+    link.run_for(3s);
+    std::vector<std::uint8_t> first_session_hello;
+    for (const auto& wire : link.recorded(1)) {
+        const auto plain = cobs_decode(std::span(wire).first(wire.size() - 1));
+        if (plain && frame::kind_of(*plain) == frame::Kind::hello) {
+            first_session_hello = wire;
+        }
+    }
+    ASSERT_FALSE(first_session_hello.empty());
+    link.restart(0, base_config(0xAA));  // B's session nonce changes with the new session
+    link.run_for(5s);
+    ASSERT_EQ(link.b().core->stats().peer_restarts, 1U);
+
+    link.restart(0, base_config(0xAAA));
+    link.a().received.clear();
+    link.inject(0, 0, first_session_hello);
+    for (std::uint32_t i = 0; i < 3; ++i) {
+        link.b().core->send_safe(0, pattern(100, i), link.now());
+    }
+    link.run_for(15s);
+    EXPECT_TRUE(link.a().core->session_established());
+    EXPECT_EQ(link.b().core->stats().peer_restarts, 2U);
+    EXPECT_EQ(count_safe(link.a(), 0), 3U);
+}
+
 TEST(GroundlinkTransport, ForgedAndReplayedFramesAreNeverDelivered) {
     SimLink link(base_config(0x10), base_config(0x20), one_path(), 9);
     for (std::uint32_t i = 0; i < 20; ++i) {
