@@ -167,6 +167,16 @@ class RadioClient::Impl {
                 {"authenticated", s.authenticated}};
     }
 
+    bool link_up() const { return driver_->link_up(); }
+    std::uint64_t bytes_sent() const { return driver_->stats().bytes_sent; }
+
+    void send_joystick(double steering, double throttle) {
+        asio::dispatch(strand_, [this, steering, throttle] {
+            driver_->send_fast(proto::kPriorityControl, proto::kTopicJoystick,
+                               proto::encode(proto::Joystick{steering, throttle}));
+        });
+    }
+
   private:
     void on_delivered(gl::Delivered m) {
         auto decoded = proto::decode(m.bytes);
@@ -210,6 +220,15 @@ void RadioClient::run_for(std::chrono::milliseconds d, const std::function<void(
 }
 nlohmann::json RadioClient::link_stats() const {
     return impl_->link_stats();
+}
+bool RadioClient::link_up() const {
+    return impl_->link_up();
+}
+void RadioClient::send_joystick(double steering, double throttle) {
+    impl_->send_joystick(steering, throttle);
+}
+std::uint64_t RadioClient::bytes_sent() const {
+    return impl_->bytes_sent();
 }
 
 }  // namespace airseg::client

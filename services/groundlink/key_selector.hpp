@@ -1,0 +1,40 @@
+#pragma once
+// Which pre-shared key the ground end uses, and so which role it has.
+//
+// The transport authenticates frames with one key. With a monitor key configured besides the control key,
+// the service runs the transport on one of them; when the link is not up and frames keep failing their MAC
+// check while none passes, the peer uses the other key, and the service rebuilds the transport with it. A
+// frame's MAC can only be made with the key itself, so the role follows from the key the link works with.
+// Sans-IO: counters in, a decision out.
+#include <cstdint>
+
+#include "services/common/command_dispatcher.hpp"
+
+namespace airseg::groundlink {
+
+class KeySelector {
+  public:
+    explicit KeySelector(bool has_monitor_key) : has_monitor_(has_monitor_key) {}
+
+    /// The role of the key in use.
+    [[nodiscard]] Role role() const { return monitor_ ? Role::Monitor : Role::Control; }
+    [[nodiscard]] std::uint64_t switches() const { return switches_; }
+
+    /// Once per statistics tick, with the transport's counters since the previous tick (of the transport in
+    /// use). Returns true when the transport must be rebuilt with the other key (role() already says which).
+    bool update(bool link_up, std::uint64_t new_mac_failures, std::uint64_t new_valid_frames) {
+        if (!has_monitor_ || link_up || new_valid_frames > 0 || new_mac_failures == 0) {
+            return false;
+        }
+        monitor_ = !monitor_;
+        ++switches_;
+        return true;
+    }
+
+  private:
+    bool has_monitor_;
+    bool monitor_ = false;
+    std::uint64_t switches_ = 0;
+};
+
+}  // namespace airseg::groundlink
