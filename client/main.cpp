@@ -152,8 +152,11 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
                 return usage_error("--timeout needs a positive number of milliseconds");
             }
             o.timeout_ms = ms;
-        } else if (o.positional.empty() && a.starts_with("-") && a.size() > 1) {
-            return usage_error("unknown option '" + a + "'");
+        } else if (a.starts_with("-") && a.size() > 1) {
+            if (o.positional.empty()) {
+                return usage_error("unknown option '" + a + "'");
+            }
+            o.positional.push_back(a);  // an option of the command itself (watch --duration MS, ...)
         } else {
             o.positional.push_back(a);
         }

@@ -259,7 +259,7 @@ TEST_F(GroundControlE2e, JoystickDrivesTheRoverAndTheOverrideIsReleasedWhenInput
     // The joystick device is a FIFO standing in for /dev/input/js0: the test writes js_event records.
     const auto fifo = dir.file("js0");
     ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-    const int writer = ::open(fifo.c_str(), O_RDWR | O_NONBLOCK);
+    const int writer = ::open(fifo.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
     ASSERT_GE(writer, 0);
     Subprocess stick({binary("client/airsegctl"), "--link", ground(), "--timeout", "30000", "joystick",
                       "--device", fifo, "--rate", "10"},
