@@ -31,14 +31,16 @@ nlohmann::json GroundlinkService::rates_json() const {
         requested[to_string(k)] = rounded(scheduler_.requested_hz(k));
         effective[to_string(k)] = rounded(scheduler_.effective_hz(k));
     }
-    return {{"requested_hz", requested},
-            {"effective_hz", effective},
-            {"factor", scheduler_.factor()},
-            {"weak_link", scheduler_.weak()},
-            {"budget_bytes_per_s", std::round(scheduler_.budget_bytes_per_s())},
-            {"lowerings", scheduler_.lowerings()},
-            {"restorations", scheduler_.restorations()},
-            {"samples_sent", samples_sent_}};
+    return {
+        {"requested_hz", requested},
+        {"effective_hz", effective},
+        {"factor", scheduler_.factor()},
+        {"weak_link", scheduler_.weak()},
+        {"budget_bytes_per_s", std::round(scheduler_.budget_bytes_per_s())},
+        {"lowerings", scheduler_.lowerings()},
+        {"restorations", scheduler_.restorations()},
+        {"samples_sent", samples_sent_},
+        {"delivery_loss", delivery_.loss() ? nlohmann::json(rounded(*delivery_.loss())) : nlohmann::json()}};
 }
 
 void GroundlinkService::register_commands() {

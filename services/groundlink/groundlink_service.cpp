@@ -149,6 +149,7 @@ void GroundlinkService::make_driver() {
                                      LinkDriver::Handlers{[this](Delivered m) { on_message(std::move(m)); },
                                                           [this](const TransportEvent& e) { on_event(e); }});
     last_mac_failures_ = last_frames_received_ = last_rx_bytes_ = 0;
+    delivery_.reset();
     last_fast_messages_ = last_fast_replaced_ = 0;
 }
 
@@ -193,6 +194,11 @@ void GroundlinkService::on_message(Delivered message) {
         on_command(*command);
     } else if (auto* joystick = std::get_if<protocol::Joystick>(&*decoded.message)) {
         on_joystick(*joystick);
+    } else if (auto* report = std::get_if<protocol::ReceptionReport>(&*decoded.message)) {
+        // A message needs about half a round trip to arrive; the margin covers the radios' buffering.
+        const auto lag = std::chrono::duration_cast<Duration>(
+            std::chrono::duration<double, std::milli>(driver_->stats().srtt_ms / 2 + 250));
+        delivery_.on_report(report->received, SteadyClock::now(), lag);
     }
     // Other types from the ground are not expected; unknown types are skipped by design.
 }
@@ -242,6 +248,10 @@ void GroundlinkService::on_event(const TransportEvent& event) {
             break;
         case TransportEvent::Kind::peer_restarted:
             spdlog::info("groundlink: the ground end restarted; session resynchronised");
+            delivery_.reset();
+            break;
+        case TransportEvent::Kind::session_established:
+            delivery_.reset();
             break;
         case TransportEvent::Kind::path_up:
             spdlog::info("groundlink: path {} up", event.path);
@@ -301,7 +311,9 @@ void GroundlinkService::feed_scheduler(TimePoint now) {
     const auto replaced = s.tx_fast.replaced + s.tx_fast.drops - last_fast_replaced_;
     LinkQuality q;
     q.up = driver_->link_up();
-    q.loss = s.frame_loss;
+    // What the ground says it received is the direct measure; the transport's Safe loss estimate stands in
+    // until the ground has reported enough (a ground end that does not report, or a slow rate).
+    q.loss = delivery_.loss().value_or(s.frame_loss);
     q.replaced_share = fast > 0 ? static_cast<double>(replaced) / static_cast<double>(fast) : 0.0;
     q.link_rate_bytes_per_s = transport_.link_rate_bytes_per_s;
     last_fast_messages_ = s.tx_fast.messages;
@@ -349,14 +361,15 @@ void GroundlinkService::on_telemetry_timer() {
             driver_->send_fast(protocol::kPriorityTelemetry, protocol::kTopicTelemetry,
                                protocol::encode(make_sample(*vehicle_)));
             ++samples_sent_;
+            delivery_.on_pushed(now);
         } else if (*kind == TelemetryKind::link_stats) {
-            send_link_stats();
+            send_link_stats(now);
         }
     }
     arm_telemetry();
 }
 
-void GroundlinkService::send_link_stats() {
+void GroundlinkService::send_link_stats(TimePoint now) {
     const auto& s = driver_->stats();
     protocol::LinkStatsReport report;
     report.rtt_ms = static_cast<std::uint16_t>(std::min(65535.0, s.srtt_ms));
@@ -365,6 +378,7 @@ void GroundlinkService::send_link_stats() {
     report.retransmissions = static_cast<std::uint32_t>(s.tx_safe.retransmissions);
     report.mac_failures = static_cast<std::uint32_t>(s.mac_failures);
     driver_->send_fast(protocol::kPriorityStatus, protocol::kTopicLinkStats, protocol::encode(report));
+    delivery_.on_pushed(now);
 }
 
 void GroundlinkService::update_health() {

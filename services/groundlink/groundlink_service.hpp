@@ -9,6 +9,7 @@
 #include "services/autopilot/autopilot.hpp"
 #include "services/common/port_keeper.hpp"
 #include "services/common/service.hpp"
+#include "services/groundlink/delivery_meter.hpp"
 #include "services/groundlink/key_selector.hpp"
 #include "services/groundlink/link/link_driver.hpp"
 #include "services/groundlink/protocol/ground_protocol.hpp"
@@ -54,7 +55,7 @@ class GroundlinkService : public Service {
     void feed_scheduler(TimePoint now);
     void arm_telemetry();
     void on_telemetry_timer();
-    void send_link_stats();
+    void send_link_stats(TimePoint now);
     void update_health();
     void publish_status();
     nlohmann::json rates_json() const;
@@ -65,6 +66,7 @@ class GroundlinkService : public Service {
     std::optional<std::array<std::uint8_t, kKeyBytes>> control_key_, monitor_key_;
     KeySelector keys_{false};
     TelemetryScheduler scheduler_;
+    DeliveryMeter delivery_;
     asio::steady_timer telemetry_timer_;
     TimePoint telemetry_armed_for_ = kNever;
     std::optional<autopilot::Telemetry> vehicle_;

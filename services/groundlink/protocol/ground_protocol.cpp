@@ -211,6 +211,9 @@ std::vector<std::uint8_t> encode(const Message& message) {
                 w.u8(static_cast<std::uint8_t>(MessageType::joystick));
                 w.le(twos(clamp_round<std::int64_t>(m.steering * 10000, -10000, 10000), 2), 2);
                 w.le(twos(clamp_round<std::int64_t>(m.throttle * 10000, -10000, 10000), 2), 2);
+            } else if constexpr (std::is_same_v<T, ReceptionReport>) {
+                w.u8(static_cast<std::uint8_t>(MessageType::reception));
+                w.le(m.received, 4);
             } else {
                 w.u8(m.type);
             }
@@ -303,6 +306,14 @@ DecodeResult decode(std::span<const std::uint8_t> bytes) {
             j.steering = static_cast<double>(std::clamp<std::int64_t>(r.sle(2), -10000, 10000)) / 10000.0;
             j.throttle = static_cast<double>(std::clamp<std::int64_t>(r.sle(2), -10000, 10000)) / 10000.0;
             out.message = j;
+            return out;
+        }
+        case MessageType::reception: {
+            if (body < 4) {
+                out.error = "reception report body too short";
+                return out;
+            }
+            out.message = ReceptionReport{static_cast<std::uint32_t>(r.le(4))};
             return out;
         }
     }

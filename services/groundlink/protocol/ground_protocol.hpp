@@ -24,6 +24,7 @@ inline constexpr std::uint8_t kPriorityBulk = 3;       // flight plans, paramete
 inline constexpr std::uint16_t kTopicTelemetry = 1;
 inline constexpr std::uint16_t kTopicLinkStats = 2;
 inline constexpr std::uint16_t kTopicJoystick = 3;
+inline constexpr std::uint16_t kTopicReception = 4;
 
 enum class MessageType : std::uint8_t {
     telemetry = 0x01,
@@ -32,6 +33,7 @@ enum class MessageType : std::uint8_t {
     command = 0x10,
     result = 0x11,
     joystick = 0x12,
+    reception = 0x13,
 };
 
 /// One vehicle telemetry sample. Units are chosen so the whole message fits 29 bytes.
@@ -95,12 +97,21 @@ struct Joystick {
     bool operator==(const Joystick&) const = default;
 };
 
+/// The ground end's count of pushed telemetry messages (telemetry samples and link statistics) received since
+/// its transport session began, sent once a second: the vehicle compares it with what it pushed to measure
+/// what the link really delivers.
+struct ReceptionReport {
+    std::uint32_t received = 0;
+    bool operator==(const ReceptionReport&) const = default;
+};
+
 struct Unknown {
     std::uint8_t type = 0;
     bool operator==(const Unknown&) const = default;
 };
 
-using Message = std::variant<Telemetry, LinkStatsReport, Event, Command, Result, Joystick, Unknown>;
+using Message =
+    std::variant<Telemetry, LinkStatsReport, Event, Command, Result, Joystick, ReceptionReport, Unknown>;
 
 std::vector<std::uint8_t> encode(const Message& message);
 

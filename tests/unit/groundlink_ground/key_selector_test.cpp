@@ -20,11 +20,15 @@ TEST(KeySelector, SwitchesKeysWhileFramesOnlyFailTheirMac) {
     KeySelector k(true);
     EXPECT_EQ(k.role(), Role::Control);
     EXPECT_FALSE(k.update(false, 0, 0)) << "silence is no evidence";
+    EXPECT_FALSE(k.update(false, 2, 0)) << "one tick may be a session the vehicle just restarted";
+    EXPECT_FALSE(k.update(false, 0, 1)) << "a valid frame clears the suspicion";
+    EXPECT_FALSE(k.update(false, 2, 0));
     EXPECT_TRUE(k.update(false, 2, 0));
     EXPECT_EQ(k.role(), Role::Monitor);
     EXPECT_FALSE(k.update(false, 0, 3)) << "frames pass with the monitor key: stay";
     EXPECT_FALSE(k.update(true, 5, 10)) << "a link that is up is never dropped for stray frames";
     EXPECT_EQ(k.role(), Role::Monitor);
+    EXPECT_FALSE(k.update(false, 3, 0));
     EXPECT_TRUE(k.update(false, 3, 0)) << "the control station came back";
     EXPECT_EQ(k.role(), Role::Control);
     EXPECT_EQ(k.switches(), 2u);

@@ -161,6 +161,16 @@ TEST(GroundProtocol, JoystickRoundTripsAndClamps) {
     EXPECT_FALSE(decode(short_body).message);
 }
 
+TEST(GroundProtocol, ReceptionReportRoundTrips) {
+    const auto bytes = encode(ReceptionReport{0x01020304});
+    ASSERT_EQ(bytes.size(), 6u);
+    EXPECT_EQ(bytes[1], 0x13);
+    EXPECT_EQ(bytes[2], 0x04);
+    EXPECT_EQ(bytes[5], 0x01);
+    EXPECT_EQ(std::get<ReceptionReport>(*decode(bytes).message), ReceptionReport{0x01020304});
+    EXPECT_FALSE(decode(std::vector<std::uint8_t>{kVersion, 0x13, 1, 2}).message);
+}
+
 TEST(GroundProtocol, StateAndModeNames) {
     EXPECT_STREQ(vehicle_state_name(4), "MANUAL_NAVIGATION");
     EXPECT_STREQ(vehicle_state_name(15), "?");
