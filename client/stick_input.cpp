@@ -1,14 +1,16 @@
 #include "client/stick_input.hpp"
 
 #include <fcntl.h>
-#include <termios.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <bit>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <optional>
+#include <string>
 
 namespace airseg::client {
 
@@ -25,7 +27,23 @@ void nudge(double& v, double by) {
     v = std::clamp(std::round((v + by) * 100.0) / 100.0, -1.0, 1.0);
 }
 
-static_assert(sizeof(termios) <= 64, "saved_termios_ must hold a struct termios");
+// Terminal modes belong to hal/ (the only room that includes termios); the keyboard's raw mode goes through
+// stty(1) on the inherited standard input instead.
+std::optional<std::string> run_stty(const std::string& args) {
+    std::string out;
+    FILE* p = ::popen(("stty " + args + " 2>/dev/null").c_str(), "r");
+    if (p == nullptr) {
+        return std::nullopt;
+    }
+    char buf[512];
+    while (std::fgets(buf, sizeof buf, p) != nullptr) {
+        out += buf;
+    }
+    if (::pclose(p) != 0) {
+        return std::nullopt;
+    }
+    return out;
+}
 
 }  // namespace
 
@@ -116,14 +134,16 @@ std::unique_ptr<StickSource> StickSource::open(const std::string& device, std::s
         s->keyboard_ = true;
         s->fd_ = STDIN_FILENO;
         if (::isatty(STDIN_FILENO) == 1) {
-            termios t{};
-            if (::tcgetattr(STDIN_FILENO, &t) == 0) {
-                std::memcpy(s->saved_termios_.data(), &t, sizeof t);
-                cfmakeraw(&t);
-                t.c_oflag |= OPOST;  // keep \n → \r\n for the status line
-                if (::tcsetattr(STDIN_FILENO, TCSANOW, &t) == 0) {
-                    s->restore_terminal_ = true;
-                }
+            auto saved = run_stty("-g").value_or("");
+            while (!saved.empty() && (saved.back() == '\n' || saved.back() == '\r')) {
+                saved.pop_back();
+            }
+            // `stty -g` prints hex fields separated by colons; anything else is not passed back to a shell.
+            const bool plain =
+                !saved.empty() && saved.find_first_not_of("0123456789abcdefABCDEF:") == std::string::npos;
+            if (plain && run_stty("raw -echo opost")) {
+                s->saved_terminal_ = saved;
+                s->restore_terminal_ = true;
             }
         }
     } else {
@@ -143,9 +163,7 @@ std::unique_ptr<StickSource> StickSource::open(const std::string& device, std::s
 
 StickSource::~StickSource() {
     if (restore_terminal_) {
-        termios t{};
-        std::memcpy(&t, saved_termios_.data(), sizeof t);
-        ::tcsetattr(STDIN_FILENO, TCSANOW, &t);
+        run_stty(saved_terminal_);
     }
     if (keyboard_) {
         const int flags = ::fcntl(fd_, F_GETFL);

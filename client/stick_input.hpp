@@ -64,7 +64,7 @@ class StickSource {
     bool owns_fd_ = false;
     bool keyboard_ = false;
     bool restore_terminal_ = false;
-    std::array<std::uint8_t, 64> saved_termios_{};  // struct termios, kept opaque here
+    std::string saved_terminal_;  // `stty -g` of the terminal before raw mode
     JsEventDecoder js_;
     KeyboardDecoder keys_;
 };
