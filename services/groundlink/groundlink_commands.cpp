@@ -120,6 +120,8 @@ void GroundlinkService::subscribe_bus() {
     subscriptions_.push_back(bus.subscribe<autopilot::Telemetry>(
         strand(), [this](const autopilot::Telemetry& t) { vehicle_ = t; }));
     subscriptions_.push_back(
+        bus.subscribe<PlanProgressSample>(strand(), [this](const PlanProgressSample& p) { plan_ = p; }));
+    subscriptions_.push_back(
         bus.subscribe<TelemetryConfigChanged>(strand(), [this](const TelemetryConfigChanged& c) {
             config_.telemetry = c.config;
             scheduler_.set_config(c.config, SteadyClock::now());

@@ -359,7 +359,7 @@ void GroundlinkService::on_telemetry_timer() {
         }
         if (*kind == TelemetryKind::vehicle && vehicle_) {
             driver_->send_fast(protocol::kPriorityTelemetry, protocol::kTopicTelemetry,
-                               protocol::encode(make_sample(*vehicle_)));
+                               protocol::encode(make_sample(*vehicle_, plan_)));
             ++samples_sent_;
             delivery_.on_pushed(now);
         } else if (*kind == TelemetryKind::link_stats) {

@@ -13,6 +13,7 @@
 #include "services/groundlink/key_selector.hpp"
 #include "services/groundlink/link/link_driver.hpp"
 #include "services/groundlink/protocol/ground_protocol.hpp"
+#include "services/groundlink/telemetry_sample.hpp"
 #include "services/groundlink/telemetry_scheduler.hpp"
 
 namespace airseg::groundlink {
@@ -70,6 +71,7 @@ class GroundlinkService : public Service {
     asio::steady_timer telemetry_timer_;
     TimePoint telemetry_armed_for_ = kNever;
     std::optional<autopilot::Telemetry> vehicle_;
+    PlanProgressSample plan_;
     std::vector<Subscription> subscriptions_;
     bool commands_registered_ = false;
     std::vector<std::unique_ptr<PortKeeper>> keepers_;

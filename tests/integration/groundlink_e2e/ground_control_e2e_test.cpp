@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -293,7 +294,11 @@ TEST_F(GroundControlE2e, JoystickDrivesTheRoverAndTheOverrideIsReleasedWhenInput
     ASSERT_TRUE(wait_until([&] { return sim_control->json("state").value("speed", 1.0) < 0.05; }, 20s, 100ms))
         << sim_control->json("state").dump();
     // Override released within the configured input timeout (500 ms), plus the rover coasting to a stop.
-    EXPECT_LT(std::chrono::steady_clock::now() - stopped_at, 10s);
+    const auto to_stop = std::chrono::steady_clock::now() - stopped_at;
+    EXPECT_LT(to_stop, 10s);
+    std::cout << "joystick: moved " << moved << " m; stopped "
+              << std::chrono::duration_cast<std::chrono::milliseconds>(to_stop).count()
+              << " ms after the client ended\n";
 }
 
 TEST_F(GroundControlE2e, WithTwentyPercentFrameLossTelemetryArrivesAndEveryCommandIsAnswered) {
