@@ -14,9 +14,11 @@
 #include <thread>
 #include <vector>
 
+#include "client/live_commands.hpp"
 #include "client/local_client.hpp"
 #include "client/radio_client.hpp"
 #include "client/status_view.hpp"
+#include "client/vehicle_commands.hpp"
 
 namespace {
 
@@ -48,7 +50,18 @@ const char* kUsageText =
     "\n"
     "Commands:\n"
     "  status             health of every service and the vehicle's state\n"
-    "  watch [--interval MS]  a live view refreshed in place until Ctrl-C (default every 1000 ms)\n"
+    "  watch [--interval MS] [--duration MS]\n"
+    "                     a live view refreshed in place until Ctrl-C: over the radio from the telemetry\n"
+    "                     the vehicle pushes (state, position, speed, battery, plan, link, events), locally\n"
+    "                     from the status document every --interval (default 1000 ms)\n"
+    "  state STATE        PARKING | DIRECTED | MANUAL_NAVIGATION | WAYPOINT_NAVIGATION\n"
+    "  param get NAME | param set NAME VALUE | param list\n"
+    "                     the autopilot's parameters\n"
+    "  rates [KIND=HZ ...]  show, or set, the pushed telemetry rates (kinds: vehicle, link_stats)\n"
+    "  log [--duration MS]  follow the vehicle's events and autopilot texts (radio only)\n"
+    "  joystick [--device /dev/input/jsN] [--rate HZ] [--duration MS]\n"
+    "                     drive in MANUAL_NAVIGATION from a joystick, or the keyboard without --device\n"
+    "                     (w/s/a/d or arrows, space centres, q quits); inputs go at --rate (default 10 Hz)\n"
     "  request JSON       send one raw request object, e.g. '{\"cmd\":\"status\"}', print the answer\n"
     "\n"
     "Exit codes: 0 done, 1 refused by the vehicle, 2 usage, 3 no link (no answer in time).\n";
@@ -140,7 +153,10 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
             }
             o.timeout_ms = ms;
         } else if (a.starts_with("-") && a.size() > 1) {
-            return usage_error("unknown option '" + a + "'");
+            if (o.positional.empty()) {
+                return usage_error("unknown option '" + a + "'");
+            }
+            o.positional.push_back(a);  // an option of the command itself (watch --duration MS, ...)
         } else {
             o.positional.push_back(a);
         }
@@ -179,15 +195,14 @@ int show_answer(const Options& o, const airseg::client::LocalAnswer& a,
     return ok ? kDone : kRefused;
 }
 
-volatile std::sig_atomic_t g_stop = 0;
-
-/// The live view: the status document redrawn in place on a terminal, appended otherwise (for logs).
+/// The local live view: the status document redrawn in place on a terminal, appended otherwise (for logs).
 int watch(const Options& o, const std::function<airseg::client::LocalAnswer(const nlohmann::json&)>& request,
-          airseg::client::RadioClient* radio, std::chrono::milliseconds interval) {
-    std::signal(SIGINT, [](int) { g_stop = 1; });
-    std::signal(SIGTERM, [](int) { g_stop = 1; });
+          airseg::client::RadioClient* radio, std::chrono::milliseconds interval,
+          std::chrono::milliseconds duration) {
     const bool tty = ::isatty(STDOUT_FILENO) == 1;
-    while (g_stop == 0) {
+    const auto began = std::chrono::steady_clock::now();
+    while (!airseg::client::stop_requested() &&
+           (duration.count() == 0 || std::chrono::steady_clock::now() - began < duration)) {
         const auto started = std::chrono::steady_clock::now();
         auto answer = request({{"cmd", "status"}});
         std::string screen;
@@ -209,7 +224,7 @@ int watch(const Options& o, const std::function<airseg::client::LocalAnswer(cons
         }
         std::cout << (tty ? "\x1b[H\x1b[2J" : "") << screen << std::flush;
         // Wait out the rest of the interval; over the radio keep the link serviced meanwhile.
-        while (g_stop == 0 && std::chrono::steady_clock::now() - started < interval) {
+        while (!airseg::client::stop_requested() && std::chrono::steady_clock::now() - started < interval) {
             if (radio != nullptr) {
                 radio->run_for(std::chrono::milliseconds(50), [](const auto&) {});
             } else {
@@ -218,6 +233,65 @@ int watch(const Options& o, const std::function<airseg::client::LocalAnswer(cons
         }
     }
     return kDone;
+}
+
+struct Requester {
+    airseg::client::LocalClient& local;
+    airseg::client::RadioClient* radio;
+    std::chrono::milliseconds timeout;
+    airseg::client::LocalAnswer request(const nlohmann::json& r) {
+        return radio ? radio->request(r, timeout) : local.request(r);
+    }
+};
+
+/// watch, log and joystick: their own options follow the command name.
+int live_command(const Options& o, Requester& client, airseg::client::RadioClient* radio) {
+    const auto& cmd = o.positional[0];
+    airseg::client::LiveOptions live;
+    live.json = o.json;
+    live.timeout = std::chrono::milliseconds(o.timeout_ms);
+    airseg::client::JoystickOptions stick;
+    long interval_ms = 1000;
+    for (std::size_t i = 1; i < o.positional.size(); ++i) {
+        const auto& a = o.positional[i];
+        if (i + 1 >= o.positional.size()) {
+            return usage_error(cmd + ": " + a + " needs a value");
+        }
+        const std::string v = o.positional[++i];
+        char* end = nullptr;
+        const double n = std::strtod(v.c_str(), &end);
+        const bool numeric = !v.empty() && *end == '\0' && n > 0;
+        if (a == "--duration" && numeric) {
+            live.duration = std::chrono::milliseconds(static_cast<long>(n));
+        } else if (a == "--interval" && cmd == "watch" && numeric) {
+            interval_ms = static_cast<long>(n);
+        } else if (a == "--device" && cmd == "joystick") {
+            stick.device = v;
+        } else if (a == "--rate" && cmd == "joystick" && numeric && n <= 50) {
+            stick.rate_hz = n;
+        } else {
+            return usage_error(cmd + ": bad option or value: " + a + " " + v);
+        }
+    }
+    if (interval_ms < 100) {
+        return usage_error("watch --interval must be at least 100 ms");
+    }
+    airseg::client::install_stop_handlers();
+    if (cmd == "watch") {
+        if (radio != nullptr) {
+            return airseg::client::run_radio_watch(*radio, live);
+        }
+        return watch(
+            o, [&](const nlohmann::json& r) { return client.request(r); }, nullptr,
+            std::chrono::milliseconds(interval_ms), live.duration);
+    }
+    if (radio == nullptr) {
+        return usage_error(cmd + " needs the radio link (--link or --udp): the vehicle pushes it");
+    }
+    if (cmd == "log") {
+        return airseg::client::run_log(*radio, live);
+    }
+    return airseg::client::run_joystick(*radio, live, stick);
 }
 
 }  // namespace
@@ -240,14 +314,7 @@ int main(int argc, char** argv) {
             return kNoLink;
         }
     }
-    struct Requester {
-        airseg::client::LocalClient& local;
-        airseg::client::RadioClient* radio;
-        std::chrono::milliseconds timeout;
-        airseg::client::LocalAnswer request(const nlohmann::json& r) {
-            return radio ? radio->request(r, timeout) : local.request(r);
-        }
-    } client{local, radio.get(), timeout};
+    Requester client{local, radio.get(), timeout};
     const auto& cmd = o.positional[0];
     if (cmd == "status") {
         if (o.positional.size() != 1) {
@@ -255,19 +322,15 @@ int main(int argc, char** argv) {
         }
         return show_answer(o, client.request({{"cmd", "status"}}), airseg::client::render_status);
     }
-    if (cmd == "watch") {
-        long interval_ms = 1000;
-        if (o.positional.size() == 3 && o.positional[1] == "--interval") {
-            interval_ms = std::strtol(o.positional[2].c_str(), nullptr, 10);
-        } else if (o.positional.size() != 1) {
-            return usage_error("watch takes only --interval MS");
+    if (cmd == "watch" || cmd == "log" || cmd == "joystick") {
+        return live_command(o, client, radio.get());
+    }
+    if (airseg::client::is_vehicle_command(cmd)) {
+        auto built = airseg::client::build_vehicle_command(o.positional);
+        if (!built.usage_error.empty()) {
+            return usage_error(built.usage_error);
         }
-        if (interval_ms < 100) {
-            return usage_error("watch --interval must be at least 100 ms");
-        }
-        return watch(
-            o, [&](const nlohmann::json& r) { return client.request(r); }, radio.get(),
-            std::chrono::milliseconds(interval_ms));
+        return show_answer(o, client.request(built.request), built.render);
     }
     if (cmd == "request") {
         if (o.positional.size() != 2) {

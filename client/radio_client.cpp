@@ -44,7 +44,8 @@ std::string validate(const RadioOptions& o) {
 
 class RadioClient::Impl {
   public:
-    explicit Impl(RadioOptions options) : options_(std::move(options)), strand_(asio::make_strand(io_)) {
+    explicit Impl(RadioOptions options)
+        : options_(std::move(options)), strand_(asio::make_strand(io_)), report_timer_(strand_) {
         std::random_device rd;
         next_id_ = rd();  // answers left over from another client's session are not mistaken for ours
     }
@@ -75,7 +76,13 @@ class RadioClient::Impl {
         driver_ = std::make_unique<gl::LinkDriver>(
             strand_, t,
             gl::LinkDriver::Handlers{[this](gl::Delivered m) { on_delivered(std::move(m)); },
-                                     [](const auto&) {}});
+                                     [this](const gl::TransportEvent& e) {
+                                         if (e.kind == gl::TransportEvent::Kind::session_established ||
+                                             e.kind == gl::TransportEvent::Kind::peer_restarted) {
+                                             pushed_received_ = 0;  // the vehicle counts per session too
+                                         }
+                                     }});
+        do_report();
         if (!options_.udp.empty()) {
             const auto colon = options_.udp.rfind(':');
             hal::UdpConfig u;
@@ -167,11 +174,40 @@ class RadioClient::Impl {
                 {"authenticated", s.authenticated}};
     }
 
+    bool link_up() const { return driver_->link_up(); }
+    std::uint64_t bytes_sent() const { return driver_->stats().bytes_sent; }
+
+    void send_joystick(double steering, double throttle) {
+        asio::dispatch(strand_, [this, steering, throttle] {
+            driver_->send_fast(proto::kPriorityControl, proto::kTopicJoystick,
+                               proto::encode(proto::Joystick{steering, throttle}));
+        });
+    }
+
   private:
+    /// Once a second while the link is up: how many pushed telemetry messages arrived, so the vehicle can
+    /// measure what the link delivers.
+    void do_report() {
+        if (driver_->link_up()) {
+            driver_->send_fast(proto::kPriorityStatus, proto::kTopicReception,
+                               proto::encode(proto::ReceptionReport{pushed_received_}));
+        }
+        report_timer_.expires_after(std::chrono::seconds(1));
+        report_timer_.async_wait([this](boost::system::error_code ec) {
+            if (!ec) {
+                do_report();
+            }
+        });
+    }
+
     void on_delivered(gl::Delivered m) {
         auto decoded = proto::decode(m.bytes);
         if (!decoded.message) {
             return;
+        }
+        if (std::holds_alternative<proto::Telemetry>(*decoded.message) ||
+            std::holds_alternative<proto::LinkStatsReport>(*decoded.message)) {
+            ++pushed_received_;
         }
         if (auto* result = std::get_if<proto::Result>(&*decoded.message)) {
             if (answer_ != nullptr && result->request_id == awaiting_) {
@@ -195,6 +231,8 @@ class RadioClient::Impl {
     std::uint32_t awaiting_ = 0;
     std::optional<nlohmann::json>* answer_ = nullptr;
     std::function<void(const proto::Message&)> on_message_;
+    asio::steady_timer report_timer_;
+    std::uint32_t pushed_received_ = 0;
 };
 
 RadioClient::RadioClient(RadioOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
@@ -210,6 +248,15 @@ void RadioClient::run_for(std::chrono::milliseconds d, const std::function<void(
 }
 nlohmann::json RadioClient::link_stats() const {
     return impl_->link_stats();
+}
+bool RadioClient::link_up() const {
+    return impl_->link_up();
+}
+void RadioClient::send_joystick(double steering, double throttle) {
+    impl_->send_joystick(steering, throttle);
+}
+std::uint64_t RadioClient::bytes_sent() const {
+    return impl_->bytes_sent();
 }
 
 }  // namespace airseg::client

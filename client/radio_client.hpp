@@ -44,6 +44,13 @@ class RadioClient {
 
     /// Link statistics as the status document's groundlink section shows them, seen from the ground.
     nlohmann::json link_stats() const;
+    bool link_up() const;
+
+    /// Queues one joystick input as a Fast message (the freshest replaces an unsent one).
+    void send_joystick(double steering, double throttle);
+
+    /// Bytes this end's transport wrote to the link so far (all paths, framing included).
+    std::uint64_t bytes_sent() const;
 
   private:
     class Impl;

@@ -17,11 +17,29 @@
 #include "daemon/systemd_notifier.hpp"
 #include "hal/gpio_libgpiod.hpp"
 #include "services/autopilot/autopilot_service.hpp"
+#include "services/groundlink/groundlink_messages.hpp"
 #include "services/groundlink/groundlink_service.hpp"
 #include "services/status/status_messages.hpp"
 #include "services/status/status_service.hpp"
 
 namespace airseg::daemon {
+
+namespace {
+
+groundlink::TelemetrySchedulerConfig telemetry_config(const Config& c) {
+    groundlink::TelemetrySchedulerConfig t;
+    for (auto kind : groundlink::kAllTelemetryKinds) {
+        const auto it = c.groundlink.telemetry_rates.find(groundlink::to_string(kind));
+        if (it != c.groundlink.telemetry_rates.end()) {
+            t.rate_hz[static_cast<std::size_t>(kind)] = it->second;
+        }
+    }
+    t.budget_share = c.groundlink.telemetry_budget_share;
+    t.min_hz = c.groundlink.telemetry_min_hz;
+    return t;
+}
+
+}  // namespace
 
 class App::Impl {
   public:
@@ -103,6 +121,8 @@ class App::Impl {
         g.udp.bind_port = static_cast<std::uint16_t>(gl.udp_port);
         g.udp.remote_address = gl.udp_remote;
         g.udp.remote_port = static_cast<std::uint16_t>(gl.udp_remote_port);
+        g.monitor_key_file = gl.monitor_key_file;
+        g.telemetry = telemetry_config(config_);
         services_.push_back(std::make_unique<groundlink::GroundlinkService>(context_, std::move(g)));
     }
 
@@ -188,6 +208,11 @@ class App::Impl {
         }
         set_log_level(result.config.log_level);
         config_.log_level = result.config.log_level;
+        const auto& gl = result.config.groundlink;
+        config_.groundlink.telemetry_rates = gl.telemetry_rates;
+        config_.groundlink.telemetry_budget_share = gl.telemetry_budget_share;
+        config_.groundlink.telemetry_min_hz = gl.telemetry_min_hz;
+        bus_.publish(groundlink::TelemetryConfigChanged{telemetry_config(config_)});
         notifier_.ready();
     }
 

@@ -51,6 +51,10 @@ struct GroundlinkConfig {
     int udp_port = 14650;                            // groundlink.udp.port
     std::string udp_remote;                          // groundlink.udp.remote: empty = answer the last sender
     int udp_remote_port = 0;                         // groundlink.udp.remote_port
+    std::string monitor_key_file;                    // groundlink.monitor_key_file: empty = no monitor role
+    std::map<std::string, double> telemetry_rates{{"vehicle", 2.0}, {"link_stats", 1.0}};  // .telemetry.rates
+    double telemetry_budget_share = 0.25;  // groundlink.telemetry.budget_share
+    double telemetry_min_hz = 0.2;         // groundlink.telemetry.min_hz
 };
 
 struct Config {

@@ -166,6 +166,16 @@ void check_consistency(const Config& c, const std::string& source,
         errors.push_back({at("groundlink.reconnect_min"), "groundlink.reconnect_min",
                           "must not be longer than groundlink.reconnect_max"});
     }
+    for (const auto& [kind, hz] : g.telemetry_rates) {
+        if (hz < 0 || hz > 20) {
+            errors.push_back({at("groundlink.telemetry.rates"), "groundlink.telemetry.rates",
+                              fmt::format("{}: {} Hz is out of range 0..20", kind, hz)});
+        }
+    }
+    if (!g.monitor_key_file.empty() && g.key_file.empty()) {
+        errors.push_back({at("groundlink.monitor_key_file"), "groundlink.monitor_key_file",
+                          "needs groundlink.key_file (the control key)"});
+    }
     // The autopilot layer's own rules, reported at the key they name.
     for (const auto& problem : autopilot_setup(c).problems) {
         const std::string key = problem_key(problem);

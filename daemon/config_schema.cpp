@@ -175,9 +175,10 @@ KeySpec string_list(std::string path, Ref ref, std::size_t min_items, std::size_
 }
 
 template <class Ref>
-KeySpec number(std::string path, Ref ref, double min, double max, std::string doc) {
+KeySpec number(std::string path, Ref ref, double min, double max, std::string doc, bool runtime = false) {
     KeySpec spec;
     spec.path = std::move(path);
+    spec.runtime = runtime;
     spec.type_name = fmt::format("number {}..{}", min, max);
     spec.doc = std::move(doc);
     spec.apply = [ref, min, max](const YAML::Node& node, Config& c) -> std::optional<std::string> {
@@ -198,9 +199,11 @@ KeySpec number(std::string path, Ref ref, double min, double max, std::string do
 /// A mapping of names to numbers, e.g. {WP_RADIUS: 2, CRUISE_SPEED: 1.5}. `names` empty = any name;
 /// otherwise only those. `whole` requires whole numbers >= 0.
 template <class Ref>
-KeySpec number_map(std::string path, Ref ref, std::vector<std::string> names, bool whole, std::string doc) {
+KeySpec number_map(std::string path, Ref ref, std::vector<std::string> names, bool whole, std::string doc,
+                   bool runtime = false) {
     KeySpec spec;
     spec.path = std::move(path);
+    spec.runtime = runtime;
     spec.type_name = names.empty() ? "mapping NAME: number"
                                    : fmt::format("mapping of {} to {}", fmt::join(names, " | "),
                                                  whole ? "whole numbers >= 0" : "numbers");
@@ -433,6 +436,21 @@ std::vector<KeySpec> build_schema() {
     s.push_back(integer(
         "groundlink.udp.remote_port", [](Config& c) -> int& { return c.groundlink.udp_remote_port; }, 0,
         65535, "UDP port of the fixed ground station (with udp.remote)"));
+    s.push_back(string(
+        "groundlink.monitor_key_file",
+        [](Config& c) -> std::string& { return c.groundlink.monitor_key_file; },
+        "second key file (mode 0600): its holders may watch but not command; empty = none", true));
+    s.push_back(number_map(
+        "groundlink.telemetry.rates",
+        [](Config& c) -> std::map<std::string, double>& { return c.groundlink.telemetry_rates; },
+        {"vehicle", "link_stats"}, false, "pushed telemetry per kind, Hz 0..20 (0 = off)", true));
+    s.push_back(number(
+        "groundlink.telemetry.budget_share",
+        [](Config& c) -> double& { return c.groundlink.telemetry_budget_share; }, 0.01, 1.0,
+        "fraction of the radio link rate pushed telemetry may use", true));
+    s.push_back(number(
+        "groundlink.telemetry.min_hz", [](Config& c) -> double& { return c.groundlink.telemetry_min_hz; },
+        0.01, 20.0, "lowest rate of a telemetry kind that is on, however weak the link", true));
     return s;
 }
 

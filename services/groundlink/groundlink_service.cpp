@@ -4,8 +4,10 @@
 
 #include <random>
 
+#include "services/groundlink/groundlink_messages.hpp"
 #include "services/groundlink/link/key_file.hpp"
 #include "services/groundlink/protocol/ground_protocol.hpp"
+#include "services/groundlink/telemetry_sample.hpp"
 #include "services/status/status_messages.hpp"
 
 namespace airseg::groundlink {
@@ -45,36 +47,54 @@ TransportConfig transport_config_for(const GroundlinkServiceConfig& config) {
 }
 
 GroundlinkService::GroundlinkService(ServiceContext& ctx, GroundlinkServiceConfig config)
-    : Service("groundlink", ctx), config_(std::move(config)), stats_timer_(strand()) {}
+    : Service("groundlink", ctx),
+      config_(std::move(config)),
+      scheduler_(config_.telemetry, transport_config_for(config_).link_rate_bytes_per_s, SteadyClock::now()),
+      telemetry_timer_(strand()),
+      stats_timer_(strand()) {}
 
 GroundlinkService::~GroundlinkService() = default;
 
 void GroundlinkService::on_start() {
-    TransportConfig transport = transport_config_for(config_);
-    transport.boot_nonce = random_nonce();
+    register_commands();
+    subscribe_bus();
+    transport_ = transport_config_for(config_);
+    transport_.boot_nonce = random_nonce();
+    auto fail = [this](std::string why) {
+        // Running unauthenticated when a key was asked for would be worse than not running the link.
+        fatal_ = std::move(why);
+        spdlog::error("groundlink: {}; the ground link stays down", fatal_);
+        update_health();
+        publish_status();
+    };
     if (!config_.key_file.empty()) {
         auto key = read_key_file(config_.key_file);
         if (!key.key) {
-            // Running unauthenticated when a key was asked for would be worse than not running the link.
-            fatal_ = key.error;
-            spdlog::error("groundlink: {}; the ground link stays down", fatal_);
-            update_health();
-            publish_status();
-            return;
+            return fail(key.error);
         }
-        transport.key = key.key;
+        control_key_ = key.key;
+        transport_.key = key.key;
     } else {
         spdlog::warn("groundlink: no key_file configured: frames are not authenticated");
     }
-    if (auto problems = transport.validate(); !problems.empty()) {
-        fatal_ = problems.front();
-        update_health();
-        return;
+    if (!config_.monitor_key_file.empty()) {
+        if (!control_key_) {
+            return fail("groundlink.monitor_key_file needs groundlink.key_file (the control key)");
+        }
+        auto key = read_key_file(config_.monitor_key_file);
+        if (!key.key) {
+            return fail(key.error);
+        }
+        if (*key.key == *control_key_) {
+            return fail("groundlink.monitor_key_file holds the same key as groundlink.key_file");
+        }
+        monitor_key_ = key.key;
+        keys_ = KeySelector(true);
     }
-    driver_ =
-        std::make_unique<LinkDriver>(strand(), transport,
-                                     LinkDriver::Handlers{[this](Delivered m) { on_message(std::move(m)); },
-                                                          [this](const TransportEvent& e) { on_event(e); }});
+    if (auto problems = transport_.validate(); !problems.empty()) {
+        return fail(problems.front());
+    }
+    make_driver();
     if (config_.mode == "udp") {
         udp_ = std::make_unique<hal::UdpSocket>(strand());
         auto r = udp_->open(config_.udp);
@@ -87,9 +107,7 @@ void GroundlinkService::on_start() {
                     driver_->handle_bytes(0, d);
                 },
                 [](std::error_code, const std::string& what) { spdlog::warn("groundlink[udp]: {}", what); });
-            driver_->set_writer(0, [this](std::vector<std::uint8_t> frame) {
-                return udp_->send(std::move(frame)) == hal::WriteResult::Queued;
-            });
+            attach_writers();
         }
     } else {
         for (std::size_t i = 0; i < config_.ports.size(); ++i) {
@@ -101,10 +119,8 @@ void GroundlinkService::on_start() {
             keepers_.push_back(std::make_unique<PortKeeper>(
                 strand(), pc,
                 PortKeeper::Handlers{
-                    [this, i] {
-                        driver_->set_writer(i, [this, i](std::vector<std::uint8_t> frame) {
-                            return keepers_[i]->write(std::move(frame)) == hal::WriteResult::Queued;
-                        });
+                    [this] {
+                        attach_writers();
                         update_health();
                     },
                     [this, i](std::span<const std::uint8_t> b) { driver_->handle_bytes(i, b); },
@@ -120,10 +136,42 @@ void GroundlinkService::on_start() {
     last_stats_at_ = SteadyClock::now();
     update_health();
     do_stats();
+    arm_telemetry();
+}
+
+void GroundlinkService::make_driver() {
+    transport_.key = keys_.role() == Role::Monitor ? monitor_key_ : control_key_;
+    if (driver_) {
+        driver_->stop();
+    }
+    driver_ =
+        std::make_unique<LinkDriver>(strand(), transport_,
+                                     LinkDriver::Handlers{[this](Delivered m) { on_message(std::move(m)); },
+                                                          [this](const TransportEvent& e) { on_event(e); }});
+    last_mac_failures_ = last_frames_received_ = last_rx_bytes_ = 0;
+    delivery_.reset();
+    last_fast_messages_ = last_fast_replaced_ = 0;
+}
+
+void GroundlinkService::attach_writers() {
+    if (udp_ && udp_->is_open()) {
+        driver_->set_writer(0, [this](std::vector<std::uint8_t> frame) {
+            return udp_->send(std::move(frame)) == hal::WriteResult::Queued;
+        });
+    }
+    for (std::size_t i = 0; i < keepers_.size(); ++i) {
+        if (keepers_[i]->is_open()) {
+            driver_->set_writer(i, [this, i](std::vector<std::uint8_t> frame) {
+                return keepers_[i]->write(std::move(frame)) == hal::WriteResult::Queued;
+            });
+        }
+    }
 }
 
 void GroundlinkService::on_stop() {
     stats_timer_.cancel();
+    telemetry_timer_.cancel();
+    subscriptions_.clear();
     if (driver_) {
         driver_->stop();
     }
@@ -143,34 +191,67 @@ void GroundlinkService::on_message(Delivered message) {
         return;
     }
     if (auto* command = std::get_if<protocol::Command>(&*decoded.message)) {
-        ++commands_;
-        const std::uint32_t id = command->request_id;
-        ctx_.commands.dispatch(command->request, Role::Control, [this, id](CommandResult result) {
-            asio::dispatch(strand(), [this, id, answer = result.to_json()] {
-                if (!driver_) {
-                    return;
-                }
-                const auto bytes = protocol::encode(protocol::Result{id, answer});
-                const auto r = driver_->send_safe(protocol::kPriorityControl, bytes);
-                if (r != SendResult::accepted) {
-                    spdlog::warn("groundlink: could not queue the answer to request {}", id);
-                }
-            });
-        });
+        on_command(*command);
+    } else if (auto* joystick = std::get_if<protocol::Joystick>(&*decoded.message)) {
+        on_joystick(*joystick);
+    } else if (auto* report = std::get_if<protocol::ReceptionReport>(&*decoded.message)) {
+        // A message needs about half a round trip to arrive; the margin covers the radios' buffering.
+        const auto lag = std::chrono::duration_cast<Duration>(
+            std::chrono::duration<double, std::milli>(driver_->stats().srtt_ms / 2 + 250));
+        delivery_.on_report(report->received, SteadyClock::now(), lag);
     }
-    // Other types from the ground are not expected yet; unknown types are skipped by design.
+    // Other types from the ground are not expected; unknown types are skipped by design.
+}
+
+void GroundlinkService::on_command(const protocol::Command& command) {
+    ++commands_;
+    const std::uint32_t id = command.request_id;
+    const Role role = keys_.role();
+    ctx_.commands.dispatch(command.request, role, [this, id](CommandResult result) {
+        asio::dispatch(strand(), [this, id, result = std::move(result)]() mutable {
+            if (result.status == CommandStatus::Forbidden) {
+                ++commands_refused_;
+                result.error += " (this ground station uses the monitor key; commands need the control key)";
+                spdlog::warn("groundlink: refused a command from a monitor: {}", result.error);
+            }
+            if (!driver_) {
+                return;
+            }
+            const auto bytes = protocol::encode(protocol::Result{id, result.to_json()});
+            const auto r = driver_->send_safe(protocol::kPriorityControl, bytes);
+            if (r != SendResult::accepted) {
+                spdlog::warn("groundlink: could not queue the answer to request {}", id);
+            }
+        });
+    });
+}
+
+void GroundlinkService::on_joystick(const protocol::Joystick& joystick) {
+    if (keys_.role() != Role::Control) {
+        if (joystick_refused_++ == 0) {
+            spdlog::warn("groundlink: joystick input from a monitor key refused");
+        }
+        return;
+    }
+    ++joystick_inputs_;
+    ctx_.bus.publish(autopilot::JoystickInput{joystick.steering, joystick.throttle});
 }
 
 void GroundlinkService::on_event(const TransportEvent& event) {
     switch (event.kind) {
         case TransportEvent::Kind::link_up:
-            spdlog::info("groundlink: link up");
+            spdlog::info("groundlink: link up ({} key)",
+                         keys_.role() == Role::Control ? "control" : "monitor");
             break;
         case TransportEvent::Kind::link_down:
             spdlog::warn("groundlink: link down");
             break;
         case TransportEvent::Kind::peer_restarted:
             spdlog::info("groundlink: the ground end restarted; session resynchronised");
+            delivery_.reset();
+            break;
+        case TransportEvent::Kind::session_established:
+            delivery_.reset();
             break;
         case TransportEvent::Kind::path_up:
             spdlog::info("groundlink: path {} up", event.path);
@@ -185,6 +266,22 @@ void GroundlinkService::on_event(const TransportEvent& event) {
     publish_status();  // the status document shows a link change at once, not at the next statistics tick
 }
 
+void GroundlinkService::send_event(protocol::Event::Severity severity, std::string text) {
+    if (!driver_ || !driver_->link_up()) {
+        return;  // events are for the operator watching now; a down link does not queue history
+    }
+    if (text.size() > protocol::kMaxEventText) {
+        text.resize(protocol::kMaxEventText);
+    }
+    const auto r =
+        driver_->send_safe(protocol::kPriorityStatus, protocol::encode(protocol::Event{severity, text}));
+    if (r == SendResult::accepted) {
+        ++events_sent_;
+    } else {
+        ++events_dropped_;
+    }
+}
+
 void GroundlinkService::do_stats() {
     const TimePoint now = SteadyClock::now();
     if (driver_) {
@@ -196,16 +293,7 @@ void GroundlinkService::do_stats() {
         }
         last_rx_bytes_ = rx;
         last_stats_at_ = now;
-        if (driver_->link_up()) {
-            protocol::LinkStatsReport report;
-            report.rtt_ms = static_cast<std::uint16_t>(std::min(65535.0, s.srtt_ms));
-            report.loss_permille = static_cast<std::uint16_t>(std::min(1000.0, s.frame_loss * 1000));
-            report.goodput_bps = static_cast<std::uint32_t>(goodput_bps_);
-            report.retransmissions = static_cast<std::uint32_t>(s.tx_safe.retransmissions);
-            report.mac_failures = static_cast<std::uint32_t>(s.mac_failures);
-            driver_->send_fast(protocol::kPriorityStatus, protocol::kTopicLinkStats,
-                               protocol::encode(report));
-        }
+        feed_scheduler(now);
     }
     update_health();
     publish_status();
@@ -215,6 +303,82 @@ void GroundlinkService::do_stats() {
             do_stats();
         }
     });
+}
+
+void GroundlinkService::feed_scheduler(TimePoint now) {
+    const auto& s = driver_->stats();
+    const auto fast = s.tx_fast.messages - last_fast_messages_;
+    const auto replaced = s.tx_fast.replaced + s.tx_fast.drops - last_fast_replaced_;
+    LinkQuality q;
+    q.up = driver_->link_up();
+    // What the ground says it received is the direct measure; the transport's Safe loss estimate stands in
+    // until the ground has reported enough (a ground end that does not report, or a slow rate).
+    q.loss = delivery_.loss().value_or(s.frame_loss);
+    q.replaced_share = fast > 0 ? static_cast<double>(replaced) / static_cast<double>(fast) : 0.0;
+    q.link_rate_bytes_per_s = transport_.link_rate_bytes_per_s;
+    last_fast_messages_ = s.tx_fast.messages;
+    last_fast_replaced_ = s.tx_fast.replaced + s.tx_fast.drops;
+    const auto mac = s.mac_failures - last_mac_failures_;
+    const auto valid = s.frames_received - last_frames_received_;
+    last_mac_failures_ = s.mac_failures;
+    last_frames_received_ = s.frames_received;
+    scheduler_.update_link(q, now);
+    arm_telemetry();
+    if (keys_.update(driver_->link_up(), mac, valid)) {
+        spdlog::info("groundlink: frames fail the MAC check; trying the {} key",
+                     keys_.role() == Role::Control ? "control" : "monitor");
+        make_driver();
+        attach_writers();
+    }
+}
+
+void GroundlinkService::arm_telemetry() {
+    const TimePoint next = scheduler_.poll_timeout();
+    if (next == telemetry_armed_for_) {
+        return;
+    }
+    telemetry_armed_for_ = next;
+    if (next == kNever) {
+        telemetry_timer_.cancel();
+        return;
+    }
+    telemetry_timer_.expires_at(next);
+    telemetry_timer_.async_wait([this](boost::system::error_code ec) {
+        if (!ec) {
+            telemetry_armed_for_ = kNever;
+            on_telemetry_timer();
+        }
+    });
+}
+
+void GroundlinkService::on_telemetry_timer() {
+    const TimePoint now = SteadyClock::now();
+    while (auto kind = scheduler_.poll_due(now)) {
+        if (!driver_ || !driver_->link_up()) {
+            continue;  // nobody listens: a sample queued now would only be stale when the link comes back
+        }
+        if (*kind == TelemetryKind::vehicle && vehicle_) {
+            driver_->send_fast(protocol::kPriorityTelemetry, protocol::kTopicTelemetry,
+                               protocol::encode(make_sample(*vehicle_, plan_)));
+            ++samples_sent_;
+            delivery_.on_pushed(now);
+        } else if (*kind == TelemetryKind::link_stats) {
+            send_link_stats(now);
+        }
+    }
+    arm_telemetry();
+}
+
+void GroundlinkService::send_link_stats(TimePoint now) {
+    const auto& s = driver_->stats();
+    protocol::LinkStatsReport report;
+    report.rtt_ms = static_cast<std::uint16_t>(std::min(65535.0, s.srtt_ms));
+    report.loss_permille = static_cast<std::uint16_t>(std::min(1000.0, s.frame_loss * 1000));
+    report.goodput_bps = static_cast<std::uint32_t>(goodput_bps_);
+    report.retransmissions = static_cast<std::uint32_t>(s.tx_safe.retransmissions);
+    report.mac_failures = static_cast<std::uint32_t>(s.mac_failures);
+    driver_->send_fast(protocol::kPriorityStatus, protocol::kTopicLinkStats, protocol::encode(report));
+    delivery_.on_pushed(now);
 }
 
 void GroundlinkService::update_health() {
@@ -270,7 +434,15 @@ void GroundlinkService::publish_status() {
     g["replays"] = s.replays;
     g["peer_restarts"] = s.peer_restarts;
     g["commands"] = commands_;
+    g["commands_refused"] = commands_refused_;
+    g["role"] = !s.authenticated ? "control (unauthenticated)" : to_string(keys_.role());
+    g["key_switches"] = keys_.switches();
+    g["joystick_inputs"] = joystick_inputs_;
+    g["joystick_refused"] = joystick_refused_;
+    g["events_sent"] = events_sent_;
+    g["events_dropped"] = events_dropped_;
     g["bad_messages"] = bad_messages_;
+    g["telemetry"] = rates_json();
     g["tx"] = {{"safe", class_json(s.tx_safe)}, {"fast", class_json(s.tx_fast)}};
     g["rx"] = {{"safe", class_json(s.rx_safe)}, {"fast", class_json(s.rx_fast)}};
     auto& paths = g["paths"] = nlohmann::json::array();

@@ -6,9 +6,15 @@
 #include <vector>
 
 #include "hal/udp_socket.hpp"
+#include "services/autopilot/autopilot.hpp"
 #include "services/common/port_keeper.hpp"
 #include "services/common/service.hpp"
+#include "services/groundlink/delivery_meter.hpp"
+#include "services/groundlink/key_selector.hpp"
 #include "services/groundlink/link/link_driver.hpp"
+#include "services/groundlink/protocol/ground_protocol.hpp"
+#include "services/groundlink/telemetry_sample.hpp"
+#include "services/groundlink/telemetry_scheduler.hpp"
 
 namespace airseg::groundlink {
 
@@ -19,6 +25,9 @@ struct GroundlinkServiceConfig {
     Duration reconnect_min = std::chrono::milliseconds(500);
     Duration reconnect_max = std::chrono::seconds(10);
     std::string key_file;  // empty: frames are not authenticated (status says so)
+    /// A second key whose holders may watch but not command (empty: none). Needs key_file.
+    std::string monitor_key_file;
+    TelemetrySchedulerConfig telemetry;
     hal::UdpConfig udp;
     TransportConfig transport;  // paths, path_mode, link rate, key and boot nonce are set by the service
     Duration stats_interval = std::chrono::seconds(1);
@@ -34,19 +43,52 @@ class GroundlinkService : public Service {
     void on_stop() override;
 
   private:
+    void make_driver();
+    void attach_writers();
+    void register_commands();
+    void subscribe_bus();
     void on_message(Delivered message);
+    void on_command(const protocol::Command& command);
+    void on_joystick(const protocol::Joystick& joystick);
     void on_event(const TransportEvent& event);
+    void send_event(protocol::Event::Severity severity, std::string text);
     void do_stats();
+    void feed_scheduler(TimePoint now);
+    void arm_telemetry();
+    void on_telemetry_timer();
+    void send_link_stats(TimePoint now);
     void update_health();
     void publish_status();
+    nlohmann::json rates_json() const;
 
     GroundlinkServiceConfig config_;
     std::unique_ptr<LinkDriver> driver_;
+    TransportConfig transport_;  // the running transport's configuration (its key changes with the role)
+    std::optional<std::array<std::uint8_t, kKeyBytes>> control_key_, monitor_key_;
+    KeySelector keys_{false};
+    TelemetryScheduler scheduler_;
+    DeliveryMeter delivery_;
+    asio::steady_timer telemetry_timer_;
+    TimePoint telemetry_armed_for_ = kNever;
+    std::optional<autopilot::Telemetry> vehicle_;
+    PlanProgressSample plan_;
+    std::vector<Subscription> subscriptions_;
+    bool commands_registered_ = false;
     std::vector<std::unique_ptr<PortKeeper>> keepers_;
     std::unique_ptr<hal::UdpSocket> udp_;
     asio::steady_timer stats_timer_;
     std::string fatal_;  // a configuration problem found at start (bad key file): the link stays down
     std::uint64_t last_rx_bytes_ = 0;
+    std::uint64_t last_mac_failures_ = 0;
+    std::uint64_t last_frames_received_ = 0;
+    std::uint64_t last_fast_messages_ = 0;
+    std::uint64_t last_fast_replaced_ = 0;
+    std::uint64_t samples_sent_ = 0;
+    std::uint64_t events_sent_ = 0;
+    std::uint64_t events_dropped_ = 0;
+    std::uint64_t commands_refused_ = 0;
+    std::uint64_t joystick_inputs_ = 0;
+    std::uint64_t joystick_refused_ = 0;
     TimePoint last_stats_at_{};
     double goodput_bps_ = 0;
     std::uint64_t commands_ = 0;

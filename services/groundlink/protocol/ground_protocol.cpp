@@ -1,6 +1,7 @@
 #include "services/groundlink/protocol/ground_protocol.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace airseg::groundlink::protocol {
@@ -126,6 +127,7 @@ bool cbor_nesting_ok(std::span<const std::uint8_t> b, std::size_t max_depth) {
 constexpr std::size_t kMaxCborDepth = 32;
 constexpr std::size_t kTelemetryBody = 27;
 constexpr std::size_t kLinkStatsBody = 16;
+constexpr std::size_t kJoystickBody = 4;
 
 void encode_body(Writer& w, const Telemetry& t) {
     w.le(twos(clamp_round<std::int64_t>(t.lat_deg * 1e7, -900000000, 900000000), 4), 4);
@@ -205,6 +207,13 @@ std::vector<std::uint8_t> encode(const Message& message) {
                 w.u8(static_cast<std::uint8_t>(MessageType::result));
                 w.le(m.request_id, 4);
                 w.bytes(nlohmann::json::to_cbor(m.answer));
+            } else if constexpr (std::is_same_v<T, Joystick>) {
+                w.u8(static_cast<std::uint8_t>(MessageType::joystick));
+                w.le(twos(clamp_round<std::int64_t>(m.steering * 10000, -10000, 10000), 2), 2);
+                w.le(twos(clamp_round<std::int64_t>(m.throttle * 10000, -10000, 10000), 2), 2);
+            } else if constexpr (std::is_same_v<T, ReceptionReport>) {
+                w.u8(static_cast<std::uint8_t>(MessageType::reception));
+                w.le(m.received, 4);
             } else {
                 w.u8(m.type);
             }
@@ -288,9 +297,86 @@ DecodeResult decode(std::span<const std::uint8_t> bytes) {
             }
             return out;
         }
+        case MessageType::joystick: {
+            if (body < kJoystickBody) {
+                out.error = "joystick body too short";
+                return out;
+            }
+            Joystick j;
+            j.steering = static_cast<double>(std::clamp<std::int64_t>(r.sle(2), -10000, 10000)) / 10000.0;
+            j.throttle = static_cast<double>(std::clamp<std::int64_t>(r.sle(2), -10000, 10000)) / 10000.0;
+            out.message = j;
+            return out;
+        }
+        case MessageType::reception: {
+            if (body < 4) {
+                out.error = "reception report body too short";
+                return out;
+            }
+            out.message = ReceptionReport{static_cast<std::uint32_t>(r.le(4))};
+            return out;
+        }
     }
     out.message = Unknown{type};
     return out;
+}
+
+namespace {
+
+constexpr std::array<const char*, 7> kVehicleStates{"UNKNOWN",  "CONFIGURE_CHECK",   "PARKING",
+                                                    "DIRECTED", "MANUAL_NAVIGATION", "WAYPOINT_NAVIGATION",
+                                                    "MANUAL"};
+
+struct ModeEntry {
+    std::uint8_t code;
+    const char* name;
+};
+constexpr std::array<ModeEntry, 12> kRoverModes{{{0, "MANUAL"},
+                                                 {1, "ACRO"},
+                                                 {3, "STEERING"},
+                                                 {4, "HOLD"},
+                                                 {5, "LOITER"},
+                                                 {6, "FOLLOW"},
+                                                 {7, "SIMPLE"},
+                                                 {10, "AUTO"},
+                                                 {11, "RTL"},
+                                                 {12, "SMART_RTL"},
+                                                 {15, "GUIDED"},
+                                                 {16, "INITIALISING"}}};
+
+}  // namespace
+
+const char* vehicle_state_name(std::uint8_t code) {
+    return code < kVehicleStates.size() ? kVehicleStates[code] : "?";
+}
+
+std::uint8_t mode_code(std::string_view name) {
+    for (const auto& m : kRoverModes) {
+        if (name == m.name) {
+            return m.code;
+        }
+    }
+    // A mode the table does not name arrives as "MODE(n)".
+    if (name.starts_with("MODE(") && name.ends_with(")") && name.size() > 6 && name.size() <= 9) {
+        unsigned v = 0;
+        for (char c : name.substr(5, name.size() - 6)) {
+            if (c < '0' || c > '9') {
+                return kModeUnknown;
+            }
+            v = v * 10 + static_cast<unsigned>(c - '0');
+        }
+        return v < kModeUnknown ? static_cast<std::uint8_t>(v) : kModeUnknown;
+    }
+    return kModeUnknown;
+}
+
+const char* mode_name(std::uint8_t code) {
+    for (const auto& m : kRoverModes) {
+        if (code == m.code) {
+            return m.name;
+        }
+    }
+    return "?";
 }
 
 }  // namespace airseg::groundlink::protocol

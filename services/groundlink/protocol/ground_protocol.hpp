@@ -6,6 +6,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -22,6 +23,8 @@ inline constexpr std::uint8_t kPriorityStatus = 2;     // link statistics, event
 inline constexpr std::uint8_t kPriorityBulk = 3;       // flight plans, parameter lists
 inline constexpr std::uint16_t kTopicTelemetry = 1;
 inline constexpr std::uint16_t kTopicLinkStats = 2;
+inline constexpr std::uint16_t kTopicJoystick = 3;
+inline constexpr std::uint16_t kTopicReception = 4;
 
 enum class MessageType : std::uint8_t {
     telemetry = 0x01,
@@ -29,6 +32,8 @@ enum class MessageType : std::uint8_t {
     event = 0x04,
     command = 0x10,
     result = 0x11,
+    joystick = 0x12,
+    reception = 0x13,
 };
 
 /// One vehicle telemetry sample. Units are chosen so the whole message fits 29 bytes.
@@ -84,12 +89,29 @@ struct Result {
     bool operator==(const Result&) const = default;
 };
 
+/// Operator stick input from the ground, sent as a Fast message at a fixed rate while the operator drives.
+/// Each axis -1..1, carried in 1/10000 steps.
+struct Joystick {
+    double steering = 0;
+    double throttle = 0;
+    bool operator==(const Joystick&) const = default;
+};
+
+/// The ground end's count of pushed telemetry messages (telemetry samples and link statistics) received since
+/// its transport session began, sent once a second: the vehicle compares it with what it pushed to measure
+/// what the link really delivers.
+struct ReceptionReport {
+    std::uint32_t received = 0;
+    bool operator==(const ReceptionReport&) const = default;
+};
+
 struct Unknown {
     std::uint8_t type = 0;
     bool operator==(const Unknown&) const = default;
 };
 
-using Message = std::variant<Telemetry, LinkStatsReport, Event, Command, Result, Unknown>;
+using Message =
+    std::variant<Telemetry, LinkStatsReport, Event, Command, Result, Joystick, ReceptionReport, Unknown>;
 
 std::vector<std::uint8_t> encode(const Message& message);
 
@@ -99,5 +121,15 @@ struct DecodeResult {
 };
 
 DecodeResult decode(std::span<const std::uint8_t> bytes);
+
+/// Wire codes of the telemetry's vehicle_state nibble (the autopilot-neutral states, in the order of
+/// autopilot::VehicleState) and their names.
+const char* vehicle_state_name(std::uint8_t code);
+
+/// Wire codes of the telemetry's mode byte: ArduPilot Rover's mode numbers; kModeUnknown when the name is not
+/// one of them.
+inline constexpr std::uint8_t kModeUnknown = 255;
+std::uint8_t mode_code(std::string_view name);
+const char* mode_name(std::uint8_t code);  // "?" for codes without a name
 
 }  // namespace airseg::groundlink::protocol

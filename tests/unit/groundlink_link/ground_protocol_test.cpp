@@ -141,5 +141,46 @@ TEST(GroundProtocol, RandomBytesNeverCrash) {
     }
 }
 
+TEST(GroundProtocol, JoystickRoundTripsAndClamps) {
+    const auto bytes = encode(Joystick{-0.5, 0.25});
+    ASSERT_EQ(bytes.size(), 6u);
+    EXPECT_EQ(bytes[1], 0x12);
+    // steering -5000 = 0xEC78, little-endian.
+    EXPECT_EQ(bytes[2], 0x78);
+    EXPECT_EQ(bytes[3], 0xEC);
+    auto d = decode(bytes);
+    ASSERT_TRUE(d.message) << d.error;
+    EXPECT_EQ(std::get<Joystick>(*d.message), (Joystick{-0.5, 0.25}));
+
+    auto clamped = decode(encode(Joystick{3.0, -7.0}));
+    EXPECT_EQ(std::get<Joystick>(*clamped.message), (Joystick{1.0, -1.0}));
+    // A hostile peer's out-of-range axes are clamped on decoding too.
+    std::vector<std::uint8_t> wild{kVersion, 0x12, 0xff, 0x7f, 0x00, 0x80};
+    EXPECT_EQ(std::get<Joystick>(*decode(wild).message), (Joystick{1.0, -1.0}));
+    std::vector<std::uint8_t> short_body{kVersion, 0x12, 0x00};
+    EXPECT_FALSE(decode(short_body).message);
+}
+
+TEST(GroundProtocol, ReceptionReportRoundTrips) {
+    const auto bytes = encode(ReceptionReport{0x01020304});
+    ASSERT_EQ(bytes.size(), 6u);
+    EXPECT_EQ(bytes[1], 0x13);
+    EXPECT_EQ(bytes[2], 0x04);
+    EXPECT_EQ(bytes[5], 0x01);
+    EXPECT_EQ(std::get<ReceptionReport>(*decode(bytes).message), ReceptionReport{0x01020304});
+    EXPECT_FALSE(decode(std::vector<std::uint8_t>{kVersion, 0x13, 1, 2}).message);
+}
+
+TEST(GroundProtocol, StateAndModeNames) {
+    EXPECT_STREQ(vehicle_state_name(4), "MANUAL_NAVIGATION");
+    EXPECT_STREQ(vehicle_state_name(15), "?");
+    EXPECT_EQ(mode_code("AUTO"), 10);
+    EXPECT_STREQ(mode_name(10), "AUTO");
+    EXPECT_EQ(mode_code("MODE(9)"), 9);
+    EXPECT_EQ(mode_code("MODE(x)"), kModeUnknown);
+    EXPECT_EQ(mode_code("MODE(999)"), kModeUnknown);
+    EXPECT_STREQ(mode_name(200), "?");
+}
+
 }  // namespace
 }  // namespace airseg::groundlink::protocol

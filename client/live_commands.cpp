@@ -1,0 +1,186 @@
+#include "client/live_commands.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <iostream>
+
+#include "client/stick_input.hpp"
+#include "client/watch_view.hpp"
+
+namespace airseg::client {
+
+namespace proto = groundlink::protocol;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+volatile std::sig_atomic_t g_stop = 0;
+
+constexpr int kDone = 0;
+constexpr int kRefused = 1;
+constexpr int kNoLink = 3;
+
+bool expired(const LiveOptions& o, Clock::time_point started) {
+    return o.duration.count() > 0 && Clock::now() - started >= o.duration;
+}
+
+/// Waits until the link is up (the vehicle pushes nothing before); false after the timeout.
+bool wait_for_link(RadioClient& radio, const LiveOptions& o,
+                   const std::function<void(const proto::Message&)>& on_message) {
+    const auto deadline = Clock::now() + o.timeout;
+    while (!radio.link_up() && g_stop == 0) {
+        if (Clock::now() >= deadline) {
+            std::cerr << "airsegctl: no link to the vehicle within " << o.timeout.count() << " ms\n";
+            return false;
+        }
+        radio.run_for(std::chrono::milliseconds(50), on_message);
+    }
+    return true;
+}
+
+}  // namespace
+
+void install_stop_handlers() {
+    std::signal(SIGINT, [](int) { g_stop = 1; });
+    std::signal(SIGTERM, [](int) { g_stop = 1; });
+}
+
+bool stop_requested() {
+    return g_stop != 0;
+}
+
+int run_radio_watch(RadioClient& radio, const LiveOptions& o) {
+    WatchState state;
+    auto take = [&state](const proto::Message& m) { state.take(m, Clock::now()); };
+    if (!wait_for_link(radio, o, take)) {
+        return kNoLink;
+    }
+    const bool tty = ::isatty(STDOUT_FILENO) == 1;
+    const auto started = Clock::now();
+    if (tty && !o.json) {
+        std::cout
+            << "\x1b[?25l\x1b[2J";  // hide the cursor, clear once; each refresh then overwrites in place
+    }
+    while (g_stop == 0 && !expired(o, started)) {
+        radio.run_for(o.refresh, take);
+        state.set_ground_link(radio.link_stats());
+        const auto now = Clock::now();
+        if (o.json) {
+            std::cout << state.to_json(now).dump() << "\n" << std::flush;
+        } else if (tty) {
+            // Home, then each line cleared to its end, then the rest of the screen: no flicker.
+            std::string screen = state.render(now);
+            std::string framed = "\x1b[H";
+            for (std::size_t start = 0; start < screen.size();) {
+                const auto nl = screen.find('\n', start);
+                framed += screen.substr(start, nl - start) + "\x1b[K\n";
+                start = nl == std::string::npos ? screen.size() : nl + 1;
+            }
+            std::cout << framed << "\x1b[J" << std::flush;
+        } else {
+            std::cout << state.render(now) << "\n" << std::flush;
+        }
+    }
+    if (tty && !o.json) {
+        std::cout << "\x1b[?25h" << std::flush;
+    }
+    return kDone;
+}
+
+int run_log(RadioClient& radio, const LiveOptions& o) {
+    auto print = [&o](const proto::Message& m) {
+        const auto* e = std::get_if<proto::Event>(&m);
+        if (e == nullptr) {
+            return;
+        }
+        if (o.json) {
+            const char* sev = e->severity == proto::Event::Severity::error     ? "error"
+                              : e->severity == proto::Event::Severity::warning ? "warning"
+                                                                               : "info";
+            std::cout << nlohmann::json{{"severity", sev}, {"text", e->text}}.dump() << "\n" << std::flush;
+        } else {
+            std::cout << event_line(*e) << "\n" << std::flush;
+        }
+    };
+    if (!wait_for_link(radio, o, print)) {
+        return kNoLink;
+    }
+    const auto started = Clock::now();
+    while (g_stop == 0 && !expired(o, started)) {
+        radio.run_for(std::chrono::milliseconds(100), print);
+    }
+    return kDone;
+}
+
+int run_joystick(RadioClient& radio, const LiveOptions& o, const JoystickOptions& j) {
+    std::string error;
+    // The first input is a command: the vehicle acknowledges that this station may drive (a monitor key is
+    // refused here, before any stick input is streamed).
+    auto first = radio.request({{"cmd", "joystick"}, {"steering", 0.0}, {"throttle", 0.0}}, o.timeout);
+    if (!first.answer) {
+        std::cerr << "airsegctl: " << first.error << "\n";
+        return kNoLink;
+    }
+    if (!first.answer->value("ok", false)) {
+        std::cerr << "airsegctl: refused: " << first.answer->value("error", std::string("no reason given"))
+                  << "\n";
+        if (o.json) {
+            std::cout << first.answer->dump() << "\n";
+        }
+        return kRefused;
+    }
+    const auto state = (*first.answer)["result"].value("state", std::string("?"));
+    auto source = StickSource::open(j.device, error);
+    if (!source) {
+        std::cerr << "airsegctl: " << error << "\n";
+        return 2;
+    }
+    if (!o.json) {
+        std::cerr << "vehicle acknowledged joystick control (state " << state << "); "
+                  << (source->keyboard() ? "w/s/a/d or arrows drive, space centres, q quits"
+                                         : "driving from " + j.device)
+                  << "\r\n";
+    }
+    WatchState view;
+    auto take = [&view](const proto::Message& m) { view.take(m, Clock::now()); };
+    const auto period =
+        std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::duration<double>(1.0 / j.rate_hz));
+    const auto started = Clock::now();
+    std::uint64_t sent = 0;
+    bool device_gone = false;
+    while (g_stop == 0 && !expired(o, started)) {
+        if (!source->poll()) {
+            device_gone = true;
+            break;
+        }
+        const Stick s = source->stick();
+        if (s.quit) {
+            break;
+        }
+        radio.send_joystick(s.steering, s.throttle);
+        ++sent;
+        radio.run_for(period, take);
+        if (!o.json && ::isatty(STDERR_FILENO) == 1) {
+            const auto& t = view.latest();
+            std::cerr << fmt::format("\rsteering {:+.2f} throttle {:+.2f}  {} {:.1f} m/s  link {}\x1b[K",
+                                     s.steering, s.throttle,
+                                     t ? proto::vehicle_state_name(t->vehicle_state) : "?",
+                                     t ? t->ground_speed_mps : 0.0, radio.link_up() ? "up" : "DOWN");
+        }
+    }
+    // Let the last input leave before the process (and its transport) goes.
+    radio.run_for(std::chrono::milliseconds(200), take);
+    const std::string why = device_gone ? "the input device closed" : "stopped";
+    if (o.json) {
+        std::cout << nlohmann::json{{"inputs_sent", sent}, {"ended", why}}.dump() << "\n";
+    } else {
+        std::cerr << "\r\n"
+                  << why << " after " << sent
+                  << " inputs; the vehicle releases the override after its input timeout\n";
+    }
+    return kDone;
+}
+
+}  // namespace airseg::client

@@ -1,0 +1,33 @@
+#pragma once
+// airsegctl's commands that live on the radio link: watch (pushed telemetry in a screen refreshed in
+// place), log (events and autopilot texts as they come) and joystick (operator input at a fixed rate).
+#include <chrono>
+#include <string>
+
+#include "client/radio_client.hpp"
+
+namespace airseg::client {
+
+struct LiveOptions {
+    bool json = false;
+    std::chrono::milliseconds timeout{5000};
+    std::chrono::milliseconds refresh{500};
+    /// Stop after this long (0: until Ctrl-C); for scripts and tests.
+    std::chrono::milliseconds duration{0};
+};
+
+/// Exit codes as everywhere in airsegctl: 0 done, 1 refused, 2 usage, 3 no link.
+int run_radio_watch(RadioClient& radio, const LiveOptions& options);
+int run_log(RadioClient& radio, const LiveOptions& options);
+
+struct JoystickOptions {
+    std::string device;  // /dev/input/jsN; empty = keyboard
+    double rate_hz = 10;
+};
+int run_joystick(RadioClient& radio, const LiveOptions& options, const JoystickOptions& joystick);
+
+/// Installs SIGINT/SIGTERM handlers that end the live commands cleanly.
+void install_stop_handlers();
+bool stop_requested();
+
+}  // namespace airseg::client

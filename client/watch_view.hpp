@@ -1,0 +1,47 @@
+#pragma once
+// airsegctl watch over the radio: what the vehicle pushes (telemetry samples, its link statistics, events)
+// gathered into one picture, and that picture as a screen of text or as one JSON line.
+#include <chrono>
+#include <deque>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "services/groundlink/protocol/ground_protocol.hpp"
+
+namespace airseg::client {
+
+class WatchState {
+  public:
+    using Clock = std::chrono::steady_clock;
+    static constexpr std::size_t kRecentEvents = 8;
+
+    /// Takes one message from the vehicle, received at `now`.
+    void take(const groundlink::protocol::Message& message, Clock::time_point now);
+    /// The ground end's own view of the link (RadioClient::link_stats()).
+    void set_ground_link(nlohmann::json stats) { ground_link_ = std::move(stats); }
+
+    /// Samples per second over the last few seconds.
+    [[nodiscard]] double sample_rate(Clock::time_point now) const;
+    [[nodiscard]] std::uint64_t samples() const { return samples_; }
+    [[nodiscard]] const std::optional<groundlink::protocol::Telemetry>& latest() const { return latest_; }
+
+    [[nodiscard]] std::string render(Clock::time_point now) const;
+    [[nodiscard]] nlohmann::json to_json(Clock::time_point now) const;
+
+  private:
+    std::optional<groundlink::protocol::Telemetry> latest_;
+    Clock::time_point latest_at_{};
+    std::deque<Clock::time_point> sample_times_;
+    std::uint64_t samples_ = 0;
+    std::optional<groundlink::protocol::LinkStatsReport> vehicle_link_;
+    std::deque<std::string> events_;
+    nlohmann::json ground_link_ = nlohmann::json::object();
+};
+
+/// A telemetry sample as JSON (state and mode by name, position, speeds, battery, GPS, plan progress).
+nlohmann::json telemetry_json(const groundlink::protocol::Telemetry& t);
+/// An event as one line for people: "warning: text".
+std::string event_line(const groundlink::protocol::Event& e);
+
+}  // namespace airseg::client

@@ -1,0 +1,158 @@
+// The ground-link service's commands (telemetry rates, joystick) and what it forwards from the bus to the
+// ground (vehicle telemetry samples, events and autopilot texts).
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "services/groundlink/groundlink_messages.hpp"
+#include "services/groundlink/groundlink_service.hpp"
+
+namespace airseg::groundlink {
+
+namespace {
+
+double rounded(double v) {
+    return std::round(v * 1000) / 1000;
+}
+
+protocol::Event::Severity severity_of(int mav_severity) {
+    // MAV_SEVERITY: 0..3 emergency..error, 4 warning, 5.. notice, info, debug.
+    if (mav_severity <= 3) {
+        return protocol::Event::Severity::error;
+    }
+    return mav_severity == 4 ? protocol::Event::Severity::warning : protocol::Event::Severity::info;
+}
+
+}  // namespace
+
+nlohmann::json GroundlinkService::rates_json() const {
+    nlohmann::json requested, effective;
+    for (auto k : kAllTelemetryKinds) {
+        requested[to_string(k)] = rounded(scheduler_.requested_hz(k));
+        effective[to_string(k)] = rounded(scheduler_.effective_hz(k));
+    }
+    return {
+        {"requested_hz", requested},
+        {"effective_hz", effective},
+        {"factor", scheduler_.factor()},
+        {"weak_link", scheduler_.weak()},
+        {"budget_bytes_per_s", std::round(scheduler_.budget_bytes_per_s())},
+        {"lowerings", scheduler_.lowerings()},
+        {"restorations", scheduler_.restorations()},
+        {"samples_sent", samples_sent_},
+        {"delivery_loss", delivery_.loss() ? nlohmann::json(rounded(*delivery_.loss())) : nlohmann::json()}};
+}
+
+void GroundlinkService::register_commands() {
+    if (commands_registered_) {
+        return;
+    }
+    commands_registered_ = true;
+    ctx_.commands.add("rates", strand(), Role::Monitor, [this](const Json&, CommandDispatcher::Reply reply) {
+        reply(CommandResult::ok(rates_json()));
+    });
+    ctx_.commands.add(
+        "rates.set", strand(), Role::Control, [this](const Json& req, CommandDispatcher::Reply reply) {
+            const auto it = req.find("rates");
+            if (it == req.end() || !it->is_object() || it->empty()) {
+                reply(CommandResult::fail(
+                    CommandStatus::BadRequest,
+                    "\"rates\" must be an object of KIND: HZ (kinds: vehicle, link_stats)"));
+                return;
+            }
+            std::vector<std::pair<TelemetryKind, double>> changes;
+            for (const auto& [name, value] : it->items()) {
+                const auto kind = telemetry_kind_from_string(name);
+                if (!kind) {
+                    reply(CommandResult::fail(CommandStatus::BadRequest,
+                                              "unknown telemetry kind '" + name + "' (vehicle, link_stats)"));
+                    return;
+                }
+                const double hz = value.is_number() ? value.get<double>() : -1.0;
+                if (!(hz >= 0 && hz <= TelemetrySchedulerConfig::kMaxHz)) {
+                    reply(CommandResult::fail(CommandStatus::BadRequest,
+                                              fmt::format("{}: rate must be a number of Hz in 0..{}", name,
+                                                          TelemetrySchedulerConfig::kMaxHz)));
+                    return;
+                }
+                changes.emplace_back(*kind, hz);
+            }
+            const TimePoint now = SteadyClock::now();
+            for (const auto& [kind, hz] : changes) {
+                scheduler_.set_rate(kind, hz, now);
+            }
+            arm_telemetry();
+            publish_status();
+            reply(CommandResult::ok(rates_json()));
+        });
+    ctx_.commands.add(
+        "joystick", strand(), Role::Control, [this](const Json& req, CommandDispatcher::Reply reply) {
+            auto axis = [&req](const char* name) -> std::optional<double> {
+                const auto it = req.find(name);
+                if (it == req.end()) {
+                    return 0.0;
+                }
+                if (!it->is_number() || !(it->get<double>() >= -1.0 && it->get<double>() <= 1.0)) {
+                    return std::nullopt;
+                }
+                return it->get<double>();
+            };
+            const auto steering = axis("steering");
+            const auto throttle = axis("throttle");
+            if (!steering || !throttle) {
+                reply(CommandResult::fail(CommandStatus::BadRequest,
+                                          "\"steering\" and \"throttle\" must be -1..1"));
+                return;
+            }
+            ++joystick_inputs_;
+            ctx_.bus.publish(autopilot::JoystickInput{*steering, *throttle});
+            nlohmann::json result{{"steering", *steering}, {"throttle", *throttle}};
+            if (vehicle_) {
+                result["state"] = protocol::vehicle_state_name(static_cast<std::uint8_t>(vehicle_->state));
+            }
+            reply(CommandResult::ok(std::move(result)));
+        });
+}
+
+void GroundlinkService::subscribe_bus() {
+    auto& bus = ctx_.bus;
+    using Sev = protocol::Event::Severity;
+    subscriptions_.push_back(bus.subscribe<autopilot::Telemetry>(
+        strand(), [this](const autopilot::Telemetry& t) { vehicle_ = t; }));
+    subscriptions_.push_back(
+        bus.subscribe<PlanProgressSample>(strand(), [this](const PlanProgressSample& p) { plan_ = p; }));
+    subscriptions_.push_back(
+        bus.subscribe<TelemetryConfigChanged>(strand(), [this](const TelemetryConfigChanged& c) {
+            config_.telemetry = c.config;
+            scheduler_.set_config(c.config, SteadyClock::now());
+            arm_telemetry();
+            publish_status();
+        }));
+    subscriptions_.push_back(
+        bus.subscribe<autopilot::ModeChanged>(strand(), [this](const autopilot::ModeChanged& m) {
+            send_event(Sev::info,
+                       fmt::format("{} -> {} ({} -> {}{})", autopilot::to_string(m.from),
+                                   autopilot::to_string(m.to), m.from_mode, m.to_mode,
+                                   m.cause == autopilot::ModeChangeCause::External ? ", external" : ""));
+        }));
+    subscriptions_.push_back(
+        bus.subscribe<autopilot::StatusText>(strand(), [this](const autopilot::StatusText& t) {
+            send_event(severity_of(t.severity), "autopilot: " + t.text);
+        }));
+    subscriptions_.push_back(bus.subscribe<autopilot::LinkUp>(
+        strand(), [this](const autopilot::LinkUp&) { send_event(Sev::info, "autopilot link up"); }));
+    subscriptions_.push_back(
+        bus.subscribe<autopilot::LinkDown>(strand(), [this](const autopilot::LinkDown& d) {
+            send_event(Sev::error, "autopilot link down: " + d.reason);
+        }));
+    subscriptions_.push_back(
+        bus.subscribe<autopilot::AutopilotRebooted>(strand(), [this](const autopilot::AutopilotRebooted& r) {
+            send_event(Sev::warning, "autopilot rebooted: " + r.evidence);
+        }));
+    subscriptions_.push_back(
+        bus.subscribe<autopilot::WaypointReached>(strand(), [this](const autopilot::WaypointReached& w) {
+            send_event(Sev::info, fmt::format("mission slot {} reached", w.seq));
+        }));
+}
+
+}  // namespace airseg::groundlink

@@ -1,0 +1,20 @@
+#pragma once
+// The vehicle telemetry sample pushed to the ground, made from the autopilot's neutral telemetry.
+#include "services/autopilot/autopilot.hpp"
+#include "services/groundlink/protocol/ground_protocol.hpp"
+
+namespace airseg::groundlink {
+
+/// Flight plan progress as the sample carries it (plan_state 0 none, 1 running, 2 paused, 3 done). Also the
+/// bus variable (publish_latest) through which a flight plan service hands its progress to the ground link.
+struct PlanProgressSample {
+    std::uint8_t plan_state = 0;
+    std::uint16_t element = 0;
+    std::uint32_t next_waypoint = 0;
+};
+
+/// Angles in radians become whole degrees; the mode name becomes its wire code (protocol::mode_code); a
+/// missing position leaves latitude and longitude 0 (the GPS fix says whether they mean anything).
+protocol::Telemetry make_sample(const autopilot::Telemetry& t, const PlanProgressSample& plan = {});
+
+}  // namespace airseg::groundlink

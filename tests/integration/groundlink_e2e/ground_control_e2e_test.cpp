@@ -1,0 +1,379 @@
+// The operator's side over the radio, end to end on real ptys: airseg-apmsim ⇄ airsegd ⇄ airseg-linksim
+// (57600 baud) ⇄ airsegctl. Pushed telemetry, roles by key, joystick driving, and a lossy link.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "tests/support/process.hpp"
+
+namespace airseg::test {
+namespace {
+
+using Json = nlohmann::json;
+constexpr auto kGenerous = 60s;
+constexpr double kHomeLat = 41.2756;
+constexpr double kHomeLon = 1.9866;
+
+/// The simulator's control socket: one datagram per command, the reply comes back to our bound address.
+class SimControl {
+  public:
+    SimControl(std::string own, std::string server) : own_(std::move(own)), server_(std::move(server)) {
+        fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+        sockaddr_un a = address(own_);
+        ::unlink(own_.c_str());
+        ::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a);
+    }
+    ~SimControl() {
+        ::close(fd_);
+        ::unlink(own_.c_str());
+    }
+    SimControl(const SimControl&) = delete;
+    SimControl& operator=(const SimControl&) = delete;
+
+    Json json(const std::string& text) {
+        sockaddr_un a = address(server_);
+        if (::sendto(fd_, text.data(), text.size(), 0, reinterpret_cast<sockaddr*>(&a), sizeof a) < 0) {
+            return Json::object();
+        }
+        pollfd p{fd_, POLLIN, 0};
+        if (::poll(&p, 1, 5000) <= 0) {
+            return Json::object();
+        }
+        char buf[65536];
+        const auto n = ::recv(fd_, buf, sizeof buf, 0);
+        auto j = Json::parse(std::string(buf, n > 0 ? static_cast<std::size_t>(n) : 0), nullptr, false);
+        return j.is_discarded() ? Json::object() : j;
+    }
+
+  private:
+    static sockaddr_un address(const std::string& path) {
+        sockaddr_un a{};
+        a.sun_family = AF_UNIX;
+        std::strncpy(a.sun_path, path.c_str(), sizeof a.sun_path - 1);
+        return a;
+    }
+    std::string own_, server_;
+    int fd_ = -1;
+};
+
+bool exists(const std::string& path) {
+    struct stat st {};
+    return ::stat(path.c_str(), &st) == 0;
+}
+
+std::vector<Json> json_lines(const std::string& text) {
+    std::vector<Json> out;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) {
+        auto j = Json::parse(line, nullptr, false);
+        if (!j.is_discarded()) {
+            out.push_back(std::move(j));
+        }
+    }
+    return out;
+}
+
+class GroundControlE2e : public ::testing::Test {
+  protected:
+    void TearDown() override {
+        if (daemon && daemon->running()) {
+            daemon->signal(SIGTERM);
+            daemon->wait_exit(10s);
+        }
+    }
+
+    void start_link(std::vector<std::string> impairments = {}) {
+        std::vector<std::string> args{binary("tools/linksim/airseg-linksim"),
+                                      "--a",
+                                      dir.file("air"),
+                                      "--b",
+                                      ground(),
+                                      "--baud",
+                                      "57600",
+                                      "--seed",
+                                      "11",
+                                      "--control",
+                                      dir.file("linksim.ctl")};
+        args.insert(args.end(), impairments.begin(), impairments.end());
+        linksim = std::make_unique<Subprocess>(args, std::map<std::string, std::string>{}, dir.path());
+        ASSERT_TRUE(wait_until([&] { return exists(dir.file("air")) && exists(ground()); }))
+            << linksim->err();
+    }
+
+    void start_sim() {
+        sim = std::make_unique<Subprocess>(
+            std::vector<std::string>{binary("tools/apmsim/airseg-apmsim"), "--link", dir.file("ttyACM0"),
+                                     "--control", dir.file("sim.ctl"), "--home",
+                                     std::to_string(kHomeLat) + "," + std::to_string(kHomeLon),
+                                     "--boot-delay", "0.5", "--calib-time", "0.5", "--quiet"},
+            std::map<std::string, std::string>{}, dir.path());
+        ASSERT_TRUE(wait_until([&] { return exists(dir.file("ttyACM0")) && exists(dir.file("sim.ctl")); }))
+            << sim->err();
+        sim_control = std::make_unique<SimControl>(dir.file("me.ctl"), dir.file("sim.ctl"));
+    }
+
+    void start_daemon(std::vector<std::string> extra = {}) {
+        std::vector<std::string> args{binary("daemon/airsegd"),
+                                      "--config",
+                                      source_path("config/airseg.yaml"),
+                                      "--set",
+                                      "status.socket=" + dir.file("status.sock"),
+                                      "--set",
+                                      "state_dir=" + dir.file("state"),
+                                      "--set",
+                                      "autopilot.port=" + dir.file("ttyACM0"),
+                                      "--set",
+                                      "autopilot.reconnect_max=500ms",
+                                      "--set",
+                                      "groundlink.ports=[" + dir.file("air") + "]"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        daemon = std::make_unique<Subprocess>(args, std::map<std::string, std::string>{}, dir.path());
+    }
+
+    /// airsegctl over the radio; `key` empty = unkeyed link.
+    RunResult ctl(std::vector<std::string> args, const std::string& key = {}, long timeout_ms = 30'000) {
+        std::vector<std::string> argv{binary("client/airsegctl"), "--link", ground(), "--timeout",
+                                      std::to_string(timeout_ms), "--json"};
+        if (!key.empty()) {
+            argv.insert(argv.end(), {"--key", key});
+        }
+        argv.insert(argv.end(), args.begin(), args.end());
+        return run(argv, {}, std::chrono::milliseconds(timeout_ms + 60'000));
+    }
+
+    Json status_doc(const std::string& key = {}) {
+        auto r = ctl({"status"}, key);
+        auto j = Json::parse(r.out, nullptr, false);
+        return r.exit_code == 0 && !j.is_discarded() ? j : Json::object();
+    }
+
+    std::string key_file(const std::string& name, char fill) {
+        const auto path = dir.file(name);
+        write_file(path, std::string(64, fill) + "\n");
+        ::chmod(path.c_str(), 0600);
+        return path;
+    }
+
+    std::string ground() const { return dir.file("ground"); }
+
+    TempDir dir;
+    std::unique_ptr<Subprocess> linksim, sim, daemon;
+    std::unique_ptr<SimControl> sim_control;
+};
+
+TEST_F(GroundControlE2e, StatusAndPushedTelemetryOverTheRadio) {
+    start_link();
+    start_sim();
+    start_daemon();
+    Json doc;
+    ASSERT_TRUE(wait_until(
+        [&] {
+            doc = status_doc();
+            return doc.value("autopilot", Json::object()).value("ready", false) &&
+                   doc["autopilot"]["position"].is_object();
+        },
+        kGenerous, 500ms))
+        << doc.dump() << "\ndaemon:\n"
+        << daemon->err();
+    EXPECT_TRUE(doc["autopilot"]["state"].is_string());
+    EXPECT_NEAR(doc["autopilot"]["position"]["lat"].get<double>(), kHomeLat, 1e-3);
+    EXPECT_EQ(doc["groundlink"]["link"], "up");
+    EXPECT_GE(doc["groundlink"]["frames_received"].get<int>(), 1);
+    EXPECT_EQ(doc["groundlink"]["telemetry"]["effective_hz"]["vehicle"], 2.0);
+
+    // watch over the radio: the pushed samples, not the status document.
+    auto watch = ctl({"watch", "--duration", "6000"});
+    ASSERT_EQ(watch.exit_code, 0) << watch.err;
+    const auto lines = json_lines(watch.out);
+    ASSERT_FALSE(lines.empty()) << watch.out;
+    const auto& last = lines.back();
+    EXPECT_GE(last["samples"].get<int>(), 6) << last.dump();
+    EXPECT_NEAR(last["vehicle"]["lat"].get<double>(), kHomeLat, 1e-3) << last.dump();
+    EXPECT_TRUE(last["vehicle"]["state"].is_string());
+    EXPECT_TRUE(last.contains("vehicle_link")) << "link statistics are pushed too: " << last.dump();
+
+    // The rates can be changed from the ground and status shows them.
+    auto rates = ctl({"rates", "vehicle=5"});
+    ASSERT_EQ(rates.exit_code, 0) << rates.err;
+    EXPECT_EQ(Json::parse(rates.out)["effective_hz"]["vehicle"], 5.0);
+    auto params = ctl({"param", "get", "WP_RADIUS"});
+    EXPECT_EQ(params.exit_code, 0) << params.err;
+    EXPECT_TRUE(Json::parse(params.out, nullptr, false).value("value", Json()).is_number()) << params.out;
+}
+
+TEST_F(GroundControlE2e, AMonitorKeyWatchesButItsCommandsAreRefused) {
+    const auto control = key_file("control.key", 'a');
+    const auto monitor = key_file("monitor.key", 'b');
+    start_link();
+    start_daemon(
+        {"--set", "groundlink.key_file=" + control, "--set", "groundlink.monitor_key_file=" + monitor});
+
+    auto watched = ctl({"status"}, monitor);
+    ASSERT_EQ(watched.exit_code, 0) << watched.err << "\ndaemon:\n" << daemon->err();
+    EXPECT_EQ(Json::parse(watched.out)["groundlink"]["role"], "monitor");
+
+    auto refused = ctl({"rates", "vehicle=4"}, monitor);
+    EXPECT_EQ(refused.exit_code, 1) << refused.err;
+    const auto why = Json::parse(refused.out, nullptr, false);
+    EXPECT_EQ(why.value("status", ""), "forbidden") << refused.out;
+    EXPECT_NE(why.value("error", "").find("monitor key"), std::string::npos) << refused.out;
+    auto stick = ctl({"joystick", "--duration", "500"}, monitor);
+    EXPECT_EQ(stick.exit_code, 1) << stick.err;
+
+    // The control key commands; status counts the refusals.
+    auto accepted = ctl({"rates", "vehicle=4"}, control);
+    ASSERT_EQ(accepted.exit_code, 0) << accepted.err << "\ndaemon:\n" << daemon->err();
+    const auto doc = status_doc(control);
+    EXPECT_EQ(doc["groundlink"]["role"], "control");
+    EXPECT_EQ(doc["groundlink"]["commands_refused"], 2);
+    EXPECT_EQ(doc["groundlink"]["telemetry"]["requested_hz"]["vehicle"], 4.0);
+
+    // No key at all gets nowhere.
+    auto stranger = ctl({"status"}, {}, 3'000);
+    EXPECT_EQ(stranger.exit_code, 3);
+}
+
+TEST_F(GroundControlE2e, JoystickDrivesTheRoverAndTheOverrideIsReleasedWhenInputStops) {
+    start_link();
+    start_sim();
+    start_daemon();
+    ASSERT_TRUE(
+        wait_until([&] { return status_doc().value("autopilot", Json::object()).value("ready", false); },
+                   kGenerous, 500ms))
+        << daemon->err();
+    auto manual = ctl({"state", "MANUAL_NAVIGATION"});
+    ASSERT_EQ(manual.exit_code, 0) << manual.err << manual.out;
+    const auto start = sim_control->json("state");
+
+    // The joystick device is a FIFO standing in for /dev/input/js0: the test writes js_event records.
+    const auto fifo = dir.file("js0");
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    const int writer = ::open(fifo.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
+    ASSERT_GE(writer, 0);
+    Subprocess stick({binary("client/airsegctl"), "--link", ground(), "--timeout", "30000", "joystick",
+                      "--device", fifo, "--rate", "10"},
+                     {}, dir.path());
+    auto event = [&](std::int16_t value, std::uint8_t axis) {
+        std::uint8_t e[8] = {0, 0, 0, 0, 0, 0, 0x02, axis};
+        std::memcpy(e + 4, &value, 2);  // struct js_event is in the host's byte order
+        ASSERT_EQ(::write(writer, e, sizeof e), 8);
+    };
+    event(-32767, 1);  // full forward
+    event(8000, 0);    // a little right
+    double moved = 0;
+    ASSERT_TRUE(wait_until(
+        [&] {
+            const auto s = sim_control->json("state");
+            const double dlat = (s.value("lat", 0.0) - start.value("lat", 0.0)) * 111'000;
+            const double dlon =
+                (s.value("lon", 0.0) - start.value("lon", 0.0)) * 111'000 * std::cos(kHomeLat * M_PI / 180);
+            moved = std::hypot(dlat, dlon);
+            return moved > 3.0 && s.value("speed", 0.0) > 0.5;
+        },
+        kGenerous, 200ms))
+        << "moved " << moved << " m; sim: " << sim_control->json("state").dump() << "\nclient:\n"
+        << stick.err() << "\ndaemon:\n"
+        << daemon->err();
+
+    // Input stops (the device goes away): the client ends, the vehicle releases the override and stops.
+    ::close(writer);
+    ASSERT_EQ(stick.wait_exit(10s), 0) << stick.err();
+    const auto stopped_at = std::chrono::steady_clock::now();
+    ASSERT_TRUE(wait_until([&] { return sim_control->json("state").value("speed", 1.0) < 0.05; }, 20s, 100ms))
+        << sim_control->json("state").dump();
+    // Override released within the configured input timeout (500 ms), plus the rover coasting to a stop.
+    const auto to_stop = std::chrono::steady_clock::now() - stopped_at;
+    EXPECT_LT(to_stop, 10s);
+    std::cout << "joystick: moved " << moved << " m; stopped "
+              << std::chrono::duration_cast<std::chrono::milliseconds>(to_stop).count()
+              << " ms after the client ended\n";
+}
+
+TEST_F(GroundControlE2e, WithTwentyPercentFrameLossTelemetryArrivesAndEveryCommandIsAnswered) {
+    start_link({"--frame-loss", "0.2"});
+    start_sim();
+    start_daemon();
+    ASSERT_TRUE(
+        wait_until([&] { return status_doc().value("autopilot", Json::object()).value("ready", false); },
+                   kGenerous, 500ms))
+        << daemon->err();
+    auto watch = ctl({"watch", "--duration", "20000"});
+    ASSERT_EQ(watch.exit_code, 0) << watch.err;
+    const auto lines = json_lines(watch.out);
+    ASSERT_FALSE(lines.empty());
+    const int samples = lines.back()["samples"].get<int>();
+    EXPECT_GE(samples, 3) << "telemetry still arrives: " << lines.back().dump();
+    EXPECT_LT(samples, 2 * 20 + 1) << "never above the requested 2 Hz";
+    // The vehicle measured the loss from the ground's reception reports and lowered the rates.
+    const auto lowered = status_doc()["groundlink"]["telemetry"];
+    EXPECT_GE(lowered.value("lowerings", 0), 1) << lowered.dump();
+    EXPECT_LT(lowered["effective_hz"].value("vehicle", 2.0), 2.0) << lowered.dump();
+    EXPECT_GT(lowered["effective_hz"].value("vehicle", 0.0), 0.0) << lowered.dump();
+
+    int answered = 0;
+    for (const auto& cmd : std::vector<std::vector<std::string>>{{"rates"},
+                                                                 {"param", "get", "WP_RADIUS"},
+                                                                 {"state", "PARKING"},
+                                                                 {"rates", "link_stats=1"},
+                                                                 {"status"}}) {
+        auto r = ctl(cmd, {}, 45'000);
+        EXPECT_TRUE(r.exit_code == 0 || r.exit_code == 1)
+            << cmd[0] << ": exit " << r.exit_code << " " << r.err;
+        EXPECT_FALSE(r.out.empty() && r.err.empty()) << "a failure is reported, never silent";
+        answered += r.exit_code == 0 ? 1 : 0;
+    }
+    EXPECT_GE(answered, 4);
+    const auto doc = status_doc();
+    std::cout << "under 20 % frame loss: " << samples << " samples in 20 s; vehicle telemetry "
+              << doc["groundlink"]["telemetry"].dump() << "\n";
+}
+
+TEST_F(GroundControlE2e, SighupAppliesTheTelemetryRatesOverThoseSetFromTheGround) {
+    const std::string config = dir.file("airseg.yaml");
+    const std::string original = read_file(source_path("config/airseg.yaml"));
+    write_file(config, original);
+    daemon = std::make_unique<Subprocess>(
+        std::vector<std::string>{
+            binary("daemon/airsegd"), "--config", config, "--set", "status.socket=" + dir.file("status.sock"),
+            "--set", "state_dir=" + dir.file("state"), "--set", "autopilot.port=" + dir.file("ttyACM0"),
+            "--set", "groundlink.ports=[" + dir.file("air") + "]"},
+        std::map<std::string, std::string>{}, dir.path());
+    auto local = [&](std::vector<std::string> args) {
+        std::vector<std::string> argv{binary("client/airsegctl"), "--local", "--socket",
+                                      dir.file("status.sock"), "--json"};
+        argv.insert(argv.end(), args.begin(), args.end());
+        auto r = run(argv, {}, 20s);
+        auto j = Json::parse(r.out, nullptr, false);
+        return r.exit_code == 0 && !j.is_discarded() ? j : Json::object();
+    };
+    ASSERT_TRUE(wait_until([&] { return local({"rates"}).contains("requested_hz"); }, 20s)) << daemon->err();
+    EXPECT_EQ(local({"rates", "vehicle=7"})["requested_hz"]["vehicle"], 7.0);
+
+    std::string changed = original;
+    const std::string from = "rates: {vehicle: 2, link_stats: 1}";
+    ASSERT_NE(changed.find(from), std::string::npos);
+    changed.replace(changed.find(from), from.size(), "rates: {vehicle: 4, link_stats: 0}");
+    write_file(config, changed);
+    daemon->signal(SIGHUP);
+    ASSERT_TRUE(
+        wait_until([&] { return local({"rates"})["requested_hz"].value("vehicle", 0.0) == 4.0; }, 20s))
+        << daemon->err();
+    const auto rates = local({"rates"});
+    EXPECT_EQ(rates["effective_hz"]["link_stats"], 0.0) << rates.dump();
+    EXPECT_NE(daemon->err().find("groundlink.telemetry.rates"), std::string::npos) << daemon->err();
+}
+
+}  // namespace
+}  // namespace airseg::test
