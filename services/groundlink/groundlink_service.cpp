@@ -88,8 +88,7 @@ void GroundlinkService::on_start() {
         if (*key.key == *control_key_) {
             return fail("groundlink.monitor_key_file holds the same key as groundlink.key_file");
         }
-        monitor_key_ = key.key;
-        keys_ = KeySelector(true);
+        transport_.second_key = key.key;
     }
     if (auto problems = transport_.validate(); !problems.empty()) {
         return fail(problems.front());
@@ -140,7 +139,6 @@ void GroundlinkService::on_start() {
 }
 
 void GroundlinkService::make_driver() {
-    transport_.key = keys_.role() == Role::Monitor ? monitor_key_ : control_key_;
     if (driver_) {
         driver_->stop();
     }
@@ -148,7 +146,7 @@ void GroundlinkService::make_driver() {
         std::make_unique<LinkDriver>(strand(), transport_,
                                      LinkDriver::Handlers{[this](Delivered m) { on_message(std::move(m)); },
                                                           [this](const TransportEvent& e) { on_event(e); }});
-    last_mac_failures_ = last_frames_received_ = last_rx_bytes_ = 0;
+    last_rx_bytes_ = 0;
     delivery_.reset();
     last_fast_messages_ = last_fast_replaced_ = 0;
 }
@@ -206,7 +204,7 @@ void GroundlinkService::on_message(Delivered message) {
 void GroundlinkService::on_command(const protocol::Command& command) {
     ++commands_;
     const std::uint32_t id = command.request_id;
-    const Role role = keys_.role();
+    const Role role = ground_role();
     ctx_.commands.dispatch(command.request, role, [this, id](CommandResult result) {
         asio::dispatch(strand(), [this, id, result = std::move(result)]() mutable {
             if (result.status == CommandStatus::Forbidden) {
@@ -227,7 +225,7 @@ void GroundlinkService::on_command(const protocol::Command& command) {
 }
 
 void GroundlinkService::on_joystick(const protocol::Joystick& joystick) {
-    if (keys_.role() != Role::Control) {
+    if (ground_role() != Role::Control) {
         if (joystick_refused_++ == 0) {
             spdlog::warn("groundlink: joystick input from a monitor key refused");
         }
@@ -240,8 +238,7 @@ void GroundlinkService::on_joystick(const protocol::Joystick& joystick) {
 void GroundlinkService::on_event(const TransportEvent& event) {
     switch (event.kind) {
         case TransportEvent::Kind::link_up:
-            spdlog::info("groundlink: link up ({} key)",
-                         keys_.role() == Role::Control ? "control" : "monitor");
+            spdlog::info("groundlink: link up ({} key)", ground_role() == Role::Control ? "control" : "monitor");
             break;
         case TransportEvent::Kind::link_down:
             spdlog::warn("groundlink: link down");
@@ -318,18 +315,8 @@ void GroundlinkService::feed_scheduler(TimePoint now) {
     q.link_rate_bytes_per_s = transport_.link_rate_bytes_per_s;
     last_fast_messages_ = s.tx_fast.messages;
     last_fast_replaced_ = s.tx_fast.replaced + s.tx_fast.drops;
-    const auto mac = s.mac_failures - last_mac_failures_;
-    const auto valid = s.frames_received - last_frames_received_;
-    last_mac_failures_ = s.mac_failures;
-    last_frames_received_ = s.frames_received;
     scheduler_.update_link(q, now);
     arm_telemetry();
-    if (keys_.update(driver_->link_up(), mac, valid)) {
-        spdlog::info("groundlink: frames fail the MAC check; trying the {} key",
-                     keys_.role() == Role::Control ? "control" : "monitor");
-        make_driver();
-        attach_writers();
-    }
 }
 
 void GroundlinkService::arm_telemetry() {
@@ -435,8 +422,7 @@ void GroundlinkService::publish_status() {
     g["peer_restarts"] = s.peer_restarts;
     g["commands"] = commands_;
     g["commands_refused"] = commands_refused_;
-    g["role"] = !s.authenticated ? "control (unauthenticated)" : to_string(keys_.role());
-    g["key_switches"] = keys_.switches();
+    g["role"] = !s.authenticated ? "control (unauthenticated)" : to_string(ground_role());
     g["joystick_inputs"] = joystick_inputs_;
     g["joystick_refused"] = joystick_refused_;
     g["events_sent"] = events_sent_;

@@ -10,7 +10,6 @@
 #include "services/common/port_keeper.hpp"
 #include "services/common/service.hpp"
 #include "services/groundlink/delivery_meter.hpp"
-#include "services/groundlink/key_selector.hpp"
 #include "services/groundlink/link/link_driver.hpp"
 #include "services/groundlink/protocol/ground_protocol.hpp"
 #include "services/groundlink/telemetry_sample.hpp"
@@ -43,6 +42,11 @@ class GroundlinkService : public Service {
     void on_stop() override;
 
   private:
+    /// The ground end's role, from the key its session was authenticated with: the monitor key (the
+    /// transport's second key) may watch, the control key may command. Unkeyed links are control.
+    [[nodiscard]] Role ground_role() const {
+        return driver_ && driver_->core().session_key() == 1 ? Role::Monitor : Role::Control;
+    }
     void make_driver();
     void attach_writers();
     void register_commands();
@@ -63,9 +67,8 @@ class GroundlinkService : public Service {
 
     GroundlinkServiceConfig config_;
     std::unique_ptr<LinkDriver> driver_;
-    TransportConfig transport_;  // the running transport's configuration (its key changes with the role)
-    std::optional<std::array<std::uint8_t, kKeyBytes>> control_key_, monitor_key_;
-    KeySelector keys_{false};
+    TransportConfig transport_;
+    std::optional<std::array<std::uint8_t, kKeyBytes>> control_key_;
     TelemetryScheduler scheduler_;
     DeliveryMeter delivery_;
     asio::steady_timer telemetry_timer_;
@@ -79,8 +82,6 @@ class GroundlinkService : public Service {
     asio::steady_timer stats_timer_;
     std::string fatal_;  // a configuration problem found at start (bad key file): the link stays down
     std::uint64_t last_rx_bytes_ = 0;
-    std::uint64_t last_mac_failures_ = 0;
-    std::uint64_t last_frames_received_ = 0;
     std::uint64_t last_fast_messages_ = 0;
     std::uint64_t last_fast_replaced_ = 0;
     std::uint64_t samples_sent_ = 0;

@@ -16,6 +16,8 @@ std::vector<std::string> TransportConfig::validate() const {
     };
     need(link_rate_bytes_per_s >= 10.0 && link_rate_bytes_per_s <= 1e8, "link_rate must be 10..1e8 bytes/s");
     need(paths == 1 || paths == 2, "paths must be 1 or 2");
+    need(!second_key || key, "second_key needs key");
+    need(!second_key || !key || *second_key != *key, "second_key must differ from key");
     need(path_mode == PathMode::single || paths == 2, "path_mode split/redundant needs paths: 2");
     need(path_mode != PathMode::single || paths == 1, "path_mode single needs paths: 1");
     need(split_tx_path < paths, "split_tx_path must be a path index below paths");

@@ -30,7 +30,11 @@ Transport::Impl::Impl(TransportConfig config, TimePoint now)
           std::chrono::duration_cast<Duration>(std::chrono::duration<double>(
               static_cast<double>(cfg.max_frame_payload + 32) / cfg.link_rate_bytes_per_s))) {
     if (cfg.key) {
-        mac = std::make_unique<FrameMac>(*cfg.key);
+        keys[0] = std::make_unique<FrameMac>(*cfg.key);
+        mac = keys[0].get();
+    }
+    if (cfg.second_key) {
+        keys[1] = std::make_unique<FrameMac>(*cfg.second_key);
     }
     stats.authenticated = mac != nullptr;
     candidate = cfg.boot_nonce;
@@ -238,6 +242,10 @@ const LinkStats& Transport::stats() const {
 bool Transport::link_up() const {
     return impl_->link;
 }
+std::size_t Transport::session_key() const {
+    return impl_->session_key;
+}
+
 bool Transport::session_established() const {
     return impl_->established && impl_->confirmed;
 }

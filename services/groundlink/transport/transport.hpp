@@ -115,6 +115,10 @@ struct TransportConfig {
     /// key: pre-shared 32-byte key (from key_file, read by the adapter). Without it frames carry no MAC and
     /// LinkStats::authenticated is false.
     std::optional<std::array<std::uint8_t, kKeyBytes>> key;
+    /// second_key: a second pre-shared key a peer may use instead of `key` (needs `key`). Each session is
+    /// bound to the key its handshake was authenticated with; session_key() says which, so an adapter can
+    /// give the two keys different rights (airsegd: control and monitor).
+    std::optional<std::array<std::uint8_t, kKeyBytes>> second_key;
     /// Random per process start, supplied by the adapter (the core never reads randomness). Must not be 0.
     std::uint64_t boot_nonce = 1;
 
@@ -263,6 +267,8 @@ class Transport {
     [[nodiscard]] const LinkStats& stats() const;
     [[nodiscard]] bool link_up() const;
     [[nodiscard]] bool session_established() const;
+    /// Key of the current session: 0 for TransportConfig::key (or no key), 1 for second_key.
+    [[nodiscard]] std::size_t session_key() const;
     [[nodiscard]] const TransportConfig& config() const;
     /// Safe messages of `priority` queued or in flight (not yet acknowledged).
     [[nodiscard]] std::size_t safe_pending(std::uint8_t priority) const;

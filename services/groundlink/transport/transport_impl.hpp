@@ -51,14 +51,14 @@ class Transport::Impl {
     // transport_rx.cpp
     void handle_bytes(std::size_t path, std::span<const std::uint8_t> bytes, TimePoint now);
     void on_plain_frame(std::size_t path, std::span<const std::uint8_t> plain, TimePoint now);
-    void on_hello(std::size_t path, const frame::Hello& h, TimePoint now);
+    void on_hello(std::size_t path, const frame::Hello& h, std::size_t key, TimePoint now);
     void on_data_frame(std::span<const std::uint8_t> frame, TimePoint now);
     void on_authentic(std::size_t path, std::uint8_t peer_heard_mask, TimePoint now);
     void on_safe(const frame::SafeChunk& c, TimePoint now);
     void on_fast(const frame::FastChunk& c, TimePoint now);
     void on_ack(const frame::AckChunk& a, TimePoint now);
-    void accept_session(std::uint64_t peer, TimePoint now);
-    void queue_hello_reply(const frame::Hello& h);
+    void accept_session(std::uint64_t peer, std::size_t key, TimePoint now);
+    void queue_hello_reply(const frame::Hello& h, std::size_t key);
     std::uint64_t fresh_nonce();
 
     // transport_tx.cpp
@@ -92,7 +92,13 @@ class Transport::Impl {
     void mark_urgent(TimePoint now) { urgent_until = now + cfg.latency_hold; }
 
     TransportConfig cfg;
-    std::unique_ptr<FrameMac> mac;
+    // keys[0] from TransportConfig::key, keys[1] from second_key. `mac` is the session's key (keys[0] until a
+    // handshake authenticated with keys[1] is accepted); null on an unkeyed link.
+    std::array<std::unique_ptr<FrameMac>, 2> keys;
+    FrameMac* mac = nullptr;
+    std::size_t session_key = 0;
+    std::size_t hello_reply_key = 0;
+    std::uint64_t unestablished_hellos = 0;  // alternates the key of hellos sent before any session
     LinkStats stats;
     TimePoint now_;
 

@@ -73,16 +73,22 @@ void Transport::Impl::on_plain_frame(std::size_t path, std::span<const std::uint
     const auto frame_bytes = body->first(body->size() - tag_bytes);
     const auto tag = body->subspan(body->size() - tag_bytes);
     if (*kind == frame::Kind::hello) {
-        if (keyed && !mac->verify(ctx, frame_bytes, tag)) {
-            ++stats.mac_failures;
-            return;
+        std::size_t key = 0;
+        if (keyed) {
+            while (key < keys.size() && !(keys[key] && keys[key]->verify(ctx, frame_bytes, tag))) {
+                ++key;
+            }
+            if (key == keys.size()) {
+                ++stats.mac_failures;
+                return;
+            }
         }
         const auto hello = frame::decode_hello(frame_bytes);
         if (!hello) {
             ++stats.malformed;
             return;
         }
-        on_hello(path, *hello, now);
+        on_hello(path, *hello, key, now);
         return;
     }
     if (!established) {
@@ -243,30 +249,35 @@ std::uint64_t Transport::Impl::fresh_nonce() {
     return v;
 }
 
-void Transport::Impl::queue_hello_reply(const frame::Hello& h) {
+void Transport::Impl::queue_hello_reply(const frame::Hello& h, std::size_t key) {
     hello_reply = h;
+    hello_reply_key = key;
     hello_reply_paths = static_cast<std::uint8_t>((1U << paths.size()) - 1U);
 }
 
-void Transport::Impl::on_hello(std::size_t path, const frame::Hello& h, TimePoint now) {
+void Transport::Impl::on_hello(std::size_t path, const frame::Hello& h, std::size_t key, TimePoint now) {
     ++stats.hellos_received;
     if (established && h.sender_nonce == peer_nonce && h.echo_nonce == my_nonce) {
+        if (key != session_key) {
+            ++stats.mac_failures;  // the session's peer cannot hold the other key
+            return;
+        }
         on_authentic(path, h.heard_mask, now);
         if (h.established) {
             confirmed = true;
         } else {
-            queue_hello_reply(frame::Hello{0, my_nonce, peer_nonce, true});
+            queue_hello_reply(frame::Hello{0, my_nonce, peer_nonce, true}, session_key);
         }
         return;
     }
     if (h.echo_nonce != 0 && h.echo_nonce == candidate) {
         // The sender echoed the nonce this end offered most recently: it is live, not a recording.
-        accept_session(h.sender_nonce, now);
+        accept_session(h.sender_nonce, key, now);
         on_authentic(path, h.heard_mask, now);
         if (h.established) {
             confirmed = true;
         }
-        queue_hello_reply(frame::Hello{0, my_nonce, peer_nonce, true});
+        queue_hello_reply(frame::Hello{0, my_nonce, peer_nonce, true}, session_key);
         return;
     }
     if (!established || (h.sender_nonce != peer_nonce && (h.echo_nonce == 0 || h.echo_nonce == my_nonce))) {
@@ -278,12 +289,16 @@ void Transport::Impl::on_hello(std::size_t path, const frame::Hello& h, TimePoin
         // session.
         last_seen_peer = h.sender_nonce;
         unanswered_hellos = 0;
-        queue_hello_reply(frame::Hello{0, candidate, h.sender_nonce, false});
+        queue_hello_reply(frame::Hello{0, candidate, h.sender_nonce, false}, key);
     }
 }
 
-void Transport::Impl::accept_session(std::uint64_t peer, TimePoint now) {
+void Transport::Impl::accept_session(std::uint64_t peer, std::size_t key, TimePoint now) {
     const bool had_session = established;
+    session_key = key;
+    if (keys[key]) {
+        mac = keys[key].get();
+    }
     established = true;
     confirmed = false;
     my_nonce = candidate;

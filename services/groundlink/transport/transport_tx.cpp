@@ -225,8 +225,10 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_hello(std::size_
     Path& ps = paths[path];
     const auto bit = static_cast<std::uint8_t>(1U << path);
     frame::Hello h;
+    std::size_t hello_key = 0;
     if (hello_reply && (hello_reply_paths & bit) != 0 && now >= ps.last_hello + cfg.hello_interval / 4) {
         h = *hello_reply;
+        hello_key = hello_reply_key;
         hello_reply_paths = static_cast<std::uint8_t>(hello_reply_paths & ~bit);
         if (hello_reply_paths == 0) {
             hello_reply.reset();
@@ -238,6 +240,10 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_hello(std::size_
         }
         h = established ? frame::Hello{0, my_nonce, peer_nonce, true}
                         : frame::Hello{0, candidate, last_seen_peer, false};
+        hello_key = session_key;
+        if (!established && keys[1]) {
+            hello_key = unestablished_hellos++ % 2;  // the peer may hold either key
+        }
     } else {
         return std::nullopt;
     }
@@ -245,7 +251,7 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_hello(std::size_
     ps.next_hello = now + cfg.hello_interval;
     ps.last_hello = now;
     ++stats.hellos_sent;
-    return frame::seal(frame::encode_hello(h), mac.get(), MacContext{});
+    return frame::seal(frame::encode_hello(h), keys[hello_key].get(), MacContext{});
 }
 
 bool Transport::Impl::add_data_chunk(std::vector<frame::Chunk>& chunks,
@@ -350,7 +356,7 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
         // A probe: an empty frame, so the peer can report whether it hears this path.
         auto plain = frame::encode_data(header_flags(), static_cast<std::uint32_t>(next_frame_number), {});
         const MacContext ctx{my_nonce, peer_nonce, next_frame_number++};
-        return frame::seal(std::move(plain), mac.get(), ctx);
+        return frame::seal(std::move(plain), mac, ctx);
     }
 
     std::vector<frame::Chunk> chunks;
@@ -421,7 +427,7 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
     auto plain = frame::encode_data(
         header_flags(), static_cast<std::uint32_t>(next_frame_number & frame::kFrameNumberMask), chunks);
     const MacContext ctx{my_nonce, peer_nonce, next_frame_number++};
-    auto sealed = frame::seal(std::move(plain), mac.get(), ctx);
+    auto sealed = frame::seal(std::move(plain), mac, ctx);
     for (std::size_t q = 0; q < paths.size(); ++q) {
         if (q != path && cfg.path_mode == PathMode::redundant && carries_data(q)) {
             if (paths[q].mirror.size() >= kMirrorCap) {

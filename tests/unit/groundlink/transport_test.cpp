@@ -72,6 +72,45 @@ TEST(GroundlinkTransport, HandshakeThenSafeBothWaysAuthenticated) {
     EXPECT_GT(link.a().core->stats().rtt_samples, 0U);
 }
 
+// The vehicle holds two keys; a ground end holding either gets a session bound to it, and one holding
+// neither never does.
+TEST(GroundlinkTransport, ASecondKeyIsAcceptedAndTheSessionSaysWhichKey) {
+    auto key_of = [](std::uint8_t seed) {
+        std::array<std::uint8_t, kKeyBytes> k{};
+        for (std::size_t i = 0; i < k.size(); ++i) {
+            k[i] = static_cast<std::uint8_t>(seed + i * 13);
+        }
+        return k;
+    };
+    TransportConfig vehicle = base_config(0x10);
+    vehicle.key = key_of(1);
+    vehicle.second_key = key_of(2);
+    for (std::uint8_t ground_key : {1, 2, 3}) {
+        TransportConfig ground = base_config(0x20 + ground_key);
+        ground.key = key_of(ground_key);
+        SimLink link(vehicle, ground, one_path(), ground_key);
+        link.b().core->send_safe(0, pattern(50, 7), link.now());
+        link.run_for(5s);
+        if (ground_key == 3) {
+            EXPECT_FALSE(link.a().core->session_established());
+            EXPECT_TRUE(link.a().received.empty());
+            EXPECT_GT(link.a().core->stats().mac_failures, 0U);
+            continue;
+        }
+        ASSERT_TRUE(link.a().core->session_established()) << "key " << int{ground_key};
+        EXPECT_EQ(link.a().core->session_key(), ground_key - 1U);
+        ASSERT_EQ(count_safe(link.a(), 0), 1U);
+        link.a().core->send_safe(1, pattern(60, 8), link.now());
+        link.run_for(3s);
+        EXPECT_EQ(count_safe(link.b(), 1), 1U) << "the vehicle answers with the session's key";
+    }
+    TransportConfig bad = vehicle;
+    bad.second_key = bad.key;
+    EXPECT_FALSE(bad.validate().empty());
+    bad.key.reset();
+    EXPECT_FALSE(bad.validate().empty());
+}
+
 TEST(GroundlinkTransport, WithoutKeyStatsSayUnauthenticated) {
     SimLink link(base_config(5, false), base_config(6, false), one_path(), 2);
     link.a().core->send_safe(1, pattern(50, 9), link.now());
