@@ -107,6 +107,7 @@ std::vector<std::string> AutopilotConfig::validate(const AutopilotConfig& c) {
                 secs(m.max_timeout), " s");
     check_range(out, "autopilot.mission.retries", m.retries, 0, 50);
     check_range(out, "autopilot.mission.give_up_after", secs(m.give_up_after), 0, 300, " s");
+    check_range(out, "autopilot.mission.vehicle_gives_up", secs(m.vehicle_gives_up), 1, 120, " s");
     check_range(out, "autopilot.mission.max_items", m.max_items, 2, 65535);
     const auto& r = c.rc_override;
     check_range(out, "autopilot.rc_override.rate_hz", r.rate_hz, 1, 50, " Hz");

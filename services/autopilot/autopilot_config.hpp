@@ -52,11 +52,14 @@ struct RcOverrideConfig {
 
 struct MissionConfig {
     Duration initial_timeout = milliseconds(1500);  // autopilot.mission.initial_timeout, before RTT is known
-    Duration min_timeout = milliseconds(400);       // autopilot.mission.min_timeout
+    Duration min_timeout = milliseconds(150);       // autopilot.mission.min_timeout
     Duration max_timeout = seconds(6);              // autopilot.mission.max_timeout
     unsigned retries = 5;  // autopilot.mission.retries: per step, refreshed on progress...
     Duration give_up_after =
-        seconds(15);                // autopilot.mission.give_up_after: ...and this long without progress
+        seconds(15);  // autopilot.mission.give_up_after: ...and this long without progress
+    Duration vehicle_gives_up =
+        seconds(8);                 // autopilot.mission.vehicle_gives_up: an upload without any
+                                    // request this long was abandoned by the vehicle (ArduPilot: 8 s)
     bool use_int = true;            // autopilot.mission.use_int: MISSION_REQUEST_INT / ITEM_INT
     std::uint16_t max_items = 700;  // autopilot.mission.max_items
 };

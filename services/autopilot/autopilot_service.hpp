@@ -52,6 +52,7 @@ class AutopilotService : public Service {
     void schedule_status();
     void publish(Event e);
     void pulse_reset(unsigned attempt);
+    void switch_baud(unsigned baud);
     void update_health();
 
     AutopilotServiceConfig config_;
@@ -66,6 +67,7 @@ class AutopilotService : public Service {
     std::map<std::uint32_t, std::uint32_t> requester_ids_;  // driver id -> requester id
     std::vector<Subscription> subscriptions_;
     bool running_ = false;
+    bool switching_baud_ = false;  // the next open is a baud probe's reopen of the same device
     std::string prefix_;
 };
 

@@ -66,6 +66,9 @@ class Driver {
     // --- port lifecycle ---
     void on_port_open(TimePoint now);
     void on_port_closed(const std::string& reason, TimePoint now);
+    /// The port was reopened at another baud rate after a SwitchBaud: the byte stream starts afresh, the
+    /// connection sequence and its timers go on.
+    void on_port_reopened(TimePoint now);
     void on_reset_pulsed(TimePoint now);
 
     // --- sans-IO plumbing ---
