@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <iostream>
+#include <map>
 
 #include "services/autopilot/ardupilot/driver.hpp"
 #include "tests/unit/autopilot/sim_harness.hpp"
@@ -169,6 +170,29 @@ TEST(DriverWithApmSim, EachVehicleStateRequestedAndConfirmed) {
             EXPECT_EQ(rig.sim.state().mode, s.mode);
         }
     }
+}
+
+// Boards other than APM 2.x get per-message rates with MAV_CMD_SET_MESSAGE_INTERVAL (the rate of 0 stops a
+// message); APM 2.x gets REQUEST_DATA_STREAM groups.
+TEST(DriverWithApmSim, MessageRatesAreSetWithSetMessageIntervalOnPixhawkBoards) {
+    auto config = driver_config(Board::Pixhawk);
+    config.message_rates = {{mav::Attitude::kId, 10.0}, {mav::GlobalPositionInt::kId, 0.0}, {1, 2.0}};
+    SimRig rig(config, sim_config(Board::Pixhawk), {}, {}, 9);
+    std::map<std::uint32_t, int> counts;
+    bool counting = false;
+    rig.driver.set_frame_tap([&](bool outgoing, std::span<const std::uint8_t> frame) {
+        if (!outgoing && counting && frame.size() > 9 && frame[0] == 0xFD) {
+            ++counts[frame[7] | (frame[8] << 8) | (frame[9] << 16)];
+        }
+    });
+    ASSERT_TRUE(rig.open_and_wait_ready());
+    rig.harness.run_for(seconds(2));  // the requests have taken effect
+    counting = true;
+    rig.harness.run_for(seconds(10));
+    EXPECT_NEAR(counts[mav::Attitude::kId], 100, 3);
+    EXPECT_EQ(counts[mav::GlobalPositionInt::kId], 0);
+    EXPECT_NEAR(counts[1], 20, 2);  // SYS_STATUS
+    EXPECT_NEAR(counts[mav::Heartbeat::kId], 10, 1);
 }
 
 TEST(DriverWithApmSim, ModeChangeByTheSimulatedRcPilotIsSeen) {
