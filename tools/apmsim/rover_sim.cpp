@@ -291,7 +291,7 @@ void RoverSim::impair(std::vector<std::uint8_t>& bytes, bool& in_burst) {
 // average (1 - p) / p bytes, and the lost fraction B / (B + (1 - p) / p) equals `loss` for
 // p = loss / (B (1 - loss) + loss).
 bool RoverSim::lose_byte(bool& in_burst) {
-    const double loss = std::min(faults_.loss, 0.999);
+    const double loss = faults_.loss;
     if (loss <= 0) {
         in_burst = false;
         return false;
