@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <map>
 
-#include "services/autopilot/mavlink/message_table.hpp"
-
 namespace airseg::daemon {
 namespace {
 
@@ -70,8 +68,8 @@ AutopilotSetup autopilot_setup(const Config& config) {
     if (!a.message_rates.empty()) {
         ap.message_rates.clear();
         for (const auto& [name, hz] : a.message_rates) {
-            if (const auto* info = mavlink::find_message(name)) {
-                ap.message_rates.push_back({info->id, hz});
+            if (const auto id = autopilot::message_id(name)) {
+                ap.message_rates.push_back({*id, hz});
             } else {
                 unknown_messages.push_back("autopilot.message_rates: " + name +
                                            " is not a MAVLink message this daemon knows");

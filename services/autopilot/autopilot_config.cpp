@@ -3,6 +3,8 @@
 #include <set>
 #include <sstream>
 
+#include "services/autopilot/mavlink/message_table.hpp"
+
 namespace airseg::autopilot {
 
 const char* to_string(Board b) {
@@ -13,6 +15,13 @@ const char* to_string(Board b) {
             return "pixhawk";
     }
     return "?";
+}
+
+std::optional<std::uint32_t> message_id(std::string_view name) {
+    if (const auto* info = mavlink::find_message(name)) {
+        return info->id;
+    }
+    return std::nullopt;
 }
 
 AutopilotConfig AutopilotConfig::defaults_for(Board board) {

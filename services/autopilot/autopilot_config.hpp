@@ -2,7 +2,9 @@
 // Configuration of the autopilot driver cores. Every field has a default; validate() lists every problem,
 // naming the YAML key (written next to each field) so the loader can report it as given.
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "services/common/time.hpp"
@@ -38,6 +40,10 @@ struct ParamSetting {
     std::string name;  // at most 16 characters
     double value = 0.0;
 };
+
+/// The id of the MAVLink message called `name` ("ATTITUDE"), for autopilot.message_rates; nullopt when this
+/// build does not know it. Keeps message names in the autopilot layer.
+std::optional<std::uint32_t> message_id(std::string_view name);
 
 struct RcOverrideConfig {
     double rate_hz = 10.0;                       // autopilot.rc_override.rate_hz (1..50)
