@@ -12,6 +12,7 @@
 #include "daemon/autopilot_commands.hpp"
 #include "daemon/autopilot_setup.hpp"
 #include "daemon/autopilot_status.hpp"
+#include "daemon/autopilot_status_led.hpp"
 #include "daemon/config_loader.hpp"
 #include "daemon/logging.hpp"
 #include "daemon/systemd_notifier.hpp"
@@ -105,6 +106,13 @@ class App::Impl {
         services_.push_back(std::make_unique<status::StatusService>(
             context_, status::StatusServiceConfig{config_.status.socket, config_.status.socket_mode}));
         auto ap = autopilot_setup(config_);  // already validated by the loader
+        if (ap.status_led) {
+            if (auto r = gpio_.request(*ap.status_led); r.ok()) {
+                status_led_ = std::make_unique<StatusLedDriver>(bus_, strand_, r.line);
+            } else {
+                spdlog::warn("status_led: {}; no status LED", r.message);
+            }
+        }
         hal::GpioFactory* gpio = ap.service.reset_line ? &gpio_ : nullptr;
         services_.push_back(
             std::make_unique<autopilot::AutopilotService>(context_, std::move(ap.service), gpio));
@@ -168,6 +176,7 @@ class App::Impl {
         signals_.cancel(ignored);
         line_sub_.reset();
         autopilot_section_.reset();
+        status_led_.reset();
         auto remaining = std::make_shared<std::size_t>(services_.size());
         for (auto& s : services_) {
             s->stop([this, remaining] {
@@ -276,6 +285,7 @@ class App::Impl {
     hal::LibgpiodFactory gpio_;
     std::vector<std::unique_ptr<Service>> services_;
     std::unique_ptr<AutopilotStatusSection> autopilot_section_;
+    std::unique_ptr<StatusLedDriver> status_led_;
     std::unique_ptr<AutopilotCommands> autopilot_commands_;
     Subscription line_sub_;
     bool stopping_ = false;

@@ -18,7 +18,7 @@ const std::map<std::string, DataStream>& stream_names() {
 }
 
 /// "gpiochip0:17" names a chip and an offset; anything else is a line name from the device tree.
-hal::GpioLineRequest reset_line(const std::string& text) {
+hal::GpioLineRequest gpio_line(const std::string& text) {
     hal::GpioLineRequest r;
     r.direction = hal::GpioDirection::Output;
     r.initial_value = false;
@@ -47,6 +47,7 @@ AutopilotSetup autopilot_setup(const Config& config) {
     for (int b : a.bauds.empty() ? std::vector<int>{a.baud} : a.bauds) {
         ap.bauds.push_back(static_cast<unsigned>(b));
     }
+    ap.baud_probe = a.baud_probe;
     if (a.reset_on_open != "auto") {
         ap.reset_on_open = a.reset_on_open == "true";
     }
@@ -61,6 +62,18 @@ AutopilotSetup autopilot_setup(const Config& config) {
         for (const auto& [name, hz] : a.streams) {
             // The schema admits only known names and whole numbers >= 0; validate() checks the upper bound.
             ap.stream_rates.push_back({stream_names().at(name), static_cast<unsigned>(std::min(hz, 1e6))});
+        }
+    }
+    std::vector<std::string> unknown_messages;
+    if (!a.message_rates.empty()) {
+        ap.message_rates.clear();
+        for (const auto& [name, hz] : a.message_rates) {
+            if (const auto id = autopilot::message_id(name)) {
+                ap.message_rates.push_back({*id, hz});
+            } else {
+                unknown_messages.push_back("autopilot.message_rates: " + name +
+                                           " is not a MAVLink message this daemon knows");
+            }
         }
     }
     ap.rc_override.rate_hz = a.rc_override_rate_hz;
@@ -79,13 +92,22 @@ AutopilotSetup autopilot_setup(const Config& config) {
     s.tlog.keep = static_cast<unsigned>(a.tlog_keep);
 
     out.problems = autopilot::AutopilotConfig::validate(ap);
+    out.problems.insert(out.problems.end(), unknown_messages.begin(), unknown_messages.end());
     for (auto& p : autopilot::TlogConfig::validate(s.tlog)) {
         out.problems.push_back(std::move(p));
     }
     if (!a.reset_line.empty()) {
-        s.reset_line = reset_line(a.reset_line);
+        s.reset_line = gpio_line(a.reset_line);
         for (auto& p : hal::GpioLineRequest::validate(*s.reset_line)) {
             out.problems.push_back("autopilot.reset.line: " + p);
+        }
+    }
+    if (!config.status_led.line.empty()) {
+        out.status_led = gpio_line(config.status_led.line);
+        out.status_led->active_low = config.status_led.active_low;
+        out.status_led->consumer = "airsegd status led";
+        for (auto& p : hal::GpioLineRequest::validate(*out.status_led)) {
+            out.problems.push_back("status_led.line: " + p);
         }
     }
     return out;
@@ -93,7 +115,8 @@ AutopilotSetup autopilot_setup(const Config& config) {
 
 std::string problem_key(const std::string& problem) {
     const auto colon = problem.find(": ");
-    if (colon == std::string::npos || !problem.starts_with("autopilot.")) {
+    if (colon == std::string::npos ||
+        !(problem.starts_with("autopilot.") || problem.starts_with("status_led."))) {
         return {};
     }
     const std::string key = problem.substr(0, colon);

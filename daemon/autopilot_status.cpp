@@ -43,6 +43,7 @@ nlohmann::json autopilot_status_json(const autopilot::AutopilotStatus& s) {
     j["reboots"] = s.reboots;
     j["reconnects"] = s.reconnects;
     j["reset_pulses"] = s.reset_pulses;
+    j["baud"] = s.baud;
     return j;
 }
 

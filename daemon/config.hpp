@@ -21,6 +21,7 @@ struct AutopilotConfig {
     std::string port = "/dev/ttyACM0";      // autopilot.port
     int baud = 115200;                      // autopilot.baud
     std::vector<int> bauds;                 // autopilot.bauds: tried in turn when non-empty
+    milliseconds baud_probe{3'000};         // autopilot.baud_probe: time for a valid frame at one rate
     std::string reset_on_open = "auto";     // autopilot.reset_on_open: auto (= board is apm2) | true | false
     milliseconds reconnect_min{500};        // autopilot.reconnect_min
     milliseconds reconnect_max{10'000};     // autopilot.reconnect_max
@@ -29,7 +30,9 @@ struct AutopilotConfig {
     milliseconds mode_timeout{1'500};       // autopilot.mode_timeout
     std::map<std::string, double> params;   // autopilot.params: {NAME: value}
     std::map<std::string, double> streams;  // autopilot.streams: {position: 4, ...}; empty = board's
-    double rc_override_rate_hz = 10.0;      // autopilot.rc_override.rate_hz
+    std::map<std::string, double>
+        message_rates;                  // autopilot.message_rates: {ATTITUDE: 10, ...}; empty = board's
+    double rc_override_rate_hz = 10.0;  // autopilot.rc_override.rate_hz
     milliseconds rc_override_input_timeout{500};               // autopilot.rc_override.input_timeout
     bool tlog_enabled = false;                                 // autopilot.tlog.enabled
     std::string tlog_path = "/var/log/airseg/autopilot.tlog";  // autopilot.tlog.path
@@ -57,6 +60,11 @@ struct GroundlinkConfig {
     double telemetry_min_hz = 0.2;         // groundlink.telemetry.min_hz
 };
 
+struct StatusLedConfig {
+    std::string line;         // status_led.line: GPIO line name or chip:offset; "" = no LED
+    bool active_low = false;  // status_led.active_low
+};
+
 struct Config {
     int threads = 0;                            // threads: 0 = one per core
     std::string log_level = "info";             // log_level
@@ -64,6 +72,7 @@ struct Config {
     StatusConfig status;
     AutopilotConfig autopilot;
     GroundlinkConfig groundlink;
+    StatusLedConfig status_led;
 };
 
 }  // namespace airseg::daemon

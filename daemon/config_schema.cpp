@@ -345,6 +345,12 @@ std::vector<KeySpec> build_schema() {
     s.push_back(baud_list(
         "autopilot.bauds", [](Config& c) -> std::vector<int>& { return c.autopilot.bauds; },
         "baud rates tried in turn (the first that yields a valid frame is kept); empty = baud"));
+    s.push_back(duration(
+        "autopilot.baud_probe", [](Config& c) -> milliseconds& { return c.autopilot.baud_probe; },
+        milliseconds(0), hours(1),
+        "time given to each rate of autopilot.bauds for a valid frame (with reset_on_open: more than the "
+        "boot "
+        "delay)"));
     s.push_back(choice(
         "autopilot.reset_on_open", [](Config& c) -> std::string& { return c.autopilot.reset_on_open; },
         {"auto", "true", "false"},
@@ -373,6 +379,11 @@ std::vector<KeySpec> build_schema() {
         "autopilot.streams", [](Config& c) -> std::map<std::string, double>& { return c.autopilot.streams; },
         {"raw_sensors", "extended_status", "rc_channels", "position", "extra1", "extra2", "extra3"}, true,
         "telemetry stream rates in Hz (REQUEST_DATA_STREAM boards); empty = the board's defaults"));
+    s.push_back(number_map(
+        "autopilot.message_rates",
+        [](Config& c) -> std::map<std::string, double>& { return c.autopilot.message_rates; }, {}, false,
+        "per-message rates in Hz by MAVLink name (SET_MESSAGE_INTERVAL boards); 0 stops a message; empty = "
+        "the board's defaults"));
     s.push_back(number(
         "autopilot.rc_override.rate_hz", [](Config& c) -> double& { return c.autopilot.rc_override_rate_hz; },
         0, 1000, "rate of RC override frames while the ground joystick drives"));
@@ -404,6 +415,15 @@ std::vector<KeySpec> build_schema() {
     s.push_back(integer(
         "autopilot.reset.max_pulses", [](Config& c) -> int& { return c.autopilot.reset_max_pulses; }, 0, 1000,
         "reset pulses tried before giving up (0 = never pulse)"));
+    // Status LED
+    s.push_back(string(
+        "status_led.line", [](Config& c) -> std::string& { return c.status_led.line; },
+        "GPIO line of the status LED (booting / ready / ground link up / fault): a line name or CHIP:OFFSET; "
+        "empty = none",
+        true));
+    s.push_back(boolean(
+        "status_led.active_low", [](Config& c) -> bool& { return c.status_led.active_low; },
+        "the LED lights when its line is electrically low"));
     // Ground link
     s.push_back(choice(
         "groundlink.mode", [](Config& c) -> std::string& { return c.groundlink.mode; },

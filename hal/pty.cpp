@@ -53,6 +53,33 @@ void remove_symlink_if_ours(const std::string& link, const std::string& target) 
     }
 }
 
+unsigned baud_of(speed_t speed) {
+    switch (speed) {
+        case B9600:
+            return 9600;
+        case B19200:
+            return 19200;
+        case B38400:
+            return 38400;
+        case B57600:
+            return 57600;
+        case B115200:
+            return 115200;
+        case B230400:
+            return 230400;
+        case B460800:
+            return 460800;
+        case B500000:
+            return 500000;
+        case B921600:
+            return 921600;
+        case B1500000:
+            return 1500000;
+        default:
+            return 0;
+    }
+}
+
 }  // namespace
 
 std::vector<std::string> PtyConfig::validate(const PtyConfig& config) {
@@ -148,6 +175,13 @@ class Pty::Impl : public std::enable_shared_from_this<Impl> {
 
     bool is_open() const { return stream_.is_open(); }
     bool peer_connected() const { return peer_; }
+    unsigned peer_baud() {
+        termios tio{};
+        if (!is_open() || ::tcgetattr(stream_.native_handle(), &tio) != 0) {
+            return 0;
+        }
+        return baud_of(::cfgetospeed(&tio));
+    }
     const std::string& link_path() const { return config_.link_path; }
     const std::string& slave_path() const { return slave_path_; }
 
@@ -344,6 +378,9 @@ OpenResult Pty::replug() {
 }
 bool Pty::is_open() const {
     return impl_->is_open();
+}
+unsigned Pty::peer_baud() const {
+    return impl_->peer_baud();
 }
 bool Pty::peer_connected() const {
     return impl_->peer_connected();

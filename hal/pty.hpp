@@ -60,6 +60,10 @@ class Pty {
 
     bool is_open() const;
     bool peer_connected() const;
+    /// The baud rate the peer set on its end: on Linux the master reads the slave's termios, so a simulator
+    /// can tell which rate the peer's UART would run at (a pty itself moves bytes at any rate). 0 when
+    /// unplugged or not a standard rate.
+    unsigned peer_baud() const;
     const std::string& link_path() const;
     /// /dev/pts/N of the current pair; empty while unplugged.
     const std::string& slave_path() const;

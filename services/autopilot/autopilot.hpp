@@ -194,8 +194,9 @@ struct AutopilotStatus {
     std::optional<Position> position;            // autopilot.position
     std::uint16_t mission_current = 0;           // autopilot.mission_current
     unsigned reboots = 0;                        // autopilot.reboots
-    unsigned reconnects = 0;  // autopilot.reconnects (filled by the service from its port keeper)
-    unsigned reset_pulses = 0;
+    unsigned reconnects = 0;    // autopilot.reconnects (filled by the service from its port keeper)
+    unsigned reset_pulses = 0;  // autopilot.reset_pulses
+    unsigned baud = 0;          // autopilot.baud: the rate the port runs at (the one kept when probing)
 };
 
 }  // namespace airseg::autopilot

@@ -3,6 +3,8 @@
 #include <set>
 #include <sstream>
 
+#include "services/autopilot/mavlink/message_table.hpp"
+
 namespace airseg::autopilot {
 
 const char* to_string(Board b) {
@@ -13,6 +15,13 @@ const char* to_string(Board b) {
             return "pixhawk";
     }
     return "?";
+}
+
+std::optional<std::uint32_t> message_id(std::string_view name) {
+    if (const auto* info = mavlink::find_message(name)) {
+        return info->id;
+    }
+    return std::nullopt;
 }
 
 AutopilotConfig AutopilotConfig::defaults_for(Board board) {
@@ -107,6 +116,7 @@ std::vector<std::string> AutopilotConfig::validate(const AutopilotConfig& c) {
                 secs(m.max_timeout), " s");
     check_range(out, "autopilot.mission.retries", m.retries, 0, 50);
     check_range(out, "autopilot.mission.give_up_after", secs(m.give_up_after), 0, 300, " s");
+    check_range(out, "autopilot.mission.vehicle_gives_up", secs(m.vehicle_gives_up), 1, 120, " s");
     check_range(out, "autopilot.mission.max_items", m.max_items, 2, 65535);
     const auto& r = c.rc_override;
     check_range(out, "autopilot.rc_override.rate_hz", r.rate_hz, 1, 50, " Hz");

@@ -2,7 +2,9 @@
 // Configuration of the autopilot driver cores. Every field has a default; validate() lists every problem,
 // naming the YAML key (written next to each field) so the loader can report it as given.
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "services/common/time.hpp"
@@ -39,6 +41,10 @@ struct ParamSetting {
     double value = 0.0;
 };
 
+/// The id of the MAVLink message called `name` ("ATTITUDE"), for autopilot.message_rates; nullopt when this
+/// build does not know it. Keeps message names in the autopilot layer.
+std::optional<std::uint32_t> message_id(std::string_view name);
+
 struct RcOverrideConfig {
     double rate_hz = 10.0;                       // autopilot.rc_override.rate_hz (1..50)
     Duration input_timeout = milliseconds(500);  // autopilot.rc_override.input_timeout (0.1..5 s)
@@ -52,11 +58,14 @@ struct RcOverrideConfig {
 
 struct MissionConfig {
     Duration initial_timeout = milliseconds(1500);  // autopilot.mission.initial_timeout, before RTT is known
-    Duration min_timeout = milliseconds(400);       // autopilot.mission.min_timeout
+    Duration min_timeout = milliseconds(150);       // autopilot.mission.min_timeout
     Duration max_timeout = seconds(6);              // autopilot.mission.max_timeout
     unsigned retries = 5;  // autopilot.mission.retries: per step, refreshed on progress...
     Duration give_up_after =
-        seconds(15);                // autopilot.mission.give_up_after: ...and this long without progress
+        seconds(15);  // autopilot.mission.give_up_after: ...and this long without progress
+    Duration vehicle_gives_up =
+        seconds(8);                 // autopilot.mission.vehicle_gives_up: an upload without any
+                                    // request this long was abandoned by the vehicle (ArduPilot: 8 s)
     bool use_int = true;            // autopilot.mission.use_int: MISSION_REQUEST_INT / ITEM_INT
     std::uint16_t max_items = 700;  // autopilot.mission.max_items
 };

@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <utility>
+
 #include "hal/gpio_pulse.hpp"
 
 namespace airseg::autopilot {
@@ -23,7 +25,11 @@ AutopilotService::AutopilotService(ServiceContext& ctx, AutopilotServiceConfig c
       driver_(config_.autopilot),
       keeper_(strand(), port_config(config_),
               PortKeeper::Handlers{[this] {
-                                       driver_.on_port_open(SteadyClock::now());
+                                       if (std::exchange(switching_baud_, false)) {
+                                           driver_.on_port_reopened(SteadyClock::now());
+                                       } else {
+                                           driver_.on_port_open(SteadyClock::now());
+                                       }
                                        pump();
                                    },
                                    [this](std::span<const std::uint8_t> bytes) {
@@ -148,9 +154,7 @@ void AutopilotService::pump() {
         if (const auto* p = std::get_if<ardupilot::PulseReset>(&*a)) {
             pulse_reset(p->attempt);
         } else if (const auto* b = std::get_if<ardupilot::SwitchBaud>(&*a)) {
-            // PortKeeper cannot reopen at another rate yet: the first configured rate stays in use.
-            spdlog::warn("{}no valid frame yet; would try {} baud, which needs PortKeeper support", prefix_,
-                         b->baud);
+            switch_baud(b->baud);
         }
     }
     if (changed) {
@@ -225,6 +229,7 @@ void AutopilotService::on_timer(const boost::system::error_code& ec) {
 void AutopilotService::publish_status() {
     AutopilotStatus s = driver_.status();
     s.reconnects = keeper_.reconnects();
+    s.baud = keeper_.baud();
     ctx_.bus.publish_latest(s);
     ctx_.bus.publish_latest(driver_.telemetry());
 }
@@ -241,6 +246,20 @@ void AutopilotService::update_health() {
                                                                                    : driver_.last_error())
                                                    : keeper_.last_error());
     }
+}
+
+// Baud probing: nothing valid came at the current rate. The port is reopened from the strand's queue, not
+// from inside pump(): the reopen calls the open handler, which pumps again.
+void AutopilotService::switch_baud(unsigned baud) {
+    spdlog::info("{}no valid frame at {} baud; trying {} baud", prefix_, keeper_.baud(), baud);
+    asio::post(strand(), [this, baud] {
+        if (!running_) {
+            return;
+        }
+        switching_baud_ = keeper_.is_open();
+        keeper_.reopen_at(baud);
+        switching_baud_ = false;
+    });
 }
 
 void AutopilotService::pulse_reset(unsigned attempt) {

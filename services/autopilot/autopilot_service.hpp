@@ -2,7 +2,8 @@
 // AutopilotService: the asio side of the ArduPilot driver. It keeps the autopilot's serial port open
 // (PortKeeper: reopen with backoff), feeds the port's bytes and a steady_timer to the sans-IO Driver, writes
 // what the driver sends, publishes the driver's events and the autopilot status and telemetry on the bus,
-// pulses the reset line when the driver asks, and records every frame in the .tlog when enabled.
+// pulses the reset line when the driver asks, reopens the port at the rate the driver's baud probing asks for,
+// and records every frame in the .tlog when enabled.
 //
 // Bus: subscribes AutopilotRequest, JoystickInput, OperatorReset; publishes the autopilot::Event types
 // (RequestDone with the requester's id) as events, and AutopilotStatus and Telemetry as variables.
@@ -52,6 +53,7 @@ class AutopilotService : public Service {
     void schedule_status();
     void publish(Event e);
     void pulse_reset(unsigned attempt);
+    void switch_baud(unsigned baud);
     void update_health();
 
     AutopilotServiceConfig config_;
@@ -66,6 +68,7 @@ class AutopilotService : public Service {
     std::map<std::uint32_t, std::uint32_t> requester_ids_;  // driver id -> requester id
     std::vector<Subscription> subscriptions_;
     bool running_ = false;
+    bool switching_baud_ = false;  // the next open is a baud probe's reopen of the same device
     std::string prefix_;
 };
 

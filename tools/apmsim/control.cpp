@@ -146,9 +146,14 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
             return "ok no heartbeats for " + w[1] + " s";
         }
         if (verb == "loss") {
-            need(2, "loss P");
-            sim.faults().loss = toolcommon::parse_probability(verb, w[1]);
-            return "ok loss " + w[1];
+            if (w.size() != 2 && w.size() != 3) {
+                throw toolcommon::UsageError("usage: loss P [BURST]");
+            }
+            const double p = toolcommon::parse_probability(verb, w[1]);
+            const double burst = w.size() == 3 ? toolcommon::parse_double(verb, w[2], 1, 10000) : 1.0;
+            sim.faults().loss = p;
+            sim.faults().loss_burst = burst;
+            return "ok loss " + w[1] + (w.size() == 3 ? " in bursts of " + w[2] + " bytes" : "");
         }
         if (verb == "corrupt") {
             need(2, "corrupt P");
@@ -186,7 +191,7 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
         if (verb == "help") {
             return "ok commands: state, modes [N], stats, rcpilot MODE, reboot [S], unplug, replug, hbstall "
                    "S, "
-                   "loss P, "
+                   "loss P [BURST], "
                    "corrupt P, ignore-mission on|off, slow MS, param NAME [VALUE]";
         }
         return "error: unknown command '" + verb + "' (try help)";

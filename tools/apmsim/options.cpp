@@ -20,6 +20,10 @@ Board:
   --boot-delay S           silence after a reset                                  [2]
   --calib-time S           calibration time after the silence                     [3]
   --no-reset-on-open       do not reboot when the port is opened (Pixhawk-style boards)
+  --baud N                 the board's UART rate. A pty moves bytes at any rate, so
+                           the simulator reads the rate the peer set on its end;
+                           while it differs, both sides receive noise, as two UARTs
+                           at different rates do                           [any rate]
   --home LAT,LON           start and home position, degrees                       [41.2756,1.9866]
   --home-alt M             home altitude above mean sea level                     [5]
   --mission-capacity N     mission items the board holds, home included           [150]
@@ -31,7 +35,10 @@ Board:
   --seed N                 seed of the fault generators (deterministic)          [1]
   --speedup N              simulated time runs N times faster than real time      [1]
 Faults (times are simulated seconds after start):
-  --loss P                 probability each byte (either direction) is lost
+  --loss P                 fraction of the bytes lost, each direction
+  --loss-burst N           lose bytes in bursts of N bytes on average (geometric
+                           lengths: frames cut short, tails, whole frames)
+                           instead of one by one                                  [1]
   --corrupt P              probability each byte (either direction) gets a bit flipped
   --hb-stall START:DUR     no heartbeats from START for DUR seconds (repeatable)
   --reboot-at S            reboot at S
@@ -55,7 +62,8 @@ Control commands (one per datagram; the reply goes to the sender's bound address
   reboot [S]               reboot now, or in S simulated seconds
   unplug | replug          remove the pty (the link is gone) / create a new one at PATH
   hbstall S                no heartbeats for S seconds
-  loss P | corrupt P       set byte loss / corruption
+  loss P [BURST]           set byte loss (in bursts of BURST bytes on average)
+  corrupt P                set byte corruption
   ignore-mission on|off    ignore mission protocol messages
   slow MS                  answer requests MS milliseconds late (0: at once)
   param NAME [VALUE]       read or set a parameter
@@ -99,6 +107,8 @@ std::optional<ApmSimOptions> parse_options(const std::vector<std::string>& args)
             o.sim.calib_time = parse_seconds(arg, value());
         } else if (arg == "--no-reset-on-open") {
             o.sim.reset_on_open = false;
+        } else if (arg == "--baud") {
+            o.baud = static_cast<unsigned>(parse_unsigned(arg, value(), 9600, 1500000));
         } else if (arg == "--home") {
             o.sim.home = parse_lat_lon(arg, value());
         } else if (arg == "--home-alt") {
@@ -133,6 +143,8 @@ std::optional<ApmSimOptions> parse_options(const std::vector<std::string>& args)
             o.speedup = parse_double(arg, value(), 0.01, 10000);
         } else if (arg == "--loss") {
             o.faults.loss = parse_probability(arg, value());
+        } else if (arg == "--loss-burst") {
+            o.faults.loss_burst = parse_double(arg, value(), 1, 10000);
         } else if (arg == "--corrupt") {
             o.faults.corrupt = parse_probability(arg, value());
         } else if (arg == "--hb-stall") {

@@ -14,6 +14,7 @@ struct ApmSimOptions {
     std::string link_path;     // --link
     std::string control_path;  // --control
     double speedup = 1.0;      // --speedup
+    unsigned baud = 0;         // --baud: the board's UART rate; 0 = whatever the peer sets
     RoverSimConfig sim;
     Faults faults;
     std::vector<std::pair<std::string, float>> params;  // --param NAME=VALUE

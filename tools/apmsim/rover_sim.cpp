@@ -195,7 +195,7 @@ void RoverSim::handle_bytes(std::span<const std::uint8_t> bytes, TimePoint now) 
     handle_timeout(now);
     counters_.bytes_in += bytes.size();
     std::vector<std::uint8_t> in(bytes.begin(), bytes.end());
-    impair(in);
+    impair(in, burst_in_);
     if (phase_ == BootPhase::Silent || in.empty()) {
         return;  // the boot loader and the early start-up do not read MAVLink
     }
@@ -218,7 +218,7 @@ void RoverSim::handle_bytes(std::span<const std::uint8_t> bytes, TimePoint now) 
 
 std::vector<std::uint8_t> RoverSim::poll_transmit() {
     auto bytes = out_.take();
-    impair(bytes);
+    impair(bytes, burst_out_);
     counters_.bytes_out += bytes.size();
     return bytes;
 }
@@ -266,14 +266,14 @@ double RoverSim::uniform() {
     return static_cast<double>(rng_() >> 11) * 0x1.0p-53;
 }
 
-void RoverSim::impair(std::vector<std::uint8_t>& bytes) {
+void RoverSim::impair(std::vector<std::uint8_t>& bytes, bool& in_burst) {
     if (faults_.loss <= 0 && faults_.corrupt <= 0) {
         return;
     }
     std::vector<std::uint8_t> kept;
     kept.reserve(bytes.size());
     for (std::uint8_t b : bytes) {
-        if (faults_.loss > 0 && uniform() < faults_.loss) {
+        if (lose_byte(in_burst)) {
             ++counters_.bytes_lost;
             continue;
         }
@@ -284,6 +284,27 @@ void RoverSim::impair(std::vector<std::uint8_t>& bytes) {
         kept.push_back(b);
     }
     bytes = std::move(kept);
+}
+
+// A two-state (Gilbert) channel. In a burst every byte is lost and the burst goes on after each with
+// probability 1 - 1/B (mean length B). Outside, a burst starts at a byte with probability p; good runs then
+// average (1 - p) / p bytes, and the lost fraction B / (B + (1 - p) / p) equals `loss` for
+// p = loss / (B (1 - loss) + loss).
+bool RoverSim::lose_byte(bool& in_burst) {
+    const double loss = faults_.loss;
+    if (loss <= 0) {
+        in_burst = false;
+        return false;
+    }
+    const double length = faults_.loss_burst;
+    if (length <= 1) {
+        return uniform() < loss;
+    }
+    if (!in_burst && uniform() >= loss / (length * (1.0 - loss) + loss)) {
+        return false;
+    }
+    in_burst = uniform() >= 1.0 / length;
+    return true;
 }
 
 void RoverSim::text(std::uint8_t severity, std::string_view message) {

@@ -66,8 +66,12 @@ struct RoverSimConfig {
 
 /// Faults that can be switched while running.
 struct Faults {
-    double loss = 0;     // probability each byte (either direction) is lost
-    double corrupt = 0;  // probability each byte (either direction) has one bit flipped
+    /// Fraction of the bytes lost, in each direction. With loss_burst <= 1 each byte is lost on its own;
+    /// above, bytes go in bursts of that mean length (geometric), so a burst cuts a frame short, takes the
+    /// tail of one frame and the head of the next, or swallows whole frames, as a radio fade does.
+    double loss = 0;
+    double loss_burst = 1;  // mean length of a loss burst, bytes
+    double corrupt = 0;     // probability each byte (either direction) has one bit flipped
     bool ignore_mission = false;
     Duration slow{0};  // delay of every answer to a request
 };
@@ -160,7 +164,8 @@ class RoverSim {
     void advance(TimePoint now);
     void enter_phase(BootPhase phase, TimePoint now);
     void dispatch(const mavlink::Frame& f, TimePoint now);
-    void impair(std::vector<std::uint8_t>& bytes);
+    void impair(std::vector<std::uint8_t>& bytes, bool& in_burst);
+    bool lose_byte(bool& in_burst);
     double uniform();
     void text(std::uint8_t severity, std::string_view message);
     std::uint32_t time_boot_ms(TimePoint now) const;
@@ -197,6 +202,8 @@ class RoverSim {
     TimePoint started_;
     TimePoint now_;
     std::mt19937_64 rng_;
+    bool burst_in_ = false;   // loss burst under way, bytes to the board
+    bool burst_out_ = false;  // loss burst under way, bytes from the board
     Faults faults_;
     SimCounters counters_;
     ParamTable params_;

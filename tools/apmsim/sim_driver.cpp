@@ -17,7 +17,8 @@ SimDriver::SimDriver(boost::asio::io_context& io, ApmSimOptions options)
     : options_(std::move(options)),
       strand_(boost::asio::make_strand(io)),
       real_origin_(SteadyClock::now()),
-      timer_(strand_) {
+      timer_(strand_),
+      noise_rng_(static_cast<std::uint32_t>(options_.sim.seed * 2654435761U + 7)) {
     RoverSimConfig config = options_.sim;
     config.unix_time_at_start_us = static_cast<std::uint64_t>(
         std::chrono::duration_cast<microseconds>(std::chrono::system_clock::now().time_since_epoch())
@@ -68,7 +69,11 @@ std::string SimDriver::start() {
         // The open is sampled, so a fast writer's first bytes can arrive before it is seen; on the board the
         // DTR reset comes first and those bytes meet the boot loader.
         on_port_opened();
-        sim_->handle_bytes(bytes, sim_now());
+        if (baud_mismatch()) {
+            sim_->handle_bytes(noise(bytes.size()), sim_now());
+        } else {
+            sim_->handle_bytes(bytes, sim_now());
+        }
         pump();
     });
     if (!options_.control_path.empty()) {
@@ -115,7 +120,7 @@ void SimDriver::pump() {
     }
     auto bytes = sim_->poll_transmit();
     if (!bytes.empty() && pty_->is_open() && pty_->peer_connected()) {
-        pty_->write(std::move(bytes));
+        pty_->write(baud_mismatch() ? noise(bytes.size()) : std::move(bytes));
     }
     log_new_events();
     arm();
@@ -161,6 +166,32 @@ void SimDriver::schedule_faults() {
         at_sim_time(w.start, [this] { log(unplug()); });
         at_sim_time(w.start + w.length, [this] { log(replug()); });
     }
+}
+
+// Two UARTs at different rates do not exchange bytes, they exchange framing errors: what each side receives
+// is noise. The pty carries bytes at any rate, so the rate the peer set on its end decides.
+bool SimDriver::baud_mismatch() {
+    if (options_.baud == 0) {
+        return false;
+    }
+    const unsigned peer = pty_->peer_baud();
+    const bool mismatch = peer != 0 && peer != options_.baud;
+    if (mismatch && peer != mismatch_logged_) {
+        log("peer at " + std::to_string(peer) + " baud, board at " + std::to_string(options_.baud) +
+            ": both sides hear noise");
+    } else if (!mismatch && mismatch_logged_ != 0) {
+        log("peer at " + std::to_string(options_.baud) + " baud, as the board");
+    }
+    mismatch_logged_ = mismatch ? peer : 0;
+    return mismatch;
+}
+
+std::vector<std::uint8_t> SimDriver::noise(std::size_t n) {
+    std::vector<std::uint8_t> out(n);
+    for (auto& b : out) {
+        b = static_cast<std::uint8_t>(noise_rng_() >> 24);
+    }
+    return out;
 }
 
 void SimDriver::on_port_opened() {

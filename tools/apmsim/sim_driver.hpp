@@ -3,7 +3,10 @@
 // steady_timer that follows the core's poll_timeout(), the control socket, and the scheduled faults of the
 // command line. Everything runs on one strand.
 #include <memory>
+#include <random>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "hal/asio.hpp"
 #include "hal/pty.hpp"
@@ -42,6 +45,8 @@ class SimDriver {
     std::string on_command(const std::string& command);
     void log(const std::string& line) const;
     void log_new_events();
+    bool baud_mismatch();
+    std::vector<std::uint8_t> noise(std::size_t n);
 
     ApmSimOptions options_;
     hal::Executor strand_;
@@ -56,6 +61,8 @@ class SimDriver {
     std::size_t reached_logged_ = 0;
     bool peer_present_ = false;  // as the board sees it (DTR)
     bool stopped_ = false;
+    std::mt19937 noise_rng_;
+    unsigned mismatch_logged_ = 0;  // the peer rate last reported as wrong (0: none)
 };
 
 }  // namespace airseg::apmsim

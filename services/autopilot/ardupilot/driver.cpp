@@ -103,6 +103,14 @@ void Driver::on_port_closed(const std::string& reason, TimePoint now) {
     update_state(now, false);
 }
 
+void Driver::on_port_reopened(TimePoint now) {
+    if (!port_open_) {
+        on_port_open(now);
+        return;
+    }
+    parser_ = mav::Parser{};
+}
+
 void Driver::on_reset_pulsed(TimePoint now) {
     quiet_since_ = now;
     time_boot_.reset();

@@ -8,6 +8,10 @@
 // where they differ, each read back) -> Ready (Ready event with the seconds since the open). A failed step is
 // retried after kRetryPause; last_error() says why the driver is not READY.
 //
+// Baud probing (more than one configured rate): when no valid frame from the autopilot's system id arrives
+// within baud_probe of the open, the driver asks for the next rate (SwitchBaud), in turn; the service reopens
+// the port and calls on_port_reopened(). The first rate that yields such a frame is kept.
+//
 // Afterwards it keeps: telemetry; the vehicle state derived from each heartbeat (mode changes made by the RC
 // pilot or the autopilot itself are published as External ModeChanged events); requested state changes,
 // confirmed by the heartbeat, retried, refused or timed out (never dropped); mission operations through
@@ -66,6 +70,9 @@ class Driver {
     // --- port lifecycle ---
     void on_port_open(TimePoint now);
     void on_port_closed(const std::string& reason, TimePoint now);
+    /// The port was reopened at another baud rate after a SwitchBaud: the byte stream starts afresh, the
+    /// connection sequence and its timers go on.
+    void on_port_reopened(TimePoint now);
     void on_reset_pulsed(TimePoint now);
 
     // --- sans-IO plumbing ---

@@ -59,11 +59,13 @@ void Driver::tap_incoming(const mav::Frame& f) {
 }
 
 void Driver::on_frame(const mav::Frame& f, TimePoint now) {
-    heard_frame_ = true;
-    baud_deadline_ = kNever;
     if (f.sysid != config_.target_sysid) {
         return;
     }
+    // Only the autopilot's own frames end baud probing: line noise at a wrong rate passes a checksum now
+    // and then, but hardly ever with the right system id as well.
+    heard_frame_ = true;
+    baud_deadline_ = kNever;
     missions_.handle_frame(f, now);
     params_.handle_frame(f, now);
     const auto p = f.payload_view();

@@ -249,6 +249,7 @@ void MissionClient::start_front(TimePoint now) {
                 break;
         }
         w.last_progress = now;
+        w.last_heard = now;
         transmit(w, now, false);
     }
 }
@@ -351,10 +352,12 @@ void MissionClient::transmit(WorkItem& w, TimePoint now, bool retry) {
 
 // Until the first RTT sample, Karn's rule: the timeout doubles with each retransmission, otherwise a link
 // slower than the initial guess would never yield an unambiguous sample. Once the RTT is known a lost frame
-// is taken for what it is on a serial radio, random loss, not congestion: a retry waits twice the timeout,
-// no more, so a lossy link gets many quick attempts (ArduPilot abandons an upload after 8 s without an item).
-Duration MissionClient::current_timeout(const WorkItem& w) const {
-    const unsigned factor = srtt_ ? (w.attempt > 0 ? 2u : 1u) : backoff_;
+// is taken for what it is on a serial radio, random loss, not congestion: a retry waits one timeout
+// (SRTT + 4 RTTVAR already covers the variation), so a lossy link gets many quick attempts. That matters:
+// ArduPilot abandons an upload after 8 s without an item, and at a few percent of bytes lost most item
+// frames are damaged, so an item needs several attempts inside those 8 s.
+Duration MissionClient::current_timeout(const WorkItem&) const {
+    const unsigned factor = srtt_ ? 1u : backoff_;
     return std::min<Duration>(base_timeout() * factor, config_.max_timeout);
 }
 
@@ -393,6 +396,15 @@ void MissionClient::handle_timeout(TimePoint now) {
         return;
     }
     WorkItem& w = work_.front();
+    const bool uploading = w.op == MissionOperation::Upload || w.op == MissionOperation::WritePartial;
+    if (uploading && w.any_request && now - w.last_heard >= config_.vehicle_gives_up &&
+        w.restarts < config_.retries) {
+        // Not even a repeated request for as long as the vehicle waits before it abandons a transfer: it has
+        // abandoned this one, and its OPERATION_CANCELLED was lost. Waiting for an answer to our item would
+        // wait forever; start again.
+        restart(w, now);
+        return;
+    }
     // Out of budget only when both the attempts and the time since the last progress are spent: on a fast,
     // lossy link the attempts come quickly, and the vehicle is still there.
     if (w.attempt >= config_.retries && now - w.last_progress >= config_.give_up_after) {
@@ -512,9 +524,16 @@ void MissionClient::on_request(std::uint16_t seq, bool as_int, TimePoint now) {
         ++stats_.ignored_frames;
         return;
     }
+    w.last_heard = now;
     const bool fresh = !w.any_request || seq > w.highest_sent;
     if (fresh) {
         progress(w, now);
+        if (!w.best || seq > *w.best) {
+            // Further than any attempt got: the vehicle's cancels so far did not stop the transfer, so the
+            // budget of restarts is refreshed. It is bounded all the same (the best can only grow n times).
+            w.best = seq;
+            w.restarts = 0;
+        }
     } else {
         ++stats_.duplicate_requests;
     }
@@ -571,17 +590,25 @@ void MissionClient::on_ack(std::uint8_t type, TimePoint now) {
     }
     const bool vehicle_lost_track = type == kOperationCancelled || (type == kError && w.any_request);
     if (uploading && vehicle_lost_track && w.restarts < config_.retries) {
-        ++w.restarts;
-        ++stats_.restarts;
-        w.any_request = false;
-        w.highest_sent = 0;
-        w.next_seq = w.first;
-        w.step = Step::WaitRequest;
-        transmit(w, now, true);
+        restart(w, now);
         return;
     }
     const std::string detail = std::string("autopilot answered MAV_MISSION_") + mission_result_name(type);
     finish(type == kNoSpace ? MissionResult::NoSpace : MissionResult::Denied, detail, now);
+}
+
+// The vehicle no longer receives this upload: announce it again from the first item.
+void MissionClient::restart(WorkItem& w, TimePoint now) {
+    ++w.restarts;
+    ++stats_.restarts;
+    w.any_request = false;
+    w.highest_sent = 0;
+    w.next_seq = w.first;
+    w.step = Step::WaitRequest;
+    w.last_heard = now;
+    w.attempt = 0;  // a new transfer, with the retry budget of one (restarts have their own)
+    w.last_progress = now;
+    transmit(w, now, true);
 }
 
 void MissionClient::on_count(std::uint16_t count, TimePoint now) {

@@ -18,7 +18,8 @@
 // MISSION_REQUEST. A download accepts either item form.
 // MAV_MISSION_INVALID_SEQUENCE during an upload means a duplicate item crossed a request on the link; it is
 // counted and the transfer goes on. MAV_MISSION_OPERATION_CANCELLED during an upload (the vehicle gave up on
-// a bad link) starts the upload again, up to `retries` times.
+// a bad link) starts the upload again, up to `retries` times in a row without an attempt getting further
+// than the attempts before it.
 //
 // Contract: enqueue with upload()/download()/write_partial()/set_current()/clear(); feed every frame from the
 // autopilot to handle_frame(); call handle_timeout(now) when poll_timeout() is due; after each input drain
@@ -122,8 +123,10 @@ class MissionClient {
         bool retransmitted = false;  // Karn's rule: no RTT sample from a retransmission
         bool answer_int = true;      // reply form for the last request
         std::uint16_t highest_sent = 0;
-        unsigned restarts = 0;
-        TimePoint last_progress{};  // upload / partial: started again after the vehicle cancelled it
+        unsigned restarts = 0;              // upload / partial: restarts since the best seq last grew
+        std::optional<std::uint16_t> best;  // upload / partial: highest seq requested by any attempt
+        TimePoint last_progress{};          // the last fresh answer (refreshes the retry budget)
+        TimePoint last_heard{};  // upload / partial: the last request of any kind for this transfer
     };
 
     Duration current_timeout(const WorkItem& w) const;
@@ -133,6 +136,7 @@ class MissionClient {
     void send_item(WorkItem& w, std::uint16_t seq, bool as_int);
     void progress(WorkItem& w, TimePoint now);
     void finish(MissionResult result, std::string detail, TimePoint now);
+    void restart(WorkItem& w, TimePoint now);
     void reject(MissionOperation op, std::uint32_t id, MissionResult r, std::string detail);
 
     void on_request(std::uint16_t seq, bool as_int, TimePoint now);

@@ -79,6 +79,9 @@ void Parser::push(std::span<const std::uint8_t> bytes, Sink sink) {
                 }
                 len_ += n;
                 pos += n;
+                if (len_ < need && resync_inside_candidate()) {
+                    continue;
+                }
                 if (len_ < need && pos == bytes.size()) {
                     return;
                 }
@@ -87,6 +90,40 @@ void Parser::push(std::span<const std::uint8_t> bytes, Sink sink) {
         }
         step(sink, false);
     }
+}
+
+// The candidate at buf_[0] is still incomplete, but a frame that begins inside it may already be complete:
+// after a lost byte (or a stray start byte in noise) the candidate's length comes from the wrong byte, and
+// waiting for it to fill would hold good frames back until unrelated later traffic arrives, on a quiet line
+// for seconds. A complete frame with a known id and a matching checksum inside the candidate proves the
+// candidate damaged: it is dropped up to that frame. Each inner start is checked once, when its frame
+// becomes complete (checked_len_ is the buffer length at the previous check).
+bool Parser::resync_inside_candidate() {
+    for (std::size_t k = 1; k < len_; ++k) {
+        if (!is_magic(buf_[k]) || len_ - k < header_length(buf_[k])) {
+            continue;
+        }
+        const Header h = read_header(buf_.data() + k);
+        const std::size_t end = k + h.frame_length();
+        if (end > len_ || end <= checked_len_) {
+            continue;
+        }
+        const MessageInfo* info = find_message(h.msgid);
+        if (info == nullptr) {
+            continue;
+        }
+        Crc16 crc;
+        crc.add(std::span<const std::uint8_t>(buf_.data() + k + 1, h.header_length - 1 + h.payload_length));
+        crc.add(info->crc_extra);
+        if (crc.value() == wire::get<std::uint16_t>(buf_.data() + k + h.header_length + h.payload_length)) {
+            mark_damaged(k, DamageKind::Truncated);
+            discard(k);
+            drop_front(k);
+            return true;
+        }
+    }
+    checked_len_ = len_;
+    return false;
 }
 
 void Parser::finish(Sink sink) {
@@ -252,6 +289,7 @@ void Parser::discard(std::size_t n) {
 void Parser::drop_front(std::size_t n) {
     std::memmove(buf_.data(), buf_.data() + n, len_ - n);
     len_ -= n;
+    checked_len_ = 0;
 }
 
 }  // namespace airseg::mavlink

@@ -19,9 +19,12 @@
 //    the stream ends there); otherwise its start byte is treated as noise. This keeps a stray 0xFD/0xFE in
 //    line noise from swallowing good frames behind it.
 //  - After a bad checksum the parser rescans from the byte after the failed start byte, so a good frame that
-//    begins inside a damaged or cut-short one is still found. Each damaged stretch is counted once: as
-//    `truncated` when a good frame began inside it (or the stream ended inside a frame), else as
-//    `bad_checksum`. Bytes outside any frame candidate count as `garbage_bytes`.
+//    begins inside a damaged or cut-short one is still found. It does not wait for a cut-short candidate to
+//    fill up: as soon as a complete frame with a known id and a matching checksum lies inside a candidate,
+//    the candidate is given up and that frame delivered (a lost byte would otherwise make the candidate
+//    claim the wrong length and hold good frames back until unrelated later bytes arrive). Each damaged
+//    stretch is counted once: as `truncated` when a good frame began inside it (or the stream ended inside a
+//    frame), else as `bad_checksum`. Bytes outside any frame candidate count as `garbage_bytes`.
 //  - Sequence numbers are tracked per (sysid, compid); a gap of n counts n lost frames (seq_lost), the same
 //    rule as the reference C library, so a repeated or reordered frame counts as a large gap.
 #include <array>
@@ -102,9 +105,11 @@ class Parser {
     void discard(std::size_t n);
     void drop_front(std::size_t n);
     void resolve_damage_by_good_frame();
+    bool resync_inside_candidate();
 
     std::array<std::uint8_t, kMaxFrameLength + 1> buf_{};  // one frame candidate, plus one byte of look-ahead
     std::size_t len_ = 0;
+    std::size_t checked_len_ = 0;  // buffer length at the last look for a complete frame inside the candidate
     std::size_t damaged_left_ = 0;
     DamageKind damage_kind_ = DamageKind::BadChecksum;
     Frame frame_{};

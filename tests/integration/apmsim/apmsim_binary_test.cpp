@@ -277,7 +277,7 @@ TEST(ApmsimBinary, HelpAndBadOptions) {
                                "--seed",     "--speedup",          "--loss",          "--corrupt",
                                "--hb-stall", "--reboot-at",        "--unplug",        "--ignore-mission",
                                "--slow",     "--control",          "rcpilot",         "modes",
-                               "hbstall",    "ignore-mission"}) {
+                               "hbstall",    "ignore-mission",     "--loss-burst",    "--baud"}) {
         EXPECT_NE(help.out.find(option), std::string::npos) << option;
     }
     auto bad = airseg::test::run(

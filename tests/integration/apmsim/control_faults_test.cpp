@@ -41,6 +41,10 @@ TEST(ApmsimControl, QueriesAndFaults) {
     EXPECT_DOUBLE_EQ(h.sim.faults().loss, 0.25);
     EXPECT_EQ(apply_control(h.sim, "loss 1.5", h.now, link).rfind("error: ", 0), 0u);
     EXPECT_DOUBLE_EQ(h.sim.faults().loss, 0.25) << "a bad value changes nothing";
+    EXPECT_EQ(apply_control(h.sim, "loss 0.1 32", h.now, link), "ok loss 0.1 in bursts of 32 bytes");
+    EXPECT_DOUBLE_EQ(h.sim.faults().loss_burst, 32.0);
+    EXPECT_EQ(apply_control(h.sim, "loss 0.25", h.now, link), "ok loss 0.25");
+    EXPECT_DOUBLE_EQ(h.sim.faults().loss_burst, 1.0) << "without BURST, bytes are lost one by one";
     EXPECT_EQ(apply_control(h.sim, "corrupt 0", h.now, link), "ok corrupt 0");
     EXPECT_EQ(apply_control(h.sim, "ignore-mission on", h.now, link), "ok ignore-mission on");
     EXPECT_TRUE(h.sim.faults().ignore_mission);

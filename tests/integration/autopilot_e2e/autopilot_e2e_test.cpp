@@ -92,21 +92,25 @@ class AutopilotE2e : public ::testing::Test {
   protected:
     void SetUp() override {
         sim_ = std::make_unique<Subprocess>(
-            std::vector<std::string>{binary("tools/apmsim/airseg-apmsim"), "--link", dir_.file("ttyACM0"),
-                                     "--control", dir_.file("ctl"), "--home",
-                                     std::to_string(kHomeLat) + "," + std::to_string(kHomeLon), "--speedup",
-                                     "10", "--boot-delay", "0.5", "--calib-time", "0.5"},
+            with(std::vector<std::string>{binary("tools/apmsim/airseg-apmsim"), "--link",
+                                          dir_.file("ttyACM0"), "--control", dir_.file("ctl"), "--home",
+                                          std::to_string(kHomeLat) + "," + std::to_string(kHomeLon),
+                                          "--speedup", "10", "--boot-delay", "0.5", "--calib-time", "0.5"},
+                 extra_sim_args_),
             std::map<std::string, std::string>{}, dir_.path());
         ASSERT_TRUE(wait_until([&] { return exists(dir_.file("ttyACM0")) && exists(dir_.file("ctl")); },
                                kGenerous, kPoll))
             << sim_->err();
         control_ = std::make_unique<SimControl>(dir_.file("me"), dir_.file("ctl"));
         daemon_ = std::make_unique<Subprocess>(
-            std::vector<std::string>{
-                binary("daemon/airsegd"), "--config", source_path("config/airseg.yaml"), "--set",
-                "status.socket=" + dir_.file("status.sock"), "--set", "state_dir=" + dir_.file("state"),
-                "--set", "autopilot.port=" + dir_.file("ttyACM0"), "--set", "autopilot.reconnect_max=500ms",
-                "--set", "groundlink.ports=[" + dir_.file("ttyUSB0") + "]"},
+            with(std::vector<std::string>{binary("daemon/airsegd"), "--config",
+                                          source_path("config/airseg.yaml"), "--set",
+                                          "status.socket=" + dir_.file("status.sock"), "--set",
+                                          "state_dir=" + dir_.file("state"), "--set",
+                                          "autopilot.port=" + dir_.file("ttyACM0"), "--set",
+                                          "autopilot.reconnect_max=500ms", "--set",
+                                          "groundlink.ports=[" + dir_.file("ttyUSB0") + "]"},
+                 extra_daemon_args_),
             std::map<std::string, std::string>{}, dir_.path());
     }
 
@@ -142,6 +146,14 @@ class AutopilotE2e : public ::testing::Test {
         return ap.is_object() && ap.value("ready", false);
     }
 
+    static std::vector<std::string> with(std::vector<std::string> args,
+                                         const std::vector<std::string>& more) {
+        args.insert(args.end(), more.begin(), more.end());
+        return args;
+    }
+
+    std::vector<std::string> extra_sim_args_;     // set by a derived fixture before SetUp
+    std::vector<std::string> extra_daemon_args_;  // idem
     TempDir dir_;
     std::unique_ptr<Subprocess> sim_;
     std::unique_ptr<SimControl> control_;
@@ -227,6 +239,27 @@ TEST_F(AutopilotE2e, UnplugShowsTheLinkDownAndReplugRecoversWithoutARestart) {
     EXPECT_EQ(autopilot_section()["link"], "up");
     EXPECT_GT(autopilot_section()["reconnects"].get<unsigned>(), reconnects);
     EXPECT_TRUE(daemon_->running());
+}
+
+// The board's UART runs at 115200; the daemon is told to try 57600 first. A pty carries bytes at any rate,
+// so the simulator reads the rate airsegd set on its end and, while it differs, both sides hear noise.
+class AutopilotBaudProbeE2e : public AutopilotE2e {
+  protected:
+    AutopilotBaudProbeE2e() {
+        extra_sim_args_ = {"--baud", "115200"};
+        extra_daemon_args_ = {"--set", "autopilot.bauds=[57600, 115200]", "--set", "autopilot.baud_probe=1s"};
+    }
+};
+
+TEST_F(AutopilotBaudProbeE2e, ProbesTheConfiguredRatesAndKeepsTheOneThatWorks) {
+    ASSERT_TRUE(wait_until([&] { return ready(); }, kGenerous, kPoll)) << daemon_->err();
+    const auto ap = autopilot_section();
+    EXPECT_EQ(ap["baud"], 115200) << ap.dump();
+    EXPECT_EQ(ap["link"], "up");
+    // The first rate was really tried, and really failed: the board heard noise at 57600.
+    EXPECT_NE(sim_->err().find("peer at 57600 baud, board at 115200"), std::string::npos) << sim_->err();
+    EXPECT_NE(daemon_->err().find("trying 115200 baud"), std::string::npos) << daemon_->err();
+    EXPECT_EQ(ap["reconnects"], 0) << "a baud switch is not a reconnect";
 }
 
 }  // namespace

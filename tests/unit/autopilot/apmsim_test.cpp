@@ -2,6 +2,9 @@
 // in simulated time: the acceptance scenarios of the autopilot layer.
 #include <gtest/gtest.h>
 
+#include <iostream>
+#include <map>
+
 #include "services/autopilot/ardupilot/driver.hpp"
 #include "tests/unit/autopilot/sim_harness.hpp"
 #include "tools/apmsim/rover_sim.hpp"
@@ -169,6 +172,29 @@ TEST(DriverWithApmSim, EachVehicleStateRequestedAndConfirmed) {
     }
 }
 
+// Boards other than APM 2.x get per-message rates with MAV_CMD_SET_MESSAGE_INTERVAL (the rate of 0 stops a
+// message); APM 2.x gets REQUEST_DATA_STREAM groups.
+TEST(DriverWithApmSim, MessageRatesAreSetWithSetMessageIntervalOnPixhawkBoards) {
+    auto config = driver_config(Board::Pixhawk);
+    config.message_rates = {{mav::Attitude::kId, 10.0}, {mav::GlobalPositionInt::kId, 0.0}, {1, 2.0}};
+    SimRig rig(config, sim_config(Board::Pixhawk), {}, {}, 9);
+    std::map<std::uint32_t, int> counts;
+    bool counting = false;
+    rig.driver.set_frame_tap([&](bool outgoing, std::span<const std::uint8_t> frame) {
+        if (!outgoing && counting && frame.size() > 9 && frame[0] == 0xFD) {
+            ++counts[frame[7] | (frame[8] << 8) | (frame[9] << 16)];
+        }
+    });
+    ASSERT_TRUE(rig.open_and_wait_ready());
+    rig.harness.run_for(seconds(2));  // the requests have taken effect
+    counting = true;
+    rig.harness.run_for(seconds(10));
+    EXPECT_NEAR(counts[mav::Attitude::kId], 100, 3);
+    EXPECT_EQ(counts[mav::GlobalPositionInt::kId], 0);
+    EXPECT_NEAR(counts[1], 20, 2);  // SYS_STATUS
+    EXPECT_NEAR(counts[mav::Heartbeat::kId], 10, 1);
+}
+
 TEST(DriverWithApmSim, ModeChangeByTheSimulatedRcPilotIsSeen) {
     SimRig rig(Board::Apm2);
     ASSERT_TRUE(rig.open_and_wait_ready());
@@ -219,6 +245,74 @@ TEST(DriverWithApmSim, Upload150ItemsOverALossyLinkVerifiedByDownload) {
     }
     EXPECT_GT(rig.sim.counters().bytes_lost, 0u);
     EXPECT_GT(rig.driver.mission_client().stats().retransmissions, 0u);
+}
+
+struct LossCase {
+    Board board;
+    double loss;
+    double burst;
+    std::uint32_t seed;
+};
+
+// The board's serial line loses `loss` of its bytes both ways (in bursts of `burst` bytes on average): the
+// upload of a full APM 2.x mission completes, slower as the loss grows, and the download returns it.
+void upload_and_verify_under_loss(const LossCase& c) {
+    LinkModel radio;
+    radio.baud = 57600;
+    radio.latency = milliseconds(20);
+    SimRig rig(driver_config(c.board), sim_config(c.board), radio, radio, c.seed);
+    ASSERT_TRUE(rig.open_and_wait_ready()) << rig.driver.last_error();
+    rig.sim.faults().loss = c.loss;
+    rig.sim.faults().loss_burst = c.burst;
+    const auto items = square(150);
+    const TimePoint start = rig.now();
+    const auto r = rig.wait_result(rig.driver.upload_mission(items, rig.now()), seconds(3600));
+    const auto& st = rig.driver.mission_client().stats();
+    const auto& ps = rig.driver.parser_stats();
+    const auto srtt = rig.driver.mission_client().smoothed_rtt();
+    std::cout << to_string(c.board) << " loss " << c.loss << " burst " << c.burst << ": upload "
+              << to_string(r.result) << " in " << std::chrono::duration<double>(rig.now() - start).count()
+              << " s, retransmissions " << st.retransmissions << " duplicates " << st.duplicate_requests
+              << " restarts " << st.restarts << " srtt " << (srtt ? srtt->count() / 1e6 : -1.0)
+              << " ms, sim cancelled " << rig.sim.mission_stats().uploads_cancelled << ", parser ok "
+              << ps.frames_ok << " bad " << ps.bad_checksum << " truncated " << ps.truncated << " base "
+              << rig.driver.mission_client().base_timeout().count() / 1e6 << " ms; " << r.detail << "\n";
+    ASSERT_EQ(r.result, RequestResult::Ok) << r.detail;
+    const TimePoint down_start = rig.now();
+    const auto d = rig.wait_result(rig.driver.download_mission(rig.now()), seconds(3600));
+    std::cout << "  download " << to_string(d.result) << " in "
+              << std::chrono::duration<double>(rig.now() - down_start).count() << " s\n";
+    ASSERT_EQ(d.result, RequestResult::Ok) << d.detail;
+    ASSERT_EQ(d.items.size(), items.size());
+    // APM 2.x items travel as float degrees: about 2e-6 degree of rounding at these latitudes.
+    const double tolerance = c.board == Board::Apm2 ? 5e-6 : 1e-7;
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        EXPECT_NEAR(d.items[i].lat, items[i].lat, tolerance) << i;
+        EXPECT_NEAR(d.items[i].lon, items[i].lon, tolerance) << i;
+    }
+    const double lost = static_cast<double>(rig.sim.counters().bytes_lost);
+    const double total = static_cast<double>(rig.sim.counters().bytes_in + rig.sim.counters().bytes_out);
+    EXPECT_NEAR(lost / total, c.loss, c.loss * 0.25);
+}
+
+// Independent byte loss is the harshest case for MAVLink: at 3 % a 50-byte item frame arrives whole only one
+// time in five. The upload gets slower (restarts when the board abandons it after 8 s), never stuck.
+TEST(DriverWithApmSim, UploadUnderRandomByteLoss) {
+    for (const double loss : {0.02, 0.03}) {
+        for (const Board board : {Board::Apm2, Board::Pixhawk}) {
+            SCOPED_TRACE(std::string(to_string(board)) + " loss " + std::to_string(loss));
+            upload_and_verify_under_loss({board, loss, 1.0, 11});
+        }
+    }
+}
+
+// The acceptance case: the board loses a tenth of the bytes it would send and receive, in bursts (a radio
+// fade): frames cut short, the tail of one and the head of the next, whole frames.
+TEST(DriverWithApmSim, UploadWithTenPercentOfBytesLostInBursts) {
+    for (const Board board : {Board::Apm2, Board::Pixhawk}) {
+        SCOPED_TRACE(to_string(board));
+        upload_and_verify_under_loss({board, 0.10, 32.0, 17});
+    }
 }
 
 TEST(DriverWithApmSim, DrivesTheMissionAndReportsReachedWaypoints) {

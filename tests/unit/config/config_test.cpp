@@ -210,6 +210,37 @@ TEST(AutopilotConfig, BoardDefaultsApplyUnlessGiven) {
     EXPECT_FALSE(autopilot_setup(Config{}).service.reset_line) << "no reset line by default";
 }
 
+TEST(AutopilotConfig, MessageRatesBaudProbeAndStatusLed) {
+    auto r = load_config_text(
+        "autopilot:\n"
+        "  board: pixhawk\n"
+        "  bauds: [57600, 115200]\n"
+        "  baud_probe: 1500ms\n"
+        "  message_rates: {ATTITUDE: 10, GLOBAL_POSITION_INT: 0}\n"
+        "status_led: {line: \"gpiochip0:18\", active_low: true}\n",
+        "m.yaml");
+    ASSERT_TRUE(r.ok()) << r.errors[0].to_string();
+    const auto setup = autopilot_setup(r.config);
+    ASSERT_TRUE(setup.problems.empty()) << setup.problems[0];
+    const auto& ap = setup.service.autopilot;
+    EXPECT_EQ(ap.baud_probe, std::chrono::milliseconds(1500));
+    ASSERT_EQ(ap.message_rates.size(), 2u);
+    EXPECT_EQ(ap.message_rates[0].msgid, 30u);  // ATTITUDE (the map is ordered by name)
+    EXPECT_DOUBLE_EQ(ap.message_rates[0].hz, 10.0);
+    EXPECT_EQ(ap.message_rates[1].msgid, 33u);  // GLOBAL_POSITION_INT
+    EXPECT_DOUBLE_EQ(ap.message_rates[1].hz, 0.0);
+    ASSERT_TRUE(setup.status_led);
+    EXPECT_EQ(setup.status_led->chip, "gpiochip0");
+    EXPECT_EQ(setup.status_led->offset, 18u);
+    EXPECT_TRUE(setup.status_led->active_low);
+    EXPECT_FALSE(autopilot_setup(Config{}).status_led) << "no LED by default";
+
+    auto bad = load_config_text("autopilot:\n  message_rates: {ATTITUDE: 4, NO_SUCH_MESSAGE: 1}\n", "n.yaml");
+    ASSERT_FALSE(bad.ok());
+    EXPECT_EQ(bad.errors[0].key, "autopilot.message_rates");
+    EXPECT_NE(bad.errors[0].message.find("NO_SUCH_MESSAGE"), std::string::npos) << bad.errors[0].message;
+}
+
 TEST(AutopilotConfig, AutopilotRulesAreReportedAtTheirKeyAndLine) {
     auto r = load_config_text(
         "autopilot:\n"

@@ -143,6 +143,31 @@ TEST(MavlinkParser, LengthByteCorruptedToHugeDoesNotHideLaterFrames) {
     EXPECT_EQ(decode<Heartbeat>(c.frames[0])->custom_mode, 100u);
 }
 
+TEST(MavlinkParser, GoodFrameInsideAnIncompleteCandidateIsDeliveredWithoutWaiting) {
+    // A lost byte made the candidate's length come from the wrong byte: it claims far more bytes than the
+    // line will carry for a while. The good frame behind it must not wait for those bytes.
+    Encoder e(1, 1);
+    Bytes bad = heartbeat_frame(e, 1);
+    bad.erase(bad.begin() + 1);  // the length byte is lost: the sequence byte becomes the length
+    bad[1] = 0xF0;
+    Bytes stream = concat({bad, heartbeat_frame(e, 7)});
+    Parser parser;
+    std::vector<Frame> frames;
+    parser.push(stream, [&](const Frame& f) { frames.push_back(f); });  // no finish(): the line is quiet
+    ASSERT_EQ(frames.size(), 1u);
+    EXPECT_EQ(decode<Heartbeat>(frames[0])->custom_mode, 7u);
+    EXPECT_EQ(parser.stats().truncated, 1u);
+
+    // Byte by byte, the same.
+    Parser slow;
+    std::vector<Frame> slow_frames;
+    for (std::uint8_t b : stream) {
+        slow.push(std::span(&b, 1), [&](const Frame& f) { slow_frames.push_back(f); });
+    }
+    ASSERT_EQ(slow_frames.size(), 1u);
+    EXPECT_EQ(decode<Heartbeat>(slow_frames[0])->custom_mode, 7u);
+}
+
 TEST(MavlinkParser, UnknownIncompatibilityFlagsAreRejectedCompatFlagsIgnored) {
     auto frame_with_flags = [](std::uint8_t incompat, std::uint8_t compat) {
         // Build by hand: the encoder never sets incompatibility flags.
