@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "client/local_client.hpp"
+#include "client/plan_command.hpp"
 #include "client/radio_client.hpp"
 #include "client/status_view.hpp"
 
@@ -50,6 +51,9 @@ const char* kUsageText =
     "  status             health of every service and the vehicle's state\n"
     "  watch [--interval MS]  a live view refreshed in place until Ctrl-C (default every 1000 ms)\n"
     "  request JSON       send one raw request object, e.g. '{\"cmd\":\"status\"}', print the answer\n"
+    "  plan load FILE | append FILE | show | skip N|NAME | pause | resume\n"
+    "                     the flight plan: answered once the autopilot has confirmed (see "
+    "docs/flight-plan.md)\n"
     "\n"
     "Exit codes: 0 done, 1 refused by the vehicle, 2 usage, 3 no link (no answer in time).\n";
 
@@ -278,6 +282,14 @@ int main(int argc, char** argv) {
             return usage_error("request: not a JSON object: " + o.positional[1]);
         }
         return show_answer(o, client.request(req), [](const nlohmann::json& r) { return r.dump(2) + "\n"; });
+    }
+    if (cmd == "plan") {
+        auto plan =
+            airseg::client::plan_command({o.positional.begin() + 1, o.positional.end()}, !o.use_radio);
+        if (!plan.request) {
+            return usage_error(plan.error);
+        }
+        return show_answer(o, client.request(*plan.request), plan.render);
     }
     return usage_error("unknown command '" + cmd + "'");
 }

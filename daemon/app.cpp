@@ -13,10 +13,12 @@
 #include "daemon/autopilot_setup.hpp"
 #include "daemon/autopilot_status.hpp"
 #include "daemon/config_loader.hpp"
+#include "daemon/flightplan_setup.hpp"
 #include "daemon/logging.hpp"
 #include "daemon/systemd_notifier.hpp"
 #include "hal/gpio_libgpiod.hpp"
 #include "services/autopilot/autopilot_service.hpp"
+#include "services/flightplan/flightplan_service.hpp"
 #include "services/groundlink/groundlink_service.hpp"
 #include "services/status/status_messages.hpp"
 #include "services/status/status_service.hpp"
@@ -104,6 +106,8 @@ class App::Impl {
         g.udp.remote_address = gl.udp_remote;
         g.udp.remote_port = static_cast<std::uint16_t>(gl.udp_remote_port);
         services_.push_back(std::make_unique<groundlink::GroundlinkService>(context_, std::move(g)));
+        services_.push_back(
+            std::make_unique<flightplan::FlightplanService>(context_, flightplan_setup(config_)));
     }
 
     void start_services() {

@@ -53,6 +53,16 @@ struct GroundlinkConfig {
     int udp_remote_port = 0;                         // groundlink.udp.remote_port
 };
 
+struct FlightplanConfig {
+    int window = 5;                        // flightplan.window: ring slots on the autopilot (>= 3)
+    std::string vehicle = "rover";         // flightplan.vehicle: profile of plans without `vehicle`
+    milliseconds request_timeout{5'000};   // flightplan.request_timeout
+    int retries = 3;                       // flightplan.retries
+    bool resume_after_reboot = true;       // flightplan.resume_after_reboot
+    bool fsync = true;                     // flightplan.fsync
+    milliseconds command_timeout{30'000};  // flightplan.command_timeout
+};
+
 struct Config {
     int threads = 0;                            // threads: 0 = one per core
     std::string log_level = "info";             // log_level
@@ -60,6 +70,7 @@ struct Config {
     StatusConfig status;
     AutopilotConfig autopilot;
     GroundlinkConfig groundlink;
+    FlightplanConfig flightplan;
 };
 
 }  // namespace airseg::daemon

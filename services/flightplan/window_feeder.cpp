@@ -112,6 +112,29 @@ void WindowFeeder::start_fresh(std::uint16_t first_slot, TimePoint now) {
     check_done();
 }
 
+void WindowFeeder::continue_with(PlanFeed feed, TimePoint now) {
+    stream_ = std::move(feed.stream);
+    if (!feed.name.empty())
+        plan_name_ = std::move(feed.name);
+    cleared_ = false;
+    if (!stream_ended_)
+        return;  // the queue goes on filling from the new stream
+    stream_ended_ = false;
+    done_ = false;
+    std::optional<std::uint16_t> stop_slot;
+    if (!queue_.empty() && queue_.back().stop) {
+        stop_slot = queue_.back().slot;
+        queue_.pop_back();
+    }
+    if (queue_.empty()) {
+        // Parked on the Stop item: the continuation goes into the next slot, then set-current points there.
+        start_fresh(stop_slot ? ring_next(*stop_slot) : std::uint16_t{1}, now);
+        return;
+    }
+    refill(now);
+    check_done();
+}
+
 void WindowFeeder::clear_plan() {
     stream_.reset();
     queue_.clear();
