@@ -302,7 +302,10 @@ void WindowFeeder::check_starvation() {
     if (!mission_ok_ || need_set_current_ || queue_.empty() || starving_)
         return;
     if (!confirmed(queue_[0])) {
+        // The autopilot took its target from a slot not yet rewritten: what it reaches there is stale. Hold,
+        // write, then point it at the head again; reached reports until then say nothing about the plan.
         starving_ = true;
+        need_set_current_ = true;
         ++counters_.starvation_holds;
         emit(FeederEvent::Kind::WindowStarved, &queue_[0].wp, queue_[0].generation, queue_[0].element_path);
     }
@@ -313,6 +316,10 @@ void WindowFeeder::check_starvation() {
 void WindowFeeder::on_reached(std::uint16_t slot, TimePoint now) {
     if (slot == jump_slot())
         return;
+    if (need_set_current_) {
+        ++counters_.ignored_reached;  // the autopilot's target is not (yet) the window's head
+        return;
+    }
     const std::size_t limit = std::min<std::size_t>(queue_.size(), config_.lost_reached_tolerance + 1);
     for (std::size_t p = 0; p < limit; ++p) {
         const Entry& e = queue_[p];
@@ -466,8 +473,10 @@ FeederRequest WindowFeeder::issue(decltype(FeederRequest::op) op, TimePoint now)
 std::optional<FeederRequest> WindowFeeder::next_write(std::size_t from, std::size_t to, TimePoint now) {
     to = std::min(to, queue_.size());
     auto writable = [&](std::size_t i) {
-        // Never rewrite the item the vehicle is driving to, unless it is the head (then it is wrong anyway).
-        return !confirmed(queue_[i]) && (i == 0 || ap_target_ != queue_[i].slot);
+        // Never rewrite the item the vehicle is driving to, unless it is the head (then it is wrong anyway)
+        // or the vehicle is held and a set-current is due (it makes the autopilot take its target afresh).
+        const bool held_for_set_current = mode_ == Mode::Hold && need_set_current_;
+        return !confirmed(queue_[i]) && (i == 0 || held_for_set_current || ap_target_ != queue_[i].slot);
     };
     for (std::size_t i = from; i < to; ++i) {
         if (!writable(i))
