@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -490,6 +491,74 @@ TEST_F(FlightplanE2e, NoFlyCrossingAndBadFieldPlansAreRejectedNamingElementAndLi
     const auto stats_after = control_->json("stats");
     EXPECT_EQ(stats_after["mission_items_received"], stats_before["mission_items_received"]);
     EXPECT_EQ(stats_after["uploads_completed"], stats_before["uploads_completed"]);
+}
+
+}  // namespace
+}  // namespace airseg::test
+
+namespace airseg::test {
+namespace {
+
+TEST_F(FlightplanE2e, SkipPauseResumeAndAppendAreConfirmedByTheBoard) {
+    const auto file = write_plan("route.yaml", line_plan("route", kHomeLat, kHomeLon + 0.0001, 0, 30, 25));
+    const auto more =
+        write_plan("more.yaml", line_plan("more", kHomeLat + 0.0080, kHomeLon + 0.0003, 90, 5, 25));
+    const auto route = expected_positions(file);
+    const auto extra = expected_positions(more);
+    start_daemon(10);
+    const auto first = control_->reached_total();
+    ASSERT_EQ(ctl({"plan", "load", file}).exit_code, 0);
+    ASSERT_TRUE(wait_until([&] { return show().value("waypoints_reached", 0) >= 3; }, kGenerous, kPoll));
+
+    auto skipped = ctl({"plan", "skip", "20"});
+    ASSERT_EQ(skipped.exit_code, 0) << skipped.json.dump() << skipped.err;
+    EXPECT_EQ(skipped.json["next_waypoint"], 20);
+    EXPECT_EQ(ctl({"plan", "skip", "5000"}).exit_code, 1);
+
+    auto paused = ctl({"plan", "pause"});
+    ASSERT_EQ(paused.exit_code, 0) << paused.err;
+    EXPECT_EQ(paused.json["state"], "paused");
+    EXPECT_EQ(control_->json("state")["mode"], "HOLD");  // answered only once the board holds
+    auto resumed = ctl({"plan", "resume"});
+    ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+    EXPECT_EQ(resumed.json["state"], "running");
+    EXPECT_EQ(control_->json("state")["mode"], "AUTO");
+
+    auto appended = ctl({"plan", "append", more});
+    ASSERT_EQ(appended.exit_code, 0) << appended.json.dump() << appended.err;
+    ASSERT_TRUE(wait_until([&] { return show().value("state", "") == "done"; }, 60s, kPoll)) << show().dump();
+
+    // On the board: the start of the route, at most the target it was heading for, then 20..29 and the
+    // appended waypoints in order.
+    const auto reached = control_->reached(first);
+    std::size_t i = 0;
+    while (i < reached.size() && i < route.size() && same_place(e7(reached[i]), route[i])) {
+        ++i;
+    }
+    ASSERT_GE(i, 3u);
+    ASSERT_LE(i, 20u);
+    std::vector<E7> rest(route.begin() + 20, route.end());
+    rest.insert(rest.end(), extra.begin(), extra.end());
+    for (std::size_t k = 0; k < rest.size(); ++k, ++i) {
+        ASSERT_LT(i, reached.size());
+        ASSERT_PRED2(same_place, e7(reached[i]), rest[k]) << "after the skip, #" << k;
+    }
+}
+
+TEST_F(FlightplanE2e, CorruptStateFilesAreReportedAndSetAsideAndTheDaemonStartsWithoutAPlan) {
+    std::filesystem::create_directories(dir_.file("state"));
+    write_file(dir_.file("state/plan.yaml"), "# airseg-plan v1 fnv64=0123 bytes=9 source=x\nplan: [\n");
+    write_file(dir_.file("state/progress.state"), "garbage\n");
+    start_daemon(5);
+    const auto plan = status().value("plan", Json());
+    ASSERT_TRUE(plan.is_object()) << status().dump();
+    EXPECT_EQ(plan["state"], "none");
+    ASSERT_TRUE(plan["error"].is_string()) << plan.dump();
+    EXPECT_NE(plan["error"].get<std::string>().find("set aside"), std::string::npos) << plan.dump();
+    EXPECT_TRUE(exists(dir_.file("state/plan.yaml.corrupt-1")));
+    EXPECT_TRUE(exists(dir_.file("state/progress.state.corrupt-1")));
+    EXPECT_FALSE(exists(dir_.file("state/plan.yaml")));
+    EXPECT_TRUE(daemon_->running());
 }
 
 }  // namespace
