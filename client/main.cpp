@@ -16,6 +16,7 @@
 
 #include "client/live_commands.hpp"
 #include "client/local_client.hpp"
+#include "client/plan_command.hpp"
 #include "client/radio_client.hpp"
 #include "client/status_view.hpp"
 #include "client/vehicle_commands.hpp"
@@ -63,6 +64,9 @@ const char* kUsageText =
     "                     drive in MANUAL_NAVIGATION from a joystick, or the keyboard without --device\n"
     "                     (w/s/a/d or arrows, space centres, q quits); inputs go at --rate (default 10 Hz)\n"
     "  request JSON       send one raw request object, e.g. '{\"cmd\":\"status\"}', print the answer\n"
+    "  plan load FILE | append FILE | show | skip N|NAME | pause | resume\n"
+    "                     the flight plan: answered once the autopilot has confirmed (see "
+    "docs/flight-plan.md)\n"
     "\n"
     "Exit codes: 0 done, 1 refused by the vehicle, 2 usage, 3 no link (no answer in time).\n";
 
@@ -341,6 +345,14 @@ int main(int argc, char** argv) {
             return usage_error("request: not a JSON object: " + o.positional[1]);
         }
         return show_answer(o, client.request(req), [](const nlohmann::json& r) { return r.dump(2) + "\n"; });
+    }
+    if (cmd == "plan") {
+        auto plan =
+            airseg::client::plan_command({o.positional.begin() + 1, o.positional.end()}, !o.use_radio);
+        if (!plan.request) {
+            return usage_error(plan.error);
+        }
+        return show_answer(o, client.request(*plan.request), plan.render);
     }
     return usage_error("unknown command '" + cmd + "'");
 }

@@ -14,11 +14,13 @@
 #include "daemon/autopilot_status.hpp"
 #include "daemon/autopilot_status_led.hpp"
 #include "daemon/config_loader.hpp"
+#include "daemon/flightplan_setup.hpp"
 #include "daemon/logging.hpp"
 #include "daemon/systemd_notifier.hpp"
 #include "hal/gpio_libgpiod.hpp"
 #include "services/autopilot/autopilot_service.hpp"
 #include "services/groundlink/groundlink_messages.hpp"
+#include "services/flightplan/flightplan_service.hpp"
 #include "services/groundlink/groundlink_service.hpp"
 #include "services/status/status_messages.hpp"
 #include "services/status/status_service.hpp"
@@ -132,6 +134,8 @@ class App::Impl {
         g.monitor_key_file = gl.monitor_key_file;
         g.telemetry = telemetry_config(config_);
         services_.push_back(std::make_unique<groundlink::GroundlinkService>(context_, std::move(g)));
+        services_.push_back(
+            std::make_unique<flightplan::FlightplanService>(context_, flightplan_setup(config_)));
     }
 
     void start_services() {

@@ -65,6 +65,16 @@ struct StatusLedConfig {
     bool active_low = false;  // status_led.active_low
 };
 
+struct FlightplanConfig {
+    int window = 5;                        // flightplan.window: ring slots on the autopilot (>= 3)
+    std::string vehicle = "rover";         // flightplan.vehicle: profile of plans without `vehicle`
+    milliseconds request_timeout{5'000};   // flightplan.request_timeout
+    int retries = 3;                       // flightplan.retries
+    bool resume_after_reboot = true;       // flightplan.resume_after_reboot
+    bool fsync = true;                     // flightplan.fsync
+    milliseconds command_timeout{30'000};  // flightplan.command_timeout
+};
+
 struct Config {
     int threads = 0;                            // threads: 0 = one per core
     std::string log_level = "info";             // log_level
@@ -73,6 +83,7 @@ struct Config {
     AutopilotConfig autopilot;
     GroundlinkConfig groundlink;
     StatusLedConfig status_led;
+    FlightplanConfig flightplan;
 };
 
 }  // namespace airseg::daemon

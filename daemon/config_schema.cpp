@@ -471,6 +471,29 @@ std::vector<KeySpec> build_schema() {
     s.push_back(number(
         "groundlink.telemetry.min_hz", [](Config& c) -> double& { return c.groundlink.telemetry_min_hz; },
         0.01, 20.0, "lowest rate of a telemetry kind that is on, however weak the link", true));
+    // Flight plans
+    s.push_back(integer(
+        "flightplan.window", [](Config& c) -> int& { return c.flightplan.window; }, 3, 250,
+        "plan waypoints kept on the autopilot at a time (its mission must hold window + 2 items)"));
+    s.push_back(choice(
+        "flightplan.vehicle", [](Config& c) -> std::string& { return c.flightplan.vehicle; },
+        {"rover", "boat", "copter", "plane"},
+        "vehicle profile (min spacing, arrival radius, cruise speed) of plans that do not name one"));
+    s.push_back(duration(
+        "flightplan.request_timeout", [](Config& c) -> milliseconds& { return c.flightplan.request_timeout; },
+        milliseconds(100), seconds(120), "wait for the autopilot to confirm one window request"));
+    s.push_back(integer(
+        "flightplan.retries", [](Config& c) -> int& { return c.flightplan.retries; }, 0, 100,
+        "extra attempts of a window request before the vehicle is held"));
+    s.push_back(boolean(
+        "flightplan.resume_after_reboot", [](Config& c) -> bool& { return c.flightplan.resume_after_reboot; },
+        "after an autopilot reboot, rebuild the window and drive on (false: stay paused)"));
+    s.push_back(boolean(
+        "flightplan.fsync", [](Config& c) -> bool& { return c.flightplan.fsync; },
+        "fsync plan and progress files (false: they survive a daemon kill but not a power cut)"));
+    s.push_back(duration(
+        "flightplan.command_timeout", [](Config& c) -> milliseconds& { return c.flightplan.command_timeout; },
+        milliseconds(100), hours(1), "how long a plan command waits for the autopilot's confirmation"));
     return s;
 }
 

@@ -39,8 +39,10 @@ SourceMark mark_of(const YAML::Node& node) {
 
 class Loader {
   public:
-    Loader(std::string file, std::size_t max_elements) : file_(std::move(file)), max_elements_(max_elements) {
+    Loader(std::string file, std::size_t max_elements, VehicleProfile vehicle)
+        : file_(std::move(file)), max_elements_(max_elements) {
         plan_.source_file = file_;
+        plan_.vehicle = std::move(vehicle);
     }
 
     LoadResult run(const YAML::Node& doc, const LoadOptions& options);
@@ -761,7 +763,7 @@ LoadResult load_plan_text(std::string_view text, const std::string& source_name,
             {source_name, 0, 0, "", "plan larger than " + std::to_string(kMaxPlanTextBytes) + " bytes"});
         return r;
     }
-    Loader loader(source_name, options.max_elements);
+    Loader loader(source_name, options.max_elements, options.default_vehicle);
     YAML::Node doc;
     try {
         doc = YAML::Load(std::string(text));

@@ -23,6 +23,9 @@ struct LoadOptions {
     std::uint64_t max_finite_waypoints = 100'000'000;
     /// Refuse plans with more elements than this (YAML aliases can describe millions in a few bytes).
     std::size_t max_elements = 50'000;
+    /// The profile of a plan without `vehicle` (flightplan.vehicle), and the base a plan's `vehicle` fields
+    /// without `type` refine.
+    VehicleProfile default_vehicle;
 };
 
 struct LoadResult {

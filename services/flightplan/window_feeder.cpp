@@ -112,6 +112,29 @@ void WindowFeeder::start_fresh(std::uint16_t first_slot, TimePoint now) {
     check_done();
 }
 
+void WindowFeeder::continue_with(PlanFeed feed, TimePoint now) {
+    stream_ = std::move(feed.stream);
+    if (!feed.name.empty())
+        plan_name_ = std::move(feed.name);
+    cleared_ = false;
+    if (!stream_ended_)
+        return;  // the queue goes on filling from the new stream
+    stream_ended_ = false;
+    done_ = false;
+    std::optional<std::uint16_t> stop_slot;
+    if (!queue_.empty() && queue_.back().stop) {
+        stop_slot = queue_.back().slot;
+        queue_.pop_back();
+    }
+    if (queue_.empty()) {
+        // Parked on the Stop item: the continuation goes into the next slot, then set-current points there.
+        start_fresh(stop_slot ? ring_next(*stop_slot) : std::uint16_t{1}, now);
+        return;
+    }
+    refill(now);
+    check_done();
+}
+
 void WindowFeeder::clear_plan() {
     stream_.reset();
     queue_.clear();
@@ -279,7 +302,10 @@ void WindowFeeder::check_starvation() {
     if (!mission_ok_ || need_set_current_ || queue_.empty() || starving_)
         return;
     if (!confirmed(queue_[0])) {
+        // The autopilot took its target from a slot not yet rewritten: what it reaches there is stale. Hold,
+        // write, then point it at the head again; reached reports until then say nothing about the plan.
         starving_ = true;
+        need_set_current_ = true;
         ++counters_.starvation_holds;
         emit(FeederEvent::Kind::WindowStarved, &queue_[0].wp, queue_[0].generation, queue_[0].element_path);
     }
@@ -290,6 +316,10 @@ void WindowFeeder::check_starvation() {
 void WindowFeeder::on_reached(std::uint16_t slot, TimePoint now) {
     if (slot == jump_slot())
         return;
+    if (need_set_current_) {
+        ++counters_.ignored_reached;  // the autopilot's target is not (yet) the window's head
+        return;
+    }
     const std::size_t limit = std::min<std::size_t>(queue_.size(), config_.lost_reached_tolerance + 1);
     for (std::size_t p = 0; p < limit; ++p) {
         const Entry& e = queue_[p];
@@ -443,8 +473,10 @@ FeederRequest WindowFeeder::issue(decltype(FeederRequest::op) op, TimePoint now)
 std::optional<FeederRequest> WindowFeeder::next_write(std::size_t from, std::size_t to, TimePoint now) {
     to = std::min(to, queue_.size());
     auto writable = [&](std::size_t i) {
-        // Never rewrite the item the vehicle is driving to, unless it is the head (then it is wrong anyway).
-        return !confirmed(queue_[i]) && (i == 0 || ap_target_ != queue_[i].slot);
+        // Never rewrite the item the vehicle is driving to, unless it is the head (then it is wrong anyway)
+        // or the vehicle is held and a set-current is due (it makes the autopilot take its target afresh).
+        const bool held_for_set_current = mode_ == Mode::Hold && need_set_current_;
+        return !confirmed(queue_[i]) && (i == 0 || held_for_set_current || ap_target_ != queue_[i].slot);
     };
     for (std::size_t i = from; i < to; ++i) {
         if (!writable(i))

@@ -59,6 +59,11 @@ class WindowFeeder {
     bool jump_to(std::string_view element_name, TimePoint now);
     /// Resume a stream restored from persistence: like replace_plan, with the reached count carried over.
     void restore_plan(PlanFeed feed, std::uint64_t waypoints_reached, TimePoint now);
+    /// Swap the stream for one that continues it (the same plan with elements appended): from its current
+    /// position `feed.stream` must produce what the current stream would produce next. Nothing already on
+    /// the autopilot changes and the counts stay; if the current stream had ended, its Stop item gives way
+    /// to what follows (a finished plan starts again at the first appended waypoint).
+    void continue_with(PlanFeed feed, TimePoint now);
     /// Forget the plan: no more requests; the vehicle finishes its current target and then holds.
     void clear_plan();
     void pause();

@@ -64,6 +64,23 @@ nlohmann::json modes_json(const RoverSim& sim) {
     return list;
 }
 
+nlohmann::json reached_json(const RoverSim& sim, std::uint64_t from, std::uint64_t count) {
+    const auto& log = sim.reached();
+    const std::uint64_t first = sim.reached_total() - log.size();  // number of log.front()
+    nlohmann::json list = nlohmann::json::array();
+    for (std::uint64_t n = std::max(from, first); n < sim.reached_total() && list.size() < count; ++n) {
+        const ReachedEvent& r = log[static_cast<std::size_t>(n - first)];
+        list.push_back({{"n", n},
+                        {"t", seconds_since(sim.started(), r.at)},
+                        {"seq", r.seq},
+                        {"lat", r.item.lat},
+                        {"lon", r.item.lon},
+                        {"distance", r.distance},
+                        {"passed", r.passed}});
+    }
+    return {{"total", sim.reached_total()}, {"first_kept", first}, {"reached", list}};
+}
+
 nlohmann::json stats_json(const RoverSim& sim) {
     const SimCounters& c = sim.counters();
     const MissionServerStats& m = sim.mission_stats();
@@ -107,6 +124,15 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
             auto all = modes_json(sim);
             const auto skip = all.size() > n ? all.size() - n : 0;
             return nlohmann::json(all.begin() + static_cast<std::ptrdiff_t>(skip), all.end()).dump();
+        }
+        if (verb == "reached") {
+            // Paged: a datagram holds a few hundred entries comfortably.
+            if (w.size() > 3) {
+                throw toolcommon::UsageError("usage: reached [FROM [COUNT]]");
+            }
+            const auto from = w.size() > 1 ? toolcommon::parse_unsigned(verb, w[1], 0, UINT64_MAX) : 0;
+            const auto count = w.size() > 2 ? toolcommon::parse_unsigned(verb, w[2], 1, 500) : 500;
+            return reached_json(sim, from, count).dump();
         }
         if (verb == "stats") {
             return stats_json(sim).dump();
@@ -189,7 +215,8 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
             return "ok param " + w[1] + " " + w[2];
         }
         if (verb == "help") {
-            return "ok commands: state, modes [N], stats, rcpilot MODE, reboot [S], unplug, replug, hbstall "
+            return "ok commands: state, modes [N], reached [FROM [COUNT]], stats, rcpilot MODE, reboot [S], "
+                   "unplug, replug, hbstall "
                    "S, "
                    "loss P [BURST], "
                    "corrupt P, ignore-mission on|off, slow MS, param NAME [VALUE]";

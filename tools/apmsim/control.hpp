@@ -23,5 +23,8 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
 nlohmann::json state_json(const RoverSim& sim, TimePoint now);
 nlohmann::json modes_json(const RoverSim& sim);
 nlohmann::json stats_json(const RoverSim& sim);
+/// Reached events number `from` on (at most `count`), each with the position of the item reached:
+/// {"total":N,"first_kept":K,"reached":[{"n":..,"t":s,"seq":..,"lat":..,"lon":..,"distance":m,"passed":b}]}.
+nlohmann::json reached_json(const RoverSim& sim, std::uint64_t from, std::uint64_t count);
 
 }  // namespace airseg::apmsim

@@ -12,6 +12,7 @@ inline constexpr std::uint16_t kCmdNavLoiterUnlimited = 17;
 inline constexpr std::uint16_t kCmdNavLoiterTurns = 18;
 inline constexpr std::uint16_t kCmdNavLoiterTime = 19;
 inline constexpr std::uint16_t kCmdNavReturnToLaunch = 20;
+inline constexpr std::uint16_t kCmdDoJump = 177;  // param1: target item, param2: repeats (-1: forever)
 
 struct StoredItem {
     std::uint16_t command = kCmdNavWaypoint;

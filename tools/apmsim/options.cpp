@@ -57,6 +57,8 @@ Control commands (one per datagram; the reply goes to the sender's bound address
   state                    position, mode, armed, current item, mission count... as JSON
   modes [N]                mode history (the last N changes) as JSON: [{"t":s,"from":..,"to":..,"cause":..,"seq":..,"count":..}]
                            causes: power on, reboot, command, rc pilot, mission end, rtl end
+  reached [FROM [COUNT]]   reached items number FROM on (at most COUNT, 500 by default) as JSON:
+                           {"total":N,"first_kept":K,"reached":[{"n":..,"seq":..,"lat":..,"lon":..,..}]}
   stats                    byte, frame and mission counters as JSON
   rcpilot MODE             the RC pilot flips the mode switch (MANUAL, HOLD, AUTO, ... or a number)
   reboot [S]               reboot now, or in S simulated seconds

@@ -93,6 +93,7 @@ struct ReachedEvent {
     std::uint16_t seq = 0;
     double distance = 0;  // metres from the item when it counted as reached
     bool passed = false;  // went past it rather than inside WP_RADIUS
+    GeoPoint item;        // where the reached item was
 };
 
 struct SimState {
@@ -151,6 +152,8 @@ class RoverSim {
     SimState state() const;
     const std::vector<ModeChange>& mode_history() const { return mode_history_; }
     const std::deque<ReachedEvent>& reached() const { return reached_; }
+    /// Reached events ever logged; reached().front() is number reached_total() - reached().size().
+    std::uint64_t reached_total() const { return reached_total_; }
     const ParamTable& params() const { return params_; }
     ParamTable& params() { return params_; }
     const MissionStore& mission() const { return store_; }
@@ -238,6 +241,9 @@ class RoverSim {
     std::optional<GeoPoint> leg_start_;
     std::optional<GeoPoint> guided_target_;
     std::deque<ReachedEvent> reached_;
+    std::uint64_t reached_total_ = 0;       // ever logged, including those dropped from reached_
+    std::vector<std::int32_t> jumps_done_;  // per item: DO_JUMP repeats taken (reset by a new mission)
+    bool loitering_ = false;                // arrived at a NAV_LOITER_UNLIM item: stay there
 
     std::array<std::uint16_t, 8> rc_override_{};  // 0: not overridden
     TimePoint rc_override_at_{};

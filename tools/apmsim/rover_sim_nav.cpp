@@ -39,7 +39,7 @@ bool RoverSim::physics_active() const {
         return false;
     }
     if (is_navigating(mode_)) {
-        return target_.has_value();
+        return target_.has_value() && !loitering_;
     }
     return is_manual(mode_) &&
            std::any_of(rc_override_.begin(), rc_override_.end(), [](auto v) { return v != 0; });
@@ -84,13 +84,30 @@ bool RoverSim::set_mode(RoverMode mode, const std::string& cause, TimePoint now)
 }
 
 void RoverSim::load_item(std::uint16_t seq, TimePoint now) {
-    // Commands that are not places (DO_ commands and the like) are passed over at once.
-    while (seq < store_.count() && seq > 0) {
+    // Commands that are not places (DO_ commands and the like) are passed over at once; DO_JUMP continues
+    // at its target while it has repeats left (-1: forever). A mission of nothing but jumps ends.
+    loitering_ = false;
+    jumps_done_.resize(store_.count(), 0);
+    for (std::size_t hops = 0; seq < store_.count() && seq > 0; ++hops) {
         const StoredItem& item = store_.at(seq);
-        if (item.is_location() || item.command == kCmdNavReturnToLaunch) {
+        if (item.is_location() || item.command == kCmdNavReturnToLaunch || hops > store_.count()) {
             break;
         }
+        if (item.command == kCmdDoJump) {
+            const auto target = static_cast<long>(std::lround(item.param1));
+            const auto repeats = static_cast<long>(std::lround(item.param2));
+            if (target >= 1 && static_cast<std::size_t>(target) < store_.count() &&
+                (repeats < 0 || jumps_done_[seq] < repeats)) {
+                ++jumps_done_[seq];
+                seq = static_cast<std::uint16_t>(target);
+                continue;
+            }
+        }
         ++seq;
+    }
+    if (seq < store_.count() && seq > 0 && !store_.at(seq).is_location() &&
+        store_.at(seq).command != kCmdNavReturnToLaunch) {
+        seq = static_cast<std::uint16_t>(store_.count());  // only jumps: nothing to drive to
     }
     if (seq >= store_.count() || seq == 0) {
         mission_complete_ = true;
@@ -131,7 +148,7 @@ void RoverSim::physics_step(TimePoint at) {
         vehicle_.drive_manual(stick(1, rc_input(1, at)), stick(3, rc_input(3, at)), dt, lim);
         return;
     }
-    if (!is_navigating(mode_) || !target_) {
+    if (!is_navigating(mode_) || !target_ || loitering_) {
         vehicle_.stop(dt, lim);
         return;
     }
@@ -178,7 +195,12 @@ void RoverSim::on_target_reached(double distance, bool passed, TimePoint now) {
     if (reached_.size() >= kMaxReachedLog) {
         reached_.pop_front();
     }
-    reached_.push_back(ReachedEvent{now, seq, distance, passed});
+    reached_.push_back(ReachedEvent{now, seq, distance, passed, target_.value_or(GeoPoint{})});
+    ++reached_total_;
+    if (store_.at(seq).command == kCmdNavLoiterUnlimited) {
+        loitering_ = true;  // stays here; the mission does not advance past it
+        return;
+    }
     if (store_.at(seq).command == kCmdNavReturnToLaunch) {
         load_item(static_cast<std::uint16_t>(store_.count()), now);  // RTL ends the mission
         return;
@@ -213,6 +235,7 @@ bool RoverSim::guided_goto(const StoredItem& item) {
 }
 
 void RoverSim::mission_changed() {
+    jumps_done_.assign(store_.count(), 0);
     params_.set("MIS_TOTAL", static_cast<float>(store_.count()));
 }
 

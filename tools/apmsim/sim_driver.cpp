@@ -23,6 +23,15 @@ SimDriver::SimDriver(boost::asio::io_context& io, ApmSimOptions options)
     config.unix_time_at_start_us = static_cast<std::uint64_t>(
         std::chrono::duration_cast<microseconds>(std::chrono::system_clock::now().time_since_epoch())
             .count());
+    // The ground station on the other end runs in real time: the board's mission protocol patience
+    // (re-request, give up) is kept in real time too, or a fast speedup would make the board give up on a
+    // partner that answers promptly.
+    if (options_.speedup > 1.0) {
+        config.mission_rerequest =
+            std::chrono::duration_cast<Duration>(config.mission_rerequest * options_.speedup);
+        config.mission_give_up =
+            std::chrono::duration_cast<Duration>(config.mission_give_up * options_.speedup);
+    }
     // Simulated time starts equal to the real clock, so both share one origin.
     sim_ = std::make_unique<RoverSim>(config, real_origin_);
     for (const auto& [name, value] : options_.params) {

@@ -222,3 +222,42 @@ TEST(ApmsimNav, FeedingItemsWhileDrivingNeverHoldsEarly) {
 
 }  // namespace
 }  // namespace airseg::apmsim::test
+
+namespace airseg::apmsim::test {
+namespace {
+
+// The rolling window's mission shape: a ring of waypoints closed by DO_JUMP (repeat -1), and a
+// NAV_LOITER_UNLIM where the vehicle stays once it gets there.
+TEST(ApmsimNav, DoJumpForeverLoopsTheRingAndLoiterUnlimitedStaysPut) {
+    SimHarness h;
+    h.boot();
+    auto items = line_mission(h.sim.config().home, 3, 15);
+    mv::MissionItemInt jump;
+    jump.command = kCmdDoJump;
+    jump.frame = 2;
+    jump.param1 = 1;
+    jump.param2 = -1;
+    items.push_back(jump);
+    ASSERT_EQ(h.upload(items), 0);
+    h.set_mode(RoverMode::Auto);
+    ASSERT_TRUE(h.run_until([&] { return h.sim.reached().size() >= 7; }, seconds(300)));
+    EXPECT_EQ(reached_seqs(h), (std::vector<std::uint16_t>{1, 2, 3, 1, 2, 3, 1}));
+    EXPECT_EQ(h.sim.state().mode, RoverMode::Auto);  // never ran off the end
+
+    h.set_mode(RoverMode::Hold);
+    auto loiter = line_mission(h.sim.config().home, 2, 15);
+    loiter[2].command = kCmdNavLoiterUnlimited;
+    ASSERT_EQ(h.upload(loiter), 0);
+    h.set_mode(RoverMode::Auto);
+    ASSERT_TRUE(h.run_until([&] { return h.sim.state().current_seq == 2 && h.sim.reached().back().seq == 2; },
+                            seconds(300)));
+    const auto reached = h.sim.reached().size();
+    h.run_for(seconds(30));
+    EXPECT_EQ(h.sim.state().mode, RoverMode::Auto);
+    EXPECT_EQ(h.sim.state().current_seq, 2);
+    EXPECT_EQ(h.sim.state().speed, 0.0);
+    EXPECT_EQ(h.sim.reached().size(), reached);  // reached once, then it stays
+}
+
+}  // namespace
+}  // namespace airseg::apmsim::test

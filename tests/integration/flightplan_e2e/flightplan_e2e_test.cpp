@@ -1,0 +1,565 @@
+// Acceptance of the flight plan manager against the real binaries: airsegd and the simulated APM:Rover
+// (airseg-apmsim, mission capacity 150) joined by a pseudo-terminal, driven with airsegctl on the local
+// socket. The simulator's control socket says what the board really did: the items it reached (with their
+// positions) and its mode history. The expected waypoints come from expanding the same plan file with the
+// flight plan library. Simulated time runs faster than real time (--speedup); every wait is on a condition.
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <sstream>
+
+#include "services/flightplan/expander.hpp"
+#include "services/flightplan/plan_loader.hpp"
+#include "tests/support/process.hpp"
+
+namespace airseg::test {
+namespace {
+
+using Json = nlohmann::json;
+
+constexpr auto kGenerous = 30s;
+constexpr auto kPoll = 200ms;  // each poll of the daemon runs airsegctl
+constexpr double kHomeLat = 41.2756;
+constexpr double kHomeLon = 1.9866;
+// Simulated seconds per real second. A waypoint every 4 m at 4 m/s is one simulated second, 20 ms of real
+// time: 2,040 waypoints take about 41 s. Measured on a 2-core machine shared with builds (load 10-14): single
+// partial writes take 1 ms typically and up to 1 s when the machine is busy, so the long scan keeps 2 s of
+// travel on board (window 100) and the slower routes of the other cases keep the default window or 10.
+constexpr int kSpeedup = 50;
+
+bool exists(const std::string& path) {
+    struct stat st {};
+    return ::stat(path.c_str(), &st) == 0;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+/// The simulator's control socket: one datagram per command, the reply comes back to our bound address.
+class SimControl {
+  public:
+    SimControl(std::string own, std::string server) : own_(std::move(own)), server_(std::move(server)) {
+        fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+        sockaddr_un a = address(own_);
+        ::unlink(own_.c_str());
+        if (::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
+            ADD_FAILURE() << "cannot bind " << own_ << ": " << std::strerror(errno);
+        }
+    }
+    ~SimControl() {
+        ::close(fd_);
+        ::unlink(own_.c_str());
+    }
+    SimControl(const SimControl&) = delete;
+    SimControl& operator=(const SimControl&) = delete;
+
+    Json json(const std::string& text) {
+        sockaddr_un a = address(server_);
+        if (::sendto(fd_, text.data(), text.size(), 0, reinterpret_cast<sockaddr*>(&a), sizeof a) < 0) {
+            ADD_FAILURE() << "simulator: cannot send '" << text << "'";
+            return Json();
+        }
+        pollfd p{fd_, POLLIN, 0};
+        if (::poll(&p, 1, 5000) <= 0) {
+            ADD_FAILURE() << "simulator: no reply to '" << text << "'";
+            return Json();
+        }
+        std::string buf(256 * 1024, '\0');
+        const auto n = ::recv(fd_, buf.data(), buf.size(), 0);
+        buf.resize(n > 0 ? static_cast<std::size_t>(n) : 0);
+        auto j = Json::parse(buf, nullptr, false);
+        if (j.is_discarded()) {
+            ADD_FAILURE() << "simulator: no JSON reply to '" << text << "': " << buf;
+            return Json();
+        }
+        return j;
+    }
+
+    struct Reached {
+        std::uint64_t n = 0;
+        double t = 0;
+        double lat = 0, lon = 0;
+    };
+    /// Every reached event numbered `from` on.
+    std::vector<Reached> reached(std::uint64_t from = 0) {
+        std::vector<Reached> out;
+        for (;;) {
+            const auto page = json("reached " + std::to_string(from) + " 500");
+            if (!page.is_object() || !page["reached"].is_array()) {
+                return out;
+            }
+            EXPECT_LE(page.value("first_kept", 0ull), from) << "the simulator's reached log overflowed";
+            for (const auto& r : page["reached"]) {
+                out.push_back({r["n"].get<std::uint64_t>(), r["t"].get<double>(), r["lat"].get<double>(),
+                               r["lon"].get<double>()});
+            }
+            if (page["reached"].size() < 500) {
+                return out;
+            }
+            from = out.back().n + 1;
+        }
+    }
+    std::uint64_t reached_total() { return json("reached 0 1").value("total", 0ull); }
+
+  private:
+    static sockaddr_un address(const std::string& path) {
+        sockaddr_un a{};
+        a.sun_family = AF_UNIX;
+        std::strncpy(a.sun_path, path.c_str(), sizeof a.sun_path - 1);
+        return a;
+    }
+    std::string own_, server_;
+    int fd_ = -1;
+};
+
+struct Answer {
+    int exit_code = -1;
+    Json json;
+    std::string err;
+};
+
+using E7 = std::pair<std::int64_t, std::int64_t>;
+
+/// The positions a plan expands to, as the autopilot stores them (1e-7 degree integers).
+std::vector<E7> expected_positions(const std::string& plan_file) {
+    auto loaded = flightplan::load_plan_file(plan_file);
+    EXPECT_TRUE(loaded.ok()) << flightplan::to_string(loaded.errors);
+    std::vector<std::pair<std::int64_t, std::int64_t>> out;
+    if (!loaded.ok()) {
+        return out;
+    }
+    flightplan::Expander stream(loaded.plan);
+    while (auto w = stream.next()) {
+        out.emplace_back(std::llround(w->position.lat * 1e7), std::llround(w->position.lon * 1e7));
+    }
+    return out;
+}
+
+E7 e7(const SimControl::Reached& r) {
+    return {std::llround(r.lat * 1e7), std::llround(r.lon * 1e7)};
+}
+
+/// APM:Rover 2.x takes mission items as MISSION_ITEM, in float degrees: about 4e-6 degree (0.4 m) between
+/// neighbouring floats at this latitude. Waypoints are metres apart, so this still tells them apart.
+bool same_place(const E7& a, const E7& b) {
+    return std::llabs(a.first - b.first) <= 40 && std::llabs(a.second - b.second) <= 40;
+}
+
+std::string scan_plan(const std::string& name, double north_m, double east_m, double spacing) {
+    // A rectangle north-east of home, lines east-west, a waypoint every `spacing` metres along each line.
+    const double lat0 = kHomeLat + 10.0 / 111320.0;
+    const double lon0 = kHomeLon;
+    const double lat1 = lat0 + north_m / 111320.0;
+    const double lon1 = lon0 + east_m / (111320.0 * std::cos(kHomeLat * std::numbers::pi / 180.0));
+    std::ostringstream o;
+    o.precision(9);
+    o << "plan:\n"
+      << "  name: " << name << "\n"
+      << "  elements:\n"
+      << "    - scan:\n"
+      << "        rectangle: {sw: [" << lat0 << ", " << lon0 << "], ne: [" << lat1 << ", " << lon1 << "]}\n"
+      << "        spacing: " << spacing << "\n"
+      << "        heading: 90\n"
+      << "        step: " << spacing << "\n";
+    return o.str();
+}
+
+/// A straight line of `count` waypoints from (lat, lon), `step` metres apart, towards `bearing_deg`.
+std::string line_plan(const std::string& name, double lat, double lon, double bearing_deg, int count,
+                      double step) {
+    std::ostringstream o;
+    o.precision(9);
+    o << "plan:\n  name: " << name << "\n  elements:\n";
+    const double b = bearing_deg * std::numbers::pi / 180.0;
+    for (int i = 0; i < count; ++i) {
+        const double north = std::cos(b) * step * i, east = std::sin(b) * step * i;
+        o << "    - waypoint: {lat: " << lat + north / 111320.0
+          << ", lon: " << lon + east / (111320.0 * std::cos(lat * std::numbers::pi / 180.0)) << "}\n";
+    }
+    return o.str();
+}
+
+class FlightplanE2e : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        sim_ = std::make_unique<Subprocess>(
+            std::vector<std::string>{binary("tools/apmsim/airseg-apmsim"),
+                                     "--link",
+                                     dir_.file("ttyACM0"),
+                                     "--control",
+                                     dir_.file("ctl"),
+                                     "--home",
+                                     std::to_string(kHomeLat) + "," + std::to_string(kHomeLon),
+                                     "--speedup",
+                                     std::to_string(kSpeedup),
+                                     "--boot-delay",
+                                     "2",
+                                     "--calib-time",
+                                     "3",
+                                     "--mission-capacity",
+                                     "150",
+                                     "--param",
+                                     "CRUISE_SPEED=4",
+                                     "--param",
+                                     "WP_RADIUS=1.5",
+                                     "--quiet"},
+            std::map<std::string, std::string>{}, dir_.path());
+        ASSERT_TRUE(wait_until([&] { return exists(dir_.file("ttyACM0")) && exists(dir_.file("ctl")); },
+                               kGenerous, kPoll))
+            << sim_->err();
+        control_ = std::make_unique<SimControl>(dir_.file("me"), dir_.file("ctl"));
+    }
+
+    void TearDown() override {
+        if (daemon_ && daemon_->running()) {
+            daemon_->signal(SIGTERM);
+            EXPECT_EQ(daemon_->wait_exit(10s), 0) << daemon_->err();
+        }
+    }
+
+    /// `window`: flightplan.window. The ground link listens on loopback UDP: a missing radio port would only
+    /// add noise.
+    void start_daemon(int window) {
+        const int udp_port = 20000 + static_cast<int>(::getpid() % 20000);
+        daemon_ = std::make_unique<Subprocess>(
+            std::vector<std::string>{binary("daemon/airsegd"),
+                                     "--config",
+                                     source_path("config/airseg.yaml"),
+                                     "--set",
+                                     "status.socket=" + dir_.file("status.sock"),
+                                     "--set",
+                                     "state_dir=" + dir_.file("state"),
+                                     "--set",
+                                     "autopilot.port=" + dir_.file("ttyACM0"),
+                                     "--set",
+                                     "autopilot.reconnect_max=500ms",
+                                     "--set",
+                                     "groundlink.mode=udp",
+                                     "--set",
+                                     "groundlink.udp.bind=127.0.0.1",
+                                     "--set",
+                                     "groundlink.udp.port=" + std::to_string(udp_port),
+                                     "--set",
+                                     "flightplan.window=" + std::to_string(window),
+                                     "--set",
+                                     "flightplan.fsync=false"},
+            std::map<std::string, std::string>{}, dir_.path());
+        ASSERT_TRUE(wait_until([&] { return ready(); }, kGenerous, kPoll)) << daemon_->err();
+    }
+
+    Answer ctl(std::vector<std::string> args) {
+        std::vector<std::string> argv{binary("client/airsegctl"),
+                                      "--local",
+                                      "--socket",
+                                      dir_.file("status.sock"),
+                                      "--json",
+                                      "--timeout",
+                                      "30000"};
+        argv.insert(argv.end(), args.begin(), args.end());
+        const auto r = run(argv, {}, 40s);
+        Answer a;
+        a.exit_code = r.exit_code;
+        a.json = Json::parse(r.out, nullptr, false);
+        a.err = r.err;
+        return a;
+    }
+    Json status() {
+        auto a = ctl({"status"});
+        return a.exit_code == 0 && a.json.is_object() ? a.json : Json::object();
+    }
+    bool ready() {
+        const auto ap = status().value("autopilot", Json());
+        return ap.is_object() && ap.value("ready", false);
+    }
+    Json show() {
+        auto a = ctl({"plan", "show"});
+        EXPECT_EQ(a.exit_code, 0) << a.err;
+        return a.json;
+    }
+    std::string write_plan(const std::string& name, const std::string& text) {
+        const auto path = dir_.file(name);
+        write_file(path, text);
+        return path;
+    }
+    /// HOLD entries in the simulator's mode history from simulated time `after` on.
+    Json holds_after(double after) {
+        Json holds = Json::array();
+        for (const auto& m : control_->json("modes")) {
+            if (m["to"] == "HOLD" && m["t"].get<double>() >= after) {
+                holds.push_back(m);
+            }
+        }
+        return holds;
+    }
+    double sim_time() { return control_->json("state").value("t", 0.0); }
+
+    TempDir dir_;
+    std::unique_ptr<Subprocess> sim_;
+    std::unique_ptr<SimControl> control_;
+    std::unique_ptr<Subprocess> daemon_;
+};
+
+TEST_F(FlightplanE2e, LongScanRunsToTheEndWithEveryWaypointReachedOnceInOrderAndNoHold) {
+    // 160 m × 200 m, a waypoint every 4 m: 40 lines of 51 points = 2,040 waypoints, 14 × the board's memory.
+    const auto file = write_plan("scan.yaml", scan_plan("long-scan", 160, 200, 4));
+    const auto expected = expected_positions(file);
+    ASSERT_GE(expected.size(), 2000u);
+    start_daemon(100);  // 100 ring slots + home + jump: 102 of the board's 150
+    const auto first = control_->reached_total();
+    const double t0 = sim_time();
+    const auto started = std::chrono::steady_clock::now();
+
+    auto load = ctl({"plan", "load", file});
+    ASSERT_EQ(load.exit_code, 0) << load.json.dump() << load.err;
+    EXPECT_EQ(load.json["state"], "running");
+    EXPECT_EQ(load.json["name"], "long-scan");
+    ASSERT_TRUE(wait_until([&] { return show().value("state", "") == "done"; }, 120s, 500ms))
+        << show().dump() << daemon_->err();
+    const double wall = seconds_since(started);
+    const double simulated = sim_time() - t0;
+    std::cout << "[ figures ] " << expected.size() << " waypoints in " << wall << " s wall, " << simulated
+              << " s simulated (speedup " << kSpeedup << ")\n";
+
+    const auto plan = show();
+    EXPECT_EQ(plan["waypoints_reached"].get<std::size_t>(), expected.size()) << plan.dump();
+    EXPECT_EQ(plan["starvation_holds"], 0) << plan.dump();
+
+    // The board's own record: every plan waypoint reached exactly once, in plan order (then the Stop item
+    // at the last position, where the vehicle stays).
+    const auto reached = control_->reached(first);
+    ASSERT_GE(reached.size(), expected.size());
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+        ASSERT_PRED2(same_place, e7(reached[i]), expected[i])
+            << "reached #" << i << " is not plan waypoint " << i;
+    }
+    for (std::size_t i = expected.size(); i < reached.size(); ++i) {
+        EXPECT_PRED2(same_place, e7(reached[i]), expected.back()) << "after the end, only the final stop";
+    }
+    EXPECT_LE(reached.size(), expected.size() + 1);
+    // Zero HOLDs: the window never ran dry.
+    EXPECT_TRUE(holds_after(t0).empty()) << holds_after(t0).dump();
+    EXPECT_EQ(control_->json("state")["mode"], "AUTO");
+}
+
+TEST_F(FlightplanE2e, ReplacingThePlanMidRouteHeadsForTheNewFirstWaypointWithoutStopping) {
+    const auto a_file = write_plan("a.yaml", line_plan("route-a", kHomeLat, kHomeLon + 0.0001, 0, 60, 25));
+    const auto b_file =
+        write_plan("b.yaml", line_plan("route-b", kHomeLat + 0.0005, kHomeLon + 0.0010, 90, 20, 8));
+    const auto a = expected_positions(a_file);
+    const auto b = expected_positions(b_file);
+    start_daemon(10);
+    const auto first = control_->reached_total();
+    const double t0 = sim_time();
+
+    ASSERT_EQ(ctl({"plan", "load", a_file}).exit_code, 0);
+    ASSERT_TRUE(wait_until([&] { return show().value("waypoints_reached", 0) >= 8; }, kGenerous, kPoll));
+    auto replaced = ctl({"plan", "load", b_file});
+    ASSERT_EQ(replaced.exit_code, 0) << replaced.json.dump() << replaced.err;
+    const auto reached_at_answer = control_->reached_total();
+    EXPECT_EQ(replaced.json["name"], "route-b");
+    ASSERT_TRUE(wait_until([&] { return show().value("state", "") == "done"; }, 60s, kPoll)) << show().dump();
+
+    const auto reached = control_->reached(first);
+    // A from its first waypoint without a gap, then B from its first waypoint to its end.
+    std::size_t i = 0;
+    while (i < reached.size() && i < a.size() && same_place(e7(reached[i]), a[i])) {
+        ++i;
+    }
+    const std::size_t a_done = i;
+    ASSERT_GE(a_done, 8u);
+    ASSERT_LT(a_done, a.size()) << "the replacement came too late";
+    for (std::size_t k = 0; k < b.size(); ++k, ++i) {
+        ASSERT_LT(i, reached.size());
+        ASSERT_PRED2(same_place, e7(reached[i]), b[k])
+            << "after " << a_done << " waypoints of A, reached #" << i << " is not B's waypoint " << k;
+    }
+    // Once the new plan was confirmed, at most the target the vehicle was already heading for was reached.
+    EXPECT_LE(first + a_done, reached_at_answer + 1);
+    // Without stopping: no HOLD and no other mode change since the first plan started.
+    EXPECT_TRUE(holds_after(t0).empty()) << holds_after(t0).dump();
+    for (const auto& m : control_->json("modes")) {
+        if (m["t"].get<double>() > t0) {
+            EXPECT_EQ(m["to"], "AUTO") << m.dump();
+        }
+    }
+}
+
+TEST_F(FlightplanE2e, KillNineMidPlanThenRestartResumesAtTheFirstUnreachedWaypoint) {
+    const auto file = write_plan("route.yaml", line_plan("route", kHomeLat, kHomeLon + 0.0001, 0, 60, 8));
+    const auto expected = expected_positions(file);
+    start_daemon(10);
+    ASSERT_EQ(ctl({"plan", "load", file}).exit_code, 0);
+    ASSERT_TRUE(wait_until([&] { return show().value("waypoints_reached", 0) >= 15; }, kGenerous, kPoll));
+    const auto reached_before = show().value("waypoints_reached", 0);
+
+    daemon_->signal(SIGKILL);
+    ASSERT_EQ(daemon_->wait_exit(10s), 128 + SIGKILL);
+    const std::string progress = read_file(dir_.file("state/progress.state"));
+    const auto at = progress.find("next_index ");
+    ASSERT_NE(at, std::string::npos) << progress;
+    const auto saved_next = std::stoul(progress.substr(at + 11));
+    EXPECT_GE(saved_next, static_cast<unsigned long>(reached_before));
+    EXPECT_LT(saved_next, expected.size());
+
+    start_daemon(10);  // opening the port reboots the board (as an APM on USB does)
+    ASSERT_TRUE(wait_until([&] { return show().value("state", "") == "done"; }, 60s, kPoll)) << show().dump();
+    EXPECT_EQ(show()["waypoints_reached"].get<std::size_t>(), expected.size());
+
+    // After the board's last boot: the first waypoint reached is the first one the daemon had not seen
+    // reached, and the rest follow in order to the end.
+    double booted = 0;
+    for (const auto& m : control_->json("modes")) {
+        if (m["cause"] == "reboot" || m["cause"] == "power on") {
+            booted = m["t"].get<double>();
+        }
+    }
+    std::vector<SimControl::Reached> after;
+    for (const auto& r : control_->reached(0)) {
+        if (r.t > booted) {
+            after.push_back(r);
+        }
+    }
+    ASSERT_FALSE(after.empty());
+    EXPECT_PRED2(same_place, e7(after[0]), expected[saved_next])
+        << "resumed elsewhere than waypoint " << saved_next;
+    for (std::size_t k = 0; saved_next + k < expected.size(); ++k) {
+        ASSERT_LT(k, after.size());
+        ASSERT_PRED2(same_place, e7(after[k]), expected[saved_next + k]) << "waypoint " << saved_next + k;
+    }
+}
+
+TEST_F(FlightplanE2e, NoFlyCrossingAndBadFieldPlansAreRejectedNamingElementAndLineAndChangeNothing) {
+    const auto good = write_plan("good.yaml", line_plan("good", kHomeLat, kHomeLon + 0.0001, 0, 40, 8));
+    start_daemon(5);
+    ASSERT_EQ(ctl({"plan", "load", good}).exit_code, 0);
+    ASSERT_EQ(ctl({"plan", "pause"}).exit_code, 0);
+    const auto before = show();
+    const auto stats_before = control_->json("stats");
+
+    const auto no_fly = write_plan("nofly.yaml",
+                                   "plan:\n"
+                                   "  name: through-the-barn\n"
+                                   "  no_fly:\n"
+                                   "    - name: barn\n"
+                                   "      buffer: 5\n"
+                                   "      polygon: [[41.2760, 1.9870], [41.2760, 1.9872], [41.2762, 1.9872], "
+                                   "[41.2762, 1.9870]]\n"
+                                   "  elements:\n"
+                                   "    - waypoint: {lat: 41.2758, lon: 1.9871}\n"
+                                   "    - waypoint: {lat: 41.2764, lon: 1.9871}\n");
+    auto rejected = ctl({"plan", "load", no_fly});
+    EXPECT_EQ(rejected.exit_code, 1);
+    const std::string why = rejected.json.value("error", "");
+    EXPECT_EQ(rejected.json.value("status", ""), "bad_request") << rejected.json.dump();
+    EXPECT_NE(why.find(no_fly + ":9:"), std::string::npos) << why;
+    EXPECT_NE(why.find("plan.elements[1]"), std::string::npos) << why;
+    EXPECT_NE(why.find("no-fly zone 'barn'"), std::string::npos) << why;
+
+    const auto bad_field = write_plan("badfield.yaml",
+                                      "plan:\n"
+                                      "  name: typo\n"
+                                      "  elements:\n"
+                                      "    - waypoint: {lat: 41.2758, lon: 1.9871}\n"
+                                      "    - waypoint: {lat: 41.2760, lon: 1.9871, sped: 2}\n");
+    auto typo = ctl({"plan", "load", bad_field});
+    EXPECT_EQ(typo.exit_code, 1);
+    const std::string typo_why = typo.json.value("error", "");
+    EXPECT_NE(typo_why.find(bad_field + ":5:"), std::string::npos) << typo_why;
+    EXPECT_NE(typo_why.find("plan.elements[1].waypoint.sped"), std::string::npos) << typo_why;
+    EXPECT_NE(typo_why.find("unknown field"), std::string::npos) << typo_why;
+
+    // Nothing changed: the same plan in the same state, and not one mission item went to the board.
+    const auto after = show();
+    EXPECT_EQ(after["name"], before["name"]);
+    EXPECT_EQ(after["state"], "paused");
+    EXPECT_EQ(after["generation"], before["generation"]);
+    EXPECT_EQ(after["source"], before["source"]);
+    const auto stats_after = control_->json("stats");
+    EXPECT_EQ(stats_after["mission_items_received"], stats_before["mission_items_received"]);
+    EXPECT_EQ(stats_after["uploads_completed"], stats_before["uploads_completed"]);
+}
+
+}  // namespace
+}  // namespace airseg::test
+
+namespace airseg::test {
+namespace {
+
+TEST_F(FlightplanE2e, SkipPauseResumeAndAppendAreConfirmedByTheBoard) {
+    const auto file = write_plan("route.yaml", line_plan("route", kHomeLat, kHomeLon + 0.0001, 0, 30, 25));
+    const auto more =
+        write_plan("more.yaml", line_plan("more", kHomeLat + 0.0080, kHomeLon + 0.0003, 90, 5, 25));
+    const auto route = expected_positions(file);
+    const auto extra = expected_positions(more);
+    start_daemon(10);
+    const auto first = control_->reached_total();
+    ASSERT_EQ(ctl({"plan", "load", file}).exit_code, 0);
+    ASSERT_TRUE(wait_until([&] { return show().value("waypoints_reached", 0) >= 3; }, kGenerous, kPoll));
+
+    auto skipped = ctl({"plan", "skip", "20"});
+    ASSERT_EQ(skipped.exit_code, 0) << skipped.json.dump() << skipped.err;
+    EXPECT_EQ(skipped.json["next_waypoint"], 20);
+    EXPECT_EQ(ctl({"plan", "skip", "5000"}).exit_code, 1);
+
+    auto paused = ctl({"plan", "pause"});
+    ASSERT_EQ(paused.exit_code, 0) << paused.err;
+    EXPECT_EQ(paused.json["state"], "paused");
+    EXPECT_EQ(control_->json("state")["mode"], "HOLD");  // answered only once the board holds
+    auto resumed = ctl({"plan", "resume"});
+    ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+    EXPECT_EQ(resumed.json["state"], "running");
+    EXPECT_EQ(control_->json("state")["mode"], "AUTO");
+
+    auto appended = ctl({"plan", "append", more});
+    ASSERT_EQ(appended.exit_code, 0) << appended.json.dump() << appended.err;
+    ASSERT_TRUE(wait_until([&] { return show().value("state", "") == "done"; }, 60s, kPoll)) << show().dump();
+
+    // On the board: the start of the route, at most the target it was heading for, then 20..29 and the
+    // appended waypoints in order.
+    const auto reached = control_->reached(first);
+    std::size_t i = 0;
+    while (i < reached.size() && i < route.size() && same_place(e7(reached[i]), route[i])) {
+        ++i;
+    }
+    ASSERT_GE(i, 3u);
+    ASSERT_LE(i, 20u);
+    std::vector<E7> rest(route.begin() + 20, route.end());
+    rest.insert(rest.end(), extra.begin(), extra.end());
+    for (std::size_t k = 0; k < rest.size(); ++k, ++i) {
+        ASSERT_LT(i, reached.size());
+        ASSERT_PRED2(same_place, e7(reached[i]), rest[k]) << "after the skip, #" << k;
+    }
+}
+
+TEST_F(FlightplanE2e, CorruptStateFilesAreReportedAndSetAsideAndTheDaemonStartsWithoutAPlan) {
+    std::filesystem::create_directories(dir_.file("state"));
+    write_file(dir_.file("state/plan.yaml"), "# airseg-plan v1 fnv64=0123 bytes=9 source=x\nplan: [\n");
+    write_file(dir_.file("state/progress.state"), "garbage\n");
+    start_daemon(5);
+    const auto plan = status().value("plan", Json());
+    ASSERT_TRUE(plan.is_object()) << status().dump();
+    EXPECT_EQ(plan["state"], "none");
+    ASSERT_TRUE(plan["error"].is_string()) << plan.dump();
+    EXPECT_NE(plan["error"].get<std::string>().find("set aside"), std::string::npos) << plan.dump();
+    EXPECT_TRUE(exists(dir_.file("state/plan.yaml.corrupt-1")));
+    EXPECT_TRUE(exists(dir_.file("state/progress.state.corrupt-1")));
+    EXPECT_FALSE(exists(dir_.file("state/plan.yaml")));
+    EXPECT_TRUE(daemon_->running());
+}
+
+}  // namespace
+}  // namespace airseg::test
