@@ -56,6 +56,12 @@ void LinkDriver::pump() {
         const TimePoint now = SteadyClock::now();
         for (std::size_t p = 0; p < core_.config().paths && p < writers_.size(); ++p) {
             if (!writers_[p]) {
+                // No port on this path (missing, or between reopen attempts): its frames go nowhere, like a
+                // radio that is off. Not taking them would leave the core's send deadline in the past and
+                // the timer firing in a loop.
+                while (core_.poll_transmit(p, now)) {
+                    ++write_refusals_;
+                }
                 continue;
             }
             while (auto frame = core_.poll_transmit(p, now)) {
