@@ -8,7 +8,10 @@
 #
 # The tests run during each build (under qemu-arm for ARM) unless --no-check is given. Each
 # package is checked afterwards (packaging/check-deb.sh: lintian, fields, ELF format).
-# Work directories: build-pkg-ARCH/. AIRSEG_SOURCE_DIR packages another tree. Missing build tools are installed with apt-get (as root).
+# Work directories: build-pkg-ARCH/. AIRSEG_SOURCE_DIR packages another tree. Missing build tools
+# are installed with apt-get (as root). AIRSEG_INTEROP_MODULES: a node_modules directory filled by
+# tests/integration/mavlink_interop/setup.sh, so that mavlink_interop runs too (no network here).
+# AIRSEG_CTEST_ARGS: ctest options (default: a failed test is rerun up to twice, as in CI).
 set -euo pipefail
 . "$(dirname "$0")/lib.sh"
 
@@ -19,7 +22,7 @@ for a in "$@"; do
   case "$a" in
     --no-check) check=0 ;;
     --clean) clean=1 ;;
-    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
     -*) die "unknown option $a" ;;
     *) arch_triplet "$a" >/dev/null; arches+=("$a") ;;
   esac
@@ -80,10 +83,11 @@ build_one() {
   # debhelper gives the build a HOME of its own inside debian/, which would start ccache empty.
   export CCACHE_DIR=${CCACHE_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/ccache}
   (cd "$src" && AIRSEG_SYSROOT="$sysroot" DEB_BUILD_OPTIONS="$opts" \
-     AIRSEG_CMAKE_ARGS="$(ccache_launcher_args)" dpkg-buildpackage "${dpkg_args[@]}") \
+     AIRSEG_CMAKE_ARGS="$(ccache_launcher_args)" AIRSEG_CTEST_ARGS="${AIRSEG_CTEST_ARGS---repeat until-pass:3}" \
+     dpkg-buildpackage "${dpkg_args[@]}") \
      >"$work/build.log" 2>&1 || { tail -n 60 "$work/build.log"; die "build for $arch failed (log: $work/build.log)"; }
   log "built $arch in $((SECONDS - start)) s (log: $work/build.log)"
-  log "$arch: $(grep -c ': warning: ' "$work/build.log" || true) compiler warnings"
+  log "$arch: $(grep -cE '^[^ :]+:[0-9]+:[0-9]+: warning: ' "$work/build.log" || true) compiler warnings"
   if [ "$check" = 1 ]; then
     # ctest's closing lines, for whoever reads this output.
     grep -E '^[0-9]+% tests passed|^Total Test time' "$work/build.log" | sed "s/^/$arch: /" || true
