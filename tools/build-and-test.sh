@@ -30,5 +30,5 @@ echo "build-and-test: native build and tests in $((SECONDS - start)) s"
 if [ -n "$cross" ]; then
   # The ARM test suites run mavlink_interop too, with the node-mavlink set up above.
   # shellcheck disable=SC2086
-  AIRSEG_INTEROP_MODULES="$PWD/$build/mavlink_interop/node_modules" packaging/ci-cross.sh $cross
+  AIRSEG_INTEROP_MODULES="$(cd "$build" && pwd)/mavlink_interop/node_modules" packaging/ci-cross.sh $cross
 fi
