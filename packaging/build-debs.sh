@@ -14,6 +14,8 @@
 # are installed with apt-get (as root). AIRSEG_INTEROP_MODULES: a node_modules directory filled by
 # tests/integration/mavlink_interop/setup.sh, so that mavlink_interop runs too (no network here).
 # AIRSEG_CTEST_ARGS: ctest options (default: a failed test is rerun up to twice, as in CI).
+# AIRSEG_EXTRA_CMAKE_ARGS: more cmake options (CI: -DAIRSEG_TEST_HANG_INJECTION=ON, so that the
+# stuck-service test runs on ARM too; packages to ship leave the test-only hook out).
 set -euo pipefail
 . "$(dirname "$0")/lib.sh"
 
@@ -26,7 +28,7 @@ for a in "$@"; do
     --no-check) check=0 ;;
     --no-debug-info) debug_info=0 ;;
     --clean) clean=1 ;;
-    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,18p' "$0"; exit 0 ;;
     -*) die "unknown option $a" ;;
     *) arch_triplet "$a" >/dev/null; arches+=("$a") ;;
   esac
@@ -90,7 +92,7 @@ build_one() {
   stage_source "$src"
   # CMake reads the compiler flags only when it creates a build directory: one kept from a build
   # with other options (tests, debug information) is started afresh.
-  local obj="$src/obj-$(arch_triplet "$arch")" key="check=$check debug_info=$debug_info"
+  local obj="$src/obj-$(arch_triplet "$arch")" key="check=$check debug_info=$debug_info ${AIRSEG_EXTRA_CMAKE_ARGS:-}"
   if [ -d "$obj" ] && [ "$(cat "$obj/.airseg-build-options" 2>/dev/null)" != "$key" ]; then
     rm -rf "$obj"
   fi
@@ -99,7 +101,7 @@ build_one() {
   # debhelper gives the build a HOME of its own inside debian/, which would start ccache empty.
   export CCACHE_DIR=${CCACHE_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/ccache}
   (cd "$src" && env "${env[@]}" AIRSEG_SYSROOT="$sysroot" DEB_BUILD_OPTIONS="$opts" \
-     AIRSEG_CMAKE_ARGS="$(ccache_launcher_args)" AIRSEG_CTEST_ARGS="${AIRSEG_CTEST_ARGS---repeat until-pass:3}" \
+     AIRSEG_CMAKE_ARGS="$(ccache_launcher_args) ${AIRSEG_EXTRA_CMAKE_ARGS:-}" AIRSEG_CTEST_ARGS="${AIRSEG_CTEST_ARGS---repeat until-pass:3}" \
      dpkg-buildpackage "${dpkg_args[@]}") \
      >"$work/build.log" 2>&1 || { tail -n 60 "$work/build.log"; die "build for $arch failed (log: $work/build.log)"; }
   echo "$key" >"$obj/.airseg-build-options"

@@ -8,8 +8,9 @@
 #    qemu-arm, and builds the sysroots.
 # 2. Builds each ARM package; each package build compiles the whole test suite with -Werror and
 #    runs it under qemu-arm (ctest through the toolchain file's emulator, helper programs through
-#    binfmt_misc), so the ARM binaries that are tested are the ones that are shipped. Without debug
-#    information (-g0, no -dbgsym package): a quarter less compile time, the same machine code.
+#    binfmt_misc), so the ARM binaries are tested as they are packaged, with two differences: no
+#    debug information (-g0, no -dbgsym package: a quarter less compile time, the same machine
+#    code), and the test-only hang injection compiled in (the stuck-service test runs on ARM too).
 # 3. Checks each .deb (packaging/check-deb.sh: lintian, Architecture, shlibs Depends, ELF format
 #    and loader).
 # 4. With --full, also builds the amd64 package (without its tests: they are CI's native stage)
@@ -26,7 +27,7 @@ for a in "$@"; do
   case "$a" in
     --full) full=1 ;;
     armhf|armel) arches+=("$a") ;;
-    -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,21p' "$0"; exit 0 ;;
     *) die "unknown argument '$a' (expected --full, armhf, armel)" ;;
   esac
 done
@@ -59,7 +60,8 @@ summary=()
 for arch in "${arches[@]}"; do
   step "cross-building $arch and running its test suite under qemu-arm"
   start=$SECONDS cpu0=$(cpu_seconds)
-  "$AIRSEG_ROOT/packaging/build-debs.sh" --no-debug-info "$arch"
+  AIRSEG_EXTRA_CMAKE_ARGS=-DAIRSEG_TEST_HANG_INJECTION=ON \
+    "$AIRSEG_ROOT/packaging/build-debs.sh" --no-debug-info "$arch"
   tests=$(grep -E '^[0-9]+% tests passed' "$AIRSEG_ROOT/build-pkg-$arch/build.log" | tail -n1)
   summary+=("$arch: $((SECONDS - start)) s wall, $(($(cpu_seconds) - cpu0)) CPU-s; ${tests:-no ctest summary}")
 done
