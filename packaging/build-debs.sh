@@ -92,7 +92,7 @@ build_one() {
   stage_source "$src"
   # CMake reads the compiler flags only when it creates a build directory: one kept from a build
   # with other options (tests, debug information) is started afresh.
-  local obj="$src/obj-$(arch_triplet "$arch")" key="check=$check debug_info=$debug_info ${AIRSEG_EXTRA_CMAKE_ARGS:-}"
+  local obj="$src/obj-$(arch_triplet "$arch")" key="check=$check debug_info=$debug_info${AIRSEG_EXTRA_CMAKE_ARGS:+ $AIRSEG_EXTRA_CMAKE_ARGS}"
   if [ -d "$obj" ] && [ "$(cat "$obj/.airseg-build-options" 2>/dev/null)" != "$key" ]; then
     rm -rf "$obj"
   fi
