@@ -187,7 +187,8 @@ TEST(MavdumpJson, NestingIsBounded) {
 
 TEST(MavdumpJson, TextFieldsTakeUnicodeEscapesAndUtf8) {
     JsonFrameEncoder encoder;
-    auto text_of_line = [&](const std::string& line) {
+    // A copy: text_of is a view into the decoded message, which ends with the lambda.
+    auto text_of_line = [&](const std::string& line) -> std::string {
         const auto r = encoder.encode_line(line);
         EXPECT_EQ(r.error, "") << line;
         const auto st = mavlink::decode<mavlink::Statustext>(parse(r.frame).at(0));
