@@ -192,7 +192,7 @@ TEST(MavdumpJson, TextFieldsTakeUnicodeEscapesAndUtf8) {
         const auto r = encoder.encode_line(line);
         EXPECT_EQ(r.error, "") << line;
         const auto st = mavlink::decode<mavlink::Statustext>(parse(r.frame).at(0));
-        return mavlink::text_of(st->text);
+        return std::string(mavlink::text_of(st->text));
     };
     // Above U+00FF a code point keeps its UTF-8 bytes, whether escaped or written as is.
     EXPECT_EQ(text_of_line(R"({"name":"STATUSTEXT","fields":{"text":"x\u20ac\ud83d\ude00"}})"),
