@@ -35,8 +35,13 @@ done
 
 t0=$SECONDS
 step() { log "[$((SECONDS - t0)) s] $*"; }
-# User + system CPU seconds of this shell's finished children so far.
-cpu_seconds() { times | awk 'NR == 2 { gsub(/[ms]/, " "); print int($1 * 60 + $2 + $3 * 60 + $4) }'; }
+# User + system CPU seconds of this script's finished children so far (read from /proc: `times` in a
+# command substitution would report the subshell's own children).
+cpu_seconds() {
+  local f
+  read -r -a f <"/proc/$$/stat"
+  echo $(((f[15] + f[16]) / $(getconf CLK_TCK)))
+}
 
 step "installing build tools"
 cross=()
