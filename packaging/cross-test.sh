@@ -32,11 +32,12 @@ else
 fi
 
 start=$SECONDS
+mkdir -p "$build"
 # shellcheck disable=SC2046
 cmake -S "$src" -B "$build" -G Ninja \
   -DCMAKE_TOOLCHAIN_FILE="$AIRSEG_ROOT/packaging/toolchain-$arch.cmake" -DAIRSEG_SYSROOT="$sysroot" \
-  -DAIRSEG_BUILD_FUZZ=OFF $(ccache_launcher_args) >"$build.configure.log" \
-  || { cat "$build.configure.log"; die "configure failed"; }
+  -DAIRSEG_BUILD_FUZZ=OFF -DAIRSEG_WERROR=ON $(ccache_launcher_args) >"$build/configure.log" \
+  || { cat "$build/configure.log"; die "configure failed"; }
 # shellcheck disable=SC2086
 cmake --build "$build" -j "$jobs" ${AIRSEG_TARGETS:+--target $AIRSEG_TARGETS}
 built=$SECONDS

@@ -92,7 +92,11 @@ TEST_F(GroundlinkEndToEnd, StatusOverTheRadioWithTenPercentFrameLoss) {
         ASSERT_EQ(r.exit_code, 0) << "call " << i << ": " << r.err << "\ndaemon:\n" << daemon->err();
         auto doc = nlohmann::json::parse(r.out);
         EXPECT_EQ(doc["services"]["autopilot"]["health"], "down");
-        EXPECT_EQ(doc["groundlink"]["link"], "up");
+        // The first request may come in the session's first frame (a slow client, e.g. under qemu, packs its
+        // hello and the request together), answered before link_up_frames (2) valid frames mark the link up.
+        if (i > 0) {
+            EXPECT_EQ(doc["groundlink"]["link"], "up") << "call " << i;
+        }
         EXPECT_EQ(doc["groundlink"]["mode"], "single");
         EXPECT_GE(doc["groundlink"]["frames_received"].get<int>(), 1);
     }

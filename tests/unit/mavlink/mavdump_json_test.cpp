@@ -187,11 +187,12 @@ TEST(MavdumpJson, NestingIsBounded) {
 
 TEST(MavdumpJson, TextFieldsTakeUnicodeEscapesAndUtf8) {
     JsonFrameEncoder encoder;
-    auto text_of_line = [&](const std::string& line) {
+    // A copy: text_of is a view into the decoded message, which ends with the lambda.
+    auto text_of_line = [&](const std::string& line) -> std::string {
         const auto r = encoder.encode_line(line);
         EXPECT_EQ(r.error, "") << line;
         const auto st = mavlink::decode<mavlink::Statustext>(parse(r.frame).at(0));
-        return mavlink::text_of(st->text);
+        return std::string(mavlink::text_of(st->text));
     };
     // Above U+00FF a code point keeps its UTF-8 bytes, whether escaped or written as is.
     EXPECT_EQ(text_of_line(R"({"name":"STATUSTEXT","fields":{"text":"x\u20ac\ud83d\ude00"}})"),
