@@ -38,5 +38,6 @@ fi
   > "$run_dir/airsegd.log" 2>&1 &
 pids+=($!)
 
-echo "demo: logs in $run_dir; on-board status: $build/client/airsegctl status --socket $run_dir/status.sock"
+echo "demo: logs in $run_dir; on-board status: $build/client/airsegctl --local --socket $run_dir/status.sock status"
+echo "demo: a flight plan: $build/client/airsegctl --local --socket $run_dir/status.sock plan load config/plans/rover-survey.yaml"
 "$build/client/airsegctl" --link "$run_dir/radio-ground" --baud 57600 --timeout 5000 watch
