@@ -13,7 +13,8 @@ cleanup() {
   for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done
   wait 2>/dev/null || true
 }
-trap cleanup EXIT INT TERM
+# HUP too: closing the terminal must not leave airsegd reopening ptys that other programs get next.
+trap cleanup EXIT INT TERM HUP
 
 wait_for() {  # wait_for PATH: until a pty link appears (at most 10 s)
   for _ in $(seq 100); do [ -e "$1" ] && return 0; sleep 0.1; done

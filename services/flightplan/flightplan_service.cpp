@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "services/flightplan/home_stream.hpp"
+#include "services/flightplan/plan_progress.hpp"
 #include "services/flightplan/resume.hpp"
 #include "services/status/status_messages.hpp"
 
@@ -454,7 +455,28 @@ void FlightplanService::schedule_status() {
     });
 }
 
+namespace {
+
+// The top-level element index from an element path such as "plan.elements[12].scan".
+std::uint32_t top_element_index(const std::string& path) {
+    const auto open = path.find('[');
+    const auto close = path.find(']', open);
+    if (open == std::string::npos || close == std::string::npos) {
+        return 0;
+    }
+    std::uint32_t n = 0;
+    for (auto i = open + 1; i < close && path[i] >= '0' && path[i] <= '9'; ++i) {
+        n = n * 10 + static_cast<std::uint32_t>(path[i] - '0');
+    }
+    return n;
+}
+
+}  // namespace
+
 void FlightplanService::publish_status(bool force) {
+    const auto p = feeder_.progress();
+    ctx_.bus.publish_latest(PlanProgress{p.state, top_element_index(p.element), p.next_waypoint.value_or(0),
+                                         p.waypoints_reached});
     Json j = progress_json();
     if (!force && j == last_status_)
         return;

@@ -2,8 +2,10 @@
 // ground (vehicle telemetry samples, events and autopilot texts).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
+#include "services/flightplan/plan_progress.hpp"
 #include "services/groundlink/groundlink_messages.hpp"
 #include "services/groundlink/groundlink_service.hpp"
 
@@ -120,7 +122,12 @@ void GroundlinkService::subscribe_bus() {
     subscriptions_.push_back(bus.subscribe<autopilot::Telemetry>(
         strand(), [this](const autopilot::Telemetry& t) { vehicle_ = t; }));
     subscriptions_.push_back(
-        bus.subscribe<PlanProgressSample>(strand(), [this](const PlanProgressSample& p) { plan_ = p; }));
+        bus.subscribe<flightplan::PlanProgress>(strand(), [this](const flightplan::PlanProgress& p) {
+            plan_ = PlanProgressSample{
+                static_cast<std::uint8_t>(p.state),
+                static_cast<std::uint16_t>(std::min<std::uint32_t>(p.element, 16383)),
+                static_cast<std::uint32_t>(std::min<std::uint64_t>(p.next_waypoint, 0xFFFFFF))};
+        }));
     subscriptions_.push_back(
         bus.subscribe<TelemetryConfigChanged>(strand(), [this](const TelemetryConfigChanged& c) {
             config_.telemetry = c.config;

@@ -5,8 +5,8 @@
 
 namespace airseg::groundlink {
 
-/// Flight plan progress as the sample carries it (plan_state 0 none, 1 running, 2 paused, 3 done). Also the
-/// bus variable (publish_latest) through which a flight plan service hands its progress to the ground link.
+/// Flight plan progress as the sample carries it (plan_state 0 none, 1 running, 2 paused, 3 done), taken from
+/// the flight plan service's flightplan::PlanProgress bus variable.
 struct PlanProgressSample {
     std::uint8_t plan_state = 0;
     std::uint16_t element = 0;

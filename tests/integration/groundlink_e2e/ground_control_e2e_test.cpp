@@ -112,13 +112,21 @@ class GroundControlE2e : public ::testing::Test {
             << linksim->err();
     }
 
-    void start_sim() {
-        sim = std::make_unique<Subprocess>(
-            std::vector<std::string>{binary("tools/apmsim/airseg-apmsim"), "--link", dir.file("ttyACM0"),
-                                     "--control", dir.file("sim.ctl"), "--home",
-                                     std::to_string(kHomeLat) + "," + std::to_string(kHomeLon),
-                                     "--boot-delay", "0.5", "--calib-time", "0.5", "--quiet"},
-            std::map<std::string, std::string>{}, dir.path());
+    void start_sim(std::vector<std::string> extra = {}) {
+        std::vector<std::string> args{binary("tools/apmsim/airseg-apmsim"),
+                                      "--link",
+                                      dir.file("ttyACM0"),
+                                      "--control",
+                                      dir.file("sim.ctl"),
+                                      "--home",
+                                      std::to_string(kHomeLat) + "," + std::to_string(kHomeLon),
+                                      "--boot-delay",
+                                      "0.5",
+                                      "--calib-time",
+                                      "0.5",
+                                      "--quiet"};
+        args.insert(args.end(), extra.begin(), extra.end());
+        sim = std::make_unique<Subprocess>(args, std::map<std::string, std::string>{}, dir.path());
         ASSERT_TRUE(wait_until([&] { return exists(dir.file("ttyACM0")) && exists(dir.file("sim.ctl")); }))
             << sim->err();
         sim_control = std::make_unique<SimControl>(dir.file("me.ctl"), dir.file("sim.ctl"));
@@ -211,6 +219,63 @@ TEST_F(GroundControlE2e, StatusAndPushedTelemetryOverTheRadio) {
     auto params = ctl({"param", "get", "WP_RADIUS"});
     EXPECT_EQ(params.exit_code, 0) << params.err;
     EXPECT_TRUE(Json::parse(params.out, nullptr, false).value("value", Json()).is_number()) << params.out;
+}
+
+// A plan sent over the radio as one Safe message (the file is read on the ground), driven by the simulated
+// rover; show, pause, resume and skip each acknowledged, and the pushed telemetry carries the plan's
+// progress.
+TEST_F(GroundControlE2e, APlanLoadedOverTheRadioIsDrivenPausedResumedAndSkipped) {
+    start_link();
+    start_sim({"--speedup", "4"});
+    start_daemon();
+    ASSERT_TRUE(
+        wait_until([&] { return status_doc().value("autopilot", Json::object()).value("ready", false); },
+                   kGenerous, 500ms))
+        << daemon->err();
+    const std::string plan = dir.file("square.yaml");
+    std::string elements;
+    for (int i = 1; i <= 12; ++i) {
+        elements += "    - waypoint: {lat: " + std::to_string(kHomeLat + 0.00008 * (i % 2)) +
+                    ", lon: " + std::to_string(kHomeLon + 0.0001 * i) + "}\n";
+    }
+    write_file(plan, "plan:\n  name: radio-square\n  vehicle: {type: rover}\n  elements:\n" + elements);
+
+    auto load = ctl({"plan", "load", plan});
+    ASSERT_EQ(load.exit_code, 0) << load.out << load.err << "\ndaemon:\n" << daemon->err();
+    Json shown;
+    auto plan_show = [&] {
+        auto r = ctl({"plan", "show"});
+        shown = Json::parse(r.out, nullptr, false);
+        return r.exit_code == 0 && !shown.is_discarded();
+    };
+    ASSERT_TRUE(
+        wait_until([&] { return plan_show() && shown.value("waypoints_reached", 0) >= 2; }, kGenerous, 500ms))
+        << shown.dump();
+    EXPECT_EQ(shown["name"], "radio-square");
+    EXPECT_EQ(shown["state"], "running");
+
+    auto pause = ctl({"plan", "pause"});
+    ASSERT_EQ(pause.exit_code, 0) << pause.out << pause.err;
+    ASSERT_TRUE(plan_show());
+    EXPECT_EQ(shown["state"], "paused");
+    EXPECT_EQ(status_doc()["autopilot"]["state"], "PARKING");
+
+    auto resume = ctl({"plan", "resume"});
+    ASSERT_EQ(resume.exit_code, 0) << resume.out << resume.err;
+    auto skip = ctl({"plan", "skip", "9"});
+    ASSERT_EQ(skip.exit_code, 0) << skip.out << skip.err;
+    ASSERT_TRUE(plan_show());
+    EXPECT_EQ(shown["state"], "running");
+    EXPECT_GE(shown.value("next_waypoint", 0), 9) << shown.dump();
+
+    auto watch = ctl({"watch", "--duration", "3000"});
+    ASSERT_EQ(watch.exit_code, 0) << watch.err;
+    const auto lines = json_lines(watch.out);
+    ASSERT_FALSE(lines.empty()) << watch.out;
+    const auto& last = lines.back();
+    ASSERT_TRUE(last["vehicle"].contains("plan"))
+        << "the pushed samples carry the plan's progress: " << last.dump();
+    EXPECT_GE(last["vehicle"]["plan"]["next_waypoint"].get<int>(), 9) << last.dump();
 }
 
 TEST_F(GroundControlE2e, AMonitorKeyWatchesButItsCommandsAreRefused) {

@@ -1,0 +1,18 @@
+#pragma once
+// Plan progress as a bus variable (publish_latest), for services that report it compactly: the ground link's
+// telemetry samples carry it to the ground.
+#include <cstdint>
+
+#include "services/flightplan/feeder_types.hpp"
+
+namespace airseg::flightplan {
+
+struct PlanProgress {
+    PlanState state = PlanState::None;
+    std::uint32_t element = 0;  // index of the top-level plan element being flown
+    std::uint64_t next_waypoint = 0;
+    std::uint64_t waypoints_reached = 0;
+    bool operator==(const PlanProgress&) const = default;
+};
+
+}  // namespace airseg::flightplan
