@@ -12,19 +12,11 @@
 
 #include "services/groundlink/transport/cobs.hpp"
 #include "services/groundlink/transport/frame.hpp"
+#include "tests/fuzz/require.hpp"
 
 namespace {
 
 using namespace airseg::groundlink;
-
-// Names the broken property before aborting, so a crash report says what failed.
-void require_at(bool condition, int line) {
-    if (!condition) {
-        std::fprintf(stderr, "property broken at %s:%d\n", __FILE__, line);
-        std::abort();
-    }
-}
-#define require(condition) require_at((condition), __LINE__)
 
 constexpr std::size_t kMaxEncoded = 600;
 

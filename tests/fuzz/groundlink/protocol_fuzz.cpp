@@ -8,19 +8,7 @@
 #include <span>
 
 #include "services/groundlink/protocol/ground_protocol.hpp"
-
-namespace {
-
-// Names the broken property before aborting, so a crash report says what failed.
-void require_at(bool condition, int line) {
-    if (!condition) {
-        std::fprintf(stderr, "property broken at %s:%d\n", __FILE__, line);
-        std::abort();
-    }
-}
-#define require(condition) require_at((condition), __LINE__)
-
-}  // namespace
+#include "tests/fuzz/require.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     using namespace airseg::groundlink::protocol;

@@ -18,6 +18,7 @@
 #include <span>
 #include <vector>
 
+#include "tests/fuzz/require.hpp"
 #include "tests/unit/groundlink/sim_link.hpp"
 
 namespace {
@@ -25,15 +26,6 @@ namespace {
 using namespace airseg::groundlink;
 using namespace std::chrono_literals;
 using airseg::TimePoint;
-
-// Names the broken property before aborting, so a crash report says what failed.
-void require_at(bool condition, int line) {
-    if (!condition) {
-        std::fprintf(stderr, "property broken at %s:%d\n", __FILE__, line);
-        std::abort();
-    }
-}
-#define require(condition) require_at((condition), __LINE__)
 
 // Consumes the input front to back; past the end it yields zeros, so every input is a complete script.
 class Script {

@@ -14,6 +14,7 @@
 #include <cstring>
 #include <nlohmann/json.hpp>
 
+#include "tests/support/control_client.hpp"
 #include "tests/support/process.hpp"
 
 namespace airseg::test {
@@ -31,57 +32,7 @@ bool exists(const std::string& path) {
     return ::stat(path.c_str(), &st) == 0;
 }
 
-/// The simulator's control socket: one datagram per command, the reply comes back to our bound address.
-class SimControl {
-  public:
-    SimControl(std::string own, std::string server) : own_(std::move(own)), server_(std::move(server)) {
-        fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-        sockaddr_un a = address(own_);
-        ::unlink(own_.c_str());
-        if (::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
-            ADD_FAILURE() << "cannot bind " << own_ << ": " << std::strerror(errno);
-        }
-    }
-    ~SimControl() {
-        ::close(fd_);
-        ::unlink(own_.c_str());
-    }
-    SimControl(const SimControl&) = delete;
-    SimControl& operator=(const SimControl&) = delete;
-
-    std::string command(const std::string& text) {
-        sockaddr_un a = address(server_);
-        if (::sendto(fd_, text.data(), text.size(), 0, reinterpret_cast<sockaddr*>(&a), sizeof a) < 0) {
-            return {};
-        }
-        pollfd p{fd_, POLLIN, 0};
-        if (::poll(&p, 1, 5000) <= 0) {
-            return {};
-        }
-        char buf[65536];
-        const auto n = ::recv(fd_, buf, sizeof buf, 0);
-        return n > 0 ? std::string(buf, static_cast<std::size_t>(n)) : std::string();
-    }
-    Json json(const std::string& text) {
-        const auto reply = command(text);
-        auto j = Json::parse(reply, nullptr, false);
-        if (j.is_discarded()) {
-            ADD_FAILURE() << "simulator: no JSON reply to '" << text << "': " << reply;
-            return Json::object();
-        }
-        return j;
-    }
-
-  private:
-    static sockaddr_un address(const std::string& path) {
-        sockaddr_un a{};
-        a.sun_family = AF_UNIX;
-        std::strncpy(a.sun_path, path.c_str(), sizeof a.sun_path - 1);
-        return a;
-    }
-    std::string own_, server_;
-    int fd_ = -1;
-};
+using SimControl = ControlClient;
 
 struct Answer {
     int exit_code = -1;
@@ -230,11 +181,11 @@ TEST_F(AutopilotE2e, UnplugShowsTheLinkDownAndReplugRecoversWithoutARestart) {
     ASSERT_TRUE(wait_until([&] { return ready(); }, kGenerous, kPoll)) << daemon_->err();
     const auto reconnects = autopilot_section()["reconnects"].get<unsigned>();
 
-    control_->command("unplug");
+    control_->ask("unplug");
     ASSERT_TRUE(wait_until([&] { return autopilot_section()["link"] == "down"; }, kGenerous, kPoll));
     EXPECT_FALSE(autopilot_section()["ready"].get<bool>());
 
-    control_->command("replug");
+    control_->ask("replug");
     ASSERT_TRUE(wait_until([&] { return ready(); }, kGenerous, kPoll)) << daemon_->err();
     EXPECT_EQ(autopilot_section()["link"], "up");
     EXPECT_GT(autopilot_section()["reconnects"].get<unsigned>(), reconnects);

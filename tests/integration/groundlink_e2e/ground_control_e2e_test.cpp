@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "tests/support/control_client.hpp"
 #include "tests/support/process.hpp"
 
 namespace airseg::test {
@@ -26,47 +27,7 @@ constexpr auto kGenerous = 60s;
 constexpr double kHomeLat = 41.2756;
 constexpr double kHomeLon = 1.9866;
 
-/// The simulator's control socket: one datagram per command, the reply comes back to our bound address.
-class SimControl {
-  public:
-    SimControl(std::string own, std::string server) : own_(std::move(own)), server_(std::move(server)) {
-        fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-        sockaddr_un a = address(own_);
-        ::unlink(own_.c_str());
-        ::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a);
-    }
-    ~SimControl() {
-        ::close(fd_);
-        ::unlink(own_.c_str());
-    }
-    SimControl(const SimControl&) = delete;
-    SimControl& operator=(const SimControl&) = delete;
-
-    Json json(const std::string& text) {
-        sockaddr_un a = address(server_);
-        if (::sendto(fd_, text.data(), text.size(), 0, reinterpret_cast<sockaddr*>(&a), sizeof a) < 0) {
-            return Json::object();
-        }
-        pollfd p{fd_, POLLIN, 0};
-        if (::poll(&p, 1, 5000) <= 0) {
-            return Json::object();
-        }
-        char buf[65536];
-        const auto n = ::recv(fd_, buf, sizeof buf, 0);
-        auto j = Json::parse(std::string(buf, n > 0 ? static_cast<std::size_t>(n) : 0), nullptr, false);
-        return j.is_discarded() ? Json::object() : j;
-    }
-
-  private:
-    static sockaddr_un address(const std::string& path) {
-        sockaddr_un a{};
-        a.sun_family = AF_UNIX;
-        std::strncpy(a.sun_path, path.c_str(), sizeof a.sun_path - 1);
-        return a;
-    }
-    std::string own_, server_;
-    int fd_ = -1;
-};
+using SimControl = ControlClient;
 
 bool exists(const std::string& path) {
     struct stat st {};
@@ -320,7 +281,7 @@ TEST_F(GroundControlE2e, JoystickDrivesTheRoverAndTheOverrideIsReleasedWhenInput
         << daemon->err();
     auto manual = ctl({"state", "MANUAL_NAVIGATION"});
     ASSERT_EQ(manual.exit_code, 0) << manual.err << manual.out;
-    const auto start = sim_control->json("state");
+    const auto start = sim_control->try_json("state");
 
     // The joystick device is a FIFO standing in for /dev/input/js0: the test writes js_event records.
     const auto fifo = dir.file("js0");
@@ -340,7 +301,7 @@ TEST_F(GroundControlE2e, JoystickDrivesTheRoverAndTheOverrideIsReleasedWhenInput
     double moved = 0;
     ASSERT_TRUE(wait_until(
         [&] {
-            const auto s = sim_control->json("state");
+            const auto s = sim_control->try_json("state");
             const double dlat = (s.value("lat", 0.0) - start.value("lat", 0.0)) * 111'000;
             const double dlon =
                 (s.value("lon", 0.0) - start.value("lon", 0.0)) * 111'000 * std::cos(kHomeLat * M_PI / 180);
@@ -348,7 +309,7 @@ TEST_F(GroundControlE2e, JoystickDrivesTheRoverAndTheOverrideIsReleasedWhenInput
             return moved > 3.0 && s.value("speed", 0.0) > 0.5;
         },
         kGenerous, 200ms))
-        << "moved " << moved << " m; sim: " << sim_control->json("state").dump() << "\nclient:\n"
+        << "moved " << moved << " m; sim: " << sim_control->try_json("state").dump() << "\nclient:\n"
         << stick.err() << "\ndaemon:\n"
         << daemon->err();
 
@@ -356,8 +317,9 @@ TEST_F(GroundControlE2e, JoystickDrivesTheRoverAndTheOverrideIsReleasedWhenInput
     ::close(writer);
     ASSERT_EQ(stick.wait_exit(10s), 0) << stick.err();
     const auto stopped_at = std::chrono::steady_clock::now();
-    ASSERT_TRUE(wait_until([&] { return sim_control->json("state").value("speed", 1.0) < 0.05; }, 20s, 100ms))
-        << sim_control->json("state").dump();
+    ASSERT_TRUE(
+        wait_until([&] { return sim_control->try_json("state").value("speed", 1.0) < 0.05; }, 20s, 100ms))
+        << sim_control->try_json("state").dump();
     // Override released within the configured input timeout (500 ms), plus the rover coasting to a stop.
     const auto to_stop = std::chrono::steady_clock::now() - stopped_at;
     EXPECT_LT(to_stop, 10s);

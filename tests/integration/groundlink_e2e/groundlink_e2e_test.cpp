@@ -158,8 +158,8 @@ TEST_F(GroundlinkEndToEnd, SplitModeOverTwoRadioPairsKeepsWorkingWhenOnePairDies
     control_command("down b");
     auto one = split_status();
     EXPECT_EQ(one.exit_code, 0) << one.err << "\ndaemon:\n" << daemon->err();
-    // The daemon goes before pair B's emulator: a daemon outliving its ports would keep reopening their paths,
-    // and a pty number freed by the emulator is soon another test's line.
+    // The daemon goes before pair B's emulator: a daemon outliving its ports would keep reopening their
+    // paths, and a pty number freed by the emulator is soon another test's line.
     daemon.reset();
 }
 
