@@ -1,28 +1,119 @@
 #!/usr/bin/env bash
-# Builds everything and runs the whole test suite (ctest). Warnings are errors when CI=true.
+# Builds the tree and runs every test stage; .ci/run runs exactly this. Warnings are errors when CI=true.
 #
-# Then, for each architecture in AIRSEG_CROSS (default: none), cross-builds the package with its whole test
-# suite and runs that suite under qemu-arm (packaging/ci-cross.sh; needs root on Debian 12), e.g.
-# AIRSEG_CROSS="armhf armel" tools/build-and-test.sh. Not yet part of .ci/run: its time on a 2-core CI
-# machine has not been measured end to end (docs/operations.md).
+# Stages, in this order (AIRSEG_STAGES chooses a subset, e.g. AIRSEG_STAGES=native):
+#   sanitize  clang build of the whole tree with AddressSanitizer, UndefinedBehaviorSanitizer and libFuzzer
+#             coverage (build-san/); the whole ctest suite, unit to system tests, any report fails the test
+#   fuzz      each libFuzzer target for AIRSEG_FUZZ_SECONDS (default 60) on its seed corpus (tests/fuzz/run.sh,
+#             same build directory); a crash or a broken property fails the stage
+#   tsan      GCC build with ThreadSanitizer (build-tsan/) of the concurrency tests (ctest label
+#             "concurrency": the bus and dispatcher, the serial port's threads, the daemon's thread pool
+#             running all its services) and the binaries they start; a race report fails the test
+#   cross     packaging/ci-cross.sh for the architectures in AIRSEG_CROSS (default "armhf armel"): each ARM
+#             package is cross-built with the whole test suite, which runs under qemu-arm (needs root)
+#   native    GCC build as shipped (build/, the one tools/demo.sh runs) and the whole ctest suite
+# Default: "sanitize fuzz tsan cross". The shipped GCC build is tested by the cross stage on the two ARM
+# targets; "native" repeats that on amd64 and is the quickest check while developing.
+# docs/operations.md ("CI") has the figures for each stage.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-build=${AIRSEG_BUILD_DIR:-build}
-cross=${AIRSEG_CROSS:-}
-start=$SECONDS
+stages=${AIRSEG_STAGES:-sanitize fuzz tsan cross}
+jobs=$(nproc)
+total=$SECONDS
+
 launcher=()
 if command -v ccache >/dev/null; then
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 fi
-cmake -S . -B "$build" -G Ninja "${launcher[@]}"
-cmake --build "$build" -j"$(nproc)"
-# The MAVLink interoperability test needs node-mavlink (pinned by its lock file) in the build directory.
-tests/integration/mavlink_interop/setup.sh "$build"
-ctest --test-dir "$build" -j"$(nproc)" --output-on-failure --timeout 300
-echo "build-and-test: native build and tests in $((SECONDS - start)) s"
-
-if [ -n "$cross" ]; then
-  # The ARM test suites run mavlink_interop too, with the node-mavlink set up above.
-  # shellcheck disable=SC2086
-  AIRSEG_INTEROP_MODULES="$(cd "$build" && pwd)/mavlink_interop/node_modules" packaging/ci-cross.sh $cross
+# On a fresh machine (CI) nothing is cached: precompiled headers save more than ccache could.
+pch=OFF
+if [ "${CI:-}" = true ]; then
+  pch=ON
 fi
+
+has_stage() { [[ " $stages " == *" $1 "* ]]; }
+elapsed() { echo "build-and-test: $1 in $((SECONDS - $2)) s"; }
+
+# The MAVLink interoperability test needs node-mavlink (pinned by its lock file) in each build directory.
+run_ctest() {
+  local dir=$1
+  shift
+  tests/integration/mavlink_interop/setup.sh "$dir"
+  ctest --test-dir "$dir" -j"$jobs" --output-on-failure --timeout 600 "$@"
+}
+
+for s in $stages; do
+  case "$s" in
+    sanitize|fuzz|tsan|cross|native) ;;
+    *) echo "build-and-test: unknown stage '$s' (expected sanitize, fuzz, tsan, cross, native)" >&2; exit 2 ;;
+  esac
+done
+
+if has_stage sanitize || has_stage fuzz; then
+  start=$SECONDS
+  # The same configuration tests/fuzz/run.sh makes, so the fuzz stage reuses this build.
+  CC=clang CXX=clang++ cmake -S . -B build-san -G Ninja "${launcher[@]}" -DAIRSEG_PCH=$pch \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" \
+    -DAIRSEG_BUILD_FUZZ=ON -DAIRSEG_BUILD_TESTS=ON -DAIRSEG_BUILD_BENCH=OFF \
+    -DAIRSEG_SANITIZE=fuzzer-no-link,address,undefined
+  cmake --build build-san -j"$jobs"
+  elapsed "sanitizer build" "$start"
+fi
+
+if has_stage sanitize; then
+  start=$SECONDS
+  # Any sanitizer report ends the process with an error, in the tests and in the programs they start.
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=0:halt_on_error=1 \
+    UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 run_ctest build-san
+  elapsed "tests under ASan+UBSan" "$start"
+fi
+
+if has_stage fuzz; then
+  start=$SECONDS
+  seconds=${AIRSEG_FUZZ_SECONDS:-60}
+  mapfile -t targets < <(find build-san/tests/fuzz -maxdepth 1 -type f -name 'fuzz_*' -perm -u+x -printf '%f\n' | sort)
+  [ ${#targets[@]} -gt 0 ] || { echo "build-and-test: no fuzz targets in build-san/tests/fuzz" >&2; exit 1; }
+  mkdir -p build-san/fuzz-logs
+  # One target per core; each log ends with libFuzzer's final statistics.
+  printf '%s\n' "${targets[@]}" | xargs -P "$jobs" -I{} sh -c \
+    'AIRSEG_FUZZ_BUILD_DIR=build-san tests/fuzz/run.sh {} '"$seconds"' >build-san/fuzz-logs/{}.log 2>&1 \
+       || { echo "fuzz: {} FAILED"; tail -n 40 build-san/fuzz-logs/{}.log; exit 255; }'
+  for t in "${targets[@]}"; do
+    runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "build-san/fuzz-logs/$t.log")
+    echo "fuzz: $t: ${runs:-?} executions in $seconds s, no finding"
+  done
+  elapsed "fuzzing (${#targets[@]} targets, $seconds s each)" "$start"
+fi
+
+if has_stage tsan; then
+  start=$SECONDS
+  cmake -S . -B build-tsan -G Ninja "${launcher[@]}" -DAIRSEG_PCH=$pch -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" -DAIRSEG_BUILD_BENCH=OFF -DAIRSEG_SANITIZE=thread
+  mapfile -t tsan_targets < <(grep '^[a-z]' tests/concurrency-tests.txt)
+  cmake --build build-tsan -j"$jobs" --target "${tsan_targets[@]}"
+  TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 \
+    ctest --test-dir build-tsan -j"$jobs" --output-on-failure --timeout 600 -L concurrency
+  elapsed "ThreadSanitizer build and tests" "$start"
+fi
+
+if has_stage cross; then
+  start=$SECONDS
+  # The ARM test suites run mavlink_interop too, with the node-mavlink set up in the first build directory.
+  modules_dir=build-san
+  has_stage sanitize || modules_dir=build-cross-interop
+  tests/integration/mavlink_interop/setup.sh "$modules_dir"
+  # shellcheck disable=SC2086
+  AIRSEG_PCH=$pch AIRSEG_INTEROP_MODULES="$(cd "$modules_dir" && pwd)/mavlink_interop/node_modules" \
+    packaging/ci-cross.sh ${AIRSEG_CROSS:-armhf armel}
+  elapsed "ARM packages and their tests under qemu-arm" "$start"
+fi
+
+if has_stage native; then
+  start=$SECONDS
+  cmake -S . -B build -G Ninja "${launcher[@]}"
+  cmake --build build -j"$jobs"
+  run_ctest build
+  elapsed "native build and tests" "$start"
+fi
+
+echo "build-and-test: stages '$stages' passed in $((SECONDS - total)) s"

@@ -93,8 +93,6 @@ class FakeRover {
     std::set<std::uint32_t> refused_modes_;
     std::map<std::string, float> params_;
     std::vector<std::string> param_order_;
-    std::size_t param_stream_next_ = 0;  // PARAM_REQUEST_LIST in progress
-    bool param_streaming_ = false;
     std::size_t param_sets_ = 0;
 
     std::vector<mav::MissionItemInt> mission_;
