@@ -19,8 +19,8 @@
 #include "daemon/systemd_notifier.hpp"
 #include "hal/gpio_libgpiod.hpp"
 #include "services/autopilot/autopilot_service.hpp"
-#include "services/groundlink/groundlink_messages.hpp"
 #include "services/flightplan/flightplan_service.hpp"
+#include "services/groundlink/groundlink_messages.hpp"
 #include "services/groundlink/groundlink_service.hpp"
 #include "services/status/status_messages.hpp"
 #include "services/status/status_service.hpp"
@@ -230,8 +230,11 @@ class App::Impl {
     }
 
     void do_watchdog() {
+        // A service silent for half the period stops the pings, checked every quarter period: a hang is
+        // noticed within three quarters of a period, so systemd's watchdog fires at most 1.75 periods after
+        // it. Services report progress every quarter period (progress_interval()), twice within the limit.
         const auto period = std::chrono::duration_cast<Duration>(*notifier_.watchdog_period());
-        const auto stalled = health_.stalled(SteadyClock::now(), period);
+        const auto stalled = health_.stalled(SteadyClock::now(), period / 2);
         if (stalled.empty()) {
             notifier_.watchdog();
             watchdog_complained_ = false;
@@ -240,7 +243,7 @@ class App::Impl {
             spdlog::error("watchdog: not pinging systemd: no progress from {}", fmt::join(stalled, ", "));
             watchdog_complained_ = true;
         }
-        watchdog_timer_.expires_after(period / 2);
+        watchdog_timer_.expires_after(period / 4);
         watchdog_timer_.async_wait([this](boost::system::error_code ec) {
             if (!ec) {
                 do_watchdog();

@@ -3,6 +3,7 @@
 #include <signal.h>
 #include <sys/stat.h>
 
+#include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "tests/support/process.hpp"
@@ -87,27 +88,42 @@ TEST_F(DaemonProcess, AStuckServiceStopsTheWatchdogPings) {
         << "airsegd is built without AIRSEG_TEST_HANG_INJECTION (a package build): no service can be made "
            "to hang";
 #endif
-    auto e = env("300000");
-    e["AIRSEG_TEST_HANG"] = "groundlink:600";
+    // WatchdogSec=1s; groundlink's strand blocks 1.5 s after the start (the delay counts from before
+    // READY=1).
+    constexpr auto kPeriod = 1000ms;
+    constexpr auto kHangDelay = 1500ms;
+    auto e = env("1000000");
+    e["AIRSEG_TEST_HANG"] = "groundlink:1500";
     Subprocess daemon(daemon_args(), e, dir.path());
-    ASSERT_TRUE(notify.wait_for("READY=1", 10s)) << daemon.err();
+    const auto ready = notify.wait_for("READY=1", 10s);
+    ASSERT_TRUE(ready) << daemon.err();
+    const auto ready_at = *ready;
     ASSERT_TRUE(notify.wait_for("WATCHDOG=1", 5s)) << "pings before the hang";
 
     // After the hang the pings stop for good: find a silence of three watchdog periods while it still runs.
+    std::chrono::steady_clock::time_point last_ping{};
     bool silent = wait_until(
         [&] {
             notify.drain();
-            const auto& m = notify.messages();
-            std::chrono::steady_clock::time_point last{};
-            for (const auto& msg : m) {
+            for (const auto& msg : notify.messages()) {
                 if (msg.text.find("WATCHDOG=1") != std::string::npos) {
-                    last = msg.at;
+                    last_ping = msg.at;
                 }
             }
-            return std::chrono::steady_clock::now() - last > 900ms;
+            return std::chrono::steady_clock::now() - last_ping > 3 * kPeriod;
         },
-        10s);
+        20s);
     EXPECT_TRUE(silent) << "WATCHDOG=1 kept coming although a service was stuck";
+    // Within one watchdog period of the hang: systemd's watchdog, armed by the last ping, then fires.
+    EXPECT_LT(last_ping - ready_at, kHangDelay + kPeriod)
+        << "the last ping came "
+        << std::chrono::duration_cast<std::chrono::milliseconds>(last_ping - ready_at - kHangDelay).count()
+        << " ms after the hang";
+    EXPECT_GT(last_ping - ready_at, kHangDelay / 2) << "the pings stopped long before the hang";
+    std::cout
+        << "watchdog: last ping "
+        << std::chrono::duration_cast<std::chrono::milliseconds>(last_ping - ready_at - kHangDelay).count()
+        << " ms after the hang (watchdog period " << kPeriod.count() << " ms)\n";
     EXPECT_TRUE(daemon.running());
     EXPECT_TRUE(wait_until([&] {
         return daemon.err().find("no progress from groundlink") != std::string::npos;
