@@ -54,7 +54,7 @@ if has_stage sanitize || has_stage fuzz; then
   # The same configuration tests/fuzz/run.sh makes, so the fuzz stage reuses this build.
   CC=clang CXX=clang++ cmake -S . -B build-san -G Ninja "${launcher[@]}" -DAIRSEG_PCH=$pch \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" \
-    -DAIRSEG_BUILD_FUZZ=ON -DAIRSEG_BUILD_TESTS=ON -DAIRSEG_BUILD_BENCH=OFF \
+    -DAIRSEG_BUILD_FUZZ=ON -DAIRSEG_BUILD_TESTS=ON -DAIRSEG_BUILD_BENCH=ON \
     -DAIRSEG_SANITIZE=fuzzer-no-link,address,undefined
   cmake --build build-san -j"$jobs"
   elapsed "sanitizer build" "$start"

@@ -6,7 +6,7 @@ packages=(
   libboost-dev libboost-program-options-dev libyaml-cpp-dev libspdlog-dev libfmt-dev
   libgpiod-dev libsystemd-dev libsodium-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  clang
+  clang libclang-rt-14-dev
 )
 sudo=""
 if [ "$(id -u)" -ne 0 ]; then

@@ -24,7 +24,7 @@ fi
 
 # Tests stay configured (not built): the fuzz targets share the test tree's CMake files.
 CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    -DAIRSEG_BUILD_FUZZ=ON -DAIRSEG_BUILD_TESTS=ON -DAIRSEG_BUILD_BENCH=OFF \
+    -DAIRSEG_BUILD_FUZZ=ON -DAIRSEG_BUILD_TESTS=ON \
     -DAIRSEG_SANITIZE=fuzzer-no-link,address,undefined >/dev/null
 cmake --build "$build" -j2 --target "$target"
 

@@ -6,6 +6,7 @@
 //    own header and payload, parses back to the same frame;
 //  - the generic field readers and the JSON printer of airseg-mavdump handle every delivered frame.
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <span>
 #include <vector>
@@ -13,16 +14,11 @@
 #include "services/autopilot/mavlink/encoder.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
 #include "tools/mavdump/frame_json.hpp"
+#include "tests/fuzz/require.hpp"
 
 namespace {
 
 using namespace airseg::mavlink;
-
-void require(bool condition) {
-    if (!condition) {
-        std::abort();
-    }
-}
 
 bool same_frame(const Frame& a, const Frame& b) {
     return a.version == b.version && a.incompat_flags == b.incompat_flags &&
@@ -96,7 +92,24 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (std::size_t i = 0; i < whole.size(); ++i) {
         require(same_frame(whole[i], chunked[i]));
     }
-    require(same_stats(a.stats(), b.stats()));
+    if (!same_stats(a.stats(), b.stats())) {
+        const auto print = [](const char* name, const ParserStats& s) {
+            std::fprintf(stderr,
+                         "%s: frames_ok %llu garbage %llu bad_checksum %llu truncated %llu unknown %llu "
+                         "incompat %llu signed %llu seq_lost %llu\n",
+                         name, static_cast<unsigned long long>(s.frames_ok),
+                         static_cast<unsigned long long>(s.garbage_bytes),
+                         static_cast<unsigned long long>(s.bad_checksum),
+                         static_cast<unsigned long long>(s.truncated),
+                         static_cast<unsigned long long>(s.unknown_msgid),
+                         static_cast<unsigned long long>(s.incompat_rejected),
+                         static_cast<unsigned long long>(s.signed_frames),
+                         static_cast<unsigned long long>(s.seq_lost));
+        };
+        print("whole", a.stats());
+        print("chunked", b.stats());
+        require(false);
+    }
     require(a.stats().garbage_bytes <= stream.size());
     return 0;
 }
