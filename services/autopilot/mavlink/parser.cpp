@@ -35,6 +35,13 @@ struct Header {
     }
 };
 
+// Length of the frame a start byte claims, from its first three bytes only (magic, payload length and, for
+// MAVLink 2, the incompatibility flags).
+std::size_t claimed_length(const std::uint8_t* p) {
+    const bool is_signed = p[0] == kMagicV2 && (p[2] & kIncompatSigned) != 0;
+    return header_length(p[0]) + p[1] + kChecksumLength + (is_signed ? kSignatureLength : 0);
+}
+
 Header read_header(const std::uint8_t* p) {
     if (p[0] == kMagicV1) {
         return Header{Version::V1, p[1], 0, 0, p[2], p[3], p[4], p[5], kHeaderLengthV1};
@@ -116,14 +123,36 @@ bool Parser::resync_inside_candidate() {
         crc.add(std::span<const std::uint8_t>(buf_.data() + k + 1, h.header_length - 1 + h.payload_length));
         crc.add(info->crc_extra);
         if (crc.value() == wire::get<std::uint16_t>(buf_.data() + k + h.header_length + h.payload_length)) {
-            mark_damaged(k, DamageKind::Truncated);
-            discard(k);
+            account_failed_starts(k);
             drop_front(k);
             return true;
         }
     }
     checked_len_ = len_;
     return false;
+}
+
+// The bytes before the good frame at buf_[k] are dropped in one go. They are accounted exactly as judging
+// them one start at a time does when the whole stream is at hand (step() and process_candidate()): every
+// start byte among them begins a failed candidate, which opens a damaged stretch of its claimed length unless
+// one is already open, and every byte is discarded. The good frame then resolves a stretch still open as
+// `truncated` (accept()). Counting the span up to k as one truncated stretch instead would depend on where
+// the chunks happen to end: it would drop a stretch already open, and skip the failed candidates in between.
+void Parser::account_failed_starts(std::size_t k) {
+    std::size_t p = 0;
+    while (p < k) {
+        if (is_magic(buf_[p])) {
+            // The claimed length needs only the length and flag bytes, which lie before the good frame.
+            mark_damaged(claimed_length(buf_.data() + p), DamageKind::BadChecksum);
+            discard(1);
+            ++p;
+            continue;
+        }
+        const auto* next = std::find_if(buf_.data() + p, buf_.data() + k, is_magic);
+        const auto n = static_cast<std::size_t>(next - (buf_.data() + p));
+        discard(n);
+        p += n;
+    }
 }
 
 void Parser::finish(Sink sink) {

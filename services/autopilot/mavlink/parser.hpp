@@ -106,6 +106,7 @@ class Parser {
     void drop_front(std::size_t n);
     void resolve_damage_by_good_frame();
     bool resync_inside_candidate();
+    void account_failed_starts(std::size_t k);
 
     std::array<std::uint8_t, kMaxFrameLength + 1> buf_{};  // one frame candidate, plus one byte of look-ahead
     std::size_t len_ = 0;

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <random>
 #include <vector>
@@ -92,6 +94,60 @@ TEST(MavlinkParser, ByteByByteAndBulkGiveTheSameResult) {
             EXPECT_EQ(decode<Heartbeat>(chunked.frames[i]), decode<Heartbeat>(bulk.frames[i]));
         }
         EXPECT_EQ(chunked.stats.garbage_bytes, bulk.stats.garbage_bytes) << chunk;
+    }
+}
+
+// A good frame completes inside a long candidate while an earlier damaged stretch is still open. Fed whole,
+// the long candidate fails its checksum and the start bytes after it are judged in turn; fed in pieces, the
+// good frame is found before the long candidate is complete. The counters must not depend on which happened.
+TEST(MavlinkParser, GoodFrameInsideALongCandidateCountsTheSameWholeAndInPieces) {
+    Encoder e(1, 1);
+    Bytes first = heartbeat_frame(e, 1);
+    first[5] = kMagicV1;  // the damage: inside this frame a MAVLink 1 start byte...
+    first[6] = 0xFF;      // ...claiming 255 bytes of payload, a 263-byte candidate
+    Bytes second = heartbeat_frame(e, 2);
+    second[12] ^= 0x01;  // inside the long candidate: a damaged frame of its own, after the first one
+    const Bytes good = heartbeat_frame(e, 3);
+    const Bytes noise(10, 0x55);
+    Bytes stream = concat({first, noise, second, noise, good});
+    stream.resize(300, 0x55);  // the long candidate is complete well before the stream ends
+    ASSERT_LT(5 + 263, stream.size());
+
+    const auto whole = run(stream);
+    ASSERT_EQ(whole.frames.size(), 1u);
+    EXPECT_EQ(decode<Heartbeat>(whole.frames[0])->custom_mode, 3u);
+    EXPECT_EQ(whole.stats.frames_ok, 1u);
+    EXPECT_EQ(whole.stats.bad_checksum, 2u);  // the first frame and the second one, each once
+    EXPECT_EQ(whole.stats.truncated, 0u);     // both damaged stretches end before the good frame
+    EXPECT_EQ(whole.stats.garbage_bytes, stream.size() - first.size() - second.size() - good.size());
+    for (std::size_t chunk = 1; chunk <= 97; ++chunk) {
+        const auto chunked = run(stream, chunk);
+        ASSERT_EQ(chunked.frames.size(), 1u) << chunk;
+        EXPECT_EQ(decode<Heartbeat>(chunked.frames[0])->custom_mode, 3u) << chunk;
+        EXPECT_EQ(chunked.stats.frames_ok, whole.stats.frames_ok) << chunk;
+        EXPECT_EQ(chunked.stats.bad_checksum, whole.stats.bad_checksum) << chunk;
+        EXPECT_EQ(chunked.stats.truncated, whole.stats.truncated) << chunk;
+        EXPECT_EQ(chunked.stats.garbage_bytes, whole.stats.garbage_bytes) << chunk;
+    }
+}
+
+// The input the fuzz target found (tests/fuzz/corpus/mavlink/), replayed here with its chunk size and others.
+TEST(MavlinkParser, FuzzFoundStreamCountsTheSameWholeAndInPieces) {
+    std::ifstream in(
+        std::string(AIRSEG_SOURCE_DIR) + "/tests/fuzz/corpus/mavlink/counters_resync_inside_open_damage.bin",
+        std::ios::binary);
+    const Bytes stream{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    ASSERT_EQ(stream.size(), 585u);
+    const auto whole = run(stream);
+    EXPECT_EQ(whole.stats.frames_ok, 4u);
+    for (std::size_t chunk = 1; chunk <= 97; ++chunk) {
+        const auto chunked = run(stream, chunk);
+        ASSERT_EQ(chunked.frames.size(), whole.frames.size()) << chunk;
+        EXPECT_EQ(chunked.stats.frames_ok, whole.stats.frames_ok) << chunk;
+        EXPECT_EQ(chunked.stats.bad_checksum, whole.stats.bad_checksum) << chunk;
+        EXPECT_EQ(chunked.stats.truncated, whole.stats.truncated) << chunk;
+        EXPECT_EQ(chunked.stats.garbage_bytes, whole.stats.garbage_bytes) << chunk;
+        EXPECT_EQ(chunked.stats.seq_lost, whole.stats.seq_lost) << chunk;
     }
 }
 
