@@ -105,12 +105,12 @@ class Parser {
     void discard(std::size_t n);
     void drop_front(std::size_t n);
     void resolve_damage_by_good_frame();
-    bool resync_inside_candidate();
+    bool resync_inside_candidate(std::size_t need);
     void account_failed_starts(std::size_t k);
 
     std::array<std::uint8_t, kMaxFrameLength + 1> buf_{};  // one frame candidate, plus one byte of look-ahead
     std::size_t len_ = 0;
-    std::size_t checked_len_ = 0;  // buffer length at the last look for a complete frame inside the candidate
+    std::size_t checked_len_ = 0;  // inner frames ending up to here were checked (resync_inside_candidate)
     std::size_t damaged_left_ = 0;
     DamageKind damage_kind_ = DamageKind::BadChecksum;
     Frame frame_{};
