@@ -131,6 +131,30 @@ TEST(MavlinkParser, GoodFrameInsideALongCandidateCountsTheSameWholeAndInPieces) 
     }
 }
 
+// An unknown-id frame followed by a start byte would be delivered unverified, but a verified frame completes
+// inside it first. Byte by byte, the verified frame is found before the unknown one is complete; fed whole,
+// the parser must come to the same result: the verified frame wins, the unknown frame counts as cut short.
+TEST(MavlinkParser, VerifiedFrameInsideAnUnknownFrameWinsWholeAndInPieces) {
+    Encoder e(1, 1);
+    const Bytes inner = heartbeat_frame(e, 7);
+    Bytes payload(5, 0x11);
+    payload.insert(payload.end(), inner.begin(), inner.end());
+    payload.resize(payload.size() + 5, 0x22);
+    const Bytes stream = concat({unknown_frame(12345, payload), heartbeat_frame(e, 8)});
+    for (std::size_t chunk = 0; chunk <= 97; ++chunk) {
+        const auto c = run(stream, chunk);
+        ASSERT_EQ(c.frames.size(), 2u) << chunk;
+        EXPECT_EQ(decode<Heartbeat>(c.frames[0])->custom_mode, 7u) << chunk;
+        EXPECT_EQ(decode<Heartbeat>(c.frames[1])->custom_mode, 8u) << chunk;
+        EXPECT_EQ(c.stats.unknown_msgid, 0u) << chunk;
+        EXPECT_EQ(c.stats.frames_ok, 2u) << chunk;
+        EXPECT_EQ(c.stats.truncated, 1u) << chunk;
+        EXPECT_EQ(c.stats.bad_checksum, 0u) << chunk;
+        // The rest of the unknown frame after the verified one, its checksum included.
+        EXPECT_EQ(c.stats.garbage_bytes, 7u) << chunk;
+    }
+}
+
 // The input the fuzz target found (tests/fuzz/corpus/mavlink/), replayed here with its chunk size and others.
 TEST(MavlinkParser, FuzzFoundStreamCountsTheSameWholeAndInPieces) {
     std::ifstream in(
