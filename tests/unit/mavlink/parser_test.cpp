@@ -97,9 +97,11 @@ TEST(MavlinkParser, ByteByByteAndBulkGiveTheSameResult) {
     }
 }
 
-// A good frame completes inside a long candidate while an earlier damaged stretch is still open. Fed whole,
-// the long candidate fails its checksum and the start bytes after it are judged in turn; fed in pieces, the
-// good frame is found before the long candidate is complete. The counters must not depend on which happened.
+// A good frame completes inside a long candidate while an earlier damaged stretch is still open, with another
+// damaged frame between them. The long candidate is given up for the good frame; the bytes before it count as
+// if each start byte there had been judged in turn: two damaged stretches, the rest garbage. Found by
+// fuzzing: when the good frame was found before the long candidate was complete (the stream in pieces), the
+// open stretch swallowed the damaged frame in between, and the counters depended on the split.
 TEST(MavlinkParser, GoodFrameInsideALongCandidateCountsTheSameWholeAndInPieces) {
     Encoder e(1, 1);
     Bytes first = heartbeat_frame(e, 1);
