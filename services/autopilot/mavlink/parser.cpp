@@ -123,9 +123,10 @@ bool Parser::resync_inside_candidate(std::size_t need) {
         }
         const Header h = read_header(buf_.data() + k);
         const std::size_t end = k + h.frame_length();
+        // Skipped: not complete in time, not before one already found (ties go to the earlier start), or
+        // checked before.
         if (end >= found_end || end <= checked_len_) {
-            continue;  // not complete in time, beaten by an earlier-ending (or equal, earlier-starting) one,
-                       // or checked
+            continue;
         }
         const MessageInfo* info = find_message(h.msgid);
         if (info == nullptr) {
@@ -148,12 +149,11 @@ bool Parser::resync_inside_candidate(std::size_t need) {
     return false;
 }
 
-// The bytes before the good frame at buf_[k] are dropped in one go. They are accounted exactly as judging
-// them one start at a time does when the whole stream is at hand (step() and process_candidate()): every
-// start byte among them begins a failed candidate, which opens a damaged stretch of its claimed length unless
-// one is already open, and every byte is discarded. The good frame then resolves a stretch still open as
-// `truncated` (accept()). Counting the span up to k as one truncated stretch instead would depend on where
-// the chunks happen to end: it would drop a stretch already open, and skip the failed candidates in between.
+// The bytes before the good frame at buf_[k] are dropped in one go. They are accounted as if each start byte
+// among them had been judged on its own and failed, as step() and process_candidate() do: it opens a damaged
+// stretch of the length it claims unless one is already open, and every byte is discarded. The good frame
+// then resolves a stretch still open as `truncated` (accept()). So a damaged frame that lies between an open
+// stretch and the good frame counts as damaged, not as noise, whether or not the good frame was found early.
 void Parser::account_failed_starts(std::size_t k) {
     std::size_t p = 0;
     while (p < k) {
