@@ -35,6 +35,13 @@ struct Header {
     }
 };
 
+// Length of the frame a start byte claims, from its first three bytes only (magic, payload length and, for
+// MAVLink 2, the incompatibility flags).
+std::size_t claimed_length(const std::uint8_t* p) {
+    const bool is_signed = p[0] == kMagicV2 && (p[2] & kIncompatSigned) != 0;
+    return header_length(p[0]) + p[1] + kChecksumLength + (is_signed ? kSignatureLength : 0);
+}
+
 Header read_header(const std::uint8_t* p) {
     if (p[0] == kMagicV1) {
         return Header{Version::V1, p[1], 0, 0, p[2], p[3], p[4], p[5], kHeaderLengthV1};
@@ -79,33 +86,46 @@ void Parser::push(std::span<const std::uint8_t> bytes, Sink sink) {
                 }
                 len_ += n;
                 pos += n;
-                if (len_ < need && resync_inside_candidate()) {
-                    continue;
-                }
-                if (len_ < need && pos == bytes.size()) {
-                    return;
-                }
-                continue;  // the header may now be complete: the required length can grow
+            }
+            if (resync_inside_candidate(need)) {
+                continue;
+            }
+            if (len_ < need) {
+                return;  // all bytes taken
+            }
+            if (required_length() != need) {
+                continue;  // the header is now complete: the required length grows
             }
         }
         step(sink, false);
     }
 }
 
-// The candidate at buf_[0] is still incomplete, but a frame that begins inside it may already be complete:
-// after a lost byte (or a stray start byte in noise) the candidate's length comes from the wrong byte, and
-// waiting for it to fill would hold good frames back until unrelated later traffic arrives, on a quiet line
-// for seconds. A complete frame with a known id and a matching checksum inside the candidate proves the
-// candidate damaged: it is dropped up to that frame. Each inner start is checked once, when its frame
-// becomes complete (checked_len_ is the buffer length at the previous check).
-bool Parser::resync_inside_candidate() {
-    for (std::size_t k = 1; k < len_; ++k) {
+// A frame that begins inside the candidate at buf_[0] may be complete before the candidate is: after a lost
+// byte (or a stray start byte in noise) the candidate's length comes from the wrong byte, and waiting for it
+// to fill would hold good frames back until unrelated later traffic arrives, on a quiet line for seconds. A
+// complete frame with a known id and a matching checksum inside the candidate proves the candidate damaged:
+// it is dropped up to that frame. Of such frames, the one that is complete first in the stream wins, and only
+// if it is complete before the candidate can be judged (`need` bytes), exactly as if the stream came one byte
+// at a time; so the outcome does not depend on how the stream is split, or on how many bytes are at hand.
+// Each inner frame is checked once: checked_len_ is the end up to which frames were checked and found
+// wanting.
+bool Parser::resync_inside_candidate(std::size_t need) {
+    const std::size_t limit = std::min(len_, need - 1);  // inner frames must end at or before this
+    if (limit <= checked_len_) {
+        return false;
+    }
+    std::size_t found = 0;
+    std::size_t found_end = limit + 1;
+    for (std::size_t k = 1; k < limit; ++k) {
         if (!is_magic(buf_[k]) || len_ - k < header_length(buf_[k])) {
             continue;
         }
         const Header h = read_header(buf_.data() + k);
         const std::size_t end = k + h.frame_length();
-        if (end > len_ || end <= checked_len_) {
+        // Skipped: not complete in time, not before one already found (ties go to the earlier start), or
+        // checked before.
+        if (end >= found_end || end <= checked_len_) {
             continue;
         }
         const MessageInfo* info = find_message(h.msgid);
@@ -116,14 +136,39 @@ bool Parser::resync_inside_candidate() {
         crc.add(std::span<const std::uint8_t>(buf_.data() + k + 1, h.header_length - 1 + h.payload_length));
         crc.add(info->crc_extra);
         if (crc.value() == wire::get<std::uint16_t>(buf_.data() + k + h.header_length + h.payload_length)) {
-            mark_damaged(k, DamageKind::Truncated);
-            discard(k);
-            drop_front(k);
-            return true;
+            found = k;
+            found_end = end;
         }
     }
-    checked_len_ = len_;
+    if (found > 0) {
+        account_failed_starts(found);
+        drop_front(found);
+        return true;
+    }
+    checked_len_ = limit;
     return false;
+}
+
+// The bytes before the good frame at buf_[k] are dropped in one go. They are accounted as if each start byte
+// among them had been judged on its own and failed, as step() and process_candidate() do: it opens a damaged
+// stretch of the length it claims unless one is already open, and every byte is discarded. The good frame
+// then resolves a stretch still open as `truncated` (accept()). So a damaged frame that lies between an open
+// stretch and the good frame counts as damaged, not as noise, whether or not the good frame was found early.
+void Parser::account_failed_starts(std::size_t k) {
+    std::size_t p = 0;
+    while (p < k) {
+        if (is_magic(buf_[p])) {
+            // The claimed length needs only the length and flag bytes, which lie before the good frame.
+            mark_damaged(claimed_length(buf_.data() + p), DamageKind::BadChecksum);
+            discard(1);
+            ++p;
+            continue;
+        }
+        const auto* next = std::find_if(buf_.data() + p, buf_.data() + k, is_magic);
+        const auto n = static_cast<std::size_t>(next - (buf_.data() + p));
+        discard(n);
+        p += n;
+    }
 }
 
 void Parser::finish(Sink sink) {

@@ -22,9 +22,13 @@
 //    begins inside a damaged or cut-short one is still found. It does not wait for a cut-short candidate to
 //    fill up: as soon as a complete frame with a known id and a matching checksum lies inside a candidate,
 //    the candidate is given up and that frame delivered (a lost byte would otherwise make the candidate
-//    claim the wrong length and hold good frames back until unrelated later bytes arrive). Each damaged
-//    stretch is counted once: as `truncated` when a good frame began inside it (or the stream ended inside a
-//    frame), else as `bad_checksum`. Bytes outside any frame candidate count as `garbage_bytes`.
+//    claim the wrong length and hold good frames back until unrelated later bytes arrive). This is decided
+//    as if the bytes came one at a time: the inner frame that is complete first wins, and only if it is
+//    complete before the candidate itself could be judged; every start byte before it counts as a failed
+//    candidate. Frames and counters therefore do not depend on how the stream is split into push() calls.
+//    Each damaged stretch (from a failed start byte over the length it claims; a start byte inside an open
+//    stretch does not extend it) is counted once: as `truncated` when a good frame began inside it (or the
+//    stream ended inside it), else as `bad_checksum`. Other bytes not in a frame count as `garbage_bytes`.
 //  - Sequence numbers are tracked per (sysid, compid); a gap of n counts n lost frames (seq_lost), the same
 //    rule as the reference C library, so a repeated or reordered frame counts as a large gap.
 #include <array>
@@ -105,11 +109,12 @@ class Parser {
     void discard(std::size_t n);
     void drop_front(std::size_t n);
     void resolve_damage_by_good_frame();
-    bool resync_inside_candidate();
+    bool resync_inside_candidate(std::size_t need);
+    void account_failed_starts(std::size_t k);
 
     std::array<std::uint8_t, kMaxFrameLength + 1> buf_{};  // one frame candidate, plus one byte of look-ahead
     std::size_t len_ = 0;
-    std::size_t checked_len_ = 0;  // buffer length at the last look for a complete frame inside the candidate
+    std::size_t checked_len_ = 0;  // inner frames ending up to here were checked (resync_inside_candidate)
     std::size_t damaged_left_ = 0;
     DamageKind damage_kind_ = DamageKind::BadChecksum;
     Frame frame_{};

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <random>
 #include <vector>
@@ -92,6 +94,86 @@ TEST(MavlinkParser, ByteByByteAndBulkGiveTheSameResult) {
             EXPECT_EQ(decode<Heartbeat>(chunked.frames[i]), decode<Heartbeat>(bulk.frames[i]));
         }
         EXPECT_EQ(chunked.stats.garbage_bytes, bulk.stats.garbage_bytes) << chunk;
+    }
+}
+
+// A good frame completes inside a long candidate while an earlier damaged stretch is still open, with another
+// damaged frame between them. The long candidate is given up for the good frame; the bytes before it count as
+// if each start byte there had been judged in turn: two damaged stretches, the rest garbage. Found by
+// fuzzing: when the good frame was found before the long candidate was complete (the stream in pieces), the
+// open stretch swallowed the damaged frame in between, and the counters depended on the split.
+TEST(MavlinkParser, GoodFrameInsideALongCandidateCountsTheSameWholeAndInPieces) {
+    Encoder e(1, 1);
+    Bytes first = heartbeat_frame(e, 1);
+    first[5] = kMagicV1;  // the damage: inside this frame a MAVLink 1 start byte...
+    first[6] = 0xFF;      // ...claiming 255 bytes of payload, a 263-byte candidate
+    Bytes second = heartbeat_frame(e, 2);
+    second[12] ^= 0x01;  // inside the long candidate: a damaged frame of its own, after the first one
+    const Bytes good = heartbeat_frame(e, 3);
+    const Bytes noise(10, 0x55);
+    Bytes stream = concat({first, noise, second, noise, good});
+    stream.resize(300, 0x55);  // the long candidate is complete well before the stream ends
+    ASSERT_LT(5 + 263, stream.size());
+
+    const auto whole = run(stream);
+    ASSERT_EQ(whole.frames.size(), 1u);
+    EXPECT_EQ(decode<Heartbeat>(whole.frames[0])->custom_mode, 3u);
+    EXPECT_EQ(whole.stats.frames_ok, 1u);
+    EXPECT_EQ(whole.stats.bad_checksum, 2u);  // the first frame and the second one, each once
+    EXPECT_EQ(whole.stats.truncated, 0u);     // both damaged stretches end before the good frame
+    EXPECT_EQ(whole.stats.garbage_bytes, stream.size() - first.size() - second.size() - good.size());
+    for (std::size_t chunk = 1; chunk <= 97; ++chunk) {
+        const auto chunked = run(stream, chunk);
+        ASSERT_EQ(chunked.frames.size(), 1u) << chunk;
+        EXPECT_EQ(decode<Heartbeat>(chunked.frames[0])->custom_mode, 3u) << chunk;
+        EXPECT_EQ(chunked.stats.frames_ok, whole.stats.frames_ok) << chunk;
+        EXPECT_EQ(chunked.stats.bad_checksum, whole.stats.bad_checksum) << chunk;
+        EXPECT_EQ(chunked.stats.truncated, whole.stats.truncated) << chunk;
+        EXPECT_EQ(chunked.stats.garbage_bytes, whole.stats.garbage_bytes) << chunk;
+    }
+}
+
+// An unknown-id frame followed by a start byte would be delivered unverified, but a verified frame completes
+// inside it first. Byte by byte, the verified frame is found before the unknown one is complete; fed whole,
+// the parser must come to the same result: the verified frame wins, the unknown frame counts as cut short.
+TEST(MavlinkParser, VerifiedFrameInsideAnUnknownFrameWinsWholeAndInPieces) {
+    Encoder e(1, 1);
+    const Bytes inner = heartbeat_frame(e, 7);
+    Bytes payload(5, 0x11);
+    payload.insert(payload.end(), inner.begin(), inner.end());
+    payload.resize(payload.size() + 5, 0x22);
+    const Bytes stream = concat({unknown_frame(12345, payload), heartbeat_frame(e, 8)});
+    for (std::size_t chunk = 0; chunk <= 97; ++chunk) {
+        const auto c = run(stream, chunk);
+        ASSERT_EQ(c.frames.size(), 2u) << chunk;
+        EXPECT_EQ(decode<Heartbeat>(c.frames[0])->custom_mode, 7u) << chunk;
+        EXPECT_EQ(decode<Heartbeat>(c.frames[1])->custom_mode, 8u) << chunk;
+        EXPECT_EQ(c.stats.unknown_msgid, 0u) << chunk;
+        EXPECT_EQ(c.stats.frames_ok, 2u) << chunk;
+        EXPECT_EQ(c.stats.truncated, 1u) << chunk;
+        EXPECT_EQ(c.stats.bad_checksum, 0u) << chunk;
+        // The rest of the unknown frame after the verified one, its checksum included.
+        EXPECT_EQ(c.stats.garbage_bytes, 7u) << chunk;
+    }
+}
+
+// The input the fuzz target found (tests/fuzz/corpus/mavlink/), replayed here with its chunk size and others.
+TEST(MavlinkParser, FuzzFoundStreamCountsTheSameWholeAndInPieces) {
+    std::ifstream in(
+        std::string(AIRSEG_SOURCE_DIR) + "/tests/fuzz/corpus/mavlink/counters_resync_inside_open_damage.bin",
+        std::ios::binary);
+    const Bytes stream{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    ASSERT_EQ(stream.size(), 585u);
+    const auto whole = run(stream);
+    EXPECT_EQ(whole.stats.frames_ok, 4u);
+    for (std::size_t chunk = 1; chunk <= 97; ++chunk) {
+        const auto chunked = run(stream, chunk);
+        ASSERT_EQ(chunked.frames.size(), whole.frames.size()) << chunk;
+        EXPECT_EQ(chunked.stats.frames_ok, whole.stats.frames_ok) << chunk;
+        EXPECT_EQ(chunked.stats.bad_checksum, whole.stats.bad_checksum) << chunk;
+        EXPECT_EQ(chunked.stats.truncated, whole.stats.truncated) << chunk;
+        EXPECT_EQ(chunked.stats.garbage_bytes, whole.stats.garbage_bytes) << chunk;
+        EXPECT_EQ(chunked.stats.seq_lost, whole.stats.seq_lost) << chunk;
     }
 }
 
