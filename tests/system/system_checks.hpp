@@ -191,13 +191,45 @@ inline void expect_reached_in_order(const std::vector<Reached>& log, const std::
     std::size_t i = 0;
     for (std::size_t k = first_index; k < expected.size(); ++k, ++i) {
         ASSERT_LT(i, log.size()) << "waypoint " << k << " of " << expected.size() << " never reached";
-        ASSERT_PRED2(same_place, log[i].at, expected[k])
-            << "reached event #" << i << " is not waypoint " << k;
+        ASSERT_PRED2(same_place, log[i].at, expected[k]) << "reached event #" << i << " is not waypoint " << k
+                                                         << "; reached: " << as_indices(log, expected);
     }
     for (; i < log.size(); ++i) {
         EXPECT_PRED2(same_place, log[i].at, expected.back()) << "after the end, only the final stop";
     }
     EXPECT_LE(log.size(), expected.size() - first_index + 1);
+}
+
+/// Plan progress through a fault that makes waypoints be driven again: every event is either the next
+/// waypoint or an earlier one (a replay: driving on from there); never a later one (a skip) or a place
+/// outside the plan; every waypoint is reached. Returns the number of replayed events.
+inline std::size_t expect_no_skip(const std::vector<Reached>& log, const std::vector<E7>& expected) {
+    std::size_t next = 0, replays = 0;
+    for (std::size_t i = 0; i < log.size(); ++i) {
+        std::size_t k = expected.size();
+        for (std::size_t j = 0; j < expected.size(); ++j) {
+            if (same_place(log[i].at, expected[j])) {
+                k = j;
+                break;
+            }
+        }
+        if (k == expected.size()) {
+            ADD_FAILURE() << "reached event #" << i
+                          << " is no plan waypoint; reached: " << as_indices(log, expected);
+            return replays;
+        }
+        if (next == expected.size() && k + 1 == expected.size()) {
+            continue;  // the final stop
+        }
+        if (k > next) {
+            ADD_FAILURE() << "waypoint " << next << " skipped; reached: " << as_indices(log, expected);
+            return replays;
+        }
+        replays += k < next ? 1 : 0;
+        next = k + 1;
+    }
+    EXPECT_EQ(next, expected.size()) << "reached: " << as_indices(log, expected);
+    return replays;
 }
 
 }  // namespace airseg::test::sys
