@@ -220,9 +220,14 @@ TEST(SystemRadio, GarbageAndOversizedMessagesFromTheGroundAreRejectedAndCounted)
     // A command far larger than a message may be (64 KiB): refused before it goes on the air.
     const auto mid = bench.status();
     const std::string big = R"({"cmd":"rates.set","pad":")" + std::string(100 * 1024, 'x') + R"("})";
+    const auto sent_big = std::chrono::steady_clock::now();
     auto oversized = bench.ctl({"request", big}, 20'000);
-    EXPECT_NE(oversized.exit_code, 0) << oversized.out;
-    EXPECT_FALSE(oversized.out.empty() && oversized.err.empty()) << "a refusal says why";
+    const double big_s = seconds_since(sent_big);
+    EXPECT_EQ(oversized.exit_code, 1) << oversized.out << oversized.err;
+    const auto big_why = Json::parse(oversized.out, nullptr, false);
+    EXPECT_EQ(big_why.value("status", ""), "bad_request") << oversized.out;
+    EXPECT_NE(big_why.value("error", "").find("not sent"), std::string::npos) << oversized.out;
+    EXPECT_LT(big_s, 10.0) << "refused at once, not after the timeout";
     // Commands the vehicle cannot make sense of: answered with an error, counted.
     auto unknown = bench.ctl({"request", R"({"cmd":"warp","factor":9})"});
     EXPECT_EQ(unknown.exit_code, 1) << unknown.out << unknown.err;
@@ -242,7 +247,7 @@ TEST(SystemRadio, GarbageAndOversizedMessagesFromTheGroundAreRejectedAndCounted)
               << ", mac_failures "
               << counter(g, "/mac_failures") - counter(before["groundlink"], "/mac_failures")
               << ", bad_messages " << counter(g, "/bad_messages") << "; oversized (100 KiB) command: exit "
-              << oversized.exit_code << " " << oversized.err << oversized.out.substr(0, 200)
+              << oversized.exit_code << " in " << big_s << " s " << oversized.out.substr(0, 200)
               << "; unknown: " << unknown.out << "; not an object: exit " << not_object.exit_code << " "
               << not_object.out << not_object.err << "; daemon received " << received
               << " commands after the garbage\n";

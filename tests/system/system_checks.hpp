@@ -202,9 +202,9 @@ inline void expect_reached_in_order(const std::vector<Reached>& log, const std::
 
 /// Plan progress through a fault that makes waypoints be driven again: every event is either the next
 /// waypoint or an earlier one (a replay: driving on from there); never a later one (a skip) or a place
-/// outside the plan; every waypoint is reached. Returns the number of replayed events.
+/// outside the plan; every waypoint is reached. Returns the number of events of waypoints reached before.
 inline std::size_t expect_no_skip(const std::vector<Reached>& log, const std::vector<E7>& expected) {
-    std::size_t next = 0, replays = 0;
+    std::size_t high = 0, replays = 0;  // high: the first waypoint never reached
     for (std::size_t i = 0; i < log.size(); ++i) {
         std::size_t k = expected.size();
         for (std::size_t j = 0; j < expected.size(); ++j) {
@@ -218,17 +218,17 @@ inline std::size_t expect_no_skip(const std::vector<Reached>& log, const std::ve
                           << " is no plan waypoint; reached: " << as_indices(log, expected);
             return replays;
         }
-        if (next == expected.size() && k + 1 == expected.size()) {
+        if (high == expected.size() && k + 1 == expected.size()) {
             continue;  // the final stop
         }
-        if (k > next) {
-            ADD_FAILURE() << "waypoint " << next << " skipped; reached: " << as_indices(log, expected);
+        if (k > high) {
+            ADD_FAILURE() << "waypoint " << high << " skipped; reached: " << as_indices(log, expected);
             return replays;
         }
-        replays += k < next ? 1 : 0;
-        next = k + 1;
+        replays += k < high ? 1 : 0;  // a waypoint reached before, driven again
+        high = std::max(high, k + 1);
     }
-    EXPECT_EQ(next, expected.size()) << "reached: " << as_indices(log, expected);
+    EXPECT_EQ(high, expected.size()) << "reached: " << as_indices(log, expected);
     return replays;
 }
 
