@@ -148,13 +148,14 @@ TEST_F(SystemPlan, AutopilotHeartbeatStall) {
     radio_commands(1);
     EXPECT_EQ(counter(bench->status(), "/autopilot/reboots"), 0u) << "a silent board is not a rebooted one";
     end_checks(expected, false);
-    // KNOWN DAEMON BUG (docs/reliability.md): the board never stopped and kept reporting the waypoints it
-    // reached, but the flight plan service treats the autopilot's readiness going away like a reconnection:
-    // it drops its window, ignores those reports, and when the heartbeats return points the board back at
-    // the first waypoint it had seen unreached: waypoints are driven twice. Checked here: none skipped, the
-    // plan completes; the replays are measured, not yet forbidden.
+    // The board never stopped and kept reporting the waypoints it reached; the daemon keeps its window
+    // through the silence and counts them (it used to drop the window and point the board back at the first
+    // waypoint it had seen unreached: 7 waypoints driven twice here). KNOWN LIMITATION (docs/reliability.md):
+    // while the heartbeats are missing the daemon sends the board nothing, so a board that runs through its
+    // window follows the ring's jump into slots not yet rewritten and drives those waypoints again (2 here).
     const auto log = reached_log(bench->sim(), first_reached);
     const auto replays = expect_no_skip(log, expected);
+    EXPECT_LT(replays, 5u) << "at most the stale ring slots, never a rewind: " << as_indices(log, expected);
     const auto stats = bench->sim().json("stats");
     std::cout << "[ figures ] heartbeat stall (8 s): link down after " << down_s << " s, up again after "
               << up_s << " s; heartbeats stalled " << stats.value("heartbeats_stalled", Json()).dump() << "; "
