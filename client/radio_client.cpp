@@ -4,6 +4,7 @@
 
 #include <deque>
 #include <random>
+#include <sstream>
 
 #include "hal/serial_port.hpp"
 #include "hal/udp_socket.hpp"
@@ -131,18 +132,33 @@ class RadioClient::Impl {
         std::optional<nlohmann::json> answer;
         awaiting_ = id;
         answer_ = &answer;
-        asio::dispatch(strand_, [this, id, req] {
+        std::optional<std::string> not_sent;
+        asio::dispatch(strand_, [this, id, req, &not_sent] {
             const auto bytes = proto::encode(proto::Command{id, req});
-            driver_->send_safe(proto::kPriorityControl, bytes);
+            const auto r = driver_->send_safe(proto::kPriorityControl, bytes);
+            if (r == gl::SendResult::too_large) {
+                not_sent = fmt::format(
+                    "the command is {} bytes, more than the link carries in one message ({} "
+                    "bytes); not sent",
+                    bytes.size(), driver_->core().config().max_message_size);
+            } else if (r != gl::SendResult::accepted) {
+                not_sent =
+                    fmt::format("the command could not be queued ({})", (std::ostringstream{} << r).str());
+            }
         });
         const auto deadline = std::chrono::steady_clock::now() + timeout;
-        while (!answer && std::chrono::steady_clock::now() < deadline) {
+        while (!answer && !not_sent && std::chrono::steady_clock::now() < deadline) {
             io_.run_for(std::chrono::milliseconds(20));
             if (io_.stopped()) {
                 io_.restart();
             }
         }
         answer_ = nullptr;
+        if (not_sent) {
+            // Refused here, before the air: answered as the vehicle answers a request it cannot take.
+            out.answer = nlohmann::json{{"ok", false}, {"status", "bad_request"}, {"error", *not_sent}};
+            return out;
+        }
         if (!answer) {
             out.error = fmt::format("no answer from the vehicle within {} ms ({})", timeout.count(),
                                     driver_->link_up() ? "link up" : "no link");

@@ -44,6 +44,13 @@ nlohmann::json autopilot_status_json(const autopilot::AutopilotStatus& s) {
     j["reconnects"] = s.reconnects;
     j["reset_pulses"] = s.reset_pulses;
     j["baud"] = s.baud;
+    if (s.tlog_enabled) {
+        // A recorder that cannot write (disk full, read-only) is reported; the daemon goes on without it.
+        j["tlog"] = {
+            {"write_errors", s.tlog_write_errors},
+            {"dropped_frames", s.tlog_dropped_frames},
+            {"error", s.tlog_error.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.tlog_error)}};
+    }
     return j;
 }
 

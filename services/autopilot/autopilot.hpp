@@ -197,6 +197,11 @@ struct AutopilotStatus {
     unsigned reconnects = 0;    // autopilot.reconnects (filled by the service from its port keeper)
     unsigned reset_pulses = 0;  // autopilot.reset_pulses
     unsigned baud = 0;          // autopilot.baud: the rate the port runs at (the one kept when probing)
+    // autopilot.tlog (filled by the service from its .tlog writer; absent when recording is off)
+    bool tlog_enabled = false;
+    std::uint64_t tlog_write_errors = 0;    // autopilot.tlog.write_errors
+    std::uint64_t tlog_dropped_frames = 0;  // autopilot.tlog.dropped_frames: lost to write errors
+    std::string tlog_error;                 // autopilot.tlog.error: the last write error, "" when none yet
 };
 
 }  // namespace airseg::autopilot

@@ -230,6 +230,10 @@ void AutopilotService::publish_status() {
     AutopilotStatus s = driver_.status();
     s.reconnects = keeper_.reconnects();
     s.baud = keeper_.baud();
+    s.tlog_enabled = config_.tlog.enabled;
+    s.tlog_write_errors = tlog_.stats().write_errors;
+    s.tlog_dropped_frames = tlog_.stats().dropped_frames;
+    s.tlog_error = tlog_.stats().last_error;
     ctx_.bus.publish_latest(s);
     ctx_.bus.publish_latest(driver_.telemetry());
 }

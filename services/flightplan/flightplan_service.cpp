@@ -269,11 +269,23 @@ void FlightplanService::on_autopilot_status(const autopilot::AutopilotStatus& s)
     if (s.ready == autopilot_ready_)
         return;
     autopilot_ready_ = s.ready;
-    // Connected afresh (or lost): what the autopilot holds is unknown; the window is uploaded again.
+    const std::pair<unsigned, unsigned> counts{s.reconnects, s.reboots};
+    if (!autopilot_ready_) {
+        // Lost: the window is kept. A board that only went silent drives on, and the waypoints it reports
+        // reached meanwhile still count; a reboot (its own event) or a reopened port makes it unknown.
+        fail_waiters("the autopilot is not ready");
+        pump();
+        return;
+    }
+    const bool same_board = ready_counts_ && *ready_counts_ == counts;
+    ready_counts_ = counts;
+    if (same_board) {
+        pump();  // back, neither rebooted nor reconnected: it still holds the window
+        return;
+    }
+    // Connected afresh: what the autopilot holds is unknown; the window is uploaded again.
     feeder_.on_autopilot_rebooted(SteadyClock::now());
     in_flight_.clear();
-    if (!autopilot_ready_)
-        fail_waiters("the autopilot is not ready");
     pump();
 }
 

@@ -101,6 +101,9 @@ class FlightplanService : public Service {
     bool returning_home_ = false;
 
     bool autopilot_ready_ = false;
+    // The autopilot's reconnects and reboots when it was last ready: back with the same counts, it only went
+    // silent for a while (heartbeats lost) and still holds the window it was driving.
+    std::optional<std::pair<unsigned, unsigned>> ready_counts_;
     std::optional<autopilot::Position> autopilot_home_;
     bool groundlink_seen_up_ = false;
     struct InFlight {

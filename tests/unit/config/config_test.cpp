@@ -306,6 +306,20 @@ TEST(AutopilotStatus, SectionCarriesTheDocumentedKeys) {
     EXPECT_EQ(down["link"], "down");
     EXPECT_TRUE(down["ready_s"].is_null());
     EXPECT_TRUE(down["position"].is_null());
+    EXPECT_FALSE(down.contains("tlog")) << "no recorder, no section";
+}
+
+TEST(AutopilotStatusJson, TlogWriteErrorsAreReported) {
+    autopilot::AutopilotStatus s;
+    s.tlog_enabled = true;
+    EXPECT_TRUE(autopilot_status_json(s)["tlog"]["error"].is_null());
+    s.tlog_write_errors = 2;
+    s.tlog_dropped_frames = 40;
+    s.tlog_error = "write /var/log/airseg/autopilot.tlog: No space left on device";
+    const auto j = autopilot_status_json(s)["tlog"];
+    EXPECT_EQ(j["write_errors"], 2);
+    EXPECT_EQ(j["dropped_frames"], 40);
+    EXPECT_EQ(j["error"], "write /var/log/airseg/autopilot.tlog: No space left on device");
 }
 
 TEST(AutopilotCommands, ResultsMapToCommandStatuses) {

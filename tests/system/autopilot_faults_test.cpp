@@ -1,0 +1,272 @@
+// System fault injection on the autopilot side while a flight plan runs: the simulated APM:Rover at
+// --speedup, airsegd, one radio pair and airsegctl. Each scenario ends with the board's own record (the
+// simulator's reached log): the plan's waypoints reached in order, none twice; the commands sent over the
+// radio answered once each; the daemon alive; the fault visible in status.
+#include "tests/system/system_checks.hpp"
+
+namespace airseg::test::sys {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+/// A bench for plans: the board at `speedup`, 4 m/s, 1.5 m waypoint radius.
+BenchOptions plan_bench(int speedup, std::vector<std::string> sets = {}) {
+    BenchOptions o;
+    o.speedup = speedup;
+    o.sim_args = {"--param", "CRUISE_SPEED=4", "--param", "WP_RADIUS=1.5"};
+    o.daemon_sets = std::move(sets);
+    return o;
+}
+
+class SystemPlan : public ::testing::Test {
+  protected:
+    void start(BenchOptions o) {
+        bench = std::make_unique<SystemBench>(std::move(o));
+        ASSERT_TRUE(bench->wait_ready()) << bench->logs();
+        commands_at_start = ground_commands(*bench);
+    }
+    /// Writes the plan, loads it on the local socket, returns its expected waypoints.
+    std::vector<E7> load(const std::string& name, int count, double step) {
+        const auto file = bench->dir().file(name + ".yaml");
+        write_file(file, line_plan(name, count, step));
+        first_reached = reached_total(bench->sim());
+        auto r = bench->ctl_local({"plan", "load", file});
+        EXPECT_EQ(r.exit_code, 0) << r.out << r.err << bench->logs();
+        return expected_positions(file);
+    }
+    bool waypoints_reached_at_least(int n) { return plan_section(*bench).value("waypoints_reached", 0) >= n; }
+    bool plan_done() { return plan_section(*bench).value("state", "") == "done"; }
+    void radio_commands(int n) {
+        for (int i = 0; i < n; ++i) {
+            send_unique(*bench, serial++, tally);
+        }
+    }
+    /// `whole_log`: every reached event since the plan was loaded is checked (else the caller checked).
+    void end_checks(const std::vector<E7>& expected, bool whole_log = true) {
+        ASSERT_TRUE(wait_until([&] { return plan_done(); }, kGenerous, kPoll))
+            << plan_section(*bench).dump() << bench->logs();
+        EXPECT_EQ(plan_section(*bench).value("waypoints_reached", 0u), expected.size());
+        if (whole_log) {
+            expect_reached_in_order(reached_log(bench->sim(), first_reached), expected);
+            if (HasFailure()) {
+                std::cout << bench->logs();
+            }
+        }
+        radio_commands(2);
+        expect_each_answered_once(tally, commands_at_start, ground_commands(*bench));
+        expect_daemon_alive(*bench);
+    }
+
+    std::unique_ptr<SystemBench> bench;
+    std::uint64_t commands_at_start = 0, first_reached = 0;
+    CommandTally tally;
+    int serial = 0;
+};
+
+TEST_F(SystemPlan, AutopilotUnpluggedAndReplugedMidPlan) {
+    start(plan_bench(10));
+    const auto expected = load("route", 16, 20);  // 5 s legs: 0.5 s of real time each
+    radio_commands(1);
+    ASSERT_TRUE(wait_until([&] { return waypoints_reached_at_least(4); }, kGenerous, kPoll)) << bench->logs();
+    const auto reconnects = counter(bench->status(), "/autopilot/reconnects");
+
+    const double unplugged_t = bench->sim().json("state").value("t", 0.0);
+    ASSERT_EQ(bench->sim().ask("unplug").value_or("").rfind("ok", 0), 0u);
+    const auto pulled = std::chrono::steady_clock::now();
+    ASSERT_TRUE(wait_until([&] { return bench->status()["autopilot"].value("link", "") == "down"; },
+                           kGenerous, kPoll))
+        << "the unplug is visible in status";
+    const double seen_s = seconds_since(pulled);
+    radio_commands(1);  // the ground link does not care
+    ASSERT_EQ(bench->sim().ask("replug").value_or("").rfind("ok", 0), 0u);
+    const auto plugged = std::chrono::steady_clock::now();
+    ASSERT_TRUE(bench->wait_ready()) << bench->logs();
+    const double ready_s = seconds_since(plugged);
+    EXPECT_GT(counter(bench->status(), "/autopilot/reconnects"), reconnects);
+    end_checks(expected, false);
+
+    // The board drove on, unplugged, until the replug reset it (an APM on USB resets when the port opens):
+    // the waypoints it reached meanwhile were never reported to the daemon, which resumes after the reset at
+    // the first waypoint it had not seen reached. Those, and only those, are driven again; none is skipped.
+    double booted = 0;
+    for (const auto& m : bench->sim().json("modes")) {
+        if (m["cause"] == "reboot") {
+            booted = m["t"].get<double>();
+        }
+    }
+    const auto log = reached_log(bench->sim(), first_reached);
+    std::size_t unseen = 0;
+    for (const auto& r : log) {
+        unseen += r.t >= unplugged_t && r.t <= booted ? 1 : 0;
+    }
+    const auto replays = expect_no_skip(log, expected);
+    EXPECT_LE(replays, unseen) << "reached: " << as_indices(log, expected);
+    std::cout << "[ figures ] unplug mid-plan: link down seen after " << seen_s << " s; ready " << ready_s
+              << " s after the replug; " << expected.size() << " waypoints reached in order, none skipped; "
+              << unseen << " reached while unplugged, " << replays
+              << " driven again; reached: " << as_indices(log, expected) << "; " << tally.answered << "/"
+              << tally.sent << " radio commands answered\n";
+}
+
+TEST_F(SystemPlan, AutopilotRebootMidPlan) {
+    start(plan_bench(10));
+    const auto expected = load("route", 16, 20);
+    radio_commands(1);
+    ASSERT_TRUE(wait_until([&] { return waypoints_reached_at_least(4); }, kGenerous, kPoll)) << bench->logs();
+    ASSERT_EQ(bench->sim().ask("reboot").value_or("").rfind("ok", 0), 0u);
+    const auto rebooted = std::chrono::steady_clock::now();
+    ASSERT_TRUE(
+        wait_until([&] { return counter(bench->status(), "/autopilot/reboots") >= 1; }, kGenerous, kPoll))
+        << "the reboot is visible in status" << bench->logs();
+    ASSERT_TRUE(bench->wait_ready()) << bench->logs();
+    const double ready_s = seconds_since(rebooted);
+    radio_commands(1);
+    end_checks(expected);
+    std::cout << "[ figures ] reboot mid-plan: ready again " << ready_s << " s after; " << expected.size()
+              << " waypoints reached in order, once each; " << tally.answered << "/" << tally.sent
+              << " radio commands answered\n";
+}
+
+TEST_F(SystemPlan, AutopilotHeartbeatStall) {
+    start(plan_bench(10));
+    const auto expected = load("route", 16, 20);
+    radio_commands(1);
+    ASSERT_TRUE(wait_until([&] { return waypoints_reached_at_least(3); }, kGenerous, kPoll)) << bench->logs();
+    // 80 simulated seconds at ×10: 8 s of real time, beyond the daemon's heartbeat_timeout (3 s).
+    ASSERT_EQ(bench->sim().ask("hbstall 80").value_or("").rfind("ok", 0), 0u);
+    const auto stalled = std::chrono::steady_clock::now();
+    ASSERT_TRUE(wait_until([&] { return bench->status()["autopilot"].value("link", "") == "down"; },
+                           kGenerous, kPoll))
+        << "the silent autopilot is visible in status" << bench->logs();
+    const double down_s = seconds_since(stalled);
+    ASSERT_TRUE(
+        wait_until([&] { return bench->status()["autopilot"].value("link", "") == "up"; }, kGenerous, kPoll))
+        << bench->logs();
+    const double up_s = seconds_since(stalled);
+    radio_commands(1);
+    EXPECT_EQ(counter(bench->status(), "/autopilot/reboots"), 0u) << "a silent board is not a rebooted one";
+    end_checks(expected, false);
+    // The board never stopped and kept reporting the waypoints it reached; the daemon keeps its window
+    // through the silence and counts them (it used to drop the window and point the board back at the first
+    // waypoint it had seen unreached: 7 waypoints driven twice here). KNOWN LIMITATION (docs/reliability.md):
+    // while the heartbeats are missing the daemon sends the board nothing, so a board that runs through its
+    // window follows the ring's jump into slots not yet rewritten and drives those waypoints again (2 here).
+    const auto log = reached_log(bench->sim(), first_reached);
+    const auto replays = expect_no_skip(log, expected);
+    EXPECT_LT(replays, 5u) << "at most the stale ring slots, never a rewind: " << as_indices(log, expected);
+    const auto stats = bench->sim().json("stats");
+    std::cout << "[ figures ] heartbeat stall (8 s): link down after " << down_s << " s, up again after "
+              << up_s << " s; heartbeats stalled " << stats.value("heartbeats_stalled", Json()).dump() << "; "
+              << expected.size() << " waypoints, none skipped, " << replays
+              << " driven again; reached: " << as_indices(log, expected) << "; " << tally.answered << "/"
+              << tally.sent << " radio commands answered\n";
+}
+
+TEST_F(SystemPlan, DaemonKilledMidPlanResumesAtTheFirstUnreachedWaypoint) {
+    start(plan_bench(10));
+    const auto expected = load("route", 16, 20);
+    radio_commands(1);
+    ASSERT_TRUE(wait_until([&] { return waypoints_reached_at_least(5); }, kGenerous, kPoll)) << bench->logs();
+    expect_each_answered_once(tally, commands_at_start, ground_commands(*bench));
+    bench->kill_daemon();
+    const std::string progress = read_file(bench->state_dir() + "/progress.state");
+    const auto at = progress.find("next_index ");
+    ASSERT_NE(at, std::string::npos) << progress;
+    const auto saved_next = std::stoul(progress.substr(at + 11));
+    ASSERT_GE(saved_next, 5u);
+    ASSERT_LT(saved_next, expected.size());
+
+    const auto restarted = std::chrono::steady_clock::now();
+    bench->start_daemon();  // opening the port reboots the board, as an APM on USB does
+    ASSERT_TRUE(bench->wait_ready()) << bench->logs();
+    const double ready_s = seconds_since(restarted);
+    const auto plan = plan_section(*bench);
+    EXPECT_GE(plan.value("waypoints_reached", 0u), saved_next) << "progress restored: " << plan.dump();
+    tally = {};
+    commands_at_start = ground_commands(*bench);  // a new daemon counts from 0
+    radio_commands(1);
+    ASSERT_TRUE(wait_until([&] { return plan_done(); }, kGenerous, kPoll))
+        << plan_section(*bench).dump() << bench->logs();
+
+    // After the board's last boot: the first waypoint reached is the first the daemon had not seen reached.
+    double booted = 0;
+    for (const auto& m : bench->sim().json("modes")) {
+        if (m["cause"] == "reboot" || m["cause"] == "power on") {
+            booted = m["t"].get<double>();
+        }
+    }
+    std::vector<Reached> after;
+    for (const auto& r : reached_log(bench->sim(), first_reached)) {
+        if (r.t > booted) {
+            after.push_back(r);
+        }
+    }
+    expect_reached_in_order(after, expected, saved_next);
+    // The board drove on alone between the kill and the reopen: those waypoints are driven again after it.
+    const auto whole = reached_log(bench->sim(), first_reached);
+    const auto replays = expect_no_skip(whole, expected);
+    end_checks(expected, false);
+    std::cout << "[ figures ] SIGKILL mid-plan at next_index " << saved_next << ": ready " << ready_s
+              << " s after the restart; resumed at waypoint " << saved_next << ", "
+              << expected.size() - saved_next << " more reached in order (" << whole.size() - after.size()
+              << " reached before the boot, " << replays << " driven again); " << tally.answered << "/"
+              << tally.sent << " radio commands answered\n";
+}
+
+TEST_F(SystemPlan, InvalidPlanRejectedNamingWhatAndWhereAndAValidOneReplacesTheRunningPlan) {
+    start(plan_bench(10));
+    const auto a = load("route-a", 30, 20);
+    ASSERT_TRUE(wait_until([&] { return waypoints_reached_at_least(3); }, kGenerous, kPoll)) << bench->logs();
+
+    // Over the radio: a plan with a misspelt field is rejected, naming file, line and field.
+    const auto bad = bench->dir().file("bad.yaml");
+    write_file(bad,
+               "plan:\n  name: typo\n  elements:\n    - waypoint: {lat: 41.2758, lon: 1.9871}\n"
+               "    - waypoint: {lat: 41.2760, lon: 1.9871, sped: 2}\n");
+    auto rejected = bench->ctl({"plan", "load", bad});
+    ++tally.sent;
+    EXPECT_EQ(rejected.exit_code, 1) << rejected.out << rejected.err;
+    const auto why = Json::parse(rejected.out, nullptr, false).value("error", "");
+    EXPECT_NE(why.find(bad + ":5:"), std::string::npos) << why;
+    EXPECT_NE(why.find("plan.elements[1].waypoint.sped"), std::string::npos) << why;
+    EXPECT_NE(why.find("unknown field"), std::string::npos) << why;
+    if (rejected.exit_code == 1 && why.find("unknown field") != std::string::npos) {
+        ++tally.answered;
+    }
+    EXPECT_EQ(plan_section(*bench).value("name", ""), "route-a") << "the running plan is untouched";
+    EXPECT_EQ(plan_section(*bench).value("state", ""), "running");
+
+    // Over the radio: a valid plan replaces the running one.
+    const auto b_file = bench->dir().file("route-b.yaml");
+    write_file(b_file, line_plan("route-b", 8, 20, -20));
+    const auto b = expected_positions(b_file);
+    auto replaced = bench->ctl({"plan", "load", b_file});
+    ++tally.sent;
+    ASSERT_EQ(replaced.exit_code, 0) << replaced.out << replaced.err << bench->logs();
+    ++tally.answered;
+    EXPECT_EQ(Json::parse(replaced.out, nullptr, false).value("name", ""), "route-b");
+    ASSERT_TRUE(wait_until([&] { return plan_done(); }, kGenerous, kPoll)) << plan_section(*bench).dump();
+
+    // On the board: A from its start without a gap, at most the target it was heading for, then all of B.
+    const auto log = reached_log(bench->sim(), first_reached);
+    std::size_t i = 0;
+    while (i < log.size() && i < a.size() && same_place(log[i].at, a[i])) {
+        ++i;
+    }
+    ASSERT_GE(i, 3u);
+    ASSERT_LT(i, a.size()) << "the replacement came too late";
+    const std::size_t a_done = i;
+    expect_reached_in_order(std::vector<Reached>(log.begin() + static_cast<long>(i), log.end()), b);
+    EXPECT_EQ(plan_section(*bench).value("name", ""), "route-b");
+    radio_commands(2);
+    expect_each_answered_once(tally, commands_at_start, ground_commands(*bench));
+    expect_daemon_alive(*bench);
+    std::cout << "[ figures ] invalid plan rejected: " << why << "; replacement after " << a_done
+              << " waypoints of A, then " << b.size() << " of B in order; " << tally.answered << "/"
+              << tally.sent << " radio commands answered\n";
+}
+
+}  // namespace
+}  // namespace airseg::test::sys
