@@ -120,7 +120,9 @@ Json ground(SystemBench& bench) {
 }
 
 TEST(SystemSecurity, FramesForgedWithTheWrongKeyAreRejectedCountedAndRunNothing) {
-    SystemBench bench({.key = true});
+    BenchOptions keyed;
+    keyed.key = true;
+    SystemBench bench(keyed);
     const auto wrong_key = bench.dir().file("wrong.key");
     write_file(wrong_key, std::string(64, 'd') + "\n");
     ASSERT_EQ(::chmod(wrong_key.c_str(), 0600), 0);
@@ -129,11 +131,12 @@ TEST(SystemSecurity, FramesForgedWithTheWrongKeyAreRejectedCountedAndRunNothing)
     {
         RecordingRelay relay(bench.ground_port());
         const auto r = ctl_through(relay.client_path(), wrong_key, {"rates", "vehicle=3.3"}, 8000);
-        EXPECT_EQ(r.exit_code, 3) << "the vehicle must not answer a ground station with the wrong key: " << r.out
-                                  << r.err;
+        EXPECT_EQ(r.exit_code, 3) << "the vehicle must not answer a ground station with the wrong key: "
+                                  << r.out << r.err;
         EXPECT_FALSE(relay.uplink().empty()) << "the forger sent nothing";
-        ASSERT_TRUE(wait_until([&] { return ground(bench).value("mac_failures", 0) > before.value("mac_failures", 0); },
-                               kGenerous, kPoll))
+        ASSERT_TRUE(wait_until(
+            [&] { return ground(bench).value("mac_failures", 0) > before.value("mac_failures", 0); },
+            kGenerous, kPoll))
             << ground(bench).dump();
     }
     const auto after = ground(bench);
@@ -150,7 +153,9 @@ TEST(SystemSecurity, FramesForgedWithTheWrongKeyAreRejectedCountedAndRunNothing)
 }
 
 TEST(SystemSecurity, ReplayedFramesAreRejectedCountedAndRunNothingTwice) {
-    SystemBench bench({.key = true});
+    BenchOptions keyed;
+    keyed.key = true;
+    SystemBench bench(keyed);
     ASSERT_TRUE(wait_until([&] { return !bench.status().empty(); }, kGenerous, kPoll)) << bench.logs();
     const auto key = bench.dir().file("ground.key");
     RecordingRelay relay(bench.ground_port());
@@ -179,8 +184,9 @@ TEST(SystemSecurity, ReplayedFramesAreRejectedCountedAndRunNothingTwice) {
         kGenerous, std::chrono::milliseconds(1500));
     const auto after = ground(bench);
     EXPECT_EQ(after.value("commands", 0), before.value("commands", 0)) << "a replayed command ran again";
-    std::cout << "[ figures ] replayed " << 2 * recording.size() << " bytes: "
-              << after.value("replays", 0) - before.value("replays", 0) << " frames rejected as replays, "
+    std::cout << "[ figures ] replayed " << 2 * recording.size()
+              << " bytes: " << after.value("replays", 0) - before.value("replays", 0)
+              << " frames rejected as replays, "
               << after.value("mac_failures", 0) - before.value("mac_failures", 0) << " by their MAC, "
               << after.value("commands", 0) - before.value("commands", 0) << " commands run\n";
     expect_daemon_alive(bench);
