@@ -18,26 +18,11 @@ if(AIRSEG_SANITIZE)
   endif()
 endif()
 
-# With AIRSEG_PCH, targets of three or more sources precompile the heavy third-party headers most files
-# include: parsing Boost.Asio, spdlog and nlohmann::json is about half of a typical file's compile time, and
-# CI compiles the tree four times (sanitizers, TSan, armhf, armel). Off by default: ccache cannot cache files
-# built with a GCC precompiled header, and incremental developer builds gain more from ccache.
-set(AIRSEG_PCH_HEADERS <utility> <boost/asio.hpp> <spdlog/spdlog.h> <nlohmann/json.hpp>)
-function(airseg_precompile_common name)
-  set(extra ${ARGN})
-  get_target_property(sources ${name} SOURCES)
-  list(LENGTH sources count)
-  if(AIRSEG_PCH AND count GREATER_EQUAL 3)
-    target_precompile_headers(${name} PRIVATE ${AIRSEG_PCH_HEADERS} ${extra})
-  endif()
-endfunction()
-
 # airseg_add_library(NAME SOURCES... [LIBS ...])
 function(airseg_add_library name)
   cmake_parse_arguments(A "" "" "SOURCES;LIBS" ${ARGN})
   add_library(${name} STATIC ${A_SOURCES})
   target_link_libraries(${name} PUBLIC airseg_options ${A_LIBS})
-  airseg_precompile_common(${name})
 endfunction()
 
 # airseg_add_test(NAME SOURCES... [LIBS ...] [LABELS ...] [TIMEOUT seconds] [RESOURCE_LOCK name])
@@ -54,7 +39,6 @@ function(airseg_add_test name)
   target_link_libraries(${name} PRIVATE airseg_options GTest::gtest GTest::gtest_main GTest::gmock ${A_LIBS})
   target_compile_definitions(${name} PRIVATE AIRSEG_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
                                              AIRSEG_BINARY_DIR="${PROJECT_BINARY_DIR}")
-  airseg_precompile_common(${name} <gtest/gtest.h> <gmock/gmock.h>)
   # tests/concurrency-tests.txt names the executables CI runs under ThreadSanitizer.
   file(STRINGS ${PROJECT_SOURCE_DIR}/tests/concurrency-tests.txt _concurrency REGEX "^[a-z]")
   if(name IN_LIST _concurrency)

@@ -11,7 +11,6 @@
 #    binfmt_misc), so the ARM binaries are tested as they are packaged, with two differences: no
 #    debug information (-g0, no -dbgsym package: a quarter less compile time, the same machine
 #    code), and the test-only hang injection compiled in (the stuck-service test runs on ARM too).
-#    AIRSEG_PCH=ON precompiles the common headers (CI: a cold build).
 # 3. Checks each .deb (packaging/check-deb.sh: lintian, Architecture, shlibs Depends, ELF format
 #    and loader).
 # 4. With --full, also builds the amd64 package (without its tests: they are CI's native stage)
@@ -66,7 +65,7 @@ summary=()
 for arch in "${arches[@]}"; do
   step "cross-building $arch and running its test suite under qemu-arm"
   start=$SECONDS cpu0=$(cpu_seconds)
-  AIRSEG_EXTRA_CMAKE_ARGS="-DAIRSEG_TEST_HANG_INJECTION=ON -DAIRSEG_PCH=${AIRSEG_PCH:-OFF}" \
+  AIRSEG_EXTRA_CMAKE_ARGS="-DAIRSEG_TEST_HANG_INJECTION=ON" \
     "$AIRSEG_ROOT/packaging/build-debs.sh" --no-debug-info "$arch"
   tests=$(grep -E '^[0-9]+% tests passed' "$AIRSEG_ROOT/build-pkg-$arch/build.log" | tail -n1)
   summary+=("$arch: $((SECONDS - start)) s wall, $(($(cpu_seconds) - cpu0)) CPU-s; ${tests:-no ctest summary}")

@@ -25,11 +25,6 @@ launcher=()
 if command -v ccache >/dev/null; then
   launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 fi
-# On a fresh machine (CI) nothing is cached: precompiled headers save more than ccache could.
-pch=OFF
-if [ "${CI:-}" = true ]; then
-  pch=ON
-fi
 
 has_stage() { [[ " $stages " == *" $1 "* ]]; }
 elapsed() { echo "build-and-test: $1 in $((SECONDS - $2)) s"; }
@@ -52,7 +47,7 @@ done
 if has_stage sanitize || has_stage fuzz; then
   start=$SECONDS
   # The same configuration tests/fuzz/run.sh makes, so the fuzz stage reuses this build.
-  CC=clang CXX=clang++ cmake -S . -B build-san -G Ninja "${launcher[@]}" -DAIRSEG_PCH=$pch \
+  CC=clang CXX=clang++ cmake -S . -B build-san -G Ninja "${launcher[@]}" \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" \
     -DAIRSEG_BUILD_FUZZ=ON -DAIRSEG_BUILD_TESTS=ON -DAIRSEG_BUILD_BENCH=ON \
     -DAIRSEG_SANITIZE=fuzzer-no-link,address,undefined
@@ -87,7 +82,7 @@ fi
 
 if has_stage tsan; then
   start=$SECONDS
-  cmake -S . -B build-tsan -G Ninja "${launcher[@]}" -DAIRSEG_PCH=$pch -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  cmake -S . -B build-tsan -G Ninja "${launcher[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" -DAIRSEG_BUILD_BENCH=OFF -DAIRSEG_SANITIZE=thread
   mapfile -t tsan_targets < <(grep '^[a-z]' tests/concurrency-tests.txt)
   cmake --build build-tsan -j"$jobs" --target "${tsan_targets[@]}"
@@ -103,7 +98,7 @@ if has_stage cross; then
   has_stage sanitize || modules_dir=build-cross-interop
   tests/integration/mavlink_interop/setup.sh "$modules_dir"
   # shellcheck disable=SC2086
-  AIRSEG_PCH=$pch AIRSEG_INTEROP_MODULES="$(cd "$modules_dir" && pwd)/mavlink_interop/node_modules" \
+  AIRSEG_INTEROP_MODULES="$(cd "$modules_dir" && pwd)/mavlink_interop/node_modules" \
     packaging/ci-cross.sh ${AIRSEG_CROSS:-armhf armel}
   elapsed "ARM packages and their tests under qemu-arm" "$start"
 fi
