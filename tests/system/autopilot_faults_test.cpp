@@ -75,7 +75,7 @@ TEST_F(SystemPlan, AutopilotUnpluggedAndReplugedMidPlan) {
     const double unplugged_t = bench->sim().json("state").value("t", 0.0);
     ASSERT_EQ(bench->sim().ask("unplug").value_or("").rfind("ok", 0), 0u);
     const auto pulled = std::chrono::steady_clock::now();
-    ASSERT_TRUE(wait_until([&] { return bench->status()["autopilot"].value("link", "") == "down"; },
+    ASSERT_TRUE(wait_until([&] { return section(bench->status(), "autopilot").value("link", "") == "down"; },
                            kGenerous, kPoll))
         << "the unplug is visible in status";
     const double seen_s = seconds_since(pulled);
@@ -137,12 +137,12 @@ TEST_F(SystemPlan, AutopilotHeartbeatStall) {
     // 80 simulated seconds at ×10: 8 s of real time, beyond the daemon's heartbeat_timeout (3 s).
     ASSERT_EQ(bench->sim().ask("hbstall 80").value_or("").rfind("ok", 0), 0u);
     const auto stalled = std::chrono::steady_clock::now();
-    ASSERT_TRUE(wait_until([&] { return bench->status()["autopilot"].value("link", "") == "down"; },
+    ASSERT_TRUE(wait_until([&] { return section(bench->status(), "autopilot").value("link", "") == "down"; },
                            kGenerous, kPoll))
         << "the silent autopilot is visible in status" << bench->logs();
     const double down_s = seconds_since(stalled);
-    ASSERT_TRUE(
-        wait_until([&] { return bench->status()["autopilot"].value("link", "") == "up"; }, kGenerous, kPoll))
+    ASSERT_TRUE(wait_until([&] { return section(bench->status(), "autopilot").value("link", "") == "up"; },
+                           kGenerous, kPoll))
         << bench->logs();
     const double up_s = seconds_since(stalled);
     radio_commands(1);

@@ -85,9 +85,9 @@ TEST(SystemDisk, DiskFullWhileWritingTheTlogAndTheStateFileKeepsTheDaemonUpAndTh
     ASSERT_TRUE(wait_until(
         [&] {
             doc = bench.status();
-            const auto plan_error = doc["plan"].value("error", Json()).is_string()
-                                        ? doc["plan"]["error"].get<std::string>()
-                                        : std::string();
+            const auto plan = section(doc, "plan");
+            const auto plan_error =
+                plan.value("error", Json()).is_string() ? plan["error"].get<std::string>() : std::string();
             return plan_error.find("No space left") != std::string::npos &&
                    counter(doc, "/autopilot/tlog/write_errors") > 0;
         },

@@ -79,8 +79,8 @@ TEST(SystemRadio, ASixtySecondOutageDelaysButLosesNoCommand) {
     CommandTally tally;
     send_unique(bench, 0, tally);
     ASSERT_EQ(tally.answered, 1) << tally.problems.front() << bench.logs();
-    ASSERT_TRUE(
-        wait_until([&] { return bench.status()["groundlink"].value("link", "") == "up"; }, kGenerous, kPoll));
+    ASSERT_TRUE(wait_until([&] { return section(bench.status(), "groundlink").value("link", "") == "up"; },
+                           kGenerous, kPoll));
 
     ASSERT_EQ(bench.link().ask("outage 60").value_or("").rfind("ok", 0), 0u);
     const auto outage_start = std::chrono::steady_clock::now();
@@ -89,7 +89,7 @@ TEST(SystemRadio, ASixtySecondOutageDelaysButLosesNoCommand) {
     Subprocess during({binary("client/airsegctl"), "--link", bench.ground_link(), "--timeout", "150000",
                        "--json", "rates", "vehicle=" + rate_text(unique_rate(1))},
                       {}, bench.dir().path());
-    EXPECT_TRUE(wait_until([&] { return bench.status()["groundlink"].value("link", "") == "down"; },
+    EXPECT_TRUE(wait_until([&] { return section(bench.status(), "groundlink").value("link", "") == "down"; },
                            kGenerous, kPoll))
         << "the outage is visible in status";
     const double down_after = seconds_since(outage_start);
@@ -137,7 +137,7 @@ TEST(SystemRadio, OnePairOfASplitLinkDeadAndBack) {
     Json paths;
     EXPECT_TRUE(wait_until(
         [&] {
-            paths = bench.status()["groundlink"].value("paths", Json::array());
+            paths = section(bench.status(), "groundlink").value("paths", Json::array());
             return paths.size() == 2 && !paths[1].value("alive", true);
         },
         kGenerous, kPoll))
@@ -150,7 +150,7 @@ TEST(SystemRadio, OnePairOfASplitLinkDeadAndBack) {
     EXPECT_TRUE(wait_until(
         [&] {
             send_unique(bench, 5 + tally.sent, tally, 60'000);  // traffic makes the path seen again
-            paths = bench.status()["groundlink"].value("paths", Json::array());
+            paths = section(bench.status(), "groundlink").value("paths", Json::array());
             return paths.size() == 2 && paths[1].value("alive", false);
         },
         kGenerous, kPoll))
@@ -206,7 +206,7 @@ TEST(SystemRadio, GarbageAndOversizedMessagesFromTheGroundAreRejectedAndCounted)
         Json g;
         EXPECT_TRUE(wait_until(
             [&] {
-                g = bench.status()["groundlink"];
+                g = section(bench.status(), "groundlink");
                 return counter(g, "/framing_errors") + counter(g, "/crc_errors") +
                            counter(g, "/mac_failures") >
                        counter(before["groundlink"], "/framing_errors") +

@@ -116,7 +116,7 @@ RunResult ctl_through(const std::string& port, const std::string& key, std::vect
 }
 
 Json ground(SystemBench& bench) {
-    return bench.status().value("groundlink", Json::object());
+    return section(bench.status(), "groundlink");
 }
 
 TEST(SystemSecurity, FramesForgedWithTheWrongKeyAreRejectedCountedAndRunNothing) {

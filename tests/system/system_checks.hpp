@@ -28,6 +28,12 @@ inline std::uint64_t counter(const Json& doc, const std::string& pointer) {
     return doc.contains(p) && doc[p].is_number() ? doc[p].get<std::uint64_t>() : 0;
 }
 
+/// A section of the status document, or {} while it is missing or null (a status call can time out).
+inline Json section(const Json& doc, const std::string& name) {
+    const auto it = doc.find(name);
+    return it != doc.end() && it->is_object() ? *it : Json::object();
+}
+
 /// Commands the ground link received (the status document from the local socket is not one).
 inline std::uint64_t ground_commands(SystemBench& bench) {
     return counter(bench.status(), "/groundlink/commands");
@@ -163,7 +169,7 @@ inline std::vector<E7> expected_positions(const std::string& plan_file) {
 }
 
 inline Json plan_section(SystemBench& bench) {
-    return bench.status().value("plan", Json::object());
+    return section(bench.status(), "plan");
 }
 
 /// The reached events as plan waypoint indices ("?" for a place not in the plan), for failure messages.
