@@ -374,9 +374,14 @@ void FlightplanService::handle_event(const FeederEvent& e) {
         case FeederEvent::Kind::HoldEnded:
             spdlog::info("{}{} {}", kPrefix, to_string(e.kind), e.element_path);
             break;
-        case FeederEvent::Kind::PlanDone:
-            spdlog::info("{}plan '{}' done", kPrefix, feeder_.progress().plan_name);
+        case FeederEvent::Kind::PlanDone: {
+            // A named copy, not a member of a temporary inside a case: clang 14's AddressSanitizer reported
+            // the temporary's destruction as a use after its scope (the CI sanitizer stage, heartbeat-stall
+            // case).
+            const std::string name = feeder_.progress().plan_name;
+            spdlog::info("{}plan '{}' done", kPrefix, name);
             break;
+        }
         case FeederEvent::Kind::PlanBlocked:
             spdlog::error("{}plan stopped: {}", kPrefix, e.detail);
             problem_ = e.detail;
