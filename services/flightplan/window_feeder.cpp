@@ -155,6 +155,9 @@ void WindowFeeder::pause() {
 void WindowFeeder::resume() {
     paused_ = false;
     fault_ = false;
+    // The operator may have taken the vehicle out of AUTO since (MANUAL, a joystick session), which the
+    // feeder is not told: resuming asks for the mission again rather than trusting the last confirmed mode.
+    mode_ = Mode::Unknown;
 }
 
 void WindowFeeder::release_hold(TimePoint now) {

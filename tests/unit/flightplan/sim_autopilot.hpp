@@ -84,6 +84,10 @@ class SimAutopilot {
         parked_ = false;
     }
 
+    /// The operator takes the vehicle out of AUTO (a MANUAL switch, a joystick session): the feeder is not
+    /// told.
+    void operator_takes_over() { auto_ = false; }
+
     std::uint16_t current() const { return current_; }
     bool in_auto() const { return auto_; }
     bool parked() const { return parked_; }

@@ -210,6 +210,22 @@ TEST(FlightplanFeeder, PauseHoldsTheVehicleAndResumeContinues) {
     expect_visited(h, 41.0, 0, 100);
 }
 
+TEST(FlightplanFeeder, ResumeAfterTheOperatorDroveTheVehicleByHandPutsItBackOnThePlan) {
+    Harness h;
+    h.feeder.replace_plan(test::synthetic(100), h.now);
+    for (int i = 0; i < 20; ++i)
+        h.step();
+    ASSERT_TRUE(h.ap.in_auto());
+    h.ap.operator_takes_over();  // e.g. MANUAL_NAVIGATION and a joystick session from the ground
+    const auto reached_by_hand = h.reached.size();
+    for (int i = 0; i < 30; ++i)
+        h.step();
+    EXPECT_EQ(h.reached.size(), reached_by_hand) << "out of AUTO the vehicle follows no plan";
+    h.feeder.resume();
+    ASSERT_LT(h.run_until_done(500), 500) << "resume must bring the vehicle back to AUTO";
+    EXPECT_EQ(h.reached, iota(0, 100));
+}
+
 TEST(FlightplanFeeder, HoldWaypointsHoldForTheirTimeOrUntilReleased) {
     Waypoint timed;
     timed.action = WaypointAction::HoldFor;
