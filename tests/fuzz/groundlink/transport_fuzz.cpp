@@ -188,6 +188,30 @@ void run_scenario(Script& s) {
                link.b().core->session_established();
     });
     require(!link.livelocked());
+    if (pending(link.a()) != 0 || pending(link.b()) != 0 || !link.a().core->session_established() ||
+        !link.b().core->session_established()) {
+        std::fprintf(stderr,
+                     "after 200 s of clean link: a pending %zu session %d, b pending %zu session %d\n",
+                     pending(link.a()), int(link.a().core->session_established()), pending(link.b()),
+                     int(link.b().core->session_established()));
+        for (const auto* e : {&link.a(), &link.b()}) {
+            const auto& st = e->core->stats();
+            std::fprintf(
+                stderr,
+                "  %s: frames sent %llu recv %llu replays %llu mac %llu crc %llu restarts %llu acks "
+                "sent %llu recv %llu safe_resent %llu refused %llu tx.safe msgs %llu retx %llu rx.safe "
+                "msgs %llu; pending per channel %zu %zu %zu %zu\n",
+                e == &link.a() ? "a" : "b", (unsigned long long)st.frames_sent,
+                (unsigned long long)st.frames_received, (unsigned long long)st.replays,
+                (unsigned long long)st.mac_failures, (unsigned long long)st.crc_errors,
+                (unsigned long long)st.peer_restarts, (unsigned long long)st.acks_sent,
+                (unsigned long long)st.acks_received, (unsigned long long)st.safe_resent,
+                (unsigned long long)st.deliveries_refused, (unsigned long long)st.tx_safe.messages,
+                (unsigned long long)st.tx_safe.retransmissions, (unsigned long long)st.rx_safe.messages,
+                e->core->safe_pending(0), e->core->safe_pending(1), e->core->safe_pending(2),
+                e->core->safe_pending(3));
+        }
+    }
     require(pending(link.a()) == 0 && pending(link.b()) == 0);
     require(link.a().core->session_established() && link.b().core->session_established());
     check_received(link.b(), incarnations[0]);
