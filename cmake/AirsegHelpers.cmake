@@ -39,11 +39,6 @@ function(airseg_add_test name)
   target_link_libraries(${name} PRIVATE airseg_options GTest::gtest GTest::gtest_main GTest::gmock ${A_LIBS})
   target_compile_definitions(${name} PRIVATE AIRSEG_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
                                              AIRSEG_BINARY_DIR="${PROJECT_BINARY_DIR}")
-  # tests/concurrency-tests.txt names the executables CI runs under ThreadSanitizer.
-  file(STRINGS ${PROJECT_SOURCE_DIR}/tests/concurrency-tests.txt _concurrency REGEX "^[a-z]")
-  if(name IN_LIST _concurrency)
-    list(APPEND A_LABELS concurrency)
-  endif()
   set(_lock)
   if(A_RESOURCE_LOCK)
     # Cases that must not run beside each other (they share a scarce resource, e.g. real-time radio links).
