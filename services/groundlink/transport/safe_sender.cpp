@@ -137,6 +137,7 @@ SafeSender::AckResult SafeSender::on_ack(const frame::AckChunk& ack, TimePoint n
         mark_acked(inflight_[static_cast<std::size_t>(seq - una_)], r, now, newest);
     }
     if (r.newly_acked > 0) {
+        probe_.reset();  // the peer hears again: acknowledgements judge the rest of the window
         for (auto& s : inflight_) {
             if (!s.acked && !s.lost && s.last_sent + reorder_slack < newest) {
                 s.lost = true;
@@ -152,21 +153,37 @@ SafeSender::AckResult SafeSender::on_ack(const frame::AckChunk& ack, TimePoint n
 }
 
 std::size_t SafeSender::on_timeout(TimePoint now, Duration rto) {
-    InFlight* oldest = nullptr;
-    for (auto& s : inflight_) {
-        if (!s.acked && !s.lost && (oldest == nullptr || s.last_sent < oldest->last_sent)) {
-            oldest = &s;
+    if (probe_) {
+        // Only the probe is timed until an acknowledgement arrives; it goes again, backed off, if it times out.
+        InFlight& p = inflight_[static_cast<std::size_t>(*probe_ - una_)];
+        if (p.lost || p.last_sent + rto > now) {
+            return 0;
+        }
+        p.lost = true;
+        ++lost_count_;
+        return 1;
+    }
+    std::optional<std::size_t> oldest;
+    for (std::size_t i = 0; i < inflight_.size(); ++i) {
+        const InFlight& s = inflight_[i];
+        if (!s.acked && !s.lost && (!oldest || s.last_sent < inflight_[*oldest].last_sent)) {
+            oldest = i;
         }
     }
-    if (oldest == nullptr || oldest->last_sent + rto > now) {
+    if (!oldest || inflight_[*oldest].last_sent + rto > now) {
         return 0;
     }
-    oldest->lost = true;
+    inflight_[*oldest].lost = true;
     ++lost_count_;
+    probe_ = una_ + *oldest;
     return 1;
 }
 
 TimePoint SafeSender::next_timeout(Duration rto) const {
+    if (probe_) {
+        const InFlight& p = inflight_[static_cast<std::size_t>(*probe_ - una_)];
+        return p.lost ? kNever : p.last_sent + rto;
+    }
     TimePoint t = kNever;
     for (const auto& s : inflight_) {
         if (!s.acked && !s.lost) {
@@ -187,6 +204,7 @@ std::size_t SafeSender::reset() {
     cut_fragments_ = 0;
     una_ = next_ = 0;
     lost_count_ = 0;
+    probe_.reset();
     bytes_held_ = 0;
     for (const auto& m : queue_) {
         bytes_held_ += m.size();

@@ -51,8 +51,11 @@ class SafeSender {
     /// `reorder_slack`: a segment counts as lost only if one sent more than this later was acknowledged
     /// (frames on two paths may arrive out of order).
     AckResult on_ack(const frame::AckChunk& ack, TimePoint now, Duration reorder_slack = Duration::zero());
-    /// Declares the oldest outstanding segment lost if it was last sent at or before now - rto (the rest are
-    /// judged by the acknowledgements its resending brings back); returns how many (0 or 1).
+    /// Declares the oldest outstanding segment lost if it was last sent at or before now - rto; returns how
+    /// many (0 or 1). That segment becomes the probe: until an acknowledgement arrives, only it is timed (and
+    /// resent, backed off, each time it times out). The rest of the window went out before it, so the
+    /// acknowledgement its resending brings back judges them; timing each on its own would send the whole
+    /// window again every timeout into a link that has gone quiet (RFC 6298, 5.4-5.6, does the same).
     std::size_t on_timeout(TimePoint now, Duration rto);
     /// When the oldest outstanding segment times out (kNever when none is outstanding).
     [[nodiscard]] TimePoint next_timeout(Duration rto) const;
@@ -87,6 +90,7 @@ class SafeSender {
     std::uint64_t una_ = 0;
     std::uint64_t next_ = 0;
     std::size_t lost_count_ = 0;
+    std::optional<std::uint64_t> probe_;  // sequence of the segment resent on the last timeout, until an ack
 };
 
 }  // namespace airseg::groundlink

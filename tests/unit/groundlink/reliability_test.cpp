@@ -119,6 +119,31 @@ TEST(GroundlinkSafeSender, TimeoutDeclaresOutstandingLostAndKarnSkipsRetransmitt
     EXPECT_TRUE(r.progress);
 }
 
+TEST(GroundlinkSafeSender, AfterATimeoutOnlyTheProbeIsTimedUntilAnAcknowledgementJudgesTheRest) {
+    SafeSender tx(8, 1 << 20, 100000);
+    tx.enqueue(seq_bytes(400));
+    for (int i = 0; i < 4; ++i) {
+        ASSERT_TRUE(tx.take_new(100, false, t0 + milliseconds(i)).has_value());
+    }
+    ASSERT_EQ(tx.on_timeout(t0 + milliseconds(500), milliseconds(500)), 1U);
+    EXPECT_EQ(tx.take_lost(t0 + milliseconds(500)).seq, 0);
+    // Segments 1..3 are older than the probe but are not timed on their own: a quiet link gets one segment
+    // per timeout, not the whole window.
+    EXPECT_EQ(tx.next_timeout(milliseconds(1000)), t0 + milliseconds(1500));
+    EXPECT_EQ(tx.on_timeout(t0 + milliseconds(510), milliseconds(1000)), 0U);
+    EXPECT_FALSE(tx.has_lost());
+    ASSERT_EQ(tx.on_timeout(t0 + milliseconds(1500), milliseconds(1000)), 1U);  // the probe again
+    EXPECT_EQ(tx.take_lost(t0 + milliseconds(1500)).seq, 0);
+    // Its acknowledgement declares the segments sent before it lost, and timing returns to normal.
+    const auto r = tx.on_ack(frame::AckChunk{0, 1, {}}, t0 + milliseconds(1600));
+    EXPECT_EQ(r.newly_acked, 1U);
+    EXPECT_EQ(r.newly_lost, 3U);
+    for (std::uint16_t seq = 1; seq <= 3; ++seq) {
+        EXPECT_EQ(tx.take_lost(t0 + milliseconds(1600 + seq)).seq, seq);
+    }
+    EXPECT_EQ(tx.next_timeout(milliseconds(500)), t0 + milliseconds(2101));
+}
+
 TEST(GroundlinkSafeSender, ResetRequeuesUnacknowledgedMessagesInOrder) {
     SafeSender tx(8, 1 << 20, 100000);
     tx.enqueue(seq_bytes(100));

@@ -489,6 +489,31 @@ TEST(GroundlinkTransport, FrameSizeShrinksUnderCorruption) {
     EXPECT_GT(count_safe(link.b(), 3), 50U);
 }
 
+TEST(GroundlinkTransport, AnEndThatHearsNoAcknowledgementsProbesInsteadOfFillingTheAir) {
+    // b hears a but a hears nothing for a minute: a's window goes out once, then one probe per timeout. If
+    // every outstanding segment timed out in turn, a would resend its window at the full link rate and, with
+    // b's own frames on the same half-duplex air, the radios would queue minutes of frames.
+    SimLink link(base_config(1), base_config(2), one_path(), 16);
+    link.run_for(2s);
+    ASSERT_TRUE(link.a().core->session_established());
+    for (std::uint32_t i = 0; i < 40; ++i) {
+        ASSERT_EQ(link.a().core->send_safe(3, pattern(2000, i), link.now()), SendResult::accepted);
+    }
+    link.path(0).b_to_a_up = false;
+    const std::uint64_t before = link.written(0, 0);
+    link.run_for(60s);
+    const std::uint64_t during = link.written(0, 0) - before;
+    EXPECT_LT(during, 5760U * 60U / 4U);  // the window once (about 64 kB) and probes, not 345 kB
+    EXPECT_LT(link.air_backlog(0), 1s);
+    link.path(0).b_to_a_up = true;
+    link.run_until(link.now() + 60s, [&] { return count_safe(link.b(), 3) == 40; });
+    ASSERT_EQ(count_safe(link.b(), 3), 40U);
+    for (std::uint32_t i = 0; i < 40; ++i) {
+        EXPECT_EQ(link.b().received[i].bytes, pattern(2000, i));
+    }
+    EXPECT_FALSE(link.livelocked());
+}
+
 TEST(GroundlinkTransport, LinkGoesDownAfterSilenceAndComesBack) {
     SimLink link(base_config(1), base_config(2), one_path(), 15);
     link.run_for(3s);
