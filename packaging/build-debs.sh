@@ -18,6 +18,7 @@
 # every failure is still printed).
 # AIRSEG_EXTRA_CMAKE_ARGS: more cmake options (CI: -DAIRSEG_TEST_HANG_INJECTION=ON, so that the
 # stuck-service test runs on ARM too; packages to ship leave the test-only hook out).
+# AIRSEG_TEST_JOBS: test cases run at once (default: AIRSEG_JOBS, the build's parallel level).
 set -euo pipefail
 . "$(dirname "$0")/lib.sh"
 
@@ -30,7 +31,7 @@ for a in "$@"; do
     --no-check) check=0 ;;
     --no-debug-info) debug_info=0 ;;
     --clean) clean=1 ;;
-    -h|--help) sed -n '2,18p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,21p' "$0"; exit 0 ;;
     -*) die "unknown option $a" ;;
     *) arch_triplet "$a" >/dev/null; arches+=("$a") ;;
   esac

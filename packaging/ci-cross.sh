@@ -1,5 +1,5 @@
 #!/bin/bash
-# ci-cross.sh [--full] [ARCH...]
+# ci-cross.sh [--full | --prepare] [ARCH...]
 #
 # The cross-build stage of CI, on a fresh Debian 12 amd64 machine (as root). ARCH: armhf and/or
 # armel (default: both).
@@ -15,6 +15,8 @@
 #    and loader).
 # 4. With --full, also builds the amd64 package (without its tests: they are CI's native stage)
 #    and installs, removes and purges it in a throwaway chroot (packaging/test-install.sh).
+# With --prepare, only step 1: CI runs it in the background while it compiles the sanitizer build, so
+# the downloads overlap the compiling.
 # The .debs are left in dist/. Each step prints its start time in seconds since the stage began,
 # and the stage ends with one line per architecture: build and test wall time, CPU time, and the
 # ctest summary.
@@ -22,13 +24,15 @@ set -euo pipefail
 . "$(dirname "$0")/lib.sh"
 
 full=0
+prepare_only=0
 arches=()
 for a in "$@"; do
   case "$a" in
     --full) full=1 ;;
+    --prepare) prepare_only=1 ;;
     armhf|armel) arches+=("$a") ;;
-    -h|--help) sed -n '2,21p' "$0"; exit 0 ;;
-    *) die "unknown argument '$a' (expected --full, armhf, armel)" ;;
+    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
+    *) die "unknown argument '$a' (expected --full, --prepare, armhf, armel)" ;;
   esac
 done
 [ ${#arches[@]} -gt 0 ] || arches=(armhf armel)
@@ -60,6 +64,10 @@ for arch in "${arches[@]}"; do
   step "sysroot $arch"
   "$AIRSEG_ROOT/packaging/ensure-sysroot.sh" "$arch" "$AIRSEG_SYSROOTS/$arch"
 done
+if [ "$prepare_only" = 1 ]; then
+  step "prepared"
+  exit 0
+fi
 
 summary=()
 for arch in "${arches[@]}"; do

@@ -20,6 +20,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 stages=${AIRSEG_STAGES:-sanitize fuzz tsan cross}
 jobs=$(nproc)
+# Test cases at once: most of them wait on real time (the simulated radios and autopilot run at real speed),
+# so twice as many as cores keeps the CPU busy.
+test_jobs=${AIRSEG_TEST_JOBS:-$((2 * jobs))}
+export AIRSEG_TEST_JOBS=$test_jobs
 total=$SECONDS
 
 launcher=()
@@ -35,7 +39,7 @@ run_ctest() {
   local dir=$1
   shift
   tests/integration/mavlink_interop/setup.sh "$dir"
-  ctest --test-dir "$dir" -j"$jobs" --output-on-failure --timeout 600 "$@"
+  ctest --test-dir "$dir" -j"$test_jobs" --output-on-failure --timeout 600 "$@"
 }
 
 for s in $stages; do
@@ -44,6 +48,16 @@ for s in $stages; do
     *) echo "build-and-test: unknown stage '$s' (expected sanitize, fuzz, tsan, cross, native)" >&2; exit 2 ;;
   esac
 done
+
+# The cross stage's downloads (cross compilers, qemu, the ARM sysroots) go on in the background while the
+# sanitizer build compiles; the cross stage waits for them.
+prepare_pid=""
+if has_stage cross && { has_stage sanitize || has_stage fuzz; }; then
+  mkdir -p build-logs
+  # shellcheck disable=SC2086
+  packaging/ci-cross.sh --prepare ${AIRSEG_CROSS:-armhf armel} >build-logs/cross-prepare.log 2>&1 &
+  prepare_pid=$!
+fi
 
 if has_stage sanitize || has_stage fuzz; then
   start=$SECONDS
@@ -93,14 +107,26 @@ if has_stage tsan; then
     "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" -DAIRSEG_BUILD_BENCH=OFF -DAIRSEG_SANITIZE=thread
   mapfile -t tsan_targets < <(grep '^[a-z]' tests/concurrency-tests.txt)
   cmake --build build-tsan -j"$jobs" --target "${tsan_targets[@]}"
-  # Each executable runs whole and directly: ctest's label list cannot carry a second label through
-  # gtest_discover_tests.
+  # Each executable runs whole and directly (ctest's label list cannot carry a second label through
+  # gtest_discover_tests), all at once: they mostly wait on real time. Each log is printed when it ends.
+  mkdir -p build-tsan/logs
+  pids=()
   for t in "${tsan_targets[@]}"; do
     exe=$(find build-tsan -type f -name "$t" -perm -u+x | head -n1)
     [ -n "$exe" ] || { echo "build-and-test: $t was not built in build-tsan" >&2; exit 1; }
-    echo "tsan: $t"
-    TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 timeout 900 "$exe" --gtest_brief=1
+    TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 timeout 900 "$exe" --gtest_brief=1 \
+      >"build-tsan/logs/$t.log" 2>&1 &
+    pids+=($!)
   done
+  failed=0
+  for i in "${!pids[@]}"; do
+    code=0
+    wait "${pids[$i]}" || code=$?
+    echo "tsan: ${tsan_targets[$i]} (exit $code)"
+    cat "build-tsan/logs/${tsan_targets[$i]}.log"
+    [ "$code" = 0 ] || failed=1
+  done
+  [ "$failed" = 0 ] || { echo "build-and-test: a ThreadSanitizer run failed" >&2; exit 1; }
   elapsed "ThreadSanitizer build and tests" "$start"
 fi
 
@@ -109,6 +135,10 @@ if has_stage cross; then
   # The ARM test suites run mavlink_interop too, with the node-mavlink set up in the first build directory.
   modules_dir=build-san
   has_stage sanitize || modules_dir=build-cross-interop
+  if [ -n "$prepare_pid" ]; then
+    wait "$prepare_pid" || { cat build-logs/cross-prepare.log; echo "build-and-test: cross preparation failed" >&2; exit 1; }
+    cat build-logs/cross-prepare.log
+  fi
   tests/integration/mavlink_interop/setup.sh "$modules_dir"
   # shellcheck disable=SC2086
   AIRSEG_INTEROP_MODULES="$(cd "$modules_dir" && pwd)/mavlink_interop/node_modules" \
