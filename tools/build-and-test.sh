@@ -92,7 +92,7 @@ if has_stage fuzz; then
   mkdir -p build-san/fuzz-logs
   # One target per core; each log ends with libFuzzer's final statistics.
   printf '%s\n' "${targets[@]}" | xargs -P "$jobs" -I{} sh -c \
-    'AIRSEG_FUZZ_BUILD_DIR=build-san tests/fuzz/run.sh {} '"$seconds"' >build-san/fuzz-logs/{}.log 2>&1 \
+    'AIRSEG_FUZZ_BUILD_DIR=build-san AIRSEG_FUZZ_PREBUILT=1 tests/fuzz/run.sh {} '"$seconds"' >build-san/fuzz-logs/{}.log 2>&1 \
        || { echo "fuzz: {} FAILED"; tail -n 40 build-san/fuzz-logs/{}.log; exit 255; }'
   for t in "${targets[@]}"; do
     runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "build-san/fuzz-logs/$t.log")

@@ -238,7 +238,8 @@ void GroundlinkService::on_joystick(const protocol::Joystick& joystick) {
 void GroundlinkService::on_event(const TransportEvent& event) {
     switch (event.kind) {
         case TransportEvent::Kind::link_up:
-            spdlog::info("groundlink: link up ({} key)", ground_role() == Role::Control ? "control" : "monitor");
+            spdlog::info("groundlink: link up ({} key)",
+                         ground_role() == Role::Control ? "control" : "monitor");
             break;
         case TransportEvent::Kind::link_down:
             spdlog::warn("groundlink: link down");
@@ -419,6 +420,7 @@ void GroundlinkService::publish_status() {
     g["framing_errors"] = s.framing_errors;
     g["mac_failures"] = s.mac_failures;
     g["replays"] = s.replays;
+    g["oversized"] = s.oversized;
     g["peer_restarts"] = s.peer_restarts;
     g["commands"] = commands_;
     g["commands_refused"] = commands_refused_;

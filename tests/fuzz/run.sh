@@ -4,7 +4,8 @@
 # TARGET is fuzz_<area>_<what>; its seeds are tests/fuzz/corpus/<area>/. New inputs go to a working corpus in
 # the build directory (the repository's seeds are not modified); a crash is written to
 # BUILD/fuzz-artifacts/TARGET/ and the script exits non-zero. The build directory is build-fuzz at the
-# repository root unless AIRSEG_FUZZ_BUILD_DIR says otherwise. Needs clang (Debian: clang, libclang-rt-dev
+# repository root unless AIRSEG_FUZZ_BUILD_DIR says otherwise; AIRSEG_FUZZ_PREBUILT=1 skips configuring and
+# building (the target must be built there already). Needs clang (Debian: clang, libclang-rt-dev
 # ships with it).
 set -eu
 if [ $# -lt 2 ]; then
@@ -22,11 +23,17 @@ if [ -z "$area" ]; then
     exit 2
 fi
 
-# Tests stay configured (not built): the fuzz targets share the test tree's CMake files.
-CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    -DAIRSEG_BUILD_FUZZ=ON -DAIRSEG_BUILD_TESTS=ON \
-    -DAIRSEG_SANITIZE=fuzzer-no-link,address,undefined >/dev/null
-cmake --build "$build" -j2 --target "$target"
+if [ "${AIRSEG_FUZZ_PREBUILT:-0}" = 1 ]; then
+    # The caller built the targets already (CI's sanitize stage); several runs at once must not
+    # regenerate the same build directory.
+    [ -x "$build/tests/fuzz/$target" ] || { echo "$0: $build/tests/fuzz/$target is not built" >&2; exit 2; }
+else
+    # Tests stay configured (not built): the fuzz targets share the test tree's CMake files.
+    CC=clang CXX=clang++ cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+        -DAIRSEG_BUILD_FUZZ=ON -DAIRSEG_BUILD_TESTS=ON \
+        -DAIRSEG_SANITIZE=fuzzer-no-link,address,undefined >/dev/null
+    cmake --build "$build" -j2 --target "$target"
+fi
 
 work="$build/fuzz-corpus/$target"
 artifacts="$build/fuzz-artifacts/$target/"

@@ -13,8 +13,8 @@ std::optional<std::vector<std::uint8_t>> FastReassembly::add(const frame::FastCh
             auto oldest =
                 std::min_element(partial_.begin(), partial_.end(),
                                  [](const Partial& a, const Partial& b) { return a.started < b.started; });
+            dropped_ += oldest->discarding ? 0 : 1;
             partial_.erase(oldest);
-            ++dropped_;
         }
         Partial p;
         p.priority = c.priority;
@@ -28,12 +28,15 @@ std::optional<std::vector<std::uint8_t>> FastReassembly::add(const frame::FastCh
         it = std::prev(partial_.end());
     }
     Partial& p = *it;
-    if (p.have[c.index]) {
+    if (p.discarding || p.have[c.index]) {
         return std::nullopt;
     }
     if (p.bytes + c.data.size() > max_message_) {
-        partial_.erase(it);
+        // Kept, empty, until it expires: the message's remaining fragments are ignored, not started afresh.
+        p.discarding = true;
+        p.pieces = {};
         ++dropped_;
+        ++oversized_;
         return std::nullopt;
     }
     p.have[c.index] = true;
@@ -52,9 +55,12 @@ std::optional<std::vector<std::uint8_t>> FastReassembly::add(const frame::FastCh
 }
 
 std::size_t FastReassembly::expire(TimePoint now) {
-    const auto before = partial_.size();
-    std::erase_if(partial_, [&](const Partial& p) { return p.started + timeout_ <= now; });
-    const std::size_t n = before - partial_.size();
+    std::size_t n = 0;
+    std::erase_if(partial_, [&](const Partial& p) {
+        const bool expired = p.started + timeout_ <= now;
+        n += expired && !p.discarding ? 1 : 0;  // an oversized one was counted when it was dropped
+        return expired;
+    });
     dropped_ += n;
     return n;
 }

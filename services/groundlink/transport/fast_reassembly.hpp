@@ -25,6 +25,8 @@ class FastReassembly {
     std::size_t expire(TimePoint now);
     [[nodiscard]] TimePoint next_deadline() const;
     [[nodiscard]] std::uint64_t dropped() const { return dropped_; }
+    /// Of those, messages that grew beyond max_message_size (only a misbehaving peer sends those).
+    [[nodiscard]] std::uint64_t oversized() const { return oversized_; }
     void reset() { partial_.clear(); }
 
   private:
@@ -38,11 +40,13 @@ class FastReassembly {
         std::vector<std::vector<std::uint8_t>> pieces;
         std::vector<bool> have;
         TimePoint started{};
+        bool discarding = false;  // grew beyond max_message_size: its remaining fragments are ignored
     };
     Duration timeout_;
     std::size_t max_message_;
     std::vector<Partial> partial_;
     std::uint64_t dropped_ = 0;
+    std::uint64_t oversized_ = 0;
 };
 
 }  // namespace airseg::groundlink

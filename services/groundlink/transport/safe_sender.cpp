@@ -154,7 +154,8 @@ SafeSender::AckResult SafeSender::on_ack(const frame::AckChunk& ack, TimePoint n
 
 std::size_t SafeSender::on_timeout(TimePoint now, Duration rto) {
     if (probe_) {
-        // Only the probe is timed until an acknowledgement arrives; it goes again, backed off, if it times out.
+        // Only the probe is timed until an acknowledgement arrives; it goes again, backed off, if it times
+        // out.
         InFlight& p = inflight_[static_cast<std::size_t>(*probe_ - una_)];
         if (p.lost || p.last_sent + rto > now) {
             return 0;

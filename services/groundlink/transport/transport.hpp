@@ -203,6 +203,7 @@ struct LinkStats {
     std::uint64_t mac_failures = 0;    ///< CRC fine, MAC wrong: forged, stale session or wrong key
     std::uint64_t replays = 0;    ///< authentic frames already seen or too old (redundant copies included)
     std::uint64_t malformed = 0;  ///< authentic frames whose content does not parse
+    std::uint64_t oversized = 0;  ///< messages dropped for growing beyond max_message_size (Safe or Fast)
     std::uint64_t hellos_sent = 0;
     std::uint64_t hellos_received = 0;
     std::uint64_t peer_restarts = 0;

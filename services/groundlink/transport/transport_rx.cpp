@@ -169,7 +169,9 @@ void Transport::Impl::on_safe(const frame::SafeChunk& c, TimePoint now) {
         return;
     }
     SafeReceiver& rx = receivers[c.channel];
+    const auto oversized_before = rx.oversize_dropped();
     const auto result = rx.on_segment(c);
+    stats.oversized += rx.oversize_dropped() - oversized_before;
     if (!ack.needed) {
         ack.first = now;
     }
@@ -207,8 +209,10 @@ void Transport::Impl::on_fast(const frame::FastChunk& c, TimePoint now) {
         whole.emplace(c.data.begin(), c.data.end());
     } else {
         const auto before = reassembly.dropped();
+        const auto oversized_before = reassembly.oversized();
         whole = reassembly.add(c, now);
         stats.rx_fast.drops += reassembly.dropped() - before;
+        stats.oversized += reassembly.oversized() - oversized_before;
     }
     if (!whole) {
         return;

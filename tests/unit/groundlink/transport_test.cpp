@@ -514,6 +514,28 @@ TEST(GroundlinkTransport, AnEndThatHearsNoAcknowledgementsProbesInsteadOfFilling
     EXPECT_FALSE(link.livelocked());
 }
 
+TEST(GroundlinkTransport, AnOversizedMessageIsDroppedCountedAndTheChannelGoesOn) {
+    // A peer configured for larger messages (or a misbehaving one): the receiver drops what exceeds its own
+    // max_message_size, counts it, and still acknowledges the segments so the messages behind it flow.
+    TransportConfig big = base_config(1);
+    big.max_message_size = 64 * 1024;
+    TransportConfig small = base_config(2);
+    small.max_message_size = 1024;
+    SimLink link(big, small, one_path(), 17);
+    link.run_for(2s);
+    ASSERT_TRUE(link.b().core->session_established());
+    ASSERT_EQ(link.a().core->send_safe(3, pattern(4000, 1), link.now()), SendResult::accepted);
+    ASSERT_EQ(link.a().core->send_safe(3, pattern(100, 2), link.now()), SendResult::accepted);
+    link.a().core->send_fast(1, 7, pattern(3000, 3), link.now());
+    link.run_until(link.now() + 30s,
+                   [&] { return count_safe(link.b(), 3) == 1 && link.a().core->safe_pending(3) == 0; });
+    ASSERT_EQ(link.b().received.size(), 1U);
+    EXPECT_EQ(link.b().received[0].bytes, pattern(100, 2));
+    EXPECT_EQ(link.b().core->stats().oversized, 2U);
+    EXPECT_EQ(link.a().core->safe_pending(3), 0U);
+    EXPECT_EQ(link.a().core->stats().oversized, 0U);
+}
+
 TEST(GroundlinkTransport, LinkGoesDownAfterSilenceAndComesBack) {
     SimLink link(base_config(1), base_config(2), one_path(), 15);
     link.run_for(3s);
