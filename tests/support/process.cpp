@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -67,11 +68,22 @@ std::string source_path(const std::string& relative) {
 Subprocess::Subprocess(std::vector<std::string> argv, std::map<std::string, std::string> env,
                        const std::string& log_dir) {
     const std::string name = std::filesystem::path(argv.at(0)).filename().string();
-    out_path_ = log_dir + "/" + name + "." + std::to_string(::getpid()) + ".out";
-    err_path_ = log_dir + "/" + name + "." + std::to_string(::getpid()) + ".err";
-    for (int n = 1; std::filesystem::exists(out_path_); ++n) {
-        out_path_ = log_dir + "/" + name + "." + std::to_string(n) + ".out";
-        err_path_ = log_dir + "/" + name + "." + std::to_string(n) + ".err";
+    // The output files are claimed here, before the spawn: the child's own open may come later (qemu-user
+    // runs posix_spawn's vfork as a fork and does not wait for it), and two children given the same file
+    // would interleave their output in it.
+    for (int n = 0;; ++n) {
+        const std::string stem =
+            log_dir + "/" + name + "." + std::to_string(::getpid()) + "." + std::to_string(n);
+        const int fd = ::open((stem + ".out").c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+        if (fd >= 0) {
+            ::close(fd);
+            out_path_ = stem + ".out";
+            err_path_ = stem + ".err";
+            break;
+        }
+        if (errno != EEXIST) {
+            throw std::runtime_error("cannot create " + stem + ".out: " + std::strerror(errno));
+        }
     }
     std::map<std::string, std::string> merged;
     for (char** e = environ; *e != nullptr; ++e) {

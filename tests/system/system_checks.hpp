@@ -13,8 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "services/flightplan/expander.hpp"
-#include "services/flightplan/plan_loader.hpp"
+#include "tests/support/reached_log.hpp"
 #include "tests/support/system_bench.hpp"
 
 namespace airseg::test::sys {
@@ -102,45 +101,6 @@ inline void expect_daemon_alive(SystemBench& bench) {
 
 // ---- plans ---------------------------------------------------------------------------------------------
 
-using E7 = std::pair<std::int64_t, std::int64_t>;
-
-struct Reached {
-    std::uint64_t n = 0;
-    double t = 0;
-    E7 at;
-};
-
-/// The simulator's log of reached items numbered `from` on.
-inline std::vector<Reached> reached_log(ControlClient& sim, std::uint64_t from = 0) {
-    std::vector<Reached> out;
-    for (;;) {
-        const auto page = sim.json("reached " + std::to_string(from) + " 500");
-        if (!page.is_object() || !page["reached"].is_array()) {
-            return out;
-        }
-        EXPECT_LE(page.value("first_kept", 0ull), from) << "the simulator's reached log overflowed";
-        for (const auto& r : page["reached"]) {
-            out.push_back(
-                {r["n"].get<std::uint64_t>(),
-                 r["t"].get<double>(),
-                 {std::llround(r["lat"].get<double>() * 1e7), std::llround(r["lon"].get<double>() * 1e7)}});
-        }
-        if (page["reached"].size() < 500) {
-            return out;
-        }
-        from = out.back().n + 1;
-    }
-}
-
-inline std::uint64_t reached_total(ControlClient& sim) {
-    return sim.json("reached 0 1").value("total", 0ull);
-}
-
-/// MISSION_ITEM carries float degrees: about 0.4 m apart here; waypoints are metres apart.
-inline bool same_place(const E7& a, const E7& b) {
-    return std::llabs(a.first - b.first) <= 40 && std::llabs(a.second - b.second) <= 40;
-}
-
 /// A straight line of `count` waypoints north of home, `step` metres apart.
 inline std::string line_plan(const std::string& name, int count, double step, double east_m = 8) {
     std::ostringstream o;
@@ -152,20 +112,6 @@ inline std::string line_plan(const std::string& name, int count, double step, do
           << ", lon: " << lon + east_m / (111320.0 * std::cos(lat * std::numbers::pi / 180.0)) << "}\n";
     }
     return o.str();
-}
-
-inline std::vector<E7> expected_positions(const std::string& plan_file) {
-    auto loaded = flightplan::load_plan_file(plan_file);
-    EXPECT_TRUE(loaded.ok()) << flightplan::to_string(loaded.errors);
-    std::vector<E7> out;
-    if (!loaded.ok()) {
-        return out;
-    }
-    flightplan::Expander stream(loaded.plan);
-    while (auto w = stream.next()) {
-        out.emplace_back(std::llround(w->position.lat * 1e7), std::llround(w->position.lon * 1e7));
-    }
-    return out;
 }
 
 inline Json plan_section(SystemBench& bench) {

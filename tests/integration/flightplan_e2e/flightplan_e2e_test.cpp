@@ -25,6 +25,7 @@
 #include "services/flightplan/plan_loader.hpp"
 #include "tests/support/control_client.hpp"
 #include "tests/support/process.hpp"
+#include "tests/support/reached_log.hpp"
 
 namespace airseg::test {
 namespace {
@@ -52,66 +53,11 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 
 using SimControl = ControlClient;
 
-struct Reached {
-    std::uint64_t n = 0;
-    double t = 0;
-    double lat = 0, lon = 0;
-};
-/// Every reached event numbered `from` on, from the simulator's log.
-std::vector<Reached> reached_log(ControlClient& sim, std::uint64_t from = 0) {
-    std::vector<Reached> out;
-    for (;;) {
-        const auto page = sim.json("reached " + std::to_string(from) + " 500");
-        if (!page.is_object() || !page["reached"].is_array()) {
-            return out;
-        }
-        EXPECT_LE(page.value("first_kept", 0ull), from) << "the simulator's reached log overflowed";
-        for (const auto& r : page["reached"]) {
-            out.push_back({r["n"].get<std::uint64_t>(), r["t"].get<double>(), r["lat"].get<double>(),
-                           r["lon"].get<double>()});
-        }
-        if (page["reached"].size() < 500) {
-            return out;
-        }
-        from = out.back().n + 1;
-    }
-}
-std::uint64_t reached_total(ControlClient& sim) {
-    return sim.json("reached 0 1").value("total", 0ull);
-}
-
 struct Answer {
     int exit_code = -1;
     Json json;
     std::string err;
 };
-
-using E7 = std::pair<std::int64_t, std::int64_t>;
-
-/// The positions a plan expands to, as the autopilot stores them (1e-7 degree integers).
-std::vector<E7> expected_positions(const std::string& plan_file) {
-    auto loaded = flightplan::load_plan_file(plan_file);
-    EXPECT_TRUE(loaded.ok()) << flightplan::to_string(loaded.errors);
-    std::vector<std::pair<std::int64_t, std::int64_t>> out;
-    if (!loaded.ok()) {
-        return out;
-    }
-    flightplan::Expander stream(loaded.plan);
-    while (auto w = stream.next()) {
-        out.emplace_back(std::llround(w->position.lat * 1e7), std::llround(w->position.lon * 1e7));
-    }
-    return out;
-}
-
-E7 e7(const Reached& r) {
-    return {std::llround(r.lat * 1e7), std::llround(r.lon * 1e7)};
-}
-
-/// APM:Rover 2.x takes mission items as MISSION_ITEM, in float degrees: about 4e-6 degree (0.4 m) between
-/// neighbouring floats at this latitude. Waypoints are metres apart, so this still tells them apart.
-bool same_place(const E7& a, const E7& b) {
-    return std::llabs(a.first - b.first) <= 40 && std::llabs(a.second - b.second) <= 40;
-}
 
 std::string scan_plan(const std::string& name, double north_m, double east_m, double spacing) {
     // A rectangle north-east of home, lines east-west, a waypoint every `spacing` metres along each line.
@@ -297,11 +243,11 @@ TEST_F(FlightplanE2e, LongScanRunsToTheEndWithEveryWaypointReachedOnceInOrderAnd
     const auto reached = reached_log(*control_, first);
     ASSERT_GE(reached.size(), expected.size());
     for (std::size_t i = 0; i < expected.size(); ++i) {
-        ASSERT_PRED2(same_place, e7(reached[i]), expected[i])
+        ASSERT_PRED2(same_place, reached[i].at, expected[i])
             << "reached #" << i << " is not plan waypoint " << i;
     }
     for (std::size_t i = expected.size(); i < reached.size(); ++i) {
-        EXPECT_PRED2(same_place, e7(reached[i]), expected.back()) << "after the end, only the final stop";
+        EXPECT_PRED2(same_place, reached[i].at, expected.back()) << "after the end, only the final stop";
     }
     EXPECT_LE(reached.size(), expected.size() + 1);
     // Zero HOLDs: the window never ran dry.
@@ -333,7 +279,7 @@ TEST_F(FlightplanE2e, ReplacingThePlanMidRouteHeadsForTheNewFirstWaypointWithout
     const auto reached = reached_log(*control_, first);
     // A from its first waypoint without a gap, then B from its first waypoint to its end.
     std::size_t i = 0;
-    while (i < reached.size() && i < a.size() && same_place(e7(reached[i]), a[i])) {
+    while (i < reached.size() && i < a.size() && same_place(reached[i].at, a[i])) {
         ++i;
     }
     const std::size_t a_done = i;
@@ -341,7 +287,7 @@ TEST_F(FlightplanE2e, ReplacingThePlanMidRouteHeadsForTheNewFirstWaypointWithout
     ASSERT_LT(a_done, a.size()) << "the replacement came too late";
     for (std::size_t k = 0; k < b.size(); ++k, ++i) {
         ASSERT_LT(i, reached.size());
-        ASSERT_PRED2(same_place, e7(reached[i]), b[k])
+        ASSERT_PRED2(same_place, reached[i].at, b[k])
             << "after " << a_done << " waypoints of A, reached #" << i << " is not B's waypoint " << k;
     }
     // Once the new plan was confirmed, at most the target the vehicle was already heading for was reached.
@@ -391,11 +337,11 @@ TEST_F(FlightplanE2e, KillNineMidPlanThenRestartResumesAtTheFirstUnreachedWaypoi
         }
     }
     ASSERT_FALSE(after.empty());
-    EXPECT_PRED2(same_place, e7(after[0]), expected[saved_next])
+    EXPECT_PRED2(same_place, after[0].at, expected[saved_next])
         << "resumed elsewhere than waypoint " << saved_next;
     for (std::size_t k = 0; saved_next + k < expected.size(); ++k) {
         ASSERT_LT(k, after.size());
-        ASSERT_PRED2(same_place, e7(after[k]), expected[saved_next + k]) << "waypoint " << saved_next + k;
+        ASSERT_PRED2(same_place, after[k].at, expected[saved_next + k]) << "waypoint " << saved_next + k;
     }
 }
 
@@ -489,7 +435,7 @@ TEST_F(FlightplanE2e, SkipPauseResumeAndAppendAreConfirmedByTheBoard) {
     // appended waypoints in order.
     const auto reached = reached_log(*control_, first);
     std::size_t i = 0;
-    while (i < reached.size() && i < route.size() && same_place(e7(reached[i]), route[i])) {
+    while (i < reached.size() && i < route.size() && same_place(reached[i].at, route[i])) {
         ++i;
     }
     ASSERT_GE(i, 3u);
@@ -498,7 +444,7 @@ TEST_F(FlightplanE2e, SkipPauseResumeAndAppendAreConfirmedByTheBoard) {
     rest.insert(rest.end(), extra.begin(), extra.end());
     for (std::size_t k = 0; k < rest.size(); ++k, ++i) {
         ASSERT_LT(i, reached.size());
-        ASSERT_PRED2(same_place, e7(reached[i]), rest[k]) << "after the skip, #" << k;
+        ASSERT_PRED2(same_place, reached[i].at, rest[k]) << "after the skip, #" << k;
     }
 }
 
