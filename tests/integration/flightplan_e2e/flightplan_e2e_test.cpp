@@ -256,10 +256,11 @@ TEST_F(FlightplanE2e, LongScanRunsToTheEndWithEveryWaypointReachedOnceInOrderAnd
 }
 
 TEST_F(FlightplanE2e, ReplacingThePlanMidRouteHeadsForTheNewFirstWaypointWithoutStopping) {
-    // A's legs take 0.5 s of real time at this speedup: the new plan's first item is written well within
-    // one leg even on a loaded machine. With shorter legs the vehicle can reach the kept target before that
-    // write, and then the feeder rightly holds rather than let it drive to a stale slot.
-    const auto a_file = write_plan("a.yaml", line_plan("route-a", kHomeLat, kHomeLon + 0.0001, 0, 20, 100));
+    // A's legs take 1 s of real time at this speedup, and the new plan goes in just after the board has
+    // reached a waypoint: its first item is then written well within the leg even under qemu on a loaded
+    // machine. Loaded near a leg's end, the vehicle can reach the kept target before that write, and then the
+    // feeder rightly holds rather than let it drive to a stale slot.
+    const auto a_file = write_plan("a.yaml", line_plan("route-a", kHomeLat, kHomeLon + 0.0001, 0, 20, 200));
     const auto b_file =
         write_plan("b.yaml", line_plan("route-b", kHomeLat + 0.0005, kHomeLon + 0.0010, 90, 20, 8));
     const auto a = expected_positions(a_file);
@@ -270,6 +271,9 @@ TEST_F(FlightplanE2e, ReplacingThePlanMidRouteHeadsForTheNewFirstWaypointWithout
 
     ASSERT_EQ(ctl({"plan", "load", a_file}).exit_code, 0);
     ASSERT_TRUE(wait_until([&] { return show().value("waypoints_reached", 0) >= 8; }, kGenerous, kPoll));
+    const auto leg_started = reached_total(*control_);
+    ASSERT_TRUE(wait_until([&] { return reached_total(*control_) > leg_started; }, kGenerous,
+                           std::chrono::milliseconds(5)));
     auto replaced = ctl({"plan", "load", b_file});
     ASSERT_EQ(replaced.exit_code, 0) << replaced.json.dump() << replaced.err;
     const auto reached_at_answer = reached_total(*control_);
