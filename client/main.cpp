@@ -64,9 +64,10 @@ const char* kUsageText =
     "                     drive in MANUAL_NAVIGATION from a joystick, or the keyboard without --device\n"
     "                     (w/s/a/d or arrows, space centres, q quits); inputs go at --rate (default 10 Hz)\n"
     "  request JSON       send one raw request object, e.g. '{\"cmd\":\"status\"}', print the answer\n"
-    "  plan load FILE | append FILE | show | skip N|NAME | pause | resume\n"
+    "  plan load FILE [--paused] | append FILE | show | skip N|NAME | pause | resume\n"
     "                     the flight plan: answered once the autopilot has confirmed (see "
-    "docs/flight-plan.md)\n"
+    "docs/flight-plan.md);\n"
+    "                     a loaded plan drives at once, or waits for plan resume with --paused\n"
     "\n"
     "Exit codes: 0 done, 1 refused by the vehicle, 2 usage, 3 no link (no answer in time).\n";
 

@@ -52,7 +52,7 @@ std::optional<nlohmann::json> file_request(const std::string& cmd, const std::st
 std::string render_plan(const nlohmann::json& r) {
     std::ostringstream o;
     for (const char* key : {"state", "name", "source", "element", "waypoints_reached", "next_waypoint",
-                            "window", "reaction", "error"}) {
+                            "window", "reaction", "interruption", "error"}) {
         if (r.contains(key)) {
             o << "plan." << key << std::string(18 - std::string(key).size(), ' ') << show_value(r[key])
               << "\n";
@@ -88,8 +88,27 @@ PlanCommand plan_command(const std::vector<std::string>& args, bool local) {
         }
         return true;
     };
-    if (sub == "load" || sub == "append") {
-        if (want(2, sub == "load" ? "load FILE" : "append FILE")) {
+    if (sub == "load") {
+        // plan load FILE [--paused]: the plan drives at once unless --paused.
+        std::vector<std::string> files;
+        bool paused = false;
+        for (std::size_t i = 1; i < args.size(); ++i) {
+            if (args[i] == "--paused") {
+                paused = true;
+            } else {
+                files.push_back(args[i]);
+            }
+        }
+        if (files.size() != 1) {
+            out.error = "usage: plan load FILE [--paused]";
+            return out;
+        }
+        out.request = file_request("plan.load", files[0], local, out.error);
+        if (out.request && paused) {
+            (*out.request)["paused"] = true;
+        }
+    } else if (sub == "append") {
+        if (want(2, "append FILE")) {
             out.request = file_request("plan." + sub, args[1], local, out.error);
         }
     } else if (sub == "show" || sub == "pause" || sub == "resume") {

@@ -51,6 +51,9 @@ AutopilotSetup autopilot_setup(const Config& config) {
     if (a.reset_on_open != "auto") {
         ap.reset_on_open = a.reset_on_open == "true";
     }
+    ap.gcs_heartbeat = a.gcs_heartbeat != "off";
+    ap.gcs_heartbeat_type = a.gcs_heartbeat == "onboard" ? autopilot::kMavTypeOnboardController
+                                                          : autopilot::kMavTypeGcs;
     ap.boot_timeout = a.boot_timeout;
     ap.heartbeat_timeout = a.heartbeat_timeout;
     ap.mode_timeout = a.mode_timeout;

@@ -43,6 +43,9 @@ nlohmann::json autopilot_status_json(const autopilot::AutopilotStatus& s) {
     j["reboots"] = s.reboots;
     j["reconnects"] = s.reconnects;
     j["reset_pulses"] = s.reset_pulses;
+    j["speed"] = s.speed ? nlohmann::json(*s.speed) : nlohmann::json(nullptr);
+    j["mission_items"] = s.mission_items;
+    j["auto_restarts_corrected"] = s.auto_restarts_corrected;
     j["baud"] = s.baud;
     if (s.tlog_enabled) {
         // A recorder that cannot write (disk full, read-only) is reported; the daemon goes on without it.

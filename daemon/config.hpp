@@ -22,6 +22,7 @@ struct AutopilotConfig {
     int baud = 115200;                      // autopilot.baud
     std::vector<int> bauds;                 // autopilot.bauds: tried in turn when non-empty
     milliseconds baud_probe{3'000};         // autopilot.baud_probe: time for a valid frame at one rate
+    std::string gcs_heartbeat = "gcs";       // autopilot.gcs_heartbeat: gcs | onboard | off
     std::string reset_on_open = "auto";     // autopilot.reset_on_open: auto (= board is apm2) | true | false
     milliseconds reconnect_min{500};        // autopilot.reconnect_min
     milliseconds reconnect_max{10'000};     // autopilot.reconnect_max

@@ -355,6 +355,11 @@ std::vector<KeySpec> build_schema() {
         "autopilot.reset_on_open", [](Config& c) -> std::string& { return c.autopilot.reset_on_open; },
         {"auto", "true", "false"},
         "the board reboots when its port is opened; auto = true for apm2 (USB), false for pixhawk"));
+    s.push_back(choice(
+        "autopilot.gcs_heartbeat", [](Config& c) -> std::string& { return c.autopilot.gcs_heartbeat; },
+        {"gcs", "onboard", "off"},
+        "our 1 Hz HEARTBEAT to the autopilot, as MAV_TYPE_GCS or MAV_TYPE_ONBOARD_CONTROLLER (ArduPilot's GCS "
+        "failsafe counts heartbeats from SYSID_MYGCS, 255, our system id), or none"));
     s.push_back(duration(
         "autopilot.reconnect_min", [](Config& c) -> milliseconds& { return c.autopilot.reconnect_min; },
         milliseconds(10), seconds(60), "first retry delay after the port could not be opened or was lost"));

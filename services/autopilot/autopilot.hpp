@@ -194,9 +194,12 @@ struct AutopilotStatus {
     std::optional<Position> position;            // autopilot.position
     std::uint16_t mission_current = 0;           // autopilot.mission_current
     unsigned reboots = 0;                        // autopilot.reboots
-    unsigned reconnects = 0;    // autopilot.reconnects (filled by the service from its port keeper)
-    unsigned reset_pulses = 0;  // autopilot.reset_pulses
-    unsigned baud = 0;          // autopilot.baud: the rate the port runs at (the one kept when probing)
+    unsigned reconnects = 0;            // autopilot.reconnects (filled by the service from its port keeper)
+    unsigned reset_pulses = 0;          // autopilot.reset_pulses
+    std::optional<double> speed;        // autopilot.speed: the leg speed the board last confirmed, m/s
+    std::string mission_items = "int";  // autopilot.mission_items: "int" (MISSION_ITEM_INT) or "float"
+    unsigned auto_restarts_corrected = 0;  // autopilot.auto_restarts_corrected: slots set back after AUTO
+    unsigned baud = 0;  // autopilot.baud: the rate the port runs at (the one kept when probing)
     // autopilot.tlog (filled by the service from its .tlog writer; absent when recording is off)
     bool tlog_enabled = false;
     std::uint64_t tlog_write_errors = 0;    // autopilot.tlog.write_errors

@@ -70,6 +70,10 @@ struct MissionConfig {
     std::uint16_t max_items = 700;  // autopilot.mission.max_items
 };
 
+/// MAV_TYPE values our own HEARTBEAT can carry.
+inline constexpr std::uint8_t kMavTypeGcs = 6;
+inline constexpr std::uint8_t kMavTypeOnboardController = 18;
+
 struct AutopilotConfig {
     Board board = Board::Apm2;                // autopilot.board: apm2 | pixhawk
     std::vector<unsigned> bauds = {115200};   // autopilot.baud (one) or autopilot.bauds (tried in turn)
@@ -81,7 +85,8 @@ struct AutopilotConfig {
     std::uint8_t own_compid = 190;            // autopilot.own_compid (MAV_COMP_ID_MISSIONPLANNER)
     std::uint8_t target_sysid = 1;            // autopilot.target_sysid
     std::uint8_t target_compid = 1;           // autopilot.target_compid
-    bool gcs_heartbeat = true;  // autopilot.gcs_heartbeat: send our 1 Hz HEARTBEAT (ArduPilot's GCS failsafe)
+    bool gcs_heartbeat = true;  // autopilot.gcs_heartbeat (off: false): send our 1 Hz HEARTBEAT
+    std::uint8_t gcs_heartbeat_type = kMavTypeGcs;  // autopilot.gcs_heartbeat: gcs | onboard
     int mavlink_version = 1;    // autopilot.mavlink_version: 1 | 2 (default per board)
     bool use_message_interval = false;            // autopilot.use_message_interval (default per board)
     std::vector<StreamRate> stream_rates;         // autopilot.streams: {position: 4, extra1: 4, ...}

@@ -12,6 +12,10 @@ const char* to_string(PlanState state) {
             return "paused";
         case PlanState::Done:
             return "done";
+        case PlanState::Interrupted:
+            return "interrupted";
+        case PlanState::Failed:
+            return "failed";
     }
     return "?";
 }
@@ -36,6 +40,12 @@ const char* to_string(FeederEvent::Kind kind) {
             return "request-failed";
         case FeederEvent::Kind::WindowStarved:
             return "window-starved";
+        case FeederEvent::Kind::Interrupted:
+            return "interrupted";
+        case FeederEvent::Kind::Continued:
+            return "continued";
+        case FeederEvent::Kind::PlanFailed:
+            return "plan-failed";
     }
     return "?";
 }

@@ -54,9 +54,34 @@ struct FeederRequest {
 };
 std::ostream& operator<<(std::ostream& os, const FeederRequest& request);
 
-enum class RequestResult : std::uint8_t { Ok, Failed };
+enum class RequestResult : std::uint8_t {
+    Ok,
+    Failed,   // not confirmed (timeout, link down, busy): asked again
+    Refused,  // the autopilot said no to the content (a mission it does not take): asking again cannot help
+};
 
-enum class PlanState : std::uint8_t { None, Running, Paused, Done };
+/// The autopilot's navigation mode, as far as the feeder cares.
+enum class VehicleMode : std::uint8_t {
+    Unknown,  // link down, booting
+    Auto,     // following its mission (ArduPilot: AUTO)
+    Hold,     // stopped (HOLD)
+    Manual,   // someone drives by hand (the RC pilot, the ground joystick)
+};
+/// Who changed the mode.
+enum class ModeCause : std::uint8_t {
+    Ours,     // this daemon asked for it (the feeder, or an operator's state command)
+    Board,    // the autopilot itself (end of its mission, a failsafe, a mode switch it treats as its own)
+    RcPilot,  // the RC pilot took the vehicle (MANUAL)
+};
+
+enum class PlanState : std::uint8_t {
+    None,
+    Running,
+    Paused,
+    Done,
+    Interrupted,  // the vehicle left AUTO by itself or was taken by hand; why: FeederProgress::interruption
+    Failed,       // the autopilot refused the plan's mission items; why: FeederProgress::failure
+};
 const char* to_string(PlanState state);
 
 struct FeederEvent {
@@ -70,6 +95,9 @@ struct FeederEvent {
         PlanBlocked,    // the stream stopped on an error (detail); the vehicle stops after the last good one
         RequestFailed,  // a request exhausted its retry budget (detail); the vehicle is held
         WindowStarved,  // the next target was not on the autopilot in time; the vehicle is held
+        Interrupted,    // the vehicle left AUTO without the feeder asking (detail: why and what follows)
+        Continued,      // back in AUTO after an interruption
+        PlanFailed,     // the autopilot refused the plan's items (detail: its answer); the vehicle is held
     };
     Kind kind = Kind::WaypointReached;
     std::uint32_t generation = 0;  // which plan (replace_plan increments it)
@@ -93,6 +121,9 @@ struct FeederProgress {
     StreamOrigin resume_origin;
     std::optional<std::uint64_t> resume_index;
     // Health counters.
+    std::string interruption;  // the last interruption (kept after the plan continued), "" if none
+    std::string failure;       // why the plan failed, "" unless state is Failed
+    std::uint64_t interruptions = 0;
     std::uint64_t starvation_holds = 0;
     std::uint64_t ignored_reached = 0;  // duplicate or late reached reports
     std::uint64_t retries = 0;

@@ -154,8 +154,23 @@ void FlightplanService::cmd_load(const Json& req, CommandDispatcher::Reply reply
         reply(CommandResult::fail(CommandStatus::Failed, "cannot keep the plan, nothing changed: " + *err));
         return;
     }
-    spdlog::info("{}{} '{}' from {}", kPrefix, append ? "appended to plan" : "plan", plan.plan->name,
-                 in.source);
+    const auto paused = req.find("paused");
+    if (paused != req.end() && !paused->is_boolean()) {
+        reply(CommandResult::fail(CommandStatus::BadRequest, "\"paused\" must be true or false"));
+        return;
+    }
+    const bool start_paused = paused != req.end() && paused->get<bool>();
+    spdlog::info("{}{} '{}' from {}{}", kPrefix, append ? "appended to plan" : "plan", plan.plan->name,
+                 in.source, start_paused ? ", paused" : "");
+    if (!append) {
+        // A loaded plan is there to be driven, whatever the vehicle did before (parked, a finished plan, a
+        // paused one), unless the operator asked for it to wait.
+        if (start_paused) {
+            feeder_.pause();
+        } else {
+            feeder_.resume();
+        }
+    }
     start_plan(std::move(plan), append, SteadyClock::now());
     wait_for_autopilot(what, std::move(reply));
 }
@@ -245,6 +260,7 @@ Json FlightplanService::progress_json() const {
     j["next_waypoint"] = optional_json(p.next_waypoint);
     j["window"] = p.window;
     j["reaction"] = last_reaction_.empty() ? Json(nullptr) : Json(last_reaction_);
+    j["interruption"] = p.interruption.empty() ? Json(nullptr) : Json(p.interruption);
     j["error"] = problem_.empty() ? Json(nullptr) : Json(problem_);
     return j;
 }

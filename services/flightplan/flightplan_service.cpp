@@ -96,6 +96,8 @@ void FlightplanService::on_start() {
             in_flight_.clear();
             pump();
         }));
+    subscriptions_.push_back(bus.subscribe<autopilot::ModeChanged>(
+        strand(), [this](const autopilot::ModeChanged& m) { on_mode_changed(m); }));
     subscriptions_.push_back(bus.subscribe<autopilot::RequestDone>(
         strand(), [this](const autopilot::RequestDone& d) { on_request_done(d); }));
     subscriptions_.push_back(
@@ -289,6 +291,35 @@ void FlightplanService::on_autopilot_status(const autopilot::AutopilotStatus& s)
     pump();
 }
 
+void FlightplanService::on_mode_changed(const autopilot::ModeChanged& m) {
+    using S = autopilot::VehicleState;
+    VehicleMode mode = VehicleMode::Unknown;
+    switch (m.to) {
+        case S::WaypointNavigation:
+            mode = VehicleMode::Auto;
+            break;
+        case S::Parking:
+            mode = VehicleMode::Hold;
+            break;
+        case S::Directed:
+        case S::ManualNavigation:
+        case S::Manual:
+            mode = VehicleMode::Manual;
+            break;
+        case S::Unknown:
+        case S::ConfigureCheck:
+            break;
+    }
+    ModeCause cause = ModeCause::Board;
+    if (m.cause == autopilot::ModeChangeCause::Requested) {
+        cause = ModeCause::Ours;
+    } else if (m.to == S::Directed) {
+        cause = ModeCause::RcPilot;  // MANUAL that nobody here asked for: the RC transmitter's switch
+    }
+    feeder_.on_mode(mode, cause, SteadyClock::now());
+    pump();
+}
+
 void FlightplanService::on_request_done(const autopilot::RequestDone& done) {
     const auto it = in_flight_.find(done.id);
     if (it == in_flight_.end())
@@ -299,6 +330,10 @@ void FlightplanService::on_request_done(const autopilot::RequestDone& done) {
                   std::chrono::duration_cast<std::chrono::milliseconds>(now - it->second.sent).count());
     in_flight_.erase(it);
     const bool ok = done.result == autopilot::RequestResult::Ok;
+    // A mission the autopilot refused (its answer, after the driver's fallbacks) or one it cannot hold is
+    // final; anything else (timeouts, a busy or reconnecting autopilot) is asked again.
+    const bool refused =
+        done.result == autopilot::RequestResult::Refused || done.result == autopilot::RequestResult::Invalid;
     if (ok) {
         fault_.reset();
     } else {
@@ -306,7 +341,11 @@ void FlightplanService::on_request_done(const autopilot::RequestDone& done) {
                         autopilot::to_string(done.result) +
                         (done.detail.empty() ? "" : " (" + done.detail + ")");
     }
-    feeder_.on_request_result(feeder_id, ok ? RequestResult::Ok : RequestResult::Failed, now);
+    feeder_.on_request_result(feeder_id,
+                              ok        ? RequestResult::Ok
+                              : refused ? RequestResult::Refused
+                                        : RequestResult::Failed,
+                              now, last_failure_);
     pump();
 }
 
@@ -394,6 +433,17 @@ void FlightplanService::handle_event(const FeederEvent& e) {
         case FeederEvent::Kind::WindowStarved:
             spdlog::warn("{}window starved at waypoint {}: holding until it is written", kPrefix,
                          e.plan_index);
+            break;
+        case FeederEvent::Kind::Interrupted:
+            spdlog::warn("{}plan interrupted at waypoint {}: {}", kPrefix, e.plan_index, e.detail);
+            break;
+        case FeederEvent::Kind::Continued:
+            spdlog::info("{}plan continues at waypoint {} after: {}", kPrefix, e.plan_index, e.detail);
+            break;
+        case FeederEvent::Kind::PlanFailed:
+            spdlog::error("{}plan failed, the vehicle is held: {}", kPrefix, e.detail);
+            problem_ = "the autopilot refused the plan: " + e.detail;
+            fail_waiters(problem_);
             break;
     }
     ctx_.bus.publish(e);

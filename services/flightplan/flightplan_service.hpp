@@ -8,7 +8,7 @@
 // plan.pause, plan.resume. A command that changes the vehicle is answered once the autopilot has confirmed
 // everything it required (the feeder has nothing left to ask), or with the failure.
 //
-// Bus: subscribes autopilot::AutopilotStatus, Telemetry, WaypointReached, MissionCurrentChanged,
+// Bus: subscribes autopilot::AutopilotStatus, Telemetry, WaypointReached, MissionCurrentChanged, ModeChanged,
 // AutopilotRebooted, RequestDone, status::StatusSection ("groundlink": the ground link's up/down state);
 // publishes AutopilotRequest, FeederEvent and ReactionTrigger (events) and the "plan" status section.
 // Log prefix: flightplan: .
@@ -84,6 +84,7 @@ class FlightplanService : public Service {
     // autopilot side
     void on_autopilot_status(const autopilot::AutopilotStatus& s);
     void on_request_done(const autopilot::RequestDone& done);
+    void on_mode_changed(const autopilot::ModeChanged& m);
     void send(const FeederRequest& request);
     void pump();
     void handle_event(const FeederEvent& e);

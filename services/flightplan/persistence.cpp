@@ -43,7 +43,8 @@ const char* state_name(PlanState s) {
 }
 
 std::optional<PlanState> parse_state(std::string_view s) {
-    for (auto st : {PlanState::None, PlanState::Running, PlanState::Paused, PlanState::Done}) {
+    for (auto st : {PlanState::None, PlanState::Running, PlanState::Paused, PlanState::Done,
+                    PlanState::Interrupted, PlanState::Failed}) {
         if (s == to_string(st))
             return st;
     }

@@ -23,7 +23,11 @@ ResumeResult resume_from(StoredState stored, const LoadOptions& options) {
         r.progress.plan_digest = r.digest;
         r.progress.state = PlanState::Running;
     }
-    if (r.progress.state != PlanState::Done && r.progress.state != PlanState::None) {
+    if (r.progress.state == PlanState::Interrupted) {
+        r.progress.state = PlanState::Paused;  // taken by hand or stopped by the board: the operator decides
+    }
+    if (r.progress.state != PlanState::Done && r.progress.state != PlanState::None &&
+        r.progress.state != PlanState::Failed) {
         auto stream = std::make_unique<Expander>(r.plan);
         if (!stream->restore(r.progress.origin, r.progress.next_index)) {
             out.problems.push_back("saved position " + std::to_string(r.progress.next_index) +

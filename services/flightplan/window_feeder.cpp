@@ -62,6 +62,9 @@ void WindowFeeder::replace_plan(PlanFeed feed, TimePoint now) {
     hold_until_.reset();
     hold_wp_.reset();
     cleared_ = false;
+    failed_.reset();
+    interrupted_.reset();
+    interrupted_by_hand_ = false;
     const bool keep_head = mission_ok_ && !queue_.empty() && !queue_[0].stop && !need_set_current_ &&
                            ap_target_ == queue_[0].slot;
     if (keep_head) {
@@ -93,6 +96,8 @@ bool WindowFeeder::jump_to(std::string_view element_name, TimePoint now) {
 }
 
 void WindowFeeder::restart(TimePoint now) {
+    interrupted_.reset();  // the operator chose where to go on: taken by hand no more
+    interrupted_by_hand_ = false;
     holds_.clear();
     holding_ = false;
     hold_until_.reset();
@@ -155,6 +160,8 @@ void WindowFeeder::pause() {
 void WindowFeeder::resume() {
     paused_ = false;
     fault_ = false;
+    interrupted_.reset();
+    interrupted_by_hand_ = false;
     // The operator may have taken the vehicle out of AUTO since (MANUAL, a joystick session), which the
     // feeder is not told: resuming asks for the mission again rather than trusting the last confirmed mode.
     mode_ = Mode::Unknown;
@@ -372,6 +379,82 @@ void WindowFeeder::on_current(std::uint16_t slot, TimePoint now) {
     }
 }
 
+bool WindowFeeder::plan_active() const {
+    return (stream_ || !queue_.empty()) && !done_ && !failed_ && !cleared_;
+}
+
+void WindowFeeder::interrupt(std::string why, bool wait_for_operator) {
+    ++counters_.interruptions;
+    interrupted_ = why;
+    interrupted_by_hand_ = wait_for_operator;
+    last_interruption_ = why;
+    const Waypoint* head = queue_.empty() ? nullptr : &queue_[0].wp;
+    emit(FeederEvent::Kind::Interrupted, head, generation_,
+         queue_.empty() ? std::string{} : queue_[0].element_path, std::move(why));
+}
+
+void WindowFeeder::fail_plan(std::string why) {
+    failed_ = why;
+    interrupted_.reset();
+    interrupted_by_hand_ = false;
+    emit(FeederEvent::Kind::PlanFailed, nullptr, generation_, {}, std::move(why));
+}
+
+void WindowFeeder::on_mode(VehicleMode mode, ModeCause cause, TimePoint) {
+    const Mode before = mode_;
+    switch (mode) {
+        case VehicleMode::Unknown:
+            mode_ = Mode::Unknown;
+            return;
+        case VehicleMode::Auto:
+            mode_ = Mode::Auto;
+            if (interrupted_ && (!interrupted_by_hand_ || cause == ModeCause::Ours)) {
+                // Back in AUTO: by the feeder after the board's own HOLD, or by an operator's state command.
+                interrupted_.reset();
+                interrupted_by_hand_ = false;
+                const Waypoint* head = queue_.empty() ? nullptr : &queue_[0].wp;
+                emit(FeederEvent::Kind::Continued, head, generation_,
+                     queue_.empty() ? std::string{} : queue_[0].element_path, last_interruption_);
+            }
+            return;
+        case VehicleMode::Hold:
+            mode_ = Mode::Hold;
+            break;
+        case VehicleMode::Manual:
+            mode_ = Mode::Manual;
+            break;
+    }
+    // Only leaving AUTO while the plan wants AUTO is news.
+    if (before != Mode::Auto || !plan_active() || desired_mode() != Mode::Auto || interrupted_) {
+        return;
+    }
+    const bool ours = outstanding_ && (std::holds_alternative<HoldVehicle>(outstanding_->request.op) ||
+                                       std::holds_alternative<ResumeMission>(outstanding_->request.op));
+    if (cause == ModeCause::Ours) {
+        if (ours) {
+            return;
+        }
+        if (mode_ == Mode::Hold) {
+            paused_ = true;  // an operator's state command to PARKING: the plan waits for resume
+            return;
+        }
+        interrupt("the operator took the vehicle (manual navigation); plan resume continues", true);
+        return;
+    }
+    if (cause == ModeCause::RcPilot || mode_ == Mode::Manual) {
+        interrupt("the RC pilot took the vehicle (MANUAL); plan resume continues", true);
+        return;
+    }
+    // The board's own HOLD: it ran out of items, took a DO_JUMP its own way, or a switch or failsafe held
+    // it. What it now heads for is unknown: point it at the head again, then AUTO.
+    need_set_current_ = true;
+    ap_target_.reset();
+    interrupt(
+        "the autopilot left AUTO for HOLD by itself (end of its mission, a failsafe or a mode switch); "
+        "continuing at the next waypoint",
+        false);
+}
+
 void WindowFeeder::on_autopilot_rebooted(TimePoint) {
     mission_ok_ = false;
     std::fill(confirmed_.begin(), confirmed_.end(), std::nullopt);
@@ -384,7 +467,8 @@ void WindowFeeder::on_autopilot_rebooted(TimePoint) {
         paused_ = true;
 }
 
-void WindowFeeder::on_request_result(std::uint32_t id, RequestResult result, TimePoint now) {
+void WindowFeeder::on_request_result(std::uint32_t id, RequestResult result, TimePoint now,
+                                     std::string_view detail) {
     if (!outstanding_ || outstanding_->request.id != id)
         return;  // stale: retried or reset since
     const FeederRequest request = std::move(outstanding_->request);
@@ -392,6 +476,16 @@ void WindowFeeder::on_request_result(std::uint32_t id, RequestResult result, Tim
     if (result == RequestResult::Ok) {
         consecutive_failures_ = 0;
         request_succeeded(request);
+        return;
+    }
+    const bool writes_items =
+        std::holds_alternative<UploadMission>(request.op) || std::holds_alternative<WriteItems>(request.op);
+    if (result == RequestResult::Refused && writes_items) {
+        // The board does not take these items (the driver has already tried the forms it knows): asking
+        // again every fault_backoff would never end. The vehicle is held and the plan ends here.
+        consecutive_failures_ = 0;
+        fail_plan(detail.empty() ? std::string("the autopilot refused the mission items")
+                                 : std::string(detail));
         return;
     }
     request_failed(now);
@@ -452,6 +546,10 @@ void WindowFeeder::handle_timeout(TimePoint now) {
 // ---- outputs -------------------------------------------------------------------------------------------
 
 std::optional<WindowFeeder::Mode> WindowFeeder::desired_mode() const {
+    if (failed_)
+        return Mode::Hold;
+    if (interrupted_by_hand_)
+        return std::nullopt;  // whoever took the vehicle keeps it until resume()
     if (!stream_ && queue_.empty()) {
         return cleared_ ? std::optional<Mode>(Mode::Hold) : std::nullopt;
     }
@@ -505,7 +603,7 @@ std::optional<FeederRequest> WindowFeeder::poll_request(TimePoint now) {
         fault_hold_pending_ = false;
         return issue(HoldVehicle{}, now);
     }
-    if (queue_.empty() || now < retry_not_before_)
+    if (queue_.empty() || now < retry_not_before_ || failed_)
         return std::nullopt;
     if (!mission_ok_) {
         UploadMission up;
@@ -572,9 +670,15 @@ FeederProgress WindowFeeder::progress() const {
         p.state = PlanState::None;
     } else if (done_) {
         p.state = PlanState::Done;
+    } else if (failed_) {
+        p.state = PlanState::Failed;
+        p.failure = *failed_;
+    } else if (paused_) {
+        p.state = PlanState::Paused;
     } else {
-        p.state = paused_ ? PlanState::Paused : PlanState::Running;
+        p.state = interrupted_ ? PlanState::Interrupted : PlanState::Running;
     }
+    p.interruption = last_interruption_;
     const Entry* first_of_plan = nullptr;
     for (const auto& e : queue_) {
         if (e.stop)

@@ -11,7 +11,8 @@
 //
 // Contract (the driver, on the service's strand):
 //   inputs   replace_plan(), skip_to(), jump_to(), pause(), resume(), release_hold(),
-//            on_reached(slot), on_current(slot), on_request_result(id, result), on_autopilot_rebooted(),
+//            on_reached(slot), on_current(slot), on_mode(mode, cause), on_request_result(id, result),
+//            on_autopilot_rebooted(),
 //            handle_timeout(now) when poll_timeout() is due;
 //   outputs  poll_request(now) after every input, until it returns nothing: at most one request is
 //            outstanding; each ends with exactly one on_request_result() (or a timeout);
@@ -21,6 +22,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "services/common/time.hpp"
@@ -73,7 +75,15 @@ class WindowFeeder {
 
     void on_reached(std::uint16_t slot, TimePoint now);
     void on_current(std::uint16_t slot, TimePoint now);
-    void on_request_result(std::uint32_t id, RequestResult result, TimePoint now);
+    /// The autopilot's mode changed. Leaving AUTO while the plan runs, without the feeder asking, interrupts
+    /// it: the board's own HOLD (end of its mission, a quirk, a failsafe) is undone at once (the window is
+    /// made whole, the head set current, AUTO asked for); a vehicle taken by hand (the RC pilot, or an
+    /// operator's state command to a manual state) is left to whoever took it until resume(); an operator's
+    /// state command to HOLD pauses the plan.
+    void on_mode(VehicleMode mode, ModeCause cause, TimePoint now);
+    /// `detail` is the autopilot's answer, for a refusal: a refused mission write fails the plan.
+    void on_request_result(std::uint32_t id, RequestResult result, TimePoint now,
+                           std::string_view detail = {});
     void on_autopilot_rebooted(TimePoint now);
     void handle_timeout(TimePoint now);
 
@@ -98,7 +108,7 @@ class WindowFeeder {
         FeederRequest request;
         TimePoint deadline;
     };
-    enum class Mode : std::uint8_t { Unknown, Auto, Hold };
+    enum class Mode : std::uint8_t { Unknown, Auto, Hold, Manual };
 
     std::uint16_t ring_next(std::uint16_t slot) const { return slot >= config_.window ? 1 : slot + 1; }
     std::uint16_t jump_slot() const { return static_cast<std::uint16_t>(config_.window + 1); }
@@ -114,6 +124,9 @@ class WindowFeeder {
     std::string stream_path(const Waypoint& wp) const;
     void request_failed(TimePoint now);
     void check_starvation();
+    bool plan_active() const;
+    void interrupt(std::string why, bool wait_for_operator);
+    void fail_plan(std::string why);
     void emit(FeederEvent::Kind kind, const Waypoint* wp, std::uint32_t generation, std::string path = {},
               std::string detail = {});
     std::optional<Mode> desired_mode() const;
@@ -141,6 +154,10 @@ class WindowFeeder {
     std::uint32_t current_mismatches_ = 0;
 
     bool paused_ = false;
+    std::optional<std::string> interrupted_;  // why, while interrupted
+    bool interrupted_by_hand_ = false;        // taken by hand: no AUTO until resume()
+    std::string last_interruption_;
+    std::optional<std::string> failed_;  // why the autopilot refused the plan
     bool starving_ = false;
     bool fault_ = false;
     TimePoint retry_not_before_ = TimePoint::min();

@@ -78,6 +78,10 @@ void Driver::on_port_open(TimePoint now) {
     quiet_since_ = now;
     heard_frame_ = false;
     parser_ = mav::Parser{};
+    missions_.forget_board();  // another board may be behind the port now
+    auto_check_.cancel();
+    forget_speed();
+    speed_by_param_ = config_.board == Board::Apm2;  // ArduRover 2.x has no MAV_CMD_DO_CHANGE_SPEED command
     time_boot_.reset();
     next_gcs_heartbeat_ = config_.gcs_heartbeat ? now : kNever;
     baud_deadline_ = config_.bauds.size() > 1 ? now + config_.baud_probe : kNever;
@@ -90,6 +94,7 @@ void Driver::on_port_open(TimePoint now) {
 
 void Driver::on_port_closed(const std::string& reason, TimePoint now) {
     port_open_ = false;
+    auto_check_.cancel();
     cancel_everything("autopilot port closed: " + reason, now);
     if (link_up_) {
         link_up_ = false;
@@ -140,6 +145,10 @@ void Driver::handle_timeout(TimePoint now) {
     if (link_up_ && now >= last_heartbeat_ + config_.heartbeat_timeout) {
         link_lost(now);
     }
+    if (auto_check_.handle_timeout(now)) {
+        report_current(telemetry_.mission_current);  // not back at the expected slot: say where it is
+    }
+    speed_timeout(now);
     if (mode_request_ && now >= mode_request_->deadline) {
         if (mode_request_->attempt >= config_.mode_retries) {
             finish_mode(RequestResult::Timeout,
@@ -171,7 +180,7 @@ void Driver::handle_timeout(TimePoint now) {
     }
     if (now >= next_gcs_heartbeat_) {
         mav::Heartbeat hb;
-        hb.type = 6;           // MAV_TYPE_GCS
+        hb.type = config_.gcs_heartbeat_type;
         hb.autopilot = 8;      // MAV_AUTOPILOT_INVALID
         hb.system_status = 4;  // MAV_STATE_ACTIVE
         out_.send(hb);
@@ -196,8 +205,11 @@ void Driver::handle_timeout(TimePoint now) {
 }
 
 TimePoint Driver::poll_timeout() const {
-    TimePoint t =
-        std::min({missions_.poll_timeout(), params_.poll_timeout(), phase_deadline_, rc_.poll_timeout()});
+    TimePoint t = std::min({missions_.poll_timeout(), params_.poll_timeout(), phase_deadline_,
+                            rc_.poll_timeout(), next_gcs_heartbeat_, auto_check_.poll_timeout()});
+    if (speed_request_) {
+        t = std::min(t, speed_request_->deadline);
+    }
     if (link_up_) {
         t = std::min(t, last_heartbeat_ + config_.heartbeat_timeout);
     }
@@ -407,11 +419,15 @@ void Driver::on_mission_done(MissionCompletion c, TimePoint now) {
             default:
                 break;
         }
+        update_speed(now);  // the item being driven to may have a new speed
     }
     done(op.id, op.kind, r, c.detail);
 }
 
 void Driver::on_param_done(ParamCompletion c, TimePoint now) {
+    if (on_speed_param_done(c, now)) {
+        return;
+    }
     if (c.id == sequence_fetch_) {
         sequence_fetch_ = 0;
         if (c.result == RequestResult::Ok) {
@@ -532,6 +548,7 @@ std::uint32_t Driver::set_current(std::uint16_t slot, TimePoint now) {
         return id;
     }
     const std::uint32_t id = next_id_++;
+    auto_check_.retarget(slot);
     mission_ops_[missions_.set_current(slot, now)] = {id, RequestKind::SetCurrent, {}, slot};
     drain_clients(now);
     return id;
@@ -610,6 +627,9 @@ std::uint32_t Driver::request_state(VehicleState target, TimePoint now) {
         return id;
     }
     mode_request_ = ModeRequest{id, target, mode, 0, now + config_.mode_timeout};
+    if (target == VehicleState::WaypointNavigation) {
+        auto_check_.arm(reported_current_, now);
+    }
     send_mode(mode);
     return id;
 }
@@ -675,6 +695,9 @@ AutopilotStatus Driver::status() const {
     s.mission_current = telemetry_.mission_current;
     s.reboots = reboots_;
     s.reset_pulses = reset_pulses_;
+    s.speed = speed_set_;
+    s.mission_items = missions_.answers_int() ? "int" : "float";
+    s.auto_restarts_corrected = auto_check_.corrections();
     return s;
 }
 

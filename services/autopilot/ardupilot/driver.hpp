@@ -16,7 +16,10 @@
 // pilot or the autopilot itself are published as External ModeChanged events); requested state changes,
 // confirmed by the heartbeat, retried, refused or timed out (never dropped); mission operations through
 // MissionClient; parameters through ParamClient; RC override from joystick input; waypoint-reached events
-// from MISSION_ITEM_REACHED or the "Reached waypoint #N" text; link DOWN after heartbeat_timeout of silence;
+// from MISSION_ITEM_REACHED or the "Reached waypoint #N" text; after every entry into AUTO the mission slot
+// the board was at (AutoEntryCheck: 2.x firmware restarts at item 1); the speed of the mission item being
+// driven to (its MissionItem::speed: MAV_CMD_DO_CHANGE_SPEED, or the CRUISE_SPEED parameter on a board
+// without the command, APM 2.x); link DOWN after heartbeat_timeout of silence;
 // unexpected reboots (time_boot_ms running slower than our clock, heartbeats saying BOOT/CALIBRATING,
 // boot banners right after a heartbeat gap) trigger a resync of parameters and mission and an
 // AutopilotRebooted event; an autopilot silent for unresponsive_timeout while its port is open makes the
@@ -35,6 +38,7 @@
 #include <variant>
 #include <vector>
 
+#include "services/autopilot/ardupilot/auto_entry_check.hpp"
 #include "services/autopilot/ardupilot/mission_client.hpp"
 #include "services/autopilot/ardupilot/outbox.hpp"
 #include "services/autopilot/ardupilot/param_client.hpp"
@@ -111,6 +115,13 @@ class Driver {
     const mavlink::ParserStats& parser_stats() const { return parser_.stats(); }
     unsigned current_baud() const { return config_.bauds[baud_index_]; }
     const std::string& last_error() const { return last_error_; }
+    const AutoEntryCheck& auto_entry_check() const { return auto_check_; }
+    /// The speed the board last confirmed for the leg it drives (m/s), if any was set.
+    std::optional<double> commanded_speed() const { return speed_set_; }
+    /// Speed changes the board confirmed, ever.
+    unsigned speed_changes() const { return speed_changes_; }
+    /// True when speeds go by the CRUISE_SPEED parameter (the board lacks MAV_CMD_DO_CHANGE_SPEED).
+    bool speed_by_param() const { return speed_by_param_; }
     bool link_up() const { return link_up_; }
     bool ready() const { return phase_ == Phase::Ready && link_up_; }
 
@@ -121,6 +132,12 @@ class Driver {
         std::uint32_t mode = 0;
         unsigned attempt = 0;
         TimePoint deadline = kNever;
+    };
+    struct SpeedRequest {
+        double value = 0.0;
+        unsigned attempt = 0;
+        TimePoint deadline = kNever;  // the command's answer; kNever while a parameter write runs
+        std::uint32_t param_op = 0;   // ParamClient id of a CRUISE_SPEED write
     };
     struct PendingOp {
         std::uint32_t id = 0;  // the requester's id; 0 for the driver's own (sequence) operations
@@ -156,6 +173,16 @@ class Driver {
     void reboot_detected(const std::string& evidence, TimePoint now);
     void link_lost(TimePoint now);
     void tap_incoming(const mavlink::Frame& f);
+    void on_mission_current(std::uint16_t seq, TimePoint now);
+    void report_current(std::uint16_t seq);
+
+    // driver_speed.cpp: the speed of the leg being driven
+    void update_speed(TimePoint now);
+    void send_speed(double value, unsigned attempt, TimePoint now);
+    void on_speed_ack(std::uint8_t result, TimePoint now);
+    void speed_timeout(TimePoint now);
+    bool on_speed_param_done(const ParamCompletion& c, TimePoint now);
+    void forget_speed();
 
     AutopilotConfig config_;
     Outbox out_;
@@ -196,6 +223,12 @@ class Driver {
     std::optional<ModeRequest> mode_request_;
     Telemetry telemetry_;
     std::optional<std::pair<std::uint16_t, TimePoint>> last_reached_;
+    std::uint16_t reported_current_ = 0;  // the mission slot last reported (MissionCurrentChanged)
+    AutoEntryCheck auto_check_;
+    std::optional<double> speed_set_;
+    std::optional<SpeedRequest> speed_request_;
+    bool speed_by_param_ = false;
+    unsigned speed_changes_ = 0;
     unsigned reboots_ = 0;
     unsigned reset_pulses_ = 0;
 

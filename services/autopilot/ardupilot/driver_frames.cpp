@@ -18,6 +18,7 @@ constexpr std::uint8_t kMavStateBoot = 1;
 constexpr std::uint8_t kMavStateCalibrating = 2;
 constexpr std::uint8_t kMavStatePoweroff = 7;
 constexpr std::uint16_t kCmdDoSetMode = 176;
+constexpr std::uint16_t kCmdDoChangeSpeed = 178;
 constexpr Duration kGapWindow = seconds(10);   // boot banners this long after a heartbeat gap mean a reboot
 constexpr Duration kSameReached = seconds(3);  // the item-reached message and the text for the same slot
 constexpr Duration kClockSlack = seconds(2);   // latency jitter allowed when comparing time_boot_ms
@@ -133,14 +134,9 @@ void Driver::on_frame(const mav::Frame& f, TimePoint now) {
             telemetry_.home = Position{m.latitude * 1e-7, m.longitude * 1e-7, m.altitude * 1e-3};
             break;
         }
-        case mav::MissionCurrent::kId: {
-            const auto seq = mav::decode_payload<mav::MissionCurrent>(p).seq;
-            if (seq != telemetry_.mission_current) {
-                telemetry_.mission_current = seq;
-                emit(MissionCurrentChanged{seq});
-            }
+        case mav::MissionCurrent::kId:
+            on_mission_current(mav::decode_payload<mav::MissionCurrent>(p).seq, now);
             break;
-        }
         case mav::MissionItemReached::kId:
             on_reached(mav::decode_payload<mav::MissionItemReached>(p).seq, now);
             break;
@@ -181,6 +177,41 @@ void Driver::on_heartbeat(const mav::Heartbeat& hb, TimePoint now) {
         enter(Phase::Params, now);
     }
     update_state(now, false);
+    if (hb.custom_mode == static_cast<std::uint32_t>(RoverMode::Auto)) {
+        if (mode_changed) {
+            if (!auto_check_.active()) {
+                auto_check_.arm(reported_current_, now);  // entered AUTO without our asking
+            }
+            auto_check_.on_auto(now);
+            update_speed(now);
+        }
+    } else if (mode_changed) {
+        auto_check_.cancel();
+    }
+}
+
+void Driver::on_mission_current(std::uint16_t seq, TimePoint now) {
+    telemetry_.mission_current = seq;
+    switch (auto_check_.on_current(seq, now)) {
+        case AutoEntryCheck::Verdict::Report:
+            report_current(seq);
+            update_speed(now);
+            break;
+        case AutoEntryCheck::Verdict::Suppress:
+            break;
+        case AutoEntryCheck::Verdict::Correct:
+            // The board restarted its mission on entering AUTO: back to the slot it was at. The completion
+            // is the driver's own (no requester waits for it).
+            (void)missions_.set_current(*auto_check_.expected(), now);
+            break;
+    }
+}
+
+void Driver::report_current(std::uint16_t seq) {
+    if (seq != reported_current_) {
+        reported_current_ = seq;
+        emit(MissionCurrentChanged{seq});
+    }
 }
 
 void Driver::on_statustext(const mav::Statustext& t, TimePoint now) {
@@ -219,6 +250,10 @@ void Driver::on_time_boot(std::uint32_t time_boot_ms, TimePoint now) {
 }
 
 void Driver::on_command_ack(const mav::CommandAck& ack, TimePoint now) {
+    if (ack.command == kCmdDoChangeSpeed) {
+        on_speed_ack(ack.result, now);
+        return;
+    }
     if (ack.command != kCmdDoSetMode || !mode_request_) {
         return;
     }
@@ -236,11 +271,14 @@ void Driver::on_reached(std::uint16_t seq, TimePoint now) {
         return;  // the same event by its second route
     }
     last_reached_ = std::pair{seq, now};
+    auto_check_.on_reached(seq);
     emit(WaypointReached{seq});
 }
 
 void Driver::reboot_detected(const std::string& evidence, TimePoint now) {
     ++reboots_;
+    auto_check_.cancel();
+    forget_speed();
     emit(AutopilotRebooted{evidence});
     cancel_everything("autopilot rebooted", now);
     last_error_ = "autopilot rebooted: " + evidence;

@@ -36,6 +36,21 @@ const char* mission_result_name(std::uint8_t type) {
     return type < std::size(kNames) ? kNames[type] : "unknown result";
 }
 
+// The float frame of an *_INT frame: MISSION_ITEM carries degrees as floats, and the *_INT frames are
+// defined for MISSION_ITEM_INT only (a strict board answers MAV_MISSION_UNSUPPORTED_FRAME).
+std::uint8_t float_frame(std::uint8_t frame) {
+    switch (frame) {
+        case 5:  // MAV_FRAME_GLOBAL_INT
+            return 0;
+        case 6:  // MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
+            return 3;
+        case 11:  // MAV_FRAME_GLOBAL_TERRAIN_ALT_INT
+            return 10;
+        default:
+            return frame;
+    }
+}
+
 bool is_global_frame(std::uint8_t frame) {
     switch (frame) {
         case 0:   // MAV_FRAME_GLOBAL
@@ -116,7 +131,7 @@ mav::MissionItem to_float_item(const mav::MissionItemInt& i) {
     f.target_system = i.target_system;
     f.target_component = i.target_component;
     f.seq = i.seq;
-    f.frame = i.frame;
+    f.frame = float_frame(i.frame);
     f.command = i.command;
     f.current = i.current;
     f.autocontinue = i.autocontinue;
@@ -134,7 +149,17 @@ mav::MissionItem to_float_item(const mav::MissionItemInt& i) {
 
 MissionClient::MissionClient(Outbox& outbox, std::uint8_t target_sysid, std::uint8_t target_compid,
                              MissionConfig config)
-    : out_(outbox), target_sysid_(target_sysid), target_compid_(target_compid), config_(config) {}
+    : out_(outbox),
+      target_sysid_(target_sysid),
+      target_compid_(target_compid),
+      config_(config),
+      use_int_(config.use_int) {}
+
+void MissionClient::forget_board() {
+    use_int_ = config_.use_int;
+    int_proven_ = false;
+    fallback_reason_.clear();
+}
 
 // --- queueing ----------------------------------------------------------------------------------------------
 
@@ -257,6 +282,7 @@ void MissionClient::start_front(TimePoint now) {
 void MissionClient::send_item(WorkItem& w, std::uint16_t seq, bool as_int) {
     const auto& item = w.items[static_cast<std::size_t>(seq - w.first)];
     if (as_int) {
+        w.sent_int = true;
         out_.send(item);
     } else {
         out_.send(to_float_item(item));
@@ -312,7 +338,7 @@ void MissionClient::transmit(WorkItem& w, TimePoint now, bool retry) {
             break;
         }
         case Step::WaitItem:
-            if (config_.use_int) {
+            if (use_int_) {
                 mav::MissionRequestInt m;
                 m.target_system = target_sysid_;
                 m.target_component = target_compid_;
@@ -526,7 +552,11 @@ void MissionClient::on_request(std::uint16_t seq, bool as_int, TimePoint now) {
     }
     w.last_heard = now;
     const bool fresh = !w.any_request || seq > w.highest_sent;
+    if (fresh && w.any_request && w.answer_int) {
+        int_proven_ = true;  // it went on after our MISSION_ITEM_INT: it takes them
+    }
     if (fresh) {
+        w.int_repeats = 0;
         progress(w, now);
         if (!w.best || seq > *w.best) {
             // Further than any attempt got: the vehicle's cancels so far did not stop the transfer, so the
@@ -540,9 +570,16 @@ void MissionClient::on_request(std::uint16_t seq, bool as_int, TimePoint now) {
     w.any_request = true;
     w.highest_sent = std::max(w.highest_sent, seq);
     w.next_seq = seq;
+    if (!fresh && w.answer_int && !as_int && !int_proven_ && ++w.int_repeats >= kIntRepeatsBeforeFallback) {
+        // Asked again and again for an item answered as MISSION_ITEM_INT, by a board that never took one:
+        // it does not know the message (MAVLink-1-era firmware drops it unread).
+        ++stats_.float_fallbacks;
+        use_int_ = false;
+        fallback_reason_ = "item requests repeated after MISSION_ITEM_INT answers";
+    }
     // With use_int the item goes as MISSION_ITEM_INT even to a MISSION_REQUEST: float degrees would cost
     // decimetres of position (ArduPilot accepts either form). Without it, the form asked for.
-    w.answer_int = as_int || config_.use_int;
+    w.answer_int = as_int || use_int_;
     w.step = (seq + 1u == end) ? Step::WaitAck : Step::WaitRequest;
     // Answer every request, a repeated one too: the vehicle asks again when our item was lost.
     send_item(w, seq, w.answer_int);
@@ -593,8 +630,28 @@ void MissionClient::on_ack(std::uint8_t type, TimePoint now) {
         restart(w, now);
         return;
     }
-    const std::string detail = std::string("autopilot answered MAV_MISSION_") + mission_result_name(type);
-    finish(type == kNoSpace ? MissionResult::NoSpace : MissionResult::Denied, detail, now);
+    const std::string answer = std::string("MAV_MISSION_") + mission_result_name(type);
+    if (uploading && w.sent_int && type != kNoSpace && use_int_ && !int_proven_) {
+        fall_back_to_float(w, answer, now);
+        return;
+    }
+    const std::string form = !uploading   ? std::string()
+                             : w.sent_int ? " to MISSION_ITEM_INT"
+                                          : " to MISSION_ITEM";
+    const std::string after = uploading && !w.sent_int && !fallback_reason_.empty()
+                                  ? " (MISSION_ITEM_INT was refused before: " + fallback_reason_ + ")"
+                                  : "";
+    finish(type == kNoSpace ? MissionResult::NoSpace : MissionResult::Denied,
+           "autopilot answered " + answer + form + after, now);
+}
+
+// The board refused items sent as MISSION_ITEM_INT: it gets MISSION_ITEM (float frames) from now on, and
+// the transfer starts again. Once only: a refusal of the float form ends the operation.
+void MissionClient::fall_back_to_float(WorkItem& w, const std::string& answer, TimePoint now) {
+    ++stats_.float_fallbacks;
+    use_int_ = false;
+    fallback_reason_ = answer + " to MISSION_ITEM_INT";
+    restart(w, now);
 }
 
 // The vehicle no longer receives this upload: announce it again from the first item.
@@ -602,6 +659,8 @@ void MissionClient::restart(WorkItem& w, TimePoint now) {
     ++w.restarts;
     ++stats_.restarts;
     w.any_request = false;
+    w.sent_int = false;
+    w.int_repeats = 0;
     w.highest_sent = 0;
     w.next_seq = w.first;
     w.step = Step::WaitRequest;

@@ -15,7 +15,14 @@
 //
 // The vehicle may ask for an item with MISSION_REQUEST or MISSION_REQUEST_INT. With use_int the answer is
 // always MISSION_ITEM_INT (float degrees would cost decimetres); without it (APM 2.x), MISSION_ITEM to a
-// MISSION_REQUEST. A download accepts either item form.
+// MISSION_REQUEST. A download accepts either item form. A float MISSION_ITEM carries a float frame
+// (MAV_FRAME_GLOBAL_RELATIVE_ALT 3 for 6, MAV_FRAME_GLOBAL 0 for 5): the *_INT frames belong to
+// MISSION_ITEM_INT only, and a strict board refuses them in a MISSION_ITEM.
+// Falling back (once per board, remembered until forget_board()): a board that refuses an upload answered
+// with MISSION_ITEM_INT (any MISSION_ACK refusal, e.g. MAV_MISSION_UNSUPPORTED_FRAME), or that asks again
+// and again for an item sent as MISSION_ITEM_INT without ever having taken one (a MAVLink-1-era board does
+// not know the message and drops it), gets MISSION_ITEM and float requests from then on; the upload starts
+// again. A refusal of the float form is final: the operation ends Denied with the board's answer.
 // MAV_MISSION_INVALID_SEQUENCE during an upload means a duplicate item crossed a request on the link; it is
 // counted and the transfer goes on. MAV_MISSION_OPERATION_CANCELLED during an upload (the vehicle gave up on
 // a bad link) starts the upload again, up to `retries` times in a row without an attempt getting further
@@ -66,13 +73,17 @@ struct MissionClientStats {
     std::uint64_t retransmissions = 0;
     std::uint64_t duplicate_requests = 0;  // the vehicle asked again for an item already sent
     std::uint64_t invalid_sequence_acks = 0;
-    std::uint64_t ignored_frames = 0;  // mission frames that matched no running operation
-    std::uint64_t restarts = 0;        // uploads started again after the vehicle cancelled them
+    std::uint64_t ignored_frames = 0;   // mission frames that matched no running operation
+    std::uint64_t restarts = 0;         // uploads started again after the vehicle cancelled them
+    std::uint64_t float_fallbacks = 0;  // boards found not to take MISSION_ITEM_INT
 };
 
 class MissionClient {
   public:
     static constexpr std::size_t kMaxQueued = 16;
+    /// Repeated requests for an item answered as MISSION_ITEM_INT before a board that never took one is
+    /// answered with MISSION_ITEM instead (a lost frame makes one repeat; three mean it is not understood).
+    static constexpr unsigned kIntRepeatsBeforeFallback = 3;
 
     MissionClient(Outbox& outbox, std::uint8_t target_sysid, std::uint8_t target_compid,
                   MissionConfig config);
@@ -93,6 +104,12 @@ class MissionClient {
     std::optional<MissionCompletion> poll_completion();
 
     bool idle() const { return work_.empty(); }
+    /// Whether items go as MISSION_ITEM_INT (false after a fallback, or when configured so).
+    bool answers_int() const { return use_int_; }
+    /// Another board may be behind the port now: start again from the configured item form.
+    void forget_board();
+    /// Why the client answers with MISSION_ITEM although configured for MISSION_ITEM_INT ("" if it does not).
+    const std::string& fallback_reason() const { return fallback_reason_; }
     /// The timeout from the RTT estimate alone.
     Duration base_timeout() const;
 
@@ -126,7 +143,9 @@ class MissionClient {
         unsigned restarts = 0;              // upload / partial: restarts since the best seq last grew
         std::optional<std::uint16_t> best;  // upload / partial: highest seq requested by any attempt
         TimePoint last_progress{};          // the last fresh answer (refreshes the retry budget)
-        TimePoint last_heard{};  // upload / partial: the last request of any kind for this transfer
+        TimePoint last_heard{};    // upload / partial: the last request of any kind for this transfer
+        bool sent_int = false;     // upload / partial: this attempt answered with MISSION_ITEM_INT
+        unsigned int_repeats = 0;  // requests repeated for an item answered as MISSION_ITEM_INT
     };
 
     Duration current_timeout(const WorkItem& w) const;
@@ -137,6 +156,7 @@ class MissionClient {
     void progress(WorkItem& w, TimePoint now);
     void finish(MissionResult result, std::string detail, TimePoint now);
     void restart(WorkItem& w, TimePoint now);
+    void fall_back_to_float(WorkItem& w, const std::string& why, TimePoint now);
     void reject(MissionOperation op, std::uint32_t id, MissionResult r, std::string detail);
 
     void on_request(std::uint16_t seq, bool as_int, TimePoint now);
@@ -156,6 +176,9 @@ class MissionClient {
     std::optional<Duration> srtt_;
     Duration rttvar_{};
     unsigned backoff_ = 1;
+    bool use_int_ = true;      // the item form this board is answered with
+    bool int_proven_ = false;  // the board went on after an item sent as MISSION_ITEM_INT
+    std::string fallback_reason_;
     MissionClientStats stats_;
 };
 

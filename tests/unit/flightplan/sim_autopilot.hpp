@@ -1,13 +1,15 @@
 #pragma once
 // A small simulated autopilot for WindowFeeder tests: mission slots (0 = home), a current target, reaches one
 // target per step while in auto, follows JumpTo items, parks on Stop items and falls into HOLD when it passes
-// the last slot (ArduPilot Rover behaviour at the end of a mission). Reboots lose the mission.
+// the last slot (ArduPilot Rover behaviour at the end of a mission). Reboots lose the mission. Every mode
+// change is reported, with its cause, as the autopilot driver reports it (mode_changes()).
 #include <cstdint>
 #include <deque>
 #include <map>
 #include <optional>
 #include <random>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -44,13 +46,20 @@ class SimAutopilot {
             return RequestResult::Ok;
         }
         if (std::holds_alternative<HoldVehicle>(r.op)) {
-            auto_ = false;
+            set_mode(VehicleMode::Hold, ModeCause::Ours);
             ++hold_requests_;
             return RequestResult::Ok;
         }
-        auto_ = true;
+        set_mode(VehicleMode::Auto, ModeCause::Ours);
         return RequestResult::Ok;
     }
+
+    struct ModeReport {
+        VehicleMode mode;
+        ModeCause cause;
+    };
+    /// Mode changes since the last call, oldest first.
+    std::vector<ModeReport> mode_changes() { return std::exchange(changes_, {}); }
 
     /// Drives to the current target: returns the reached slot, if any.
     std::optional<std::uint16_t> step() {
@@ -69,7 +78,7 @@ class SimAutopilot {
             next = slots_[next].jump_slot;
         }
         if (next >= slots_.size()) {
-            auto_ = false;  // mission complete: ArduPilot Rover goes HOLD
+            set_mode(VehicleMode::Hold, ModeCause::Board);  // mission complete: ArduPilot Rover goes HOLD
             ++end_of_mission_holds_;
         } else {
             current_ = static_cast<std::uint16_t>(next);
@@ -81,12 +90,16 @@ class SimAutopilot {
         slots_.assign(1, home());
         current_ = 0;
         auto_ = false;
+        mode_ = VehicleMode::Unknown;
         parked_ = false;
     }
 
-    /// The operator takes the vehicle out of AUTO (a MANUAL switch, a joystick session): the feeder is not
-    /// told.
-    void operator_takes_over() { auto_ = false; }
+    /// The RC pilot takes the vehicle out of AUTO (the transmitter's MANUAL switch).
+    void operator_takes_over() { set_mode(VehicleMode::Manual, ModeCause::RcPilot); }
+    /// The autopilot falls into HOLD by itself (a failsafe, a quirk of its mission logic).
+    void board_holds() { set_mode(VehicleMode::Hold, ModeCause::Board); }
+    /// An operator's state command (through this daemon, not the feeder) parks the vehicle.
+    void operator_parks() { set_mode(VehicleMode::Hold, ModeCause::Ours); }
 
     std::uint16_t current() const { return current_; }
     bool in_auto() const { return auto_; }
@@ -97,6 +110,13 @@ class SimAutopilot {
     int writes() const { return writes_; }
 
   private:
+    void set_mode(VehicleMode mode, ModeCause cause) {
+        auto_ = mode == VehicleMode::Auto;
+        if (mode != mode_) {
+            mode_ = mode;
+            changes_.push_back({mode, cause});
+        }
+    }
     static MissionItem home() {
         MissionItem h;
         h.position = {0.0, 0.0};
@@ -105,6 +125,8 @@ class SimAutopilot {
     std::vector<MissionItem> slots_;
     std::uint16_t current_ = 0;
     bool auto_ = false;
+    VehicleMode mode_ = VehicleMode::Unknown;
+    std::vector<ModeReport> changes_;
     bool parked_ = false;
     std::vector<LatLon> visited_;
     int end_of_mission_holds_ = 0;
@@ -168,6 +190,7 @@ struct Impairments {
     double drop_reached = 0.0;       // probability a reached report is lost
     double fail_request = 0.0;       // probability a request fails
     bool fail_writes = false;        // every partial write fails (the autopilot refuses them)
+    bool refuse_missions = false;    // every upload and write is refused (a board that takes none of them)
     int requests_per_step = 2;       // link budget
     bool report_current = true;      // MISSION_CURRENT every step
 };
@@ -179,6 +202,7 @@ class Harness {
         : feeder(config), imp_(imp), rng_(seed) {}
 
     void step() {
+        report_modes();  // what the vehicle did between steps (the RC pilot, the board itself)
         int budget = imp_.requests_per_step;
         while (budget-- > 0) {
             auto r = feeder.poll_request(now);
@@ -186,13 +210,21 @@ class Harness {
                 break;
             const bool fail =
                 chance(imp_.fail_request) || (imp_.fail_writes && std::holds_alternative<WriteItems>(r->op));
-            const RequestResult res = fail ? RequestResult::Failed : ap.apply(*r);
-            feeder.on_request_result(r->id, res, now);
+            const bool refuse = imp_.refuse_missions && (std::holds_alternative<WriteItems>(r->op) ||
+                                                         std::holds_alternative<UploadMission>(r->op));
+            const RequestResult res = refuse ? RequestResult::Refused
+                                      : fail ? RequestResult::Failed
+                                             : ap.apply(*r);
+            // The driver reports a confirmed mode change before the request's result.
+            report_modes();
+            feeder.on_request_result(r->id, res, now, refuse ? "MAV_MISSION_UNSUPPORTED_FRAME" : "");
             drain();
         }
         std::vector<std::uint16_t> deliver(late_.begin(), late_.end());
         late_.clear();
-        if (auto reached = ap.step()) {
+        const auto reached_now = ap.step();
+        report_modes();
+        if (auto reached = reached_now) {
             if (chance(imp_.drop_reached)) {
                 // lost
             } else if (chance(imp_.delay_reached)) {
@@ -225,6 +257,13 @@ class Harness {
             step();
         }
         return limit;
+    }
+
+    void report_modes() {
+        for (const auto& m : ap.mode_changes()) {
+            feeder.on_mode(m.mode, m.cause, now);
+            drain();
+        }
     }
 
     void drain() {

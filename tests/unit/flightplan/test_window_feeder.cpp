@@ -226,6 +226,105 @@ TEST(FlightplanFeeder, ResumeAfterTheOperatorDroveTheVehicleByHandPutsItBackOnTh
     EXPECT_EQ(h.reached, iota(0, 100));
 }
 
+TEST(FlightplanFeeder, TheBoardsOwnHoldMidPlanIsUndoneAndThePlanGoesOnInOrder) {
+    Harness h;
+    h.feeder.replace_plan(test::synthetic(100), h.now);
+    for (int i = 0; i < 20; ++i)
+        h.step();
+    ASSERT_TRUE(h.ap.in_auto());
+    const auto target_before = h.ap.current();
+    h.ap.board_holds();
+    h.step();
+    EXPECT_EQ(h.count(FeederEvent::Kind::Interrupted), 1u);
+    EXPECT_NE(h.feeder.progress().interruption.find("HOLD by itself"), std::string::npos)
+        << h.feeder.progress().interruption;
+    // Within a few steps (the daemon's second each) the vehicle is back in AUTO at the same target.
+    int back = 0;
+    while (!h.ap.in_auto() && back < 5) {
+        h.step();
+        ++back;
+    }
+    EXPECT_LT(back, 5) << "the plan must continue by itself after the board's own HOLD";
+    EXPECT_EQ(h.count(FeederEvent::Kind::Continued), 1u);
+    EXPECT_EQ(h.feeder.progress().state, PlanState::Running);
+    (void)target_before;
+    ASSERT_LT(h.run_until_done(500), 500);
+    EXPECT_EQ(h.reached, iota(0, 100));
+    expect_visited(h, 41.0, 0, 100);
+    EXPECT_EQ(h.feeder.progress().interruptions, 1u);
+}
+
+TEST(FlightplanFeeder, TheRcPilotTakingTheVehicleInterruptsThePlanUntilResume) {
+    Harness h;
+    h.feeder.replace_plan(test::synthetic(60), h.now);
+    for (int i = 0; i < 10; ++i)
+        h.step();
+    h.ap.operator_takes_over();
+    h.step();
+    EXPECT_EQ(h.feeder.progress().state, PlanState::Interrupted);
+    EXPECT_NE(h.feeder.progress().interruption.find("RC pilot"), std::string::npos);
+    const auto reached = h.reached.size();
+    for (int i = 0; i < 20; ++i)
+        h.step();
+    EXPECT_FALSE(h.ap.in_auto()) << "the RC pilot keeps the vehicle: no AUTO behind the pilot's back";
+    EXPECT_EQ(h.ap.hold_requests(), 0) << "nor a HOLD";
+    EXPECT_EQ(h.reached.size(), reached);
+    h.feeder.resume();
+    ASSERT_LT(h.run_until_done(300), 300);
+    EXPECT_EQ(h.reached, iota(0, 60));
+}
+
+TEST(FlightplanFeeder, AnOperatorsParkingCommandPausesThePlan) {
+    Harness h;
+    h.feeder.replace_plan(test::synthetic(60), h.now);
+    for (int i = 0; i < 10; ++i)
+        h.step();
+    h.ap.operator_parks();
+    for (int i = 0; i < 10; ++i)
+        h.step();
+    EXPECT_EQ(h.feeder.progress().state, PlanState::Paused);
+    EXPECT_FALSE(h.ap.in_auto());
+    EXPECT_EQ(h.count(FeederEvent::Kind::Interrupted), 0u);
+    h.feeder.resume();
+    ASSERT_LT(h.run_until_done(300), 300);
+    EXPECT_EQ(h.reached, iota(0, 60));
+}
+
+TEST(FlightplanFeeder, ANewPlanAfterTheOperatorParkedAFinishedOneDrives) {
+    Harness h;
+    h.feeder.replace_plan(test::synthetic(8, 41.0), h.now);
+    ASSERT_LT(h.run_until_done(100), 100);
+    h.step();
+    h.ap.operator_parks();
+    for (int i = 0; i < 3; ++i)
+        h.step();
+    ASSERT_FALSE(h.ap.in_auto());
+    h.feeder.resume();  // what plan.load does unless --paused
+    h.feeder.replace_plan(test::synthetic(10, 42.0), h.now);
+    ASSERT_LT(h.run_until_done(100), 100) << "the second plan must drive without a separate resume";
+    ASSERT_EQ(h.ap.visited().size(), 18u);
+    EXPECT_EQ(h.ap.visited().back(), test::SyntheticStream::position_of(42.0, 9));
+}
+
+TEST(FlightplanFeeder, AMissionTheAutopilotRefusesFailsThePlanInsteadOfRetryingForever) {
+    Impairments imp;
+    imp.refuse_missions = true;
+    Harness h({}, imp);
+    h.feeder.replace_plan(test::synthetic(30), h.now);
+    for (int i = 0; i < 60; ++i)
+        h.step();
+    const auto p = h.feeder.progress();
+    EXPECT_EQ(p.state, PlanState::Failed);
+    EXPECT_NE(p.failure.find("UNSUPPORTED_FRAME"), std::string::npos) << p.failure;
+    EXPECT_EQ(h.count(FeederEvent::Kind::PlanFailed), 1u);
+    EXPECT_FALSE(h.feeder.poll_request(h.now).has_value()) << "nothing more is asked of the autopilot";
+    // A new plan starts afresh (on a board that now takes it).
+    h.impairments().refuse_missions = false;
+    h.feeder.replace_plan(test::synthetic(20, 42.0), h.now);
+    ASSERT_LT(h.run_until_done(200), 200);
+    EXPECT_EQ(h.ap.visited().size(), 20u);
+}
+
 TEST(FlightplanFeeder, HoldWaypointsHoldForTheirTimeOrUntilReleased) {
     Waypoint timed;
     timed.action = WaypointAction::HoldFor;

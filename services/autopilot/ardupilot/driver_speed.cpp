@@ -1,0 +1,122 @@
+// Driver: the speed of the leg being driven. A plan's cruise and per-leg speeds travel as the speed of each
+// mission item (MissionItem::speed, the leg to that item). When the board heads for an item in AUTO whose
+// speed differs from the last one it confirmed, the driver sets it: MAV_CMD_DO_CHANGE_SPEED (COMMAND_LONG,
+// confirmed by COMMAND_ACK) on boards that have the command, the CRUISE_SPEED parameter (PARAM_SET, read
+// back) on those that do not (ArduRover 2.x; also any board that refuses the command or never answers it).
+// A parameter write is kept in the board's EEPROM: it is sent only when the speed changes.
+#include <cmath>
+
+#include "services/autopilot/ardupilot/driver.hpp"
+
+namespace airseg::autopilot::ardupilot {
+
+namespace mav = airseg::mavlink;
+
+namespace {
+constexpr std::uint16_t kCmdDoChangeSpeed = 178;
+constexpr float kSpeedTypeGround = 1.0F;
+constexpr float kThrottleUnchanged = -1.0F;
+constexpr std::uint8_t kResultAccepted = 0;
+constexpr std::uint8_t kResultInProgress = 5;
+constexpr double kSameSpeed = 0.005;  // m/s: below this two speeds are the same
+constexpr const char* kCruiseSpeed = "CRUISE_SPEED";
+
+bool same(double a, double b) {
+    return std::fabs(a - b) < kSameSpeed;
+}
+}  // namespace
+
+void Driver::forget_speed() {
+    speed_set_.reset();
+    speed_request_.reset();
+}
+
+void Driver::update_speed(TimePoint now) {
+    if (!ready() || state_ != VehicleState::WaypointNavigation || auto_check_.active()) {
+        return;  // a restarted mission is set back first: its slot is not the leg being driven
+    }
+    const std::uint16_t slot = reported_current_;
+    if (slot < 1 || slot > mission_.size()) {
+        return;
+    }
+    const MissionItem& item = mission_[slot - 1];
+    if (item.kind != MissionItem::Kind::Waypoint || !item.speed || *item.speed <= 0.0) {
+        return;
+    }
+    const double v = *item.speed;
+    if (speed_request_ ? same(speed_request_->value, v) : (speed_set_ && same(*speed_set_, v))) {
+        return;
+    }
+    send_speed(v, 0, now);
+}
+
+void Driver::send_speed(double value, unsigned attempt, TimePoint now) {
+    if (speed_by_param_) {
+        speed_request_ =
+            SpeedRequest{value, attempt, kNever, params_.set(kCruiseSpeed, static_cast<float>(value), now)};
+        drain_clients(now);
+        return;
+    }
+    mav::CommandLong m;
+    m.target_system = config_.target_sysid;
+    m.target_component = config_.target_compid;
+    m.command = kCmdDoChangeSpeed;
+    m.confirmation = static_cast<std::uint8_t>(std::min(attempt, 255u));
+    m.param1 = kSpeedTypeGround;
+    m.param2 = static_cast<float>(value);
+    m.param3 = kThrottleUnchanged;
+    out_.send(m);
+    speed_request_ = SpeedRequest{value, attempt, now + config_.mode_timeout, 0};
+}
+
+void Driver::on_speed_ack(std::uint8_t result, TimePoint now) {
+    if (!speed_request_ || speed_request_->param_op != 0) {
+        return;
+    }
+    if (result == kResultInProgress) {
+        return;
+    }
+    const double v = speed_request_->value;
+    if (result == kResultAccepted) {
+        speed_request_.reset();
+        speed_set_ = v;
+        ++speed_changes_;
+        return;
+    }
+    // Refused (UNSUPPORTED, DENIED, FAILED...): this board takes its speed from CRUISE_SPEED.
+    speed_by_param_ = true;
+    send_speed(v, 0, now);
+}
+
+void Driver::speed_timeout(TimePoint now) {
+    if (!speed_request_ || now < speed_request_->deadline) {
+        return;
+    }
+    const SpeedRequest r = *speed_request_;
+    if (r.attempt < config_.mode_retries) {
+        send_speed(r.value, r.attempt + 1, now);
+        return;
+    }
+    speed_by_param_ = true;  // never answered: a board without the command
+    send_speed(r.value, 0, now);
+}
+
+bool Driver::on_speed_param_done(const ParamCompletion& c, TimePoint now) {
+    if (!speed_request_ || speed_request_->param_op == 0 || c.id != speed_request_->param_op) {
+        return false;
+    }
+    const double v = speed_request_->value;
+    speed_request_.reset();
+    if (c.result == RequestResult::Ok) {
+        speed_set_ = v;
+        ++speed_changes_;
+    } else if (c.result != RequestResult::Cancelled) {
+        // Not asked again for the same speed (a board without CRUISE_SPEED would be asked forever): the
+        // next different speed tries again.
+        speed_set_ = v;
+    }
+    update_speed(now);
+    return true;
+}
+
+}  // namespace airseg::autopilot::ardupilot
