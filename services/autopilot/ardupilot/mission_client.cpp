@@ -631,7 +631,7 @@ void MissionClient::on_ack(std::uint8_t type, TimePoint now) {
         return;
     }
     const std::string answer = std::string("MAV_MISSION_") + mission_result_name(type);
-    if (uploading && w.sent_int && type != kNoSpace && use_int_ && !int_proven_) {
+    if (uploading && w.sent_int && type != kNoSpace && use_int_) {
         fall_back_to_float(w, answer, now);
         return;
     }

@@ -553,3 +553,201 @@ TEST(Driver, TelemetryFromTheStreams) {
 
 }  // namespace
 }  // namespace airseg::autopilot::ardupilot
+
+namespace airseg::autopilot::ardupilot {
+namespace {
+
+// --- firmware eras: what each board takes -----------------------------------------------------------------
+
+AutopilotConfig pixhawk_config() {
+    auto c = AutopilotConfig::defaults_for(Board::Pixhawk);
+    c.params = {{"CRUISE_SPEED", 3.0}};
+    return c;
+}
+
+FakeRover::Options strict_float_rover() {
+    FakeRover::Options o = apm2_rover();
+    o.accepted_frames = {0, 2, 3};  // MAV_FRAME_GLOBAL, MISSION, GLOBAL_RELATIVE_ALT
+    return o;
+}
+
+std::size_t count_int_items(const FakeRover& rover) {
+    std::size_t n = 0;
+    for (const auto& [msgid, frame] : rover.item_frames()) {
+        n += msgid == mav::MissionItemInt::kId;
+    }
+    return n;
+}
+
+TEST(Driver, OurHeartbeatGoesToTheAutopilotAtOneHertzWithTheConfiguredType) {
+    auto config = apm2_config();
+    config.gcs_heartbeat_type = kMavTypeOnboardController;
+    Rig rig(config, apm2_rover());
+    std::vector<TimePoint> sent;
+    mav::Parser parser;
+    rig.driver.set_frame_tap([&](bool outgoing, std::span<const std::uint8_t> frame) {
+        if (!outgoing) {
+            return;
+        }
+        parser.push(frame, [&](const mav::Frame& f) {
+            if (f.msgid == mav::Heartbeat::kId) {
+                EXPECT_EQ(mav::decode_payload<mav::Heartbeat>(f.payload_view()).type,
+                          kMavTypeOnboardController);
+                sent.push_back(rig.now());
+            }
+        });
+    });
+    rig.bring_up();
+    const TimePoint from = rig.now();
+    const std::size_t before = sent.size();
+    rig.harness.run_for(seconds(20));
+    // Nothing else asks for the driver's attention in a quiet READY state: the heartbeat keeps its own time.
+    EXPECT_GE(sent.size() - before, 19u);
+    EXPECT_LE(sent.size() - before, 21u);
+    for (std::size_t i = before + 1; i < sent.size(); ++i) {
+        EXPECT_LE(sent[i] - sent[i - 1], milliseconds(1050)) << "gap before heartbeat " << i;
+    }
+    EXPECT_GT(sent.front(), kStart - seconds(1));
+    (void)from;
+}
+
+TEST(Driver, FloatMissionItemsCarryFloatFramesOnABoardThatTakesOnlyThose) {
+    Rig rig(apm2_config(), strict_float_rover());
+    rig.bring_up();
+    const auto r = rig.wait_result(rig.driver.upload_mission(plan(8), rig.now()));
+    ASSERT_EQ(r.result, RequestResult::Ok) << r.detail;
+    ASSERT_EQ(rig.rover.item_frames().size(), 9u);  // home (slot 0) and the 8 items
+    for (std::size_t i = 0; i < rig.rover.item_frames().size(); ++i) {
+        const auto [msgid, frame] = rig.rover.item_frames()[i];
+        EXPECT_EQ(msgid, mav::MissionItem::kId);
+        // Home in MAV_FRAME_GLOBAL; the rest MAV_FRAME_GLOBAL_RELATIVE_ALT, never frame 6 in a MISSION_ITEM.
+        EXPECT_EQ(frame, i == 0 ? 0 : 3) << "item " << i;
+    }
+    EXPECT_EQ(rig.rover.mission()[1].frame, 3);
+    EXPECT_EQ(rig.driver.status().mission_items, "float");
+}
+
+TEST(Driver, ABoardRefusingMissionItemIntGetsFloatItemsOnceAndForAll) {
+    FakeRover::Options o = strict_float_rover();
+    o.version = mav::Version::V2;
+    Rig rig(pixhawk_config(), o);
+    rig.bring_up();
+    ASSERT_EQ(rig.driver.status().mission_items, "int");
+    const auto r = rig.wait_result(rig.driver.upload_mission(plan(8), rig.now()));
+    ASSERT_EQ(r.result, RequestResult::Ok) << r.detail;
+    // Home and item 1 went as MISSION_ITEM_INT; item 1 was refused, then everything as MISSION_ITEM.
+    EXPECT_EQ(count_int_items(rig.rover), 2u);
+    EXPECT_EQ(rig.rover.mission()[8].frame, 3);
+    EXPECT_EQ(rig.driver.status().mission_items, "float");
+    EXPECT_EQ(rig.driver.mission_client().stats().float_fallbacks, 1u);
+    // Remembered: the next write goes as MISSION_ITEM at once.
+    MissionItem wp = plan(2).front();
+    ASSERT_EQ(rig.wait_result(rig.driver.write_items(2, {wp}, rig.now())).result, RequestResult::Ok);
+    EXPECT_EQ(count_int_items(rig.rover), 2u);
+}
+
+TEST(Driver, ARefusalOfTheFloatFormIsFinalAndNamesTheBoardsAnswer) {
+    FakeRover::Options o = strict_float_rover();
+    o.accepted_frames = {2};  // a board that takes no global frame at all
+    Rig rig(apm2_config(), o);
+    rig.bring_up();
+    const TimePoint start = rig.now();
+    const auto r = rig.wait_result(rig.driver.upload_mission(plan(4), rig.now()));
+    EXPECT_EQ(r.result, RequestResult::Refused);
+    EXPECT_NE(r.detail.find("MAV_MISSION_UNSUPPORTED_FRAME"), std::string::npos) << r.detail;
+    EXPECT_NE(r.detail.find("MISSION_ITEM"), std::string::npos) << r.detail;
+    EXPECT_LT(rig.now() - start, seconds(5)) << "a refusal is an answer, not a reason to retry";
+    EXPECT_LE(rig.rover.item_frames().size(), 2u);
+}
+
+TEST(Driver, EnteringAutoOnABoardThatRestartsAtItemOneGoesBackToTheSlotItWasAt) {
+    FakeRover::Options o = apm2_rover();
+    o.restart_mission_on_auto = true;
+    Rig rig(apm2_config(), o);
+    rig.bring_up();
+    ASSERT_EQ(rig.wait_result(rig.driver.upload_mission(plan(8), rig.now())).result, RequestResult::Ok);
+    ASSERT_EQ(rig.wait_result(rig.driver.set_current(5, rig.now())).result, RequestResult::Ok);
+    rig.harness.run_for(seconds(2));
+    const std::size_t events_before = rig.events.size();
+    ASSERT_EQ(rig.wait_result(rig.driver.request_state(VehicleState::WaypointNavigation, rig.now())).result,
+              RequestResult::Ok);
+    rig.harness.run_for(seconds(4));
+    EXPECT_EQ(rig.rover.mission_current(), 5) << "the board must be set back to the slot it was at";
+    EXPECT_EQ(rig.driver.status().auto_restarts_corrected, 1u);
+    for (std::size_t i = events_before; i < rig.events.size(); ++i) {
+        if (const auto* c = std::get_if<MissionCurrentChanged>(&rig.events[i])) {
+            EXPECT_EQ(c->seq, 5) << "the restart to item 1 must not reach the flight plan manager";
+        }
+    }
+    // A board that keeps its slot is left alone.
+    Rig modern(pixhawk_config(), FakeRover::Options{});
+    modern.bring_up();
+    ASSERT_EQ(modern.wait_result(modern.driver.upload_mission(plan(8), modern.now())).result,
+              RequestResult::Ok);
+    ASSERT_EQ(modern.wait_result(modern.driver.set_current(5, modern.now())).result, RequestResult::Ok);
+    ASSERT_EQ(modern.wait_result(modern.driver.request_state(VehicleState::WaypointNavigation, modern.now()))
+                  .result,
+              RequestResult::Ok);
+    modern.harness.run_for(seconds(4));
+    EXPECT_EQ(modern.rover.mission_current(), 5);
+    EXPECT_EQ(modern.driver.status().auto_restarts_corrected, 0u);
+}
+
+std::vector<MissionItem> plan_with_speeds() {
+    auto items = plan(8);
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        items[i].speed = i < 3 ? 1.5 : 2.5;
+    }
+    return items;
+}
+
+TEST(Driver, TheLegSpeedGoesByCommandOnBoardsThatHaveItAndByCruiseSpeedOnOthers) {
+    // Pixhawk-era: MAV_CMD_DO_CHANGE_SPEED, once per change.
+    Rig modern(pixhawk_config(), FakeRover::Options{});
+    modern.bring_up();
+    ASSERT_EQ(modern.wait_result(modern.driver.upload_mission(plan_with_speeds(), modern.now())).result,
+              RequestResult::Ok);
+    ASSERT_EQ(modern.wait_result(modern.driver.set_current(1, modern.now())).result, RequestResult::Ok);
+    ASSERT_EQ(modern.wait_result(modern.driver.request_state(VehicleState::WaypointNavigation, modern.now()))
+                  .result,
+              RequestResult::Ok);
+    modern.harness.run_for(seconds(2));
+    ASSERT_EQ(modern.rover.speed_commands(), std::vector<float>{1.5F});
+    ASSERT_EQ(modern.wait_result(modern.driver.set_current(2, modern.now())).result, RequestResult::Ok);
+    modern.harness.run_for(seconds(2));
+    EXPECT_EQ(modern.rover.speed_commands(), std::vector<float>{1.5F}) << "same speed: nothing sent";
+    ASSERT_EQ(modern.wait_result(modern.driver.set_current(5, modern.now())).result, RequestResult::Ok);
+    modern.harness.run_for(seconds(2));
+    EXPECT_EQ(modern.rover.speed_commands(), (std::vector<float>{1.5F, 2.5F}));
+    EXPECT_EQ(modern.driver.status().speed, 2.5);
+
+    // APM 2.x: no such command; CRUISE_SPEED is written (and read back).
+    Rig old(apm2_config(), apm2_rover());
+    old.bring_up();
+    ASSERT_EQ(old.wait_result(old.driver.upload_mission(plan_with_speeds(), old.now())).result,
+              RequestResult::Ok);
+    ASSERT_EQ(old.wait_result(old.driver.set_current(5, old.now())).result, RequestResult::Ok);
+    ASSERT_EQ(old.wait_result(old.driver.request_state(VehicleState::WaypointNavigation, old.now())).result,
+              RequestResult::Ok);
+    old.harness.run_for(seconds(3));
+    EXPECT_TRUE(old.rover.speed_commands().empty());
+    EXPECT_FLOAT_EQ(old.rover.params()["CRUISE_SPEED"], 2.5F);
+    EXPECT_EQ(old.driver.status().speed, 2.5);
+
+    // A board that refuses the command: CRUISE_SPEED from then on.
+    FakeRover::Options refusing;
+    refusing.change_speed_command = false;
+    Rig odd(pixhawk_config(), refusing);
+    odd.bring_up();
+    ASSERT_EQ(odd.wait_result(odd.driver.upload_mission(plan_with_speeds(), odd.now())).result,
+              RequestResult::Ok);
+    ASSERT_EQ(odd.wait_result(odd.driver.set_current(1, odd.now())).result, RequestResult::Ok);
+    ASSERT_EQ(odd.wait_result(odd.driver.request_state(VehicleState::WaypointNavigation, odd.now())).result,
+              RequestResult::Ok);
+    odd.harness.run_for(seconds(3));
+    EXPECT_FLOAT_EQ(odd.rover.params()["CRUISE_SPEED"], 1.5F);
+    EXPECT_TRUE(odd.driver.speed_by_param());
+}
+
+}  // namespace
+}  // namespace airseg::autopilot::ardupilot

@@ -190,6 +190,19 @@ void FakeRover::send_ack(std::uint8_t type) {
     send(a);
 }
 
+void FakeRover::set_mode(std::uint32_t mode, TimePoint now) {
+    const bool entering_auto = mode == kAuto && mode_ != kAuto;
+    mode_ = mode;
+    if (entering_auto && options_.restart_mission_on_auto && mission_.size() > 1) {
+        current_ = 1;
+        mav::MissionCurrent mc;
+        mc.seq = current_;
+        mc.total = static_cast<std::uint16_t>(mission_.size());
+        send(mc);
+    }
+    send_heartbeat(now);
+}
+
 void FakeRover::on_frame(const mav::Frame& f, TimePoint now) {
     switch (f.msgid) {
         case mav::MissionCount::kId: {
@@ -249,6 +262,14 @@ void FakeRover::on_frame(const mav::Frame& f, TimePoint now) {
             if (!receiving_) {
                 send_ack(1);  // MAV_MISSION_ERROR: not receiving
                 return;
+            }
+            if (item.command == 16 || item.command == 17) {
+                item_frames_.emplace_back(f.msgid, item.frame);
+                if (!options_.accepted_frames.empty() && !options_.accepted_frames.contains(item.frame)) {
+                    receiving_ = false;
+                    send_ack(2);  // MAV_MISSION_UNSUPPORTED_FRAME: the transfer ends
+                    return;
+                }
             }
             if (item.seq != request_i_) {
                 send_ack(13);
@@ -356,8 +377,7 @@ void FakeRover::on_frame(const mav::Frame& f, TimePoint now) {
         case mav::SetMode::kId: {
             const auto m = mav::decode_payload<mav::SetMode>(f.payload_view());
             if (!refused_modes_.contains(m.custom_mode)) {
-                mode_ = m.custom_mode;
-                send_heartbeat(now);
+                set_mode(m.custom_mode, now);
             }
             return;
         }
@@ -372,9 +392,14 @@ void FakeRover::on_frame(const mav::Frame& f, TimePoint now) {
                 ack.result = refused_modes_.contains(mode) ? 4 : 0;
                 send(ack);
                 if (ack.result == 0) {
-                    mode_ = mode;
-                    send_heartbeat(now);
+                    set_mode(mode, now);
                 }
+            } else if (m.command == 178) {  // MAV_CMD_DO_CHANGE_SPEED
+                ack.result = options_.change_speed_command ? 0 : 3;
+                if (ack.result == 0) {
+                    speed_commands_.push_back(m.param2);
+                }
+                send(ack);
             } else {
                 ack.result = 0;
                 send(ack);

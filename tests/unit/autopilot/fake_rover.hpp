@@ -37,6 +37,10 @@ class FakeRover {
         bool boot_texts = true;             // "Initialising APM" and the version banner after a boot
         std::size_t params = 40;
         std::size_t max_items = 400;
+        /// Frames a position item may have; others get MAV_MISSION_UNSUPPORTED_FRAME (empty: any).
+        std::set<std::uint8_t> accepted_frames;
+        bool restart_mission_on_auto = false;  // AUTO starts the mission at item 1 (APM:Rover 2.x)
+        bool change_speed_command = true;      // knows MAV_CMD_DO_CHANGE_SPEED (else UNSUPPORTED)
     };
 
     explicit FakeRover(Options options, TimePoint now);
@@ -65,6 +69,10 @@ class FakeRover {
     TimePoint last_override_at() const { return last_override_at_; }
     std::size_t overrides_received() const { return overrides_; }
     std::size_t param_sets() const { return param_sets_; }
+    /// Speeds set by MAV_CMD_DO_CHANGE_SPEED, in order.
+    const std::vector<float>& speed_commands() const { return speed_commands_; }
+    /// Frames of the position items received, in order (MISSION_ITEM or MISSION_ITEM_INT).
+    const std::vector<std::pair<std::uint32_t, std::uint8_t>>& item_frames() const { return item_frames_; }
     unsigned upload_aborts() const { return upload_aborts_; }
     std::uint32_t time_boot_ms(TimePoint now) const;
 
@@ -78,6 +86,7 @@ class FakeRover {
     void send_param(std::size_t index);
     void request_item(TimePoint now);
     void send_ack(std::uint8_t type);
+    void set_mode(std::uint32_t mode, TimePoint now);
     void text(std::uint8_t severity, const std::string& s);
 
     Options options_;
@@ -91,6 +100,8 @@ class FakeRover {
     bool boot_texts_sent_;
     std::uint32_t mode_ = kHold;
     std::set<std::uint32_t> refused_modes_;
+    std::vector<float> speed_commands_;
+    std::vector<std::pair<std::uint32_t, std::uint8_t>> item_frames_;  // (message id, frame)
     std::map<std::string, float> params_;
     std::vector<std::string> param_order_;
     std::size_t param_sets_ = 0;
