@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <utility>
 
 #include "hal/gpio_pulse.hpp"
@@ -46,7 +47,7 @@ AutopilotService::AutopilotService(ServiceContext& ctx, AutopilotServiceConfig c
       prefix_("autopilot[" + config_.port.serial.path + "]: ") {
     if (config_.tlog.enabled) {
         driver_.set_frame_tap([this](bool, std::span<const std::uint8_t> frame) {
-            tlog_.record(frame, std::chrono::system_clock::now());
+            tlog_.record(frame, std::chrono::system_clock::now(), SteadyClock::now());
         });
     }
 }
@@ -191,8 +192,9 @@ void AutopilotService::publish(Event e) {
         e);
 }
 
+// One timer for the driver's deadlines and the .tlog's flush deadline.
 void AutopilotService::arm_timer() {
-    const TimePoint next = driver_.poll_timeout();
+    const TimePoint next = std::min(driver_.poll_timeout(), tlog_.poll_timeout());
     if (next == timer_at_) {
         return;
     }
@@ -222,7 +224,9 @@ void AutopilotService::on_timer(const boost::system::error_code& ec) {
         return;
     }
     timer_at_ = kNever;
-    driver_.handle_timeout(SteadyClock::now());
+    const TimePoint now = SteadyClock::now();
+    driver_.handle_timeout(now);
+    tlog_.handle_timeout(now);
     pump();
 }
 

@@ -2,8 +2,8 @@
 // AutopilotService: the asio side of the ArduPilot driver. It keeps the autopilot's serial port open
 // (PortKeeper: reopen with backoff), feeds the port's bytes and a steady_timer to the sans-IO Driver, writes
 // what the driver sends, publishes the driver's events and the autopilot status and telemetry on the bus,
-// pulses the reset line when the driver asks, reopens the port at the rate the driver's baud probing asks for,
-// and records every frame in the .tlog when enabled.
+// pulses the reset line when the driver asks, reopens the port at the rate the driver's baud probing asks
+// for, and records every frame in the .tlog when enabled (its flush deadline shares the driver's timer).
 //
 // Bus: subscribes AutopilotRequest, JoystickInput, OperatorReset; publishes the autopilot::Event types
 // (RequestDone with the requester's id) as events, and AutopilotStatus and Telemetry as variables.

@@ -41,7 +41,7 @@ void TlogWriter::fail(const char* what, int err) {
     stats_.last_error = std::string(what) + " " + config_.path + ": " + std::strerror(err);
 }
 
-bool TlogWriter::open(WallTime now) {
+bool TlogWriter::open(TimePoint now) {
     if (fd_ >= 0) {
         return true;
     }
@@ -66,7 +66,7 @@ void TlogWriter::close() {
     }
 }
 
-void TlogWriter::rotate(WallTime now) {
+void TlogWriter::rotate(TimePoint now) {
     flush();
     close();
     const auto name = [&](unsigned i) {
@@ -82,21 +82,21 @@ void TlogWriter::rotate(WallTime now) {
     }
     ++stats_.rotations;
     file_bytes_ = 0;
-    next_open_attempt_ = WallTime{};
+    next_open_attempt_ = TimePoint::min();
     open(now);
 }
 
-void TlogWriter::record(std::span<const std::uint8_t> frame, WallTime at) {
+void TlogWriter::record(std::span<const std::uint8_t> frame, WallTime at, TimePoint now) {
     if (!config_.enabled) {
         return;
     }
     const std::size_t record_size = 8 + frame.size();
-    if (fd_ < 0 && !open(at)) {
+    if (fd_ < 0 && !open(now)) {
         ++stats_.dropped_frames;
         return;
     }
     if (file_bytes_ + record_size > config_.max_bytes && file_bytes_ > 0) {
-        rotate(at);
+        rotate(now);
         if (fd_ < 0) {
             ++stats_.dropped_frames;
             return;
@@ -104,6 +104,9 @@ void TlogWriter::record(std::span<const std::uint8_t> frame, WallTime at) {
     }
     const auto us = std::chrono::duration_cast<std::chrono::microseconds>(at.time_since_epoch()).count();
     const auto u = static_cast<std::uint64_t>(us);
+    if (buffer_.empty()) {
+        flush_due_ = now + config_.flush_interval;
+    }
     for (int shift = 56; shift >= 0; shift -= 8) {
         buffer_.push_back(static_cast<std::uint8_t>(u >> shift));
     }
@@ -115,7 +118,14 @@ void TlogWriter::record(std::span<const std::uint8_t> frame, WallTime at) {
     }
 }
 
+void TlogWriter::handle_timeout(TimePoint now) {
+    if (now >= flush_due_) {
+        flush();
+    }
+}
+
 void TlogWriter::flush() {
+    flush_due_ = kNever;
     if (buffer_.empty()) {
         return;
     }
