@@ -46,7 +46,7 @@ void Expander::reset_to_origin() {
     stack_.clear();
     leaf_ = kNoNode;
     position_ = origin_.index;
-    speed_ = plan_->vehicle.cruise_speed;
+    speed_ = plan_->vehicle.commanded_cruise_speed();
     // The first waypoint after a (re)start always carries the speed, so the autopilot gets it set.
     speed_changed_ = true;
     last_position_.reset();

@@ -125,6 +125,7 @@ struct FeederProgress {
     std::string failure;       // why the plan failed, "" unless state is Failed
     std::uint64_t interruptions = 0;
     std::uint64_t starvation_holds = 0;
+    std::uint64_t retargets = 0;  // the vehicle reached its target while the next slot's write was in flight
     std::uint64_t ignored_reached = 0;  // duplicate or late reached reports
     std::uint64_t retries = 0;
     std::uint64_t failures = 0;

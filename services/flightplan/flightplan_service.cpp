@@ -227,9 +227,10 @@ bool FlightplanService::return_home(TimePoint now) {
         if (!store_->save_progress(paused))
             last_saved_ = paused;
     }
-    feeder_.replace_plan(PlanFeed{std::make_unique<HomeStream>(*home, v.cruise_speed, v.arrival_radius),
-                                  active_->plan->name + " (return home)"},
-                         now);
+    feeder_.replace_plan(
+        PlanFeed{std::make_unique<HomeStream>(*home, v.commanded_cruise_speed(), v.arrival_radius),
+                 active_->plan->name + " (return home)"},
+        now);
     active_->stream = nullptr;
     returning_home_ = true;
     return true;

@@ -78,6 +78,11 @@ struct VehicleProfile {
     double min_spacing = 4.0;     // metres between consecutive generated waypoints
     double arrival_radius = 2.0;  // metres
     double cruise_speed = 2.0;    // m/s
+    /// The plan states cruise_speed: waypoints carry it to the autopilot. Without it, legs without a speed of
+    /// their own (a speed element or a per-element speed) go at the autopilot's own speed (CRUISE_SPEED).
+    bool cruise_speed_given = false;
+    /// The speed a waypoint carries until a speed element: 0 means the autopilot's own.
+    double commanded_cruise_speed() const { return cruise_speed_given ? cruise_speed : 0.0; }
     static std::optional<VehicleProfile> defaults_for(std::string_view type);
 };
 

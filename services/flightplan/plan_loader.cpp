@@ -473,8 +473,10 @@ void Loader::parse_vehicle(const YAML::Node& v, const std::string& path) {
         plan_.vehicle.min_spacing = *x;
     if (auto x = number(v, "arrival_radius", path, false, 0.0, 1e5, true))
         plan_.vehicle.arrival_radius = *x;
-    if (auto x = number(v, "cruise_speed", path, false, 0.0, 1000.0, true))
+    if (auto x = number(v, "cruise_speed", path, false, 0.0, 1000.0, true)) {
         plan_.vehicle.cruise_speed = *x;
+        plan_.vehicle.cruise_speed_given = true;
+    }
 }
 
 std::optional<Reaction> Loader::parse_reaction(const YAML::Node& node, const std::string& path) {

@@ -312,6 +312,17 @@ void WindowFeeder::check_starvation() {
     if (!mission_ok_ || need_set_current_ || queue_.empty() || starving_)
         return;
     if (!confirmed(queue_[0])) {
+        const auto* in_flight = outstanding_ ? std::get_if<WriteItems>(&outstanding_->request.op) : nullptr;
+        if (in_flight && mode_ == Mode::Auto && in_flight->first_slot <= queue_[0].slot &&
+            queue_[0].slot < in_flight->first_slot + in_flight->items.size()) {
+            // The vehicle reached its target while the write of the slot after it was on its way (a plan
+            // replaced near the end of a leg): it heads for that slot's old content for one round trip. No
+            // HOLD for that: once the write lands, set-current retargets it (reached reports until then say
+            // nothing about the plan). Should the write fail, the vehicle is held (request_failed).
+            need_set_current_ = true;
+            ++counters_.retargets;
+            return;
+        }
         // The autopilot took its target from a slot not yet rewritten: what it reaches there is stale. Hold,
         // write, then point it at the head again; reached reports until then say nothing about the plan.
         starving_ = true;
@@ -492,6 +503,13 @@ void WindowFeeder::on_request_result(std::uint32_t id, RequestResult result, Tim
 }
 
 void WindowFeeder::request_failed(TimePoint now) {
+    if (need_set_current_ && !starving_ && mode_ == Mode::Auto && !queue_.empty() && !confirmed(queue_[0]) &&
+        ap_target_ == queue_[0].slot) {
+        // A retarget waited for this write: the vehicle drives to stale content until it lands. Hold now.
+        starving_ = true;
+        ++counters_.starvation_holds;
+        emit(FeederEvent::Kind::WindowStarved, &queue_[0].wp, queue_[0].generation, queue_[0].element_path);
+    }
     // The reconciliation in poll_request() regenerates the same request: retrying needs no copy of it.
     if (++consecutive_failures_ <= config_.retries) {
         ++counters_.retries;

@@ -226,6 +226,7 @@ class Driver {
     std::uint16_t reported_current_ = 0;  // the mission slot last reported (MissionCurrentChanged)
     AutoEntryCheck auto_check_;
     std::optional<double> speed_set_;
+    std::optional<double> board_speed_;  // CRUISE_SPEED before the first change
     std::optional<SpeedRequest> speed_request_;
     bool speed_by_param_ = false;
     unsigned speed_changes_ = 0;

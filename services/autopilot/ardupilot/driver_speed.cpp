@@ -3,7 +3,9 @@
 // speed differs from the last one it confirmed, the driver sets it: MAV_CMD_DO_CHANGE_SPEED (COMMAND_LONG,
 // confirmed by COMMAND_ACK) on boards that have the command, the CRUISE_SPEED parameter (PARAM_SET, read
 // back) on those that do not (ArduRover 2.x; also any board that refuses the command or never answers it).
-// A parameter write is kept in the board's EEPROM: it is sent only when the speed changes.
+// A leg without a speed goes at the board's own speed, CRUISE_SPEED as it was before the first change (kept for
+// the driver's lifetime: on a board set by parameter, CRUISE_SPEED holds the plan's speed afterwards). A
+// parameter write is kept in the board's EEPROM: it is sent only when the speed changes.
 #include <cmath>
 
 #include "services/autopilot/ardupilot/driver.hpp"
@@ -40,10 +42,23 @@ void Driver::update_speed(TimePoint now) {
         return;
     }
     const MissionItem& item = mission_[slot - 1];
-    if (item.kind != MissionItem::Kind::Waypoint || !item.speed || *item.speed <= 0.0) {
+    if (item.kind != MissionItem::Kind::Waypoint) {
         return;
     }
-    const double v = *item.speed;
+    double v = 0.0;
+    if (item.speed && *item.speed > 0.0) {
+        v = *item.speed;
+        if (!board_speed_) {
+            // What the board drives at by itself, before the first change: legs without a speed go back to it.
+            if (const auto own = params_.cached(kCruiseSpeed)) {
+                board_speed_ = *own;
+            }
+        }
+    } else if (board_speed_ && (speed_set_ || speed_request_)) {
+        v = *board_speed_;  // a leg without a speed of its own after legs with one
+    } else {
+        return;
+    }
     if (speed_request_ ? same(speed_request_->value, v) : (speed_set_ && same(*speed_set_, v))) {
         return;
     }

@@ -696,7 +696,9 @@ TEST(Driver, EnteringAutoOnABoardThatRestartsAtItemOneGoesBackToTheSlotItWasAt) 
 std::vector<MissionItem> plan_with_speeds() {
     auto items = plan(8);
     for (std::size_t i = 0; i < items.size(); ++i) {
-        items[i].speed = i < 3 ? 1.5 : 2.5;
+        if (i < 6) {
+            items[i].speed = i < 3 ? 1.5 : 2.5;  // the last two legs have none: the board's own speed
+        }
     }
     return items;
 }
@@ -720,6 +722,10 @@ TEST(Driver, TheLegSpeedGoesByCommandOnBoardsThatHaveItAndByCruiseSpeedOnOthers)
     modern.harness.run_for(seconds(2));
     EXPECT_EQ(modern.rover.speed_commands(), (std::vector<float>{1.5F, 2.5F}));
     EXPECT_EQ(modern.driver.status().speed, 2.5);
+    ASSERT_EQ(modern.wait_result(modern.driver.set_current(7, modern.now())).result, RequestResult::Ok);
+    modern.harness.run_for(seconds(2));
+    EXPECT_EQ(modern.rover.speed_commands(), (std::vector<float>{1.5F, 2.5F, 3.0F}))
+        << "a leg without a speed goes back to the board's CRUISE_SPEED";
 
     // APM 2.x: no such command; CRUISE_SPEED is written (and read back).
     Rig old(apm2_config(), apm2_rover());

@@ -157,8 +157,10 @@ TEST(FlightplanExpander, RepeatSpeedHoldAndOrbitSemantics) {
     const auto wps = expand_all(plan);
     const auto& root = plan->nodes[plan->main_list];
     EXPECT_EQ(wps.size(), *root.count);
-    // Speed: cruise at first, 3 after the speed element, 1.5 after the inner one, and a per-waypoint 4.
-    EXPECT_DOUBLE_EQ(wps[0].speed, plan->vehicle.cruise_speed);
+    // Speed: the autopilot's own at first (the plan states no cruise_speed: 0), 3 after the speed element,
+    // 1.5 after the inner one, and a per-waypoint 4.
+    EXPECT_FALSE(plan->vehicle.cruise_speed_given);
+    EXPECT_DOUBLE_EQ(wps[0].speed, 0.0);
     EXPECT_DOUBLE_EQ(wps[1].speed, 3.0);
     EXPECT_TRUE(wps[1].speed_changed);
     EXPECT_DOUBLE_EQ(wps[2].speed, 1.5);

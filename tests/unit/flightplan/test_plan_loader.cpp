@@ -36,6 +36,8 @@ TEST(FlightplanLoader, ExampleSurveyHasTheExpectedShape) {
     EXPECT_EQ(p.vehicle.type, "rover");
     EXPECT_DOUBLE_EQ(p.vehicle.min_spacing, 4.0);
     EXPECT_DOUBLE_EQ(p.vehicle.cruise_speed, 1.5);
+    EXPECT_TRUE(p.vehicle.cruise_speed_given);
+    EXPECT_DOUBLE_EQ(p.vehicle.commanded_cruise_speed(), 1.5);
     ASSERT_EQ(p.no_fly.size(), 1u);
     EXPECT_DOUBLE_EQ(p.no_fly[0].buffer, 5.0);
     ASSERT_TRUE(p.reactions.link_loss.has_value());

@@ -325,6 +325,36 @@ TEST(FlightplanFeeder, AMissionTheAutopilotRefusesFailsThePlanInsteadOfRetryingF
     EXPECT_EQ(h.ap.visited().size(), 20u);
 }
 
+TEST(FlightplanFeeder, AReplacementWhoseFirstWriteLandsJustAfterTheTargetIsReachedRetargetsWithoutAHold) {
+    Harness h;
+    h.feeder.replace_plan(test::synthetic(40, 41.0), h.now);
+    for (int i = 0; i < 10; ++i)
+        h.step();
+    ASSERT_TRUE(h.ap.in_auto());
+    const std::size_t a_done = h.ap.visited().size();
+    h.feeder.replace_plan(test::synthetic(20, 42.0), h.now);
+    auto write = h.feeder.poll_request(h.now);
+    ASSERT_TRUE(write.has_value());
+    ASSERT_TRUE(std::holds_alternative<WriteItems>(write->op)) << *write;
+    // The vehicle reaches the kept target before the write of the slot after it has landed: it now heads
+    // for that slot's old content (route A's next waypoint).
+    const auto reached = h.ap.step();
+    ASSERT_TRUE(reached.has_value());
+    h.feeder.on_reached(*reached, h.now);
+    h.feeder.on_current(h.ap.current(), h.now);
+    h.drain();
+    h.feeder.on_request_result(write->id, h.ap.apply(*write), h.now);
+    h.drain();
+    ASSERT_LT(h.run_until_done(200), 200);
+    EXPECT_EQ(h.ap.hold_requests(), 0) << "a write one round trip late is no reason to stop the vehicle";
+    EXPECT_EQ(h.feeder.progress().starvation_holds, 0u);
+    EXPECT_EQ(h.feeder.progress().retargets, 1u);
+    // A up to the kept target, then B from its first waypoint: never A's stale next one.
+    ASSERT_EQ(h.ap.visited().size(), a_done + 1 + 20);
+    for (std::uint64_t i = 0; i < 20; ++i)
+        EXPECT_EQ(h.ap.visited()[a_done + 1 + i], test::SyntheticStream::position_of(42.0, i)) << i;
+}
+
 TEST(FlightplanFeeder, HoldWaypointsHoldForTheirTimeOrUntilReleased) {
     Waypoint timed;
     timed.action = WaypointAction::HoldFor;
