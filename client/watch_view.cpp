@@ -18,6 +18,10 @@ const char* plan_state_name(std::uint8_t s) {
             return "paused";
         case 3:
             return "done";
+        case 4:
+            return "interrupted";
+        case 5:
+            return "failed";
         default:
             return "none";
     }

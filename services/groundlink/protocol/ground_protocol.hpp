@@ -51,7 +51,7 @@ struct Telemetry {
     std::uint8_t satellites = 0;      // capped at 15
     std::uint8_t vehicle_state = 0;   // autopilot-neutral vehicle state (0..15)
     std::uint8_t mode = 0;            // autopilot mode number (0..255)
-    std::uint8_t plan_state = 0;      // 0 none, 1 running, 2 paused, 3 done
+    std::uint8_t plan_state = 0;      // 0 none, 1 running, 2 paused, 3 done, 4 interrupted, 5 failed
     std::uint16_t plan_element = 0;   // capped at 16383
     std::uint32_t next_waypoint = 0;  // index in the expanded plan, capped at 2^24-1
 

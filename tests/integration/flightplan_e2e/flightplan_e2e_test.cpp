@@ -470,3 +470,162 @@ TEST_F(FlightplanE2e, CorruptStateFilesAreReportedAndSetAsideAndTheDaemonStartsW
 
 }  // namespace
 }  // namespace airseg::test
+
+namespace airseg::test {
+namespace {
+
+/// A lawnmower of `lines` lines of `per_line` waypoints, `step` metres apart along a line and `gap` between
+/// lines, driven at `speed` (stated in the plan, so it is sent to the board).
+std::string lawnmower_plan(const std::string& name, int lines, int per_line, double step, double gap,
+                           double speed) {
+    std::ostringstream o;
+    o.precision(9);
+    o << "plan:\n  name: " << name << "\n  vehicle: {type: rover, cruise_speed: " << speed
+      << "}\n  elements:\n";
+    const double lat0 = kHomeLat + 10.0 / 111320.0;
+    const double m_lon = 1.0 / (111320.0 * std::cos(kHomeLat * std::numbers::pi / 180.0));
+    for (int l = 0; l < lines; ++l) {
+        for (int k = 0; k < per_line; ++k) {
+            const int along = l % 2 == 0 ? k : per_line - 1 - k;
+            o << "    - waypoint: {lat: " << lat0 + l * gap / 111320.0
+              << ", lon: " << kHomeLon + along * step * m_lon << "}\n";
+        }
+    }
+    return o.str();
+}
+
+// HOLD that this daemon did not ask for: the RC transmitter's mode switch set to HOLD (to the daemon the same
+// as the board's own HOLD: a failsafe, the end of its mission).
+const std::string kForceHold = "rcpilot HOLD";
+
+double metres_between(const E7& a, const E7& b) {
+    const double dlat = static_cast<double>(b.first - a.first) * 1e-7 * 111320.0;
+    const double dlon = static_cast<double>(b.second - a.second) * 1e-7 * 111320.0 *
+                        std::cos(kHomeLat * std::numbers::pi / 180.0);
+    return std::hypot(dlat, dlon);
+}
+
+TEST_F(FlightplanE2e, ALawnmowerIsDrivenInOrderWithoutAHoldAtThePlansSpeedWithinFivePercentOfTheIdealTime) {
+    // 6 lines of 10 waypoints 20 m apart, lines 12 m apart: 60 waypoints, 12 times the window of 5.
+    constexpr double kSpeed = 3.0;  // the board's own CRUISE_SPEED is 4: the plan's speed must reach it
+    const auto file = write_plan("mower.yaml", lawnmower_plan("mower", 6, 10, 20, 12, kSpeed));
+    const auto expected = expected_positions(file);
+    ASSERT_EQ(expected.size(), 60u);
+    start_daemon(5);
+    const auto first = reached_total(*control_);
+    const double t0 = sim_time();
+    auto load = ctl({"plan", "load", file});
+    ASSERT_EQ(load.exit_code, 0) << load.json.dump() << load.err;
+    EXPECT_EQ(load.json["state"], "running");
+    ASSERT_TRUE(wait_until([&] { return show().value("state", "") == "done"; }, 90s, kPoll))
+        << show().dump() << daemon_->err();
+
+    const auto reached = reached_log(*control_, first);
+    ASSERT_GE(reached.size(), expected.size());
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+        ASSERT_PRED2(same_place, reached[i].at, expected[i]) << "reached #" << i << " is not waypoint " << i;
+    }
+    for (std::size_t i = expected.size(); i < reached.size(); ++i) {
+        EXPECT_PRED2(same_place, reached[i].at, expected.back()) << "after the end, only the final stop";
+    }
+    const double done_at = reached[expected.size() - 1].t;
+    for (const auto& h : holds_after(t0)) {
+        EXPECT_GE(h["t"].get<double>(), done_at) << "a HOLD before the plan's end: " << h.dump();
+    }
+    // Ideal: the legs from the first waypoint to the last at the plan's speed. The vehicle counts a waypoint
+    // reached within WP_RADIUS (1.5 m) of it, so each leg is driven about that much shorter or longer.
+    double metres = 0;
+    for (std::size_t i = 1; i < expected.size(); ++i) {
+        metres += metres_between(expected[i - 1], expected[i]);
+    }
+    const double ideal = metres / kSpeed;
+    const double actual = reached[expected.size() - 1].t - reached[0].t;
+    std::cout << "[ figures ] " << "59 legs, " << metres << " m, " << actual
+              << " s simulated, ideal " << ideal << " s (" << 100.0 * (actual - ideal) / ideal << " %)\n";
+    EXPECT_NEAR(actual, ideal, 0.05 * ideal);
+    const auto ap = status().value("autopilot", Json());
+    EXPECT_EQ(ap.value("speed", Json()), Json(kSpeed)) << ap.dump();
+}
+
+TEST_F(FlightplanE2e, APlanLoadedAfterAFinishedOneAndAParkingCommandDrivesWithoutResume) {
+    const auto a_file = write_plan("a.yaml", line_plan("first", kHomeLat, kHomeLon + 0.0001, 0, 5, 10));
+    const auto b_file =
+        write_plan("b.yaml", line_plan("second", kHomeLat + 0.0002, kHomeLon + 0.0003, 90, 6, 10));
+    const auto b = expected_positions(b_file);
+    start_daemon(5);
+    ASSERT_EQ(ctl({"plan", "load", a_file}).exit_code, 0);
+    ASSERT_TRUE(wait_until([&] { return show().value("state", "") == "done"; }, 60s, kPoll)) << show().dump();
+    auto parked = ctl({"request", R"({"cmd":"state","state":"PARKING"})"});
+    ASSERT_EQ(parked.exit_code, 0) << parked.json.dump() << parked.err;
+    ASSERT_EQ(control_->json("state")["mode"], "HOLD");
+    const auto first = reached_total(*control_);
+    auto load = ctl({"plan", "load", b_file});
+    ASSERT_EQ(load.exit_code, 0) << load.json.dump() << load.err;
+    EXPECT_EQ(load.json["state"], "running");
+    EXPECT_EQ(control_->json("state")["mode"], "AUTO") << "plan load means drive it";
+    ASSERT_TRUE(wait_until([&] { return show().value("state", "") == "done"; }, 60s, kPoll)) << show().dump();
+    const auto reached = reached_log(*control_, first);
+    ASSERT_GE(reached.size(), b.size());
+    for (std::size_t i = 0; i < b.size(); ++i) {
+        ASSERT_PRED2(same_place, reached[i].at, b[i]) << "reached #" << i << " is not waypoint " << i;
+    }
+    // --paused loads and waits.
+    const auto c_file = write_plan("c.yaml", line_plan("third", kHomeLat, kHomeLon + 0.0001, 0, 3, 10));
+    auto waiting = ctl({"plan", "load", c_file, "--paused"});
+    ASSERT_EQ(waiting.exit_code, 0) << waiting.json.dump() << waiting.err;
+    EXPECT_EQ(waiting.json["state"], "paused");
+    EXPECT_EQ(control_->json("state")["mode"], "HOLD");
+}
+
+TEST_F(FlightplanE2e, TheBoardFallingIntoHoldMidPlanIsSeenSaidAndUndoneWithinFiveSeconds) {
+    const auto file = write_plan("route.yaml", line_plan("route", kHomeLat, kHomeLon + 0.0001, 0, 40, 10));
+    const auto expected = expected_positions(file);
+    start_daemon(5);
+    const auto first = reached_total(*control_);
+    ASSERT_EQ(ctl({"plan", "load", file}).exit_code, 0);
+    ASSERT_TRUE(wait_until([&] { return show().value("waypoints_reached", 0) >= 8; }, kGenerous, kPoll));
+    const double forced_at = sim_time();
+    const auto forced = control_->ask(kForceHold);
+    ASSERT_TRUE(forced && forced->rfind("ok", 0) == 0) << forced.value_or("no answer");
+    const auto held_since = std::chrono::steady_clock::now();
+    // Back in AUTO within 5 s of real time (250 simulated s at this speedup: the bound is the daemon's).
+    ASSERT_TRUE(wait_until(
+        [&] {
+            for (const auto& m : control_->json("modes")) {
+                if (m["t"].get<double>() > forced_at && m["to"] == "AUTO") {
+                    return true;
+                }
+            }
+            return false;
+        },
+        5s, 50ms))
+        << control_->json("modes").dump() << daemon_->err();
+    std::cout << "[ figures ] " << "back in AUTO " << seconds_since(held_since)
+              << " s after the HOLD\n";
+    const auto plan = show();
+    ASSERT_TRUE(plan["interruption"].is_string()) << plan.dump();
+    EXPECT_NE(plan["interruption"].get<std::string>().find("HOLD"), std::string::npos) << plan.dump();
+    ASSERT_TRUE(wait_until([&] { return show().value("state", "") == "done"; }, 60s, kPoll)) << show().dump();
+    const auto reached = reached_log(*control_, first);
+    ASSERT_GE(reached.size(), expected.size());
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+        ASSERT_PRED2(same_place, reached[i].at, expected[i]) << "reached #" << i << " is not waypoint " << i;
+    }
+}
+
+TEST_F(FlightplanE2e, AMissionTheBoardRefusesFailsThePlanWithItsAnswerAndPlanLoadExitsOne) {
+    // 200 ring slots, home and the jump: 202 items for a board that holds 150.
+    const auto file = write_plan("route.yaml", line_plan("route", kHomeLat, kHomeLon + 0.0001, 0, 250, 10));
+    start_daemon(200);
+    auto load = ctl({"plan", "load", file});
+    EXPECT_EQ(load.exit_code, 1) << load.json.dump() << load.err;
+    const auto plan = show();
+    EXPECT_EQ(plan["state"], "failed") << plan.dump();
+    ASSERT_TRUE(plan["error"].is_string()) << plan.dump();
+    EXPECT_NE(plan["error"].get<std::string>().find("NO_SPACE"), std::string::npos) << plan.dump();
+    EXPECT_TRUE(daemon_->running());
+}
+
+
+}  // namespace
+}  // namespace airseg::test

@@ -57,6 +57,18 @@ TEST(GroundProtocol, TelemetryIsTwentyNineBytesAndRoundTrips) {
     EXPECT_EQ(t.next_waypoint, 123456u);
 }
 
+TEST(GroundProtocol, EveryPlanStateRoundTripsBesideTheVehicleState) {
+    for (std::uint8_t state = 0; state <= 5; ++state) {
+        auto t = sample();
+        t.plan_state = state;
+        t.vehicle_state = 15;
+        const auto decoded = decode(encode(t));
+        ASSERT_TRUE(decoded.message) << decoded.error;
+        EXPECT_EQ(std::get<Telemetry>(*decoded.message).plan_state, state);
+        EXPECT_EQ(std::get<Telemetry>(*decoded.message).vehicle_state, 15);
+    }
+}
+
 TEST(GroundProtocol, TelemetryClampsOutOfRangeValues) {
     Telemetry t;
     t.lat_deg = -33.9;
