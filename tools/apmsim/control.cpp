@@ -42,6 +42,8 @@ nlohmann::json state_json(const RoverSim& sim, TimePoint now) {
         {"battery_remaining", s.battery_remaining},
         {"odometer", s.odometer},
         {"reached", sim.reached().size()},
+        {"cruise_speed", s.cruise_speed},
+        {"firmware", firmware_name(sim.config().firmware.firmware)},
     };
     if (s.target) {
         j["target"] = {{"lat", s.target->lat}, {"lon", s.target->lon}, {"distance", s.target_distance}};
@@ -81,6 +83,21 @@ nlohmann::json reached_json(const RoverSim& sim, std::uint64_t from, std::uint64
     return {{"total", sim.reached_total()}, {"first_kept", first}, {"reached", list}};
 }
 
+nlohmann::json speeds_json(const RoverSim& sim, std::uint64_t from, std::uint64_t count) {
+    const auto& log = sim.speed_log();
+    const std::uint64_t first = sim.speed_log_total() - log.size();
+    nlohmann::json list = nlohmann::json::array();
+    for (std::uint64_t n = std::max(from, first); n < sim.speed_log_total() && list.size() < count; ++n) {
+        const SpeedChange& c = log[static_cast<std::size_t>(n - first)];
+        list.push_back({{"n", n},
+                        {"t", seconds_since(sim.started(), c.at)},
+                        {"speed", c.speed},
+                        {"cause", c.cause},
+                        {"seq", c.seq}});
+    }
+    return {{"total", sim.speed_log_total()}, {"first_kept", first}, {"speeds", list}};
+}
+
 nlohmann::json stats_json(const RoverSim& sim) {
     const SimCounters& c = sim.counters();
     const MissionServerStats& m = sim.mission_stats();
@@ -90,6 +107,8 @@ nlohmann::json stats_json(const RoverSim& sim) {
             {"bytes_corrupted", c.bytes_corrupted},
             {"frames_in", c.frames_in},
             {"frames_ignored", c.frames_ignored},
+            {"bad_checksum", c.bad_checksum},
+            {"mavlink2_ignored", c.mavlink2_ignored},
             {"heartbeats_sent", c.heartbeats_sent},
             {"heartbeats_stalled", c.heartbeats_stalled},
             {"uploads_completed", m.uploads_completed},
@@ -134,6 +153,14 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
             const auto count = w.size() > 2 ? toolcommon::parse_unsigned(verb, w[2], 1, 500) : 500;
             return reached_json(sim, from, count).dump();
         }
+        if (verb == "speeds") {
+            if (w.size() > 3) {
+                throw toolcommon::UsageError("usage: speeds [FROM [COUNT]]");
+            }
+            const auto from = w.size() > 1 ? toolcommon::parse_unsigned(verb, w[1], 0, UINT64_MAX) : 0;
+            const auto count = w.size() > 2 ? toolcommon::parse_unsigned(verb, w[2], 1, 500) : 500;
+            return speeds_json(sim, from, count).dump();
+        }
         if (verb == "stats") {
             return stats_json(sim).dump();
         }
@@ -148,6 +175,19 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
                        std::string(phase_name(sim.state().phase)) + ")";
             }
             return "ok mode " + std::string(mode_name(*mode));
+        }
+        if (verb == "mode") {
+            need(2, "mode MODE");
+            const auto mode = parse_mode(w[1]);
+            if (!mode || *mode == RoverMode::Initialising) {
+                return "error: mode: unknown mode '" + w[1] + "'";
+            }
+            if (!sim.force_mode(*mode, now)) {
+                return "error: mode: " + std::string(mode_name(*mode)) + " refused (" +
+                       std::string(phase_name(sim.state().phase)) + ", firmware " +
+                       std::string(firmware_name(sim.config().firmware.firmware)) + ")";
+            }
+            return "ok mode " + std::string(mode_name(sim.state().mode));
         }
         if (verb == "reboot") {
             if (w.size() == 1) {
@@ -209,17 +249,16 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
             }
             need(3, "param NAME [VALUE]");
             const double v = toolcommon::parse_double(verb, w[2], -1e9, 1e9);
-            if (!sim.params().set(w[1], static_cast<float>(v))) {
+            if (!sim.set_param(w[1], static_cast<float>(v), now)) {
                 return "error: param: unknown parameter '" + w[1] + "'";
             }
             return "ok param " + w[1] + " " + w[2];
         }
         if (verb == "help") {
-            return "ok commands: state, modes [N], reached [FROM [COUNT]], stats, rcpilot MODE, reboot [S], "
-                   "unplug, replug, hbstall "
-                   "S, "
-                   "loss P [BURST], "
-                   "corrupt P, ignore-mission on|off, slow MS, param NAME [VALUE]";
+            return "ok commands: state, modes [N], reached [FROM [COUNT]], speeds [FROM [COUNT]], stats, "
+                   "rcpilot MODE, mode MODE, reboot [S], unplug, replug, hbstall S, loss P [BURST], corrupt "
+                   "P, "
+                   "ignore-mission on|off, slow MS, param NAME [VALUE]";
         }
         return "error: unknown command '" + verb + "' (try help)";
     } catch (const toolcommon::UsageError& e) {

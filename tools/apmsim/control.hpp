@@ -26,5 +26,8 @@ nlohmann::json stats_json(const RoverSim& sim);
 /// Reached events number `from` on (at most `count`), each with the position of the item reached:
 /// {"total":N,"first_kept":K,"reached":[{"n":..,"t":s,"seq":..,"lat":..,"lon":..,"distance":m,"passed":b}]}.
 nlohmann::json reached_json(const RoverSim& sim, std::uint64_t from, std::uint64_t count);
+/// Speed changes number `from` on (at most `count`):
+/// {"total":N,"first_kept":K,"speeds":[{"n":..,"t":s,"speed":m/s,"cause":..,"seq":..}]}.
+nlohmann::json speeds_json(const RoverSim& sim, std::uint64_t from, std::uint64_t count);
 
 }  // namespace airseg::apmsim

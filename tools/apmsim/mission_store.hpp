@@ -1,5 +1,6 @@
 #pragma once
 // The board's stored mission (its EEPROM): item 0 is home, items 1.. are the plan. Survives reboots.
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -12,7 +13,15 @@ inline constexpr std::uint16_t kCmdNavLoiterUnlimited = 17;
 inline constexpr std::uint16_t kCmdNavLoiterTurns = 18;
 inline constexpr std::uint16_t kCmdNavLoiterTime = 19;
 inline constexpr std::uint16_t kCmdNavReturnToLaunch = 20;
-inline constexpr std::uint16_t kCmdDoJump = 177;  // param1: target item, param2: repeats (-1: forever)
+inline constexpr std::uint16_t kCmdNavTakeoff = 22;
+inline constexpr std::uint16_t kCmdNavLast = 95;  // MAV_CMD_NAV_LAST: ids below are navigation commands
+inline constexpr std::uint16_t kCmdConditionDelay = 112;
+inline constexpr std::uint16_t kCmdConditionChangeAlt = 113;
+inline constexpr std::uint16_t kCmdConditionDistance = 114;
+inline constexpr std::uint16_t kCmdConditionLast = 159;  // MAV_CMD_CONDITION_LAST
+inline constexpr std::uint16_t kCmdDoJump = 177;         // param1: target item, param2: repeats (-1: forever)
+inline constexpr std::uint16_t kCmdDoChangeSpeed =
+    178;  // param1: speed type, param2: m/s, param3: throttle %
 
 struct StoredItem {
     std::uint16_t command = kCmdNavWaypoint;
@@ -53,6 +62,11 @@ class MissionStore {
             items_[seq] = item;
         }
         return true;
+    }
+    /// Makes the mission exactly `count` items (at least home): keeps the first ones, fills new slots with
+    /// `blank`.
+    void resize(std::size_t count, const StoredItem& blank) {
+        items_.resize(std::max<std::size_t>(1, std::min(count, capacity_)), blank);
     }
     /// Keeps the first `count` items (home always stays).
     void truncate(std::size_t count) {

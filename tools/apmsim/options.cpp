@@ -7,9 +7,9 @@ using toolcommon::UsageError;
 const char* usage() {
     return R"(usage: airseg-apmsim --link PATH [options]
 
-Simulates an ArduPilot APM:Rover board (APM 2.x, Rover 2.x firmware) on a pseudo-terminal. PATH becomes a
-symlink to the pty slave; open it as you would open /dev/ttyACM0. The board speaks MAVLink as system 1,
-component 1 (MAV_TYPE_GROUND_ROVER, MAV_AUTOPILOT_ARDUPILOTMEGA) to any ground station.
+Simulates an ArduPilot APM:Rover board on a pseudo-terminal. PATH becomes a symlink to the pty slave; open
+it as you would open /dev/ttyACM0. The board speaks MAVLink as system 1, component 1
+(MAV_TYPE_GROUND_ROVER, MAV_AUTOPILOT_ARDUPILOTMEGA) to any ground station.
 
 Like an APM on USB, the board reboots when a program opens the port (DTR): it goes silent for the boot
 delay, then sends "Initialising APM..." and heartbeats in MAV_STATE_BOOT/CALIBRATING (mode INITIALISING)
@@ -17,6 +17,13 @@ for the calibration time, then "Ready to drive." in STANDBY/ACTIVE and mode INIT
 
 Board:
   --link PATH              symlink to the pty slave (required)
+  --firmware PROFILE       what the board runs (docs/simulators.md, "Firmware profiles"):
+                           modern: ArduPilot Rover as today (MAVLink 2, MISSION_ITEM_INT,
+                             COMMAND_LONG modes, AUTO resumes, MISSION_ITEM_REACHED);
+                           rover2: APMrover2 2.4x on an APM 2.5 (MAVLink 1 only, float
+                             mission items, SET_MODE without acknowledgement, AUTO
+                             restarts at item 1, text-only reached reports, 500 ms
+                             re-request and 1 s patience in uploads)      [modern]
   --boot-delay S           silence after a reset                                  [2]
   --calib-time S           calibration time after the silence                     [3]
   --no-reset-on-open       do not reboot when the port is opened (Pixhawk-style boards)
@@ -30,7 +37,7 @@ Board:
   --reached-style STYLE    both: MISSION_ITEM_REACHED and the STATUSTEXT
                            "Reached waypoint #N dist Mm"; text: the text only,
                            as APM:Rover 2.x firmware does                          [both]
-  --mavlink1               speak MAVLink 1 (default MAVLink 2)
+  --mavlink1               speak MAVLink 1 (default MAVLink 2; rover2 always does)
   --param NAME=VALUE       set a parameter before boot (repeatable), e.g. WP_RADIUS=3
   --seed N                 seed of the fault generators (deterministic)          [1]
   --speedup N              simulated time runs N times faster than real time      [1]
@@ -60,7 +67,10 @@ Control commands (one per datagram; the reply goes to the sender's bound address
   reached [FROM [COUNT]]   reached items number FROM on (at most COUNT, 500 by default) as JSON:
                            {"total":N,"first_kept":K,"reached":[{"n":..,"seq":..,"lat":..,"lon":..,..}]}
   stats                    byte, frame and mission counters as JSON
+  speeds [FROM [COUNT]]    changes of the navigation speed number FROM on as JSON:
+                           {"total":N,"first_kept":K,"speeds":[{"n":..,"t":s,"speed":..,"cause":..,"seq":..}]}
   rcpilot MODE             the RC pilot flips the mode switch (MANUAL, HOLD, AUTO, ... or a number)
+  mode MODE                the board changes mode by itself, as its failsafe would (cause "board")
   reboot [S]               reboot now, or in S simulated seconds
   unplug | replug          remove the pty (the link is gone) / create a new one at PATH
   hbstall S                no heartbeats for S seconds
@@ -89,6 +99,20 @@ GeoPoint parse_lat_lon(std::string_view option, std::string_view text) {
 std::optional<ApmSimOptions> parse_options(const std::vector<std::string>& args) {
     using namespace toolcommon;
     ApmSimOptions o;
+    // The firmware sets defaults (MAVLink version, reached style, mission timers) that the other options
+    // may then change, wherever --firmware stands on the line.
+    for (std::size_t i = 0; i < args.size(); ++i) {
+        if (args[i] == "--firmware") {
+            if (i + 1 >= args.size()) {
+                throw UsageError("--firmware: missing value");
+            }
+            const auto f = parse_firmware(args[i + 1]);
+            if (!f) {
+                throw UsageError("--firmware: expected modern or rover2, got '" + args[i + 1] + "'");
+            }
+            o.sim = RoverSimConfig::for_firmware(*f);
+        }
+    }
     for (std::size_t i = 0; i < args.size(); ++i) {
         const std::string& arg = args[i];
         auto value = [&]() -> std::string_view {
@@ -101,6 +125,8 @@ std::optional<ApmSimOptions> parse_options(const std::vector<std::string>& args)
             return std::nullopt;
         } else if (arg == "--link") {
             o.link_path = value();
+        } else if (arg == "--firmware") {
+            value();  // applied above
         } else if (arg == "--control") {
             o.control_path = value();
         } else if (arg == "--boot-delay") {

@@ -25,8 +25,24 @@ StoredItem home_item(const RoverSimConfig& c) {
 
 }  // namespace
 
+RoverSimConfig RoverSimConfig::for_firmware(Firmware f) {
+    RoverSimConfig c;
+    c.firmware = FirmwareProfile::of(f);
+    if (f == Firmware::Rover2) {
+        c.version = mavlink::Version::V1;
+        c.reached_style = ReachedStyle::TextOnly;
+        c.mission_rerequest = milliseconds(500);  // "tnow > waypoint_timelast_request + 500"
+        c.mission_give_up = seconds(1);           // waypoint_receive_timeout(1000)
+    }
+    return c;
+}
+
 std::vector<std::string> RoverSimConfig::validate(const RoverSimConfig& c) {
     std::vector<std::string> errors;
+    if (!c.firmware.reads_mavlink2 && c.version == mavlink::Version::V2) {
+        errors.emplace_back("firmware " + std::string(firmware_name(c.firmware.firmware)) +
+                            ": a board that reads MAVLink 1 only must send MAVLink 1");
+    }
     if (!(c.home.lat >= -89 && c.home.lat <= 89) || !(c.home.lon >= -180 && c.home.lon <= 180)) {
         errors.emplace_back("home: latitude must be within ±89 and longitude within ±180 degrees");
     }
@@ -73,21 +89,48 @@ RoverSim::RoverSim(RoverSimConfig config, TimePoint now)
                   [this] { return current_seq_; },
               },
               config_.mission_rerequest, config_.mission_give_up),
-      parser_(std::make_unique<mv::Parser>()),
+      legacy_server_(store_, out_,
+                     LegacyMissionHooks{
+                         [this] { return static_cast<std::uint16_t>(r2_.command_index); },
+                         [this](std::uint16_t seq) { r2_change_command(seq, now_); },
+                         [this](const StoredItem& item) { r2_guided_goto(item, now_); },
+                         [this] { mission_changed(); },
+                         [this] { return home_alt_cm(); },
+                     },
+                     config_.mission_rerequest, config_.mission_give_up),
       vehicle_(config_.home) {
     last_step_ = now;
+    new_parser();
+    if (rover2_mission()) {
+        r2_boot_ready(now);  // the stored home of the last run
+    }
+    note_speed("power on", now);
     reboot(now);
+}
+
+void RoverSim::new_parser() {
+    if (config_.firmware.reads_mavlink2) {
+        parser_ = std::make_unique<mv::Parser>();
+        return;
+    }
+    // The 2.x message table has no CRC_EXTRA for the _INT mission messages (MAVLink 1 ids only).
+    std::vector<std::uint32_t> unknown;
+    if (!config_.firmware.mission_int) {
+        unknown = {mv::MissionRequestInt::kId, mv::MissionItemInt::kId};
+    }
+    legacy_parser_ = std::make_unique<LegacyParser>(std::move(unknown));
 }
 
 void RoverSim::reboot(TimePoint now) {
     advance(now);
     out_.drop_held();
     server_.reset();
+    legacy_server_.reset();
     streams_.clear();
     if (parsing_) {
         reboot_during_parse_ = true;  // the parser is mid-push: replaced when the push returns
     } else {
-        parser_ = std::make_unique<mv::Parser>();
+        new_parser();
     }
     ++boots_;
     boot_started_ = now;
@@ -100,6 +143,16 @@ void RoverSim::reboot(TimePoint now) {
     leg_start_.reset();
     guided_target_.reset();
     rc_override_.fill(0);
+    r2_ = Rover2Nav{};
+    // What was set without saving (a 2.x DO_CHANGE_SPEED) is lost; a DO_CHANGE_SPEED's speed is forgotten.
+    for (const auto& [name, saved] : unsaved_params_) {
+        params_.set(name, saved);
+    }
+    unsaved_params_.clear();
+    speed_override_.reset();
+    if (!speed_log_.empty()) {
+        note_speed("reboot", now);
+    }
     if (mode_ != RoverMode::Initialising) {
         set_mode(RoverMode::Initialising, "reboot", now);
     }
@@ -123,17 +176,37 @@ void RoverSim::enter_phase(BootPhase phase, TimePoint now) {
             phase_until_ = now + config_.calib_time;
             heartbeat_sent_this_boot_ = false;
             next_heartbeat_ = now;
+            if (rover2_telemetry()) {
+                // system.pde startup_ground() and startup_INS_ground(), with the 2.x severities; the
+                // mavlink_delay() callback sends "Initialising APM..." while the board waits.
+                r2_text(1, "<startup_ground> GROUND START");
+                r2_text(1, "Demo Servos!");
+                r2_text(2, "Warming up ADC...");
+                r2_text(1, "Initialising APM...");
+                r2_text(1, "Demo Servos!");
+                r2_text(1, "Demo Servos!");
+                r2_text(2, "Beginning INS calibration; do not move vehicle");
+                break;
+            }
             text(kSeverityInfo, "Initialising APM...");
             text(kSeverityCritical, "Beginning INS calibration; do not move vehicle");
             break;
         case BootPhase::Ready: {
             phase_until_ = kNever;
+            if (rover2_mission()) {
+                r2_boot_ready(now);
+            }
             const auto initial = mode_from_number(static_cast<std::uint32_t>(params_.get("INITIAL_MODE", 0)));
             set_mode(initial && *initial != RoverMode::Initialising ? *initial : RoverMode::Manual,
                      boots_ == 1 ? "power on" : "reboot", now);
             armed_ = params_.get("ARMING_REQUIRE", 0) == 0;  // no arming step: armed from boot
             load_stream_rates(now);
-            text(kSeverityInfo, "Ready to drive.");
+            if (rover2_telemetry()) {
+                r2_text(1, "\n\n Ready to drive.");
+                r2_text(1, "init home");  // init_home(), once the GPS has a fix
+            } else {
+                text(kSeverityInfo, "Ready to drive.");
+            }
             next_heartbeat_ = now;
             break;
         }
@@ -153,6 +226,19 @@ void RoverSim::advance(TimePoint now) {
         now_ = last_step_;
         out_.set_reply_context(now_, Duration::zero());
         physics_step(last_step_);
+        // The 2.x navigate() / update_commands() tasks at 10 Hz, at the first physics step at or after their
+        // time.
+        while (r2_.next_tick <= last_step_) {
+            r2_.next_tick += milliseconds(100);
+            r2_tick(last_step_);
+        }
+    }
+    while (r2_.next_tick <= now) {
+        const TimePoint tick = r2_.next_tick;
+        r2_.next_tick += milliseconds(100);
+        now_ = std::max(now_, tick);
+        out_.set_reply_context(now_, Duration::zero());
+        r2_tick(tick);
     }
     now_ = now;
 }
@@ -176,12 +262,14 @@ void RoverSim::handle_timeout(TimePoint now) {
     }
     out_.set_reply_context(now, faults_.slow);
     server_.handle_timeout(now);
+    legacy_server_.handle_timeout(now);
+    note_speed("param", now);  // a parameter written directly (params())
     out_.release(now);
 }
 
 TimePoint RoverSim::poll_timeout() const {
-    TimePoint t =
-        std::min({phase_until_, next_heartbeat_, reboot_at_, out_.next_release(), server_.poll_timeout()});
+    TimePoint t = std::min({phase_until_, next_heartbeat_, reboot_at_, out_.next_release(),
+                            server_.poll_timeout(), legacy_server_.poll_timeout(), r2_.next_tick});
     if (phase_ == BootPhase::Ready) {
         t = std::min(t, streams_.next_due());
     }
@@ -200,19 +288,30 @@ void RoverSim::handle_bytes(std::span<const std::uint8_t> bytes, TimePoint now) 
         return;  // the boot loader and the early start-up do not read MAVLink
     }
     parsing_ = true;
-    parser_->push(in, [&](const mv::Frame& f) {
+    const auto on_frame = [&](const mv::Frame& f) {
         if (reboot_during_parse_) {
             return;  // the board went down: the rest of this input meets the boot loader
         }
         ++counters_.frames_in;
         out_.set_reply_context(now, faults_.slow);
         dispatch(f, now);
-    });
+    };
+    if (legacy_parser_) {
+        const LegacyParserStats before = legacy_parser_->stats();
+        legacy_parser_->push(in, on_frame);
+        counters_.bad_checksum += legacy_parser_->stats().bad_crc - before.bad_crc;
+        counters_.mavlink2_ignored += legacy_parser_->stats().v2_starts - before.v2_starts;
+    } else {
+        const std::uint64_t before = parser_->stats().bad_checksum;
+        parser_->push(in, on_frame);
+        counters_.bad_checksum += parser_->stats().bad_checksum - before;
+    }
     parsing_ = false;
     if (reboot_during_parse_) {
         reboot_during_parse_ = false;
-        parser_ = std::make_unique<mv::Parser>();
+        new_parser();
     }
+    note_speed("param", now);
     out_.release(now);
 }
 
@@ -224,6 +323,11 @@ std::vector<std::uint8_t> RoverSim::poll_transmit() {
 }
 
 void RoverSim::dispatch(const mv::Frame& f, TimePoint now) {
+    if (!config_.firmware.mission_int &&
+        (f.msgid == mv::MissionRequestInt::kId || f.msgid == mv::MissionItemInt::kId)) {
+        ++counters_.frames_ignored;  // a firmware without the _INT mission messages
+        return;
+    }
     const bool mission_frame = f.msgid == mv::MissionRequestList::kId || f.msgid == mv::MissionRequest::kId ||
                                f.msgid == mv::MissionRequestInt::kId || f.msgid == mv::MissionCount::kId ||
                                f.msgid == mv::MissionItem::kId || f.msgid == mv::MissionItemInt::kId ||
@@ -235,7 +339,11 @@ void RoverSim::dispatch(const mv::Frame& f, TimePoint now) {
             ++counters_.frames_ignored;
             return;
         }
-        server_.handle(f, now);
+        if (rover2_mission()) {
+            legacy_server_.handle(f, now);
+        } else {
+            server_.handle(f, now);
+        }
         return;
     }
     switch (f.msgid) {
@@ -331,7 +439,7 @@ SimState RoverSim::state() const {
     s.position = vehicle_.position();
     s.heading_deg = vehicle_.heading() * 180.0 / 3.14159265358979323846;
     s.speed = vehicle_.speed();
-    s.current_seq = current_seq_;
+    s.current_seq = rover2_mission() ? static_cast<std::uint16_t>(r2_.command_index) : current_seq_;
     s.mission_count = store_.count();
     s.target = target_;
     s.target_distance = target_ ? distance_m(vehicle_.position(), *target_) : 0;
@@ -340,7 +448,43 @@ SimState RoverSim::state() const {
     const double capacity = std::max(1.0F, params_.get("BATT_CAPACITY", 3300));
     s.battery_remaining = std::clamp(100.0 * (1.0 - consumed_mah_ / capacity), 0.0, 100.0);
     s.odometer = vehicle_.odometer();
+    s.cruise_speed = cruise_speed();
     return s;
+}
+
+double RoverSim::cruise_speed() const {
+    // A parameter set to nonsense must not fling the car off the planet.
+    const double param = std::clamp(static_cast<double>(params_.get("CRUISE_SPEED", 2)), 0.0, 50.0);
+    return std::clamp(speed_override_.value_or(param), 0.0, 50.0);
+}
+
+void RoverSim::note_speed(const std::string& cause, TimePoint now, std::optional<std::uint16_t> seq) {
+    const double speed = cruise_speed();
+    if (!speed_log_.empty() && speed_log_.back().speed == speed) {
+        return;
+    }
+    if (speed_log_.size() >= kMaxSpeedLog) {
+        speed_log_.pop_front();
+    }
+    speed_log_.push_back(SpeedChange{now, speed, cause, seq.value_or(state().current_seq)});
+    ++speed_log_total_;
+}
+
+void RoverSim::set_unsaved_param(const std::string& name, float value) {
+    if (const auto i = params_.index_of(name)) {
+        unsaved_params_.try_emplace(name, params_.at(*i).value);
+        params_.set(name, value);
+    }
+}
+
+bool RoverSim::set_param(const std::string& name, float value, TimePoint now, const std::string& cause) {
+    handle_timeout(now);
+    if (!params_.set(name, value)) {
+        return false;
+    }
+    unsaved_params_.erase(name);
+    apply_param_side_effects(name, cause, now);
+    return true;
 }
 
 }  // namespace airseg::apmsim

@@ -9,16 +9,22 @@
 //   sim.handle_timeout(now);                   // when now >= sim.poll_timeout()
 //   write(sim.poll_transmit());                // after each of the above
 //   re-arm the timer at sim.poll_timeout()     // the single earliest deadline
-// Board events: port_opened(now) (the USB DTR reset), reboot(now), schedule_reboot(at), rc_pilot(mode, now).
-// Time must not go backwards between calls.
+// Board events: port_opened(now) (the USB DTR reset), reboot(now), schedule_reboot(at), rc_pilot(mode, now),
+// force_mode(mode, now) (the board changes mode itself, as a failsafe does). Time must not go backwards
+// between calls.
 //
 // What it does: boot sequence (silent, then "Initialising APM..." and heartbeats in CALIBRATING, then
 // STANDBY and "Ready to drive."), 1 Hz heartbeats with Rover custom modes, telemetry streams, parameters,
 // the mission protocol (mission_server.hpp), modes and a kinematic vehicle that drives missions, RTL,
 // guided targets and RC overrides, and the fault injection of Faults. Every mode change is recorded with
-// its cause in mode_history().
+// its cause in mode_history(), every change of the speed the rover drives at in speed_log().
+//
+// The firmware it behaves as is RoverSimConfig::firmware (firmware_profile.hpp): modern ArduPilot Rover, or
+// APMrover2 2.4x (rover2), whose receiver, mission protocol, command processor and telemetry are modelled
+// on that firmware's source (legacy_parser.hpp, legacy_mission_server.hpp, rover_sim_rover2.cpp).
 #include <cstdint>
 #include <deque>
+#include <map>
 #include <memory>
 #include <optional>
 #include <random>
@@ -29,6 +35,9 @@
 #include "services/autopilot/mavlink/frame.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
 #include "services/common/time.hpp"
+#include "tools/apmsim/firmware_profile.hpp"
+#include "tools/apmsim/legacy_mission_server.hpp"
+#include "tools/apmsim/legacy_parser.hpp"
 #include "tools/apmsim/mission_server.hpp"
 #include "tools/apmsim/mission_store.hpp"
 #include "tools/apmsim/outbox.hpp"
@@ -45,6 +54,9 @@ enum class ReachedStyle : std::uint8_t {
 };
 
 struct RoverSimConfig {
+    /// The firmware the board runs. for_firmware() sets it together with the version, reached style and
+    /// mission timers that firmware has.
+    FirmwareProfile firmware = FirmwareProfile::modern();
     GeoPoint home{41.2756, 1.9866};  // a car park in Castelldefels
     float home_alt = 5.0F;           // metres above mean sea level
     Duration boot_delay = seconds(2);
@@ -61,6 +73,10 @@ struct RoverSimConfig {
     /// GPS time stamps.
     std::uint64_t unix_time_at_start_us = 1'401'580'800'000'000;  // 2014-06-01
 
+    /// Defaults for a board running `f`: modern is the default configuration; rover2 speaks MAVLink 1,
+    /// reports reached waypoints by text only, re-requests a missing mission item after 500 ms and stops
+    /// listening 1 s after the last one (GCS_Mavlink.pde of APMrover2 2.43).
+    static RoverSimConfig for_firmware(Firmware f);
     static std::vector<std::string> validate(const RoverSimConfig& c);
 };
 
@@ -96,6 +112,15 @@ struct ReachedEvent {
     GeoPoint item;        // where the reached item was
 };
 
+/// A change of the speed the rover drives at in AUTO, RTL and GUIDED (CRUISE_SPEED, or a DO_CHANGE_SPEED).
+struct SpeedChange {
+    TimePoint at{};
+    double speed = 0;       // m/s
+    std::string cause;      // "power on", "reboot", "param" (PARAM_SET), "control", "command line",
+                            // "command" (COMMAND_LONG), "mission", "mode" (AUTO entered)
+    std::uint16_t seq = 0;  // current mission item then (for "mission": the DO_CHANGE_SPEED item)
+};
+
 struct SimState {
     BootPhase phase = BootPhase::Silent;
     RoverMode mode = RoverMode::Initialising;
@@ -111,6 +136,7 @@ struct SimState {
     std::uint32_t boots = 0;
     double battery_remaining = 100;  // percent
     double odometer = 0;             // metres
+    double cruise_speed = 0;         // m/s the rover drives at when navigating
 };
 
 struct SimCounters {
@@ -120,6 +146,9 @@ struct SimCounters {
     std::uint64_t bytes_corrupted = 0;  // by the corruption fault, both directions
     std::uint64_t frames_in = 0;
     std::uint64_t frames_ignored = 0;  // not for us, while silent, or mission frames while ignoring
+    std::uint64_t bad_checksum =
+        0;  // frames whose checksum failed (rover2: also ids it has no CRC_EXTRA for)
+    std::uint64_t mavlink2_ignored = 0;  // MAVLink 2 frames a MAVLink 1 only board met (its 0xFD start bytes)
     std::uint64_t heartbeats_sent = 0;
     std::uint64_t heartbeats_stalled = 0;
 };
@@ -129,6 +158,7 @@ class RoverSim {
     static constexpr std::uint8_t kSysid = 1;
     static constexpr std::uint8_t kCompid = 1;
     static constexpr std::size_t kMaxReachedLog = 4096;
+    static constexpr std::size_t kMaxSpeedLog = 4096;
 
     RoverSim(RoverSimConfig config, TimePoint now);
 
@@ -144,6 +174,12 @@ class RoverSim {
     void schedule_reboot(TimePoint at) { reboot_at_ = at; }
     /// The RC pilot flips the mode switch. False while the board is not ready.
     bool rc_pilot(RoverMode mode, TimePoint now);
+    /// The board changes mode by itself (as its failsafe would): recorded with cause "board". False while
+    /// the board is not ready, or when the firmware refuses (no such mode, AUTO without a mission).
+    bool force_mode(RoverMode mode, TimePoint now);
+    /// Sets (and saves) a parameter from outside MAVLink: the control socket, the command line. A speed
+    /// change is logged with `cause`.
+    bool set_param(const std::string& name, float value, TimePoint now, const std::string& cause = "control");
     /// Heartbeats stop for `d` from `now` (everything else goes on).
     void stall_heartbeats(Duration d, TimePoint now) { hb_stall_until_ = now + d; }
 
@@ -154,10 +190,18 @@ class RoverSim {
     const std::deque<ReachedEvent>& reached() const { return reached_; }
     /// Reached events ever logged; reached().front() is number reached_total() - reached().size().
     std::uint64_t reached_total() const { return reached_total_; }
+    /// Changes of the navigation speed, the oldest first (the last kMaxSpeedLog); the first is the power-on
+    /// value. speed_log().front() is number speed_log_total() - speed_log().size().
+    const std::deque<SpeedChange>& speed_log() const { return speed_log_; }
+    std::uint64_t speed_log_total() const { return speed_log_total_; }
+    /// The speed the rover drives at when navigating, m/s.
+    double cruise_speed() const;
     const ParamTable& params() const { return params_; }
     ParamTable& params() { return params_; }
     const MissionStore& mission() const { return store_; }
-    const MissionServerStats& mission_stats() const { return server_.stats(); }
+    const MissionServerStats& mission_stats() const {
+        return rover2_mission() ? legacy_server_.stats() : server_.stats();
+    }
     const SimCounters& counters() const { return counters_; }
     const RoverSimConfig& config() const { return config_; }
     TimePoint started() const { return started_; }
@@ -171,6 +215,16 @@ class RoverSim {
     bool lose_byte(bool& in_burst);
     double uniform();
     void text(std::uint8_t severity, std::string_view message);
+    void new_parser();
+    bool addressed(std::uint8_t target_system) const {
+        return target_system == kSysid || (target_system == 0 && config_.firmware.broadcast_target);
+    }
+    bool rover2_mission() const { return config_.firmware.mission == Dialect::Rover2; }
+    bool rover2_commands() const { return config_.firmware.commands == Dialect::Rover2; }
+    bool rover2_telemetry() const { return config_.firmware.telemetry == Dialect::Rover2; }
+    // Speed: the log and what changes the speed.
+    void note_speed(const std::string& cause, TimePoint now, std::optional<std::uint16_t> seq = {});
+    void set_unsaved_param(const std::string& name, float value);
     std::uint32_t time_boot_ms(TimePoint now) const;
     std::uint64_t unix_us(TimePoint now) const;
     // rover_sim_nav.cpp: modes, navigation, physics
@@ -186,8 +240,8 @@ class RoverSim {
     GeoPoint home_point() const { return config_.home; }
     // rover_sim_commands.cpp: parameters, commands, RC
     void on_param(const mavlink::Frame& f);
-    void send_param(std::size_t index);
-    void apply_param_side_effects(const std::string& name, TimePoint now);
+    void send_param(std::size_t index, std::optional<std::uint16_t> reported_index = std::nullopt);
+    void apply_param_side_effects(const std::string& name, const std::string& cause, TimePoint now);
     void on_command_long(const mavlink::Frame& f, TimePoint now);
     void on_set_mode(const mavlink::Frame& f, TimePoint now);
     void on_request_data_stream(const mavlink::Frame& f, TimePoint now);
@@ -200,6 +254,30 @@ class RoverSim {
     void send_home_position();
     void send_autopilot_version();
     std::uint16_t rc_input(int channel, TimePoint now) const;
+    // rover_sim_rover2.cpp: the APMrover2 2.4x command processor, modes and command handlers
+    bool r2_set_mode(RoverMode mode, const std::string& cause, TimePoint now);
+    void r2_boot_ready(TimePoint now);
+    void r2_restart_nav(TimePoint now);
+    void r2_process_next_command(TimePoint now);
+    void r2_process_nav_cmd(TimePoint now);
+    void r2_process_non_nav_command(TimePoint now);
+    void r2_do_jump(TimePoint now);
+    void r2_do_change_speed(TimePoint now);
+    void r2_do_rtl(const std::string& cause, TimePoint now);
+    void r2_set_next_wp(const GeoPoint& wp);
+    void r2_change_command(std::uint16_t seq, TimePoint now);
+    void r2_guided_goto(const StoredItem& item, TimePoint now);
+    void r2_tick(TimePoint now);
+    bool r2_verify_nav(TimePoint now);
+    bool r2_verify_condition(TimePoint now);
+    bool r2_verify_rtl();
+    void r2_reached(bool passed, double distance, TimePoint now);
+    StoredItem r2_cmd(int index) const;
+    std::int32_t home_alt_cm() const;
+    void r2_text(std::uint8_t severity, std::string_view message);
+    void r2_on_command_long(const mavlink::Frame& f, TimePoint now);
+    void r2_on_set_mode(const mavlink::Frame& f, TimePoint now);
+    void r2_send_heartbeat();
 
     RoverSimConfig config_;
     TimePoint started_;
@@ -213,8 +291,10 @@ class RoverSim {
     MissionStore store_;
     Outbox out_;
     MissionServer server_;
+    LegacyMissionServer legacy_server_;
     StreamScheduler streams_;
-    std::unique_ptr<mavlink::Parser> parser_;
+    std::unique_ptr<mavlink::Parser> parser_;      // modern: MAVLink 1 and 2
+    std::unique_ptr<LegacyParser> legacy_parser_;  // rover2: the MAVLink 1.0 receiver
     bool parsing_ = false;
     bool reboot_during_parse_ = false;
     VehicleModel vehicle_;
@@ -248,6 +328,32 @@ class RoverSim {
     std::array<std::uint16_t, 8> rc_override_{};  // 0: not overridden
     TimePoint rc_override_at_{};
     double consumed_mah_ = 0;
+
+    // Speed. Modern: a DO_CHANGE_SPEED sets the speed until AUTO is entered again (AR_WPNav's desired
+    // speed); CRUISE_SPEED applies otherwise. Rover2: DO_CHANGE_SPEED writes CRUISE_SPEED in RAM only, so a
+    // reboot brings the saved value back (unsaved_params_).
+    std::optional<double> speed_override_;
+    std::map<std::string, float> unsaved_params_;  // name -> value saved in EEPROM
+    std::deque<SpeedChange> speed_log_;
+    std::uint64_t speed_log_total_ = 0;
+
+    // The APMrover2 2.4x command processor (commands_process.pde), its variables as the firmware has them.
+    struct Rover2Nav {
+        std::uint8_t nav_index = 0;      // nav_command_index
+        std::uint8_t non_nav_index = 0;  // non_nav_command_index
+        std::uint8_t nav_id = 0;         // nav_command_ID (0: NO_COMMAND)
+        std::uint8_t non_nav_id = 0;     // non_nav_command_ID (0: NO_COMMAND, 255: WAIT_COMMAND)
+        std::int32_t command_index = 0;  // g.command_index: MISSION_CURRENT
+        StoredItem next_nav;
+        StoredItem next_nonnav;
+        GeoPoint next_wp;  // next_WP
+        GeoPoint prev_wp;  // prev_WP
+        TimePoint condition_start{};
+        std::int32_t condition_value = 0;
+        std::int32_t condition_rate = 0;
+        TimePoint next_tick = kNever;  // the 10 Hz navigate() / update_commands() tasks
+    };
+    Rover2Nav r2_;
 };
 
 }  // namespace airseg::apmsim

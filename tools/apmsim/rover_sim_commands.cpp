@@ -1,6 +1,7 @@
 // RoverSim: parameters, commands, mode requests, stream requests and RC overrides from the GCS.
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "services/autopilot/mavlink/messages.hpp"
 #include "tools/apmsim/rover_sim.hpp"
@@ -32,15 +33,11 @@ constexpr std::uint8_t kFailed = 4;
 
 constexpr std::uint8_t kModeFlagCustomModeEnabled = 1;
 
-bool for_us(std::uint8_t target_system) {
-    return target_system == RoverSim::kSysid || target_system == 0;
-}
-
 }  // namespace
 
 void RoverSim::on_param(const mv::Frame& f) {
     if (f.msgid == mv::ParamRequestList::kId) {
-        if (!for_us(mv::decode_payload<mv::ParamRequestList>(f.payload_view()).target_system)) {
+        if (!addressed(mv::decode_payload<mv::ParamRequestList>(f.payload_view()).target_system)) {
             return;
         }
         for (std::size_t i = 0; i < params_.size(); ++i) {
@@ -50,7 +47,26 @@ void RoverSim::on_param(const mv::Frame& f) {
     }
     if (f.msgid == mv::ParamRequestRead::kId) {
         const auto m = mv::decode_payload<mv::ParamRequestRead>(f.payload_view());
-        if (!for_us(m.target_system)) {
+        if (!addressed(m.target_system)) {
+            return;
+        }
+        if (rover2_telemetry()) {
+            // GCS_Mavlink.pde: an unknown name or index is reported in a text, and the PARAM_VALUE echoes
+            // the request's index (-1, that is 65535, for a read by name).
+            if (m.param_index != -1) {
+                if (m.param_index < 0 || static_cast<std::size_t>(m.param_index) >= params_.size()) {
+                    r2_text(1, "Unknown parameter index " + std::to_string(m.param_index));
+                    return;
+                }
+                send_param(static_cast<std::size_t>(m.param_index));
+                return;
+            }
+            const std::string name(mv::text_of(m.param_id).substr(0, 16));
+            if (const auto i = params_.index_of(name)) {
+                send_param(*i, UINT16_MAX);
+            } else {
+                r2_text(1, "Unknown parameter " + name);
+            }
             return;
         }
         if (m.param_index >= 0) {
@@ -63,30 +79,40 @@ void RoverSim::on_param(const mv::Frame& f) {
         return;  // an unknown parameter gets no answer, as on the board
     }
     const auto m = mv::decode_payload<mv::ParamSet>(f.payload_view());
-    if (!for_us(m.target_system)) {
+    if (!addressed(m.target_system)) {
         return;
     }
     const std::string name(mv::text_of(m.param_id));
+    if (rover2_telemetry() && !std::isfinite(m.param_value)) {
+        return;  // "not nan, not inf"
+    }
     if (const auto i = params_.set(name, m.param_value)) {
-        apply_param_side_effects(name, now_);
-        send_param(*i);
+        unsaved_params_.erase(name);  // set_and_save()
+        apply_param_side_effects(name, "param", now_);
+        // 2.x answers with index -1: "we don't actually know what its index is".
+        send_param(*i, rover2_telemetry() ? std::optional<std::uint16_t>(UINT16_MAX) : std::nullopt);
     }
 }
 
-void RoverSim::send_param(std::size_t index) {
+void RoverSim::send_param(std::size_t index, std::optional<std::uint16_t> reported_index) {
     const Param& p = params_.at(index);
     mv::ParamValue v;
     mv::set_text(v.param_id, p.name);
     v.param_value = p.value;
     v.param_type = static_cast<std::uint8_t>(p.type);
     v.param_count = static_cast<std::uint16_t>(params_.size());
-    v.param_index = static_cast<std::uint16_t>(index);
+    v.param_index = reported_index.value_or(static_cast<std::uint16_t>(index));
     out_.reply(v);
 }
 
-void RoverSim::apply_param_side_effects(const std::string& name, TimePoint now) {
+void RoverSim::apply_param_side_effects(const std::string& name, const std::string& cause, TimePoint now) {
     if (name.rfind("SR0_", 0) == 0 && phase_ == BootPhase::Ready) {
         load_stream_rates(now);
+    }
+    if (name == "CRUISE_SPEED") {
+        // The new value applies at once, also over an earlier DO_CHANGE_SPEED (modern).
+        speed_override_.reset();
+        note_speed(cause, now);
     }
 }
 
@@ -98,7 +124,7 @@ void RoverSim::load_stream_rates(TimePoint now) {
 
 void RoverSim::on_request_data_stream(const mv::Frame& f, TimePoint now) {
     const auto m = mv::decode_payload<mv::RequestDataStream>(f.payload_view());
-    if (!for_us(m.target_system) || phase_ != BootPhase::Ready) {
+    if (!addressed(m.target_system) || phase_ != BootPhase::Ready) {
         return;
     }
     const double hz =
@@ -113,8 +139,12 @@ void RoverSim::on_request_data_stream(const mv::Frame& f, TimePoint now) {
 }
 
 void RoverSim::on_set_mode(const mv::Frame& f, TimePoint now) {
+    if (rover2_commands()) {
+        r2_on_set_mode(f, now);
+        return;
+    }
     const auto m = mv::decode_payload<mv::SetMode>(f.payload_view());
-    if (!for_us(m.target_system)) {
+    if (!addressed(m.target_system)) {
         return;
     }
     std::uint8_t result = kFailed;
@@ -133,8 +163,12 @@ void RoverSim::on_set_mode(const mv::Frame& f, TimePoint now) {
 }
 
 void RoverSim::on_command_long(const mv::Frame& f, TimePoint now) {
+    if (rover2_commands()) {
+        r2_on_command_long(f, now);
+        return;
+    }
     const auto c = mv::decode_payload<mv::CommandLong>(f.payload_view());
-    if (!for_us(c.target_system)) {
+    if (!addressed(c.target_system)) {
         return;
     }
     std::uint8_t result = kUnsupported;
@@ -153,6 +187,19 @@ void RoverSim::on_command_long(const mv::Frame& f, TimePoint now) {
             }
             break;
         }
+        case kCmdDoChangeSpeed:
+            // Rover's handle of MAV_CMD_DO_CHANGE_SPEED: param2 is the new speed (m/s), param1 (speed type)
+            // and param3 (throttle) are not used; a negative speed fails (Mode::set_desired_speed()).
+            if (!config_.firmware.change_speed_command) {
+                result = kUnsupported;
+            } else if (!(c.param2 >= 0)) {
+                result = kFailed;
+            } else {
+                speed_override_ = c.param2;
+                note_speed("command", now);
+                result = kAccepted;
+            }
+            break;
         case kCmdMissionStart:
             result = !ready                                      ? kTemporarilyRejected
                      : set_mode(RoverMode::Auto, "command", now) ? kAccepted
@@ -248,8 +295,11 @@ void RoverSim::on_command_long(const mv::Frame& f, TimePoint now) {
 
 void RoverSim::on_rc_override(const mv::Frame& f, TimePoint now) {
     const auto m = mv::decode_payload<mv::RcChannelsOverride>(f.payload_view());
-    if (!for_us(m.target_system)) {
+    if (!addressed(m.target_system)) {
         return;
+    }
+    if (rover2_commands() && f.sysid != static_cast<std::uint8_t>(params_.get("SYSID_MYGCS", 255))) {
+        return;  // "Only accept control from our gcs"
     }
     const std::array<std::uint16_t, 8> ch{m.chan1_raw, m.chan2_raw, m.chan3_raw, m.chan4_raw,
                                           m.chan5_raw, m.chan6_raw, m.chan7_raw, m.chan8_raw};

@@ -46,6 +46,9 @@ bool RoverSim::physics_active() const {
 }
 
 bool RoverSim::set_mode(RoverMode mode, const std::string& cause, TimePoint now) {
+    if (rover2_mission()) {
+        return r2_set_mode(mode, cause, now);
+    }
     if (mode == RoverMode::Auto && store_.count() <= 1) {
         text(kSeverityInfo, "No Mission. Can't set AUTO.");
         return false;
@@ -63,6 +66,12 @@ bool RoverSim::set_mode(RoverMode mode, const std::string& cause, TimePoint now)
     // Entering AUTO may end the mission at once (nothing left to drive to), which switches to HOLD.
     switch (mode) {
         case RoverMode::Auto:
+            if (from != RoverMode::Auto) {
+                // ModeAuto::_enter() initialises the waypoint controller: a DO_CHANGE_SPEED of an earlier
+                // run is forgotten and CRUISE_SPEED applies.
+                speed_override_.reset();
+                note_speed("mode", now);
+            }
             if (mission_complete_ || current_seq_ == 0 || current_seq_ >= store_.count()) {
                 current_seq_ = 1;  // start from the first item after home
             }
@@ -92,6 +101,15 @@ void RoverSim::load_item(std::uint16_t seq, TimePoint now) {
         const StoredItem& item = store_.at(seq);
         if (item.is_location() || item.command == kCmdNavReturnToLaunch || hops > store_.count()) {
             break;
+        }
+        if (item.command == kCmdDoChangeSpeed) {
+            // Run while heading to the next place, as AP_Mission starts the do-commands after a nav command.
+            // param2 is the speed (m/s); the speed type of param1 is not looked at (Rover's
+            // do_change_speed()); zero or less leaves the speed.
+            if (item.param2 > 0) {
+                speed_override_ = item.param2;
+                note_speed("mission", now, seq);
+            }
         }
         if (item.command == kCmdDoJump) {
             const auto target = static_cast<long>(std::lround(item.param1));
@@ -152,8 +170,10 @@ void RoverSim::physics_step(TimePoint at) {
         vehicle_.stop(dt, lim);
         return;
     }
-    // A parameter set to nonsense must not fling the car off the planet.
-    vehicle_.drive_to(*target_, std::clamp(params_.get("CRUISE_SPEED", 2), 0.0F, 50.0F), dt, lim);
+    vehicle_.drive_to(*target_, cruise_speed(), dt, lim);
+    if (rover2_mission()) {
+        return;  // the 2.x navigate() task decides when a place is reached (r2_tick)
+    }
     const double distance = distance_m(vehicle_.position(), *target_);
     const double radius = std::max(0.1F, params_.get("WP_RADIUS", 2));
     if (distance <= radius) {
@@ -245,6 +265,16 @@ bool RoverSim::rc_pilot(RoverMode mode, TimePoint now) {
         return false;
     }
     return set_mode(mode, "rc pilot", now);
+}
+
+bool RoverSim::force_mode(RoverMode mode, TimePoint now) {
+    handle_timeout(now);
+    if (phase_ != BootPhase::Ready || mode == RoverMode::Initialising) {
+        return false;
+    }
+    const bool ok = set_mode(mode, "board", now);
+    out_.release(now);
+    return ok;
 }
 
 }  // namespace airseg::apmsim

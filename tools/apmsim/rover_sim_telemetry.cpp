@@ -44,6 +44,10 @@ void RoverSim::send_heartbeat(TimePoint now) {
         ++counters_.heartbeats_stalled;
         return;
     }
+    if (rover2_telemetry()) {
+        r2_send_heartbeat();
+        return;
+    }
     mv::Heartbeat hb;
     hb.type = kMavTypeGroundRover;
     hb.autopilot = kMavAutopilotArdupilotmega;
@@ -84,6 +88,11 @@ void RoverSim::send_heartbeat(TimePoint now) {
 
 void RoverSim::send_mission_current() {
     mv::MissionCurrent m;
+    if (rover2_telemetry()) {
+        m.seq = static_cast<std::uint16_t>(r2_.command_index);  // send_current_waypoint(): g.command_index
+        out_.send(m);
+        return;
+    }
     m.seq = current_seq_;
     m.total = static_cast<std::uint16_t>(store_.count() - 1);
     // MISSION_STATE: 1 no mission, 2 not started, 3 active, 4 paused, 5 complete.
@@ -131,6 +140,14 @@ void RoverSim::send_stream_message(std::uint32_t msgid, TimePoint now) {
     const double amps = 1.5 + 10.0 * std::abs(vehicle_.throttle());
     const auto remaining = static_cast<std::int8_t>(std::lround(100.0 * (1.0 - used)));
     const auto servo = [](double v) { return static_cast<std::uint16_t>(1500 + std::lround(400 * v)); };
+    if (rover2_telemetry()) {
+        // GCS_Mavlink.pde of 2.43 streams no SYSTEM_TIME, BATTERY_STATUS or RC_CHANNELS, and no
+        // NAV_CONTROLLER_OUTPUT in MANUAL.
+        if (msgid == mv::SystemTime::kId || msgid == mv::BatteryStatus::kId || msgid == mv::RcChannels::kId ||
+            (msgid == mv::NavControllerOutput::kId && mode_ == RoverMode::Manual)) {
+            return;
+        }
+    }
 
     switch (msgid) {
         case mv::SysStatus::kId: {

@@ -35,7 +35,7 @@ SimDriver::SimDriver(boost::asio::io_context& io, ApmSimOptions options)
     // Simulated time starts equal to the real clock, so both share one origin.
     sim_ = std::make_unique<RoverSim>(config, real_origin_);
     for (const auto& [name, value] : options_.params) {
-        sim_->params().set(name, value);
+        sim_->set_param(name, value, real_origin_, "command line");
     }
     sim_->faults() = options_.faults;
     if (options_.reboot_at) {

@@ -269,15 +269,56 @@ TEST(ApmsimBinary, UnplugReplugAndRunTimeFaults) {
     EXPECT_EQ(ask_json(ctl, "state")["boots"], 3);
 }
 
+TEST(ApmsimBinary, Rover2FirmwareOnThePty) {
+    TempDir dir;
+    Subprocess sim(sim_argv(dir, {"--speedup", "20", "--firmware", "rover2"}), {}, dir.path());
+    ASSERT_TRUE(
+        wait_until([&] { return exists(dir.file("ttyACM0")) && exists(dir.file("ctl")); }, kGenerous));
+    ControlClient ctl(dir.file("me"), dir.file("ctl"));
+    GcsLink gcs;
+    ASSERT_TRUE(gcs.open(dir.file("ttyACM0")));
+    ASSERT_TRUE(gcs.wait_for<mv::Statustext>(
+        [](const mv::Statustext& t) { return mv::text_of(t.text) == "\n\n Ready to drive."; }, kGenerous, 0));
+    for (const auto& h : gcs.heard) {
+        EXPECT_EQ(h.frame.version, mv::Version::V1);
+    }
+    mv::ParamRequestRead q;
+    q.param_index = -1;
+    mv::set_text(q.param_id, "CRUISE_SPEED");
+    ASSERT_TRUE(gcs.send(q));  // MAVLink 2: noise to this board
+    ASSERT_TRUE(wait_until([&] { return ask_json(ctl, "stats")["mavlink2_ignored"] == 1; }, kGenerous));
+    gcs.set_version(mv::Version::V1);
+    const std::size_t from = gcs.heard.size();
+    ASSERT_TRUE(gcs.send(q));
+    ASSERT_TRUE(gcs.wait_for<mv::ParamValue>(kGenerous, from));
+
+    EXPECT_EQ(ask_json(ctl, "state")["firmware"], "rover2");
+    EXPECT_EQ(ctl.command("mode HOLD").value_or(""), "ok mode HOLD\n");
+    ASSERT_TRUE(gcs.wait_frame([](const mv::Frame& f) { return is_heartbeat(f, 4); }, kGenerous, from));
+    EXPECT_EQ(ask_json(ctl, "modes").back()["cause"], "board");
+    const auto speeds = ask_json(ctl, "speeds");
+    ASSERT_GE(speeds["speeds"].size(), 1u);
+    EXPECT_EQ(speeds["speeds"][0]["cause"], "power on");
+    EXPECT_EQ(speeds["speeds"][0]["speed"], 2.0);
+}
+
 TEST(ApmsimBinary, HelpAndBadOptions) {
     auto help = airseg::test::run({airseg::test::binary("tools/apmsim/airseg-apmsim"), "--help"});
     EXPECT_EQ(help.exit_code, 0);
-    for (const char* option : {"--link",     "--boot-delay",       "--calib-time",    "--no-reset-on-open",
-                               "--home",     "--mission-capacity", "--reached-style", "--mavlink1",
-                               "--seed",     "--speedup",          "--loss",          "--corrupt",
-                               "--hb-stall", "--reboot-at",        "--unplug",        "--ignore-mission",
-                               "--slow",     "--control",          "rcpilot",         "modes",
-                               "hbstall",    "ignore-mission",     "--loss-burst",    "--baud"}) {
+    for (const char* option : {"--link",          "--boot-delay",
+                               "--calib-time",    "--no-reset-on-open",
+                               "--home",          "--mission-capacity",
+                               "--reached-style", "--mavlink1",
+                               "--seed",          "--speedup",
+                               "--loss",          "--corrupt",
+                               "--hb-stall",      "--reboot-at",
+                               "--unplug",        "--ignore-mission",
+                               "--slow",          "--control",
+                               "rcpilot",         "modes",
+                               "hbstall",         "ignore-mission",
+                               "--loss-burst",    "--baud",
+                               "--firmware",      "speeds",
+                               "mode MODE"}) {
         EXPECT_NE(help.out.find(option), std::string::npos) << option;
     }
     auto bad = airseg::test::run(

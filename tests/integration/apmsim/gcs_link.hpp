@@ -58,6 +58,8 @@ class GcsLink {
         }
     }
     bool is_open() const { return fd_ >= 0; }
+    /// The MAVLink version of what this station sends (MAVLink 2 unless told).
+    void set_version(mv::Version v) { encoder_.set_version(v); }
     RealClock::time_point opened_at() const { return opened_at_; }
 
     template <mv::Message M>

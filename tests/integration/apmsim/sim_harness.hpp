@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "services/autopilot/mavlink/encoder.hpp"
@@ -170,12 +171,68 @@ class SimHarness {
         return std::nullopt;
     }
 
+    /// Uploads float `items` (home first) with MISSION_COUNT / MISSION_ITEM, as a MAVLink 1 ground station
+    /// does; returns the final MISSION_ACK type (a refusal of one item included), nothing on silence.
+    std::optional<std::uint8_t> upload_float(const std::vector<mv::MissionItem>& items) {
+        mv::MissionCount c;
+        c.count = static_cast<std::uint16_t>(items.size());
+        std::size_t scan = received.size();
+        send(c);
+        for (int guard = 0; guard < 100000; ++guard) {
+            std::optional<std::uint16_t> wanted;
+            std::optional<std::uint8_t> acked;
+            run_until(
+                [&] {
+                    for (; scan < received.size(); ++scan) {
+                        const auto& f = received[scan].frame;
+                        if (auto r = mv::decode<mv::MissionRequest>(f)) {
+                            wanted = r->seq;
+                        } else if (auto a = mv::decode<mv::MissionAck>(f); a && a->type != 13) {
+                            acked = a->type;
+                        }
+                        if (wanted || acked) {
+                            ++scan;
+                            return true;
+                        }
+                    }
+                    return false;
+                },
+                seconds(20));
+            if (acked) {
+                return acked;
+            }
+            if (!wanted) {
+                return std::nullopt;
+            }
+            mv::MissionItem item = items.at(*wanted);
+            item.seq = *wanted;
+            send(item);
+        }
+        return std::nullopt;
+    }
+
     void set_mode(RoverMode mode) {
         mv::CommandLong c;
         c.command = 176;
         c.param1 = 1;
         c.param2 = static_cast<float>(mode);
         send(c);
+    }
+    /// The mode by SET_MODE (message 11), as 2.x ground stations did it.
+    void set_mode_message(RoverMode mode) {
+        mv::SetMode m;
+        m.target_system = 1;
+        m.base_mode = 1;  // MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
+        m.custom_mode = static_cast<std::uint32_t>(mode);
+        send(m);
+    }
+    /// Texts received since index `from`.
+    std::vector<std::string> texts(std::size_t from = 0) const {
+        std::vector<std::string> out;
+        for (const auto& t : all<mv::Statustext>(from)) {
+            out.emplace_back(mv::text_of(t.text));
+        }
+        return out;
     }
 
     RoverSim sim;
@@ -206,6 +263,48 @@ inline mv::MissionItemInt waypoint(GeoPoint origin, double north, double east) {
     m.x = static_cast<std::int32_t>(std::lround(p.lat * 1e7));
     m.y = static_cast<std::int32_t>(std::lround(p.lon * 1e7));
     m.z = 0;
+    return m;
+}
+
+/// The same item as MISSION_ITEM (degrees as float).
+inline mv::MissionItem to_float(const mv::MissionItemInt& m) {
+    mv::MissionItem f;
+    f.target_system = m.target_system;
+    f.target_component = m.target_component;
+    f.seq = m.seq;
+    f.frame = m.frame;
+    f.command = m.command;
+    f.current = m.current;
+    f.autocontinue = m.autocontinue;
+    f.param1 = m.param1;
+    f.param2 = m.param2;
+    f.param3 = m.param3;
+    f.param4 = m.param4;
+    f.x = static_cast<float>(m.x / 1e7);
+    f.y = static_cast<float>(m.y / 1e7);
+    f.z = m.z;
+    return f;
+}
+
+inline std::vector<mv::MissionItem> to_float(const std::vector<mv::MissionItemInt>& items) {
+    std::vector<mv::MissionItem> out;
+    for (const auto& m : items) {
+        out.push_back(to_float(m));
+    }
+    return out;
+}
+
+/// A mission item that is not a place (DO_ and CONDITION_ commands).
+inline mv::MissionItem command_item(std::uint16_t command, float p1, float p2 = 0, float p3 = 0) {
+    mv::MissionItem m;
+    m.target_system = 1;
+    m.target_component = 1;
+    m.frame = 0;
+    m.command = command;
+    m.autocontinue = 1;
+    m.param1 = p1;
+    m.param2 = p2;
+    m.param3 = p3;
     return m;
 }
 
