@@ -122,6 +122,8 @@ class Driver {
     unsigned speed_changes() const { return speed_changes_; }
     /// True when speeds go by the CRUISE_SPEED parameter (the board lacks MAV_CMD_DO_CHANGE_SPEED).
     bool speed_by_param() const { return speed_by_param_; }
+    /// True when Stop items go as waypoints and the driver holds the vehicle on arrival.
+    bool stops_as_waypoints() const { return stop_as_waypoint_; }
     bool link_up() const { return link_up_; }
     bool ready() const { return phase_ == Phase::Ready && link_up_; }
 
@@ -153,6 +155,8 @@ class Driver {
     void sequence_failed(const std::string& why, TimePoint now);
     void drain_clients(TimePoint now);
     void on_mission_done(MissionCompletion c, TimePoint now);
+    bool retry_with_stops_as_waypoints(const PendingOp& op, const MissionCompletion& c, TimePoint now);
+    void hold_at_stop(std::uint16_t slot, TimePoint now);
     void on_param_done(ParamCompletion c, TimePoint now);
     void cancel_everything(const std::string& why, TimePoint now);
     void done(std::uint32_t id, RequestKind kind, RequestResult result, std::string detail = {});
@@ -225,6 +229,8 @@ class Driver {
     std::optional<std::pair<std::uint16_t, TimePoint>> last_reached_;
     std::uint16_t reported_current_ = 0;  // the mission slot last reported (MissionCurrentChanged)
     AutoEntryCheck auto_check_;
+    bool stop_as_waypoint_ = false;            // the board lacks NAV_LOITER_UNLIM: Stop items go as waypoints
+    std::optional<TimePoint> stop_hold_sent_;  // HOLD sent on reaching such a Stop, until the board holds
     std::optional<double> speed_set_;
     std::optional<double> board_speed_;  // CRUISE_SPEED before the first change
     std::optional<SpeedRequest> speed_request_;

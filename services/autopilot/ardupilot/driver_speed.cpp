@@ -3,8 +3,8 @@
 // speed differs from the last one it confirmed, the driver sets it: MAV_CMD_DO_CHANGE_SPEED (COMMAND_LONG,
 // confirmed by COMMAND_ACK) on boards that have the command, the CRUISE_SPEED parameter (PARAM_SET, read
 // back) on those that do not (ArduRover 2.x; also any board that refuses the command or never answers it).
-// A leg without a speed goes at the board's own speed, CRUISE_SPEED as it was before the first change (kept for
-// the driver's lifetime: on a board set by parameter, CRUISE_SPEED holds the plan's speed afterwards). A
+// A leg without a speed goes at the board's own speed, CRUISE_SPEED as it was before the first change (kept
+// for the driver's lifetime: on a board set by parameter, CRUISE_SPEED holds the plan's speed afterwards). A
 // parameter write is kept in the board's EEPROM: it is sent only when the speed changes.
 #include <cmath>
 
@@ -49,7 +49,8 @@ void Driver::update_speed(TimePoint now) {
     if (item.speed && *item.speed > 0.0) {
         v = *item.speed;
         if (!board_speed_) {
-            // What the board drives at by itself, before the first change: legs without a speed go back to it.
+            // What the board drives at by itself, before the first change: legs without a speed go back to
+            // it.
             if (const auto own = params_.cached(kCruiseSpeed)) {
                 board_speed_ = *own;
             }

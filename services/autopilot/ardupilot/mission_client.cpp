@@ -409,7 +409,11 @@ void MissionClient::progress(WorkItem& w, TimePoint now) {
 void MissionClient::finish(MissionResult result, std::string detail, TimePoint now) {
     WorkItem w = std::move(work_.front());
     work_.pop_front();
-    MissionCompletion c{w.id, w.op, result, std::move(detail), {}};
+    MissionCompletion c{w.id, w.op, result, std::move(detail), {}, {}};
+    if (result == MissionResult::Denied || result == MissionResult::NoSpace) {
+        c.refusal = refusal_;
+    }
+    refusal_.reset();
     if (w.op == MissionOperation::Download && result == MissionResult::Success) {
         c.items = std::move(w.items);
     }
@@ -638,6 +642,7 @@ void MissionClient::on_ack(std::uint8_t type, TimePoint now) {
     const std::string form = !uploading   ? std::string()
                              : w.sent_int ? " to MISSION_ITEM_INT"
                                           : " to MISSION_ITEM";
+    refusal_ = type;
     const std::string after = uploading && !w.sent_int && !fallback_reason_.empty()
                                   ? " (MISSION_ITEM_INT was refused before: " + fallback_reason_ + ")"
                                   : "";

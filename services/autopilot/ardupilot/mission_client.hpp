@@ -67,6 +67,7 @@ struct MissionCompletion {
     MissionResult result = MissionResult::Success;
     std::string detail;
     std::vector<mavlink::MissionItemInt> items;  // Download: the whole mission, slot 0 (home) first
+    std::optional<std::uint8_t> refusal;         // Denied / NoSpace: the MAV_MISSION_RESULT the board sent
 };
 
 struct MissionClientStats {
@@ -179,6 +180,7 @@ class MissionClient {
     bool use_int_ = true;      // the item form this board is answered with
     bool int_proven_ = false;  // the board went on after an item sent as MISSION_ITEM_INT
     std::string fallback_reason_;
+    std::optional<std::uint8_t> refusal_;  // the MISSION_ACK type ending the running operation
     MissionClientStats stats_;
 };
 

@@ -17,13 +17,14 @@ std::int32_t to_e7(double degrees) {
 }
 }  // namespace
 
-mavlink::MissionItemInt encode_item(const MissionItem& item) {
+mavlink::MissionItemInt encode_item(const MissionItem& item, bool stop_as_waypoint) {
     mavlink::MissionItemInt m;
     m.autocontinue = 1;
     switch (item.kind) {
         case MissionItem::Kind::Waypoint:
         case MissionItem::Kind::Stop:
-            m.command = item.kind == MissionItem::Kind::Waypoint ? kNavWaypoint : kNavLoiterUnlim;
+            m.command =
+                item.kind == MissionItem::Kind::Waypoint || stop_as_waypoint ? kNavWaypoint : kNavLoiterUnlim;
             m.frame = kFrameGlobalRelativeAltInt;
             m.x = to_e7(item.lat);
             m.y = to_e7(item.lon);

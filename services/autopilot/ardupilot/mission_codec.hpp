@@ -12,7 +12,9 @@
 
 namespace airseg::autopilot::ardupilot {
 
-mavlink::MissionItemInt encode_item(const MissionItem& item);
+/// `stop_as_waypoint`: a board without NAV_LOITER_UNLIM (APM:Rover 2.x answers MAV_MISSION_UNSUPPORTED)
+/// gets a Stop as a NAV_WAYPOINT at its position; the driver holds the vehicle when it gets there.
+mavlink::MissionItemInt encode_item(const MissionItem& item, bool stop_as_waypoint = false);
 /// Commands other than the three above read as a Waypoint at the item's position.
 MissionItem decode_item(const mavlink::MissionItemInt& item);
 /// The home slot as an item (ArduPilot keeps home in slot 0, in absolute altitude).

@@ -263,6 +263,11 @@ void FakeRover::on_frame(const mav::Frame& f, TimePoint now) {
                 send_ack(1);  // MAV_MISSION_ERROR: not receiving
                 return;
             }
+            if (item.command == 17 && !options_.loiter_unlim) {
+                receiving_ = false;
+                send_ack(3);  // MAV_MISSION_UNSUPPORTED
+                return;
+            }
             if (item.command == 16 || item.command == 17) {
                 item_frames_.emplace_back(f.msgid, item.frame);
                 if (!options_.accepted_frames.empty() && !options_.accepted_frames.contains(item.frame)) {
