@@ -59,6 +59,15 @@ bool checksum_matches(const std::uint8_t* p, const Header& h, const MessageInfo&
     return crc.value() == wire::get<std::uint16_t>(p + h.header_length + h.payload_length);
 }
 
+// Whether a candidate found inside another one has a length its message can have: a MAVLink 1 payload is
+// exactly the base fields, a MAVLink 2 one at most all fields (trailing zeros truncated). A frame inside
+// another is looked for among bytes that are not a frame start for certain, where a 16-bit checksum alone
+// would match by chance once in 65,536 candidates with a declared id; a heartbeat-sized pattern in an
+// undeclared message's payload is common enough for that to happen on a busy link.
+bool plausible_inner(const Header& h, const MessageInfo& info) {
+    return h.version == Version::V1 ? h.payload_length == info.base_length : h.payload_length <= info.length;
+}
+
 }  // namespace
 
 const LinkStats* Parser::link(std::uint8_t sysid, std::uint8_t compid) const {
@@ -158,10 +167,11 @@ std::size_t Parser::unverifiable_length(Head kind) const {
 // Bytes needed before the head can be judged:
 //  - a frame with a known id: up to its checksum;
 //  - a frame with an unknown id: the whole frame and one byte of look-ahead, which must be a start byte;
-//    then, since its length byte cannot be trusted, also every candidate with a known id that starts inside
-//    it, so that a verified frame is never given up for it;
+//    then, since its length byte cannot be trusted, also every candidate that starts inside it and could
+//    turn out a verified frame (a known id and a plausible length), so that such a frame is never given up
+//    for it;
 //  - a signature (not verified, so a lost byte in it would otherwise eat the start byte of the next frame):
-//    its 13 bytes and every candidate with a known id that starts inside it;
+//    its 13 bytes and every candidate inside it that could turn out a verified frame;
 //  - an unknown id with an unknown incompatibility flag: only its header (it is given up at once).
 std::size_t Parser::required_length() const {
     const Head kind = head();
@@ -188,7 +198,7 @@ std::size_t Parser::required_length() const {
 
 // The larger of `at_least` and the end of every candidate starting in [first, end) that could still turn
 // out to be a verified frame: up to its header while the header is incomplete, up to its checksum when its
-// id is known.
+// id is known and its length plausible for it.
 std::size_t Parser::pending_end(std::size_t first, std::size_t end, std::size_t at_least) const {
     std::size_t need = at_least;
     for (std::size_t k = first; k < std::min(end, len_); ++k) {
@@ -201,7 +211,8 @@ std::size_t Parser::pending_end(std::size_t first, std::size_t end, std::size_t 
             continue;
         }
         const Header h = read_header(buf_.data() + k);
-        if (find_message(h.msgid) != nullptr) {
+        const MessageInfo* info = find_message(h.msgid);
+        if (info != nullptr && plausible_inner(h, *info)) {
             need = std::max(need, k + h.checked_length());
         }
     }
@@ -211,10 +222,11 @@ std::size_t Parser::pending_end(std::size_t first, std::size_t end, std::size_t 
 // A frame that begins inside the head may be complete before the head can be judged: after a lost byte (or
 // a stray start byte in noise) the head's length comes from the wrong byte, and waiting for it to fill
 // would hold good frames back until unrelated later traffic arrives, on a quiet line for seconds. A
-// complete frame with a known id and a matching checksum inside the head proves the head damaged: it is
-// dropped up to that frame. Of such frames, the one that is complete first in the stream wins, and only if
-// it is complete before the head can be judged (`need` bytes), exactly as if the stream came one byte at a
-// time; so the outcome does not depend on how the stream is split, or on how many bytes are at hand.
+// complete frame with a known id, a plausible length and a matching checksum inside the head proves the
+// head damaged: it is dropped up to that frame. Of such frames, the one that is complete first in the stream
+// wins, and only if it is complete before the head can be judged (`need` bytes), exactly as if the stream
+// came one byte at a time; so the outcome does not depend on how the stream is split, or on how many bytes
+// are at hand.
 //
 // A head that cannot be verified (unknown id, signature) also loses to a verified frame complete at the
 // moment it could be judged, and it waits for the candidates inside it (required_length()). But if a
@@ -246,7 +258,7 @@ bool Parser::resync_inside_candidate(Sink sink, std::size_t need) {
             continue;
         }
         const MessageInfo* info = find_message(h.msgid);
-        if (info != nullptr && checksum_matches(buf_.data() + k, h, *info)) {
+        if (info != nullptr && plausible_inner(h, *info) && checksum_matches(buf_.data() + k, h, *info)) {
             found = true;
             found_at = k;
             found_end = end;

@@ -21,14 +21,17 @@
 //    checksum_verified == false (unknown_msgid) only when the byte right after it starts another frame (or
 //    the stream ends there), and no verified frame begins inside it; otherwise its start byte is treated as
 //    noise. So a stray 0xFD/0xFE in line noise, or a damaged length byte, does not swallow good frames: a
-//    candidate with a known id that starts inside an unknown frame is waited for (until it can be judged, or
-//    until a verified frame after the unknown one is complete, whichever comes first). Such an unknown frame
-//    may wait for later bytes; a verified frame after it is never held back by that.
+//    candidate with a known id and a plausible length (below) that starts inside an unknown frame is waited
+//    for (until it can be judged, or until a verified frame after the unknown one is complete, whichever
+//    comes first). Such an unknown frame may wait for later bytes; a verified frame after it is never held
+//    back by that.
 //  - After a bad checksum the parser rescans from the byte after the failed start byte, so a good frame that
 //    begins inside a damaged or cut-short one is still found. It does not wait for a cut-short candidate to
 //    fill up: as soon as a complete frame with a known id and a matching checksum lies inside a candidate,
 //    the candidate is given up and that frame delivered (a lost byte would otherwise make the candidate
-//    claim the wrong length and hold good frames back until unrelated later bytes arrive). This is decided
+//    claim the wrong length and hold good frames back until unrelated later bytes arrive). A frame inside
+//    another must also have a length its message can have (MAVLink 1: the base fields exactly; MAVLink 2:
+//    at most all fields), since a checksum alone matches by chance once in 65,536 candidates. This is decided
 //    as if the bytes came one at a time: the inner frame that is complete first wins, and only if it is
 //    complete before the candidate itself could be judged; every start byte before it counts as a failed
 //    candidate. Frames and counters therefore do not depend on how the stream is split into push() calls.

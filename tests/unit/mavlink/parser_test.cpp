@@ -347,8 +347,8 @@ TEST(MavlinkParser, StrayStartByteInNoiseDoesNotSwallowFrames) {
 // A stray start byte in damaged bytes reads as a MAVLink 1 frame of an undeclared id whose claimed end falls
 // on a 0xFD inside the next, good frame (here its sequence number), so the look-ahead rule took it for a
 // frame followed by another: it was delivered unverified and the verified frame it overlaps was lost. Found
-// by comparing with the C library's parser on an ArduPilot-like stream (reference_compare_test.cpp, seed 5:
-// a damaged AHRS2 frame whose payload held 0xFE and an undeclared id). A candidate that cannot be verified
+// by comparing with the C library's parser on an ArduPilot-like stream (reference_compare_test.cpp: a
+// damaged AHRS2 frame whose payload held 0xFE and an undeclared id). A candidate that cannot be verified
 // now waits for every candidate with a known id that starts inside it, and loses to a verified one.
 TEST(MavlinkParser, UnverifiableCandidateEndingOnAStartByteInsideAVerifiedFrameDoesNotSwallowIt) {
     const Bytes good = heartbeat_with_seq(0xFD, 7);
@@ -379,6 +379,54 @@ TEST(MavlinkParser, UndeclaredFrameWithADamagedLengthDoesNotSwallowTheVerifiedFr
         EXPECT_EQ(c.stats.unknown_msgid, 0u) << chunk;
         EXPECT_EQ(c.stats.truncated, 1u) << chunk;
         EXPECT_EQ(c.stats.bad_checksum, 0u) << chunk;
+        EXPECT_EQ(c.stats.garbage_bytes, 0u) << chunk;
+    }
+}
+
+// Bytes as received in the comparison with the C library (seed 137): a MISSION_CURRENT whose
+// incompatibility flags were hit (0x00 became 0x40), then an intact GPS_RAW_INT. The damaged frame's own
+// sequence number, 0xFD, reads as a signed frame of an undeclared id claiming 26 bytes, whose end falls on
+// the GPS frame's sequence number 0xFE. The C library gives the damaged frame up at its flag byte and decodes
+// the GPS frame; airseg lost it to the unverifiable candidate.
+TEST(MavlinkParser, SignedUnverifiableCandidateFromADamagedFrameDoesNotSwallowTheNextFrame) {
+    const Bytes damaged{0xFD, 0x0E, 0x40, 0x00, 0xFD, 0x01, 0x01, 0x2A, 0x00, 0x00, 0x6C, 0x00, 0xF7,
+                        0x11, 0x00, 0x00, 0x42, 0xB5, 0xAC, 0xE7, 0xA6, 0x0F, 0xE2, 0xC5, 0xC8, 0x0B};
+    const Bytes gps{0xFD, 0x33, 0x00, 0x00, 0xFE, 0x01, 0x01, 0x18, 0x00, 0x00, 0x30, 0x00, 0x00,
+                    0x00, 0x00, 0x00, 0x00, 0x00, 0xDD, 0x04, 0xA8, 0x40, 0x00, 0x00, 0x00, 0x00,
+                    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x3B, 0x00, 0x08, 0x00, 0x62, 0x00, 0x00,
+                    0xFC, 0xA2, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x96, 0x7B, 0x12, 0x1A,
+                    0xB5, 0xEE, 0x79, 0x2D, 0x00, 0x00, 0x00, 0x00, 0xC0, 0xC6, 0x5E};
+    const Bytes stream = concat({damaged, gps});
+    for (std::size_t chunk = 0; chunk <= 97; ++chunk) {
+        const auto c = run(stream, chunk);
+        ASSERT_EQ(c.frames.size(), 1u) << chunk;
+        EXPECT_EQ(c.frames[0].msgid, GpsRawInt::kId) << chunk;
+        EXPECT_EQ(c.frames[0].seq, 0xFE) << chunk;
+        EXPECT_EQ(c.stats.unknown_msgid, 0u) << chunk;
+    }
+}
+
+// Intact bytes from the comparison with the C library (seed 2, 50 MB): an AHRS2 (undeclared) whose payload
+// holds 0xFE 0x1C ...: a MAVLink 1 HEARTBEAT claiming 28 bytes, reaching into the SYS_STATUS after it, whose
+// checksum matches there by chance (one in 65,536). Waiting for candidates inside undeclared frames made
+// that coincidence deliver a HEARTBEAT that was never sent, and lose both real frames. A frame inside another
+// must have a length its message can have (a MAVLink 1 HEARTBEAT has 9 bytes).
+TEST(MavlinkParser, ChecksumMatchingByChanceInsideAnUndeclaredFrameDoesNotWin) {
+    const Bytes ahrs2{0xFD, 0x18, 0x00, 0x00, 0xCB, 0x01, 0x01, 0xB2, 0x00, 0x00, 0xE0, 0x09,
+                      0x18, 0x4B, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xFE, 0x1C,
+                      0xDB, 0xD9, 0x00, 0x00, 0x00, 0x00, 0xC2, 0xF5, 0x60, 0x41, 0x3E, 0xF9};
+    const Bytes sys_status{0xFD, 0x28, 0x00, 0x00, 0xCC, 0x01, 0x01, 0x01, 0x00, 0x00, 0x00, 0x00, 0x00,
+                           0x00, 0x00, 0x00, 0x00, 0x00, 0x0A, 0xC2, 0x62, 0xBC, 0x8A, 0x27, 0x00, 0x00,
+                           0x95, 0x00, 0x3E, 0x00, 0x0F, 0x00, 0x2B, 0x3D, 0x31, 0x55, 0x3F, 0x00, 0x00,
+                           0x00, 0xBE, 0x3D, 0x00, 0x00, 0x00, 0x0A, 0x00, 0x00, 0x00, 0x64, 0xE4, 0x62};
+    const Bytes stream = concat({ahrs2, sys_status});
+    for (std::size_t chunk = 0; chunk <= 97; ++chunk) {
+        const auto c = run(stream, chunk);
+        ASSERT_EQ(c.frames.size(), 2u) << chunk;
+        EXPECT_EQ(c.frames[0].msgid, 178u) << chunk;
+        EXPECT_FALSE(c.frames[0].checksum_verified) << chunk;
+        EXPECT_EQ(c.frames[1].msgid, SysStatus::kId) << chunk;
+        EXPECT_TRUE(c.frames[1].checksum_verified) << chunk;
         EXPECT_EQ(c.stats.garbage_bytes, 0u) << chunk;
     }
 }
@@ -436,12 +484,13 @@ TEST(MavlinkParser, UndeclaredIdWithUnknownIncompatibilityFlagIsGivenUpAtItsHead
     }
 }
 
-// An undeclared frame holding a start byte that reads as a declared message claiming 200 bytes must wait
-// until that candidate can be judged, or until a verified frame after it is complete (the candidate can then
-// no longer be complete first). So the frame after it is not held back on a quiet line.
+// An undeclared frame holding a start byte that reads as a declared message (a MAVLink 1 AUTOPILOT_VERSION,
+// 68 bytes) must wait until that candidate can be judged, or until a verified frame after it is complete (the
+// candidate can then no longer be complete first). So the frame after it is not held back on a quiet line.
 TEST(MavlinkParser, UndeclaredFrameWaitingForACandidateInsideItDoesNotHoldBackTheFrameAfterIt) {
     Encoder e(1, 1);
-    const Bytes unknown = unknown_frame(12345, {0x00, kMagicV1, 200, 0x00, 0x01, 0x01, 0x00, 0x00});
+    const Bytes unknown =
+        unknown_frame(12345, {0x00, kMagicV1, 60, 0x00, 0x01, 0x01, AutopilotVersion::kId, 0x00});
     const Bytes stream = concat({unknown, heartbeat_frame(e, 5)});
     for (std::size_t chunk = 1; chunk <= stream.size(); ++chunk) {
         Parser parser;
