@@ -29,10 +29,11 @@ struct Header {
     std::uint32_t msgid;
     std::size_t header_length;
 
-    std::size_t frame_length() const {
-        const bool is_signed = version == Version::V2 && (incompat_flags & kIncompatSigned) != 0;
-        return header_length + payload_length + kChecksumLength + (is_signed ? kSignatureLength : 0);
-    }
+    bool is_signed() const { return version == Version::V2 && (incompat_flags & kIncompatSigned) != 0; }
+    bool unknown_flags() const { return (incompat_flags & ~kIncompatSigned) != 0; }
+    // Up to the end of the checksum: all a frame with a known id needs to be verified.
+    std::size_t checked_length() const { return header_length + payload_length + kChecksumLength; }
+    std::size_t frame_length() const { return checked_length() + (is_signed() ? kSignatureLength : 0); }
 };
 
 // Length of the frame a start byte claims, from its first three bytes only (magic, payload length and, for
@@ -50,6 +51,23 @@ Header read_header(const std::uint8_t* p) {
     return Header{Version::V2, p[1], p[2], p[3], p[4], p[5], p[6], msgid, kHeaderLengthV2};
 }
 
+// Whether the frame with a known id at p (complete up to its checksum) has a matching checksum.
+bool checksum_matches(const std::uint8_t* p, const Header& h, const MessageInfo& info) {
+    Crc16 crc;
+    crc.add(std::span<const std::uint8_t>(p + 1, h.header_length - 1 + h.payload_length));
+    crc.add(info.crc_extra);
+    return crc.value() == wire::get<std::uint16_t>(p + h.header_length + h.payload_length);
+}
+
+// Whether a candidate found inside another one has a length its message can have: a MAVLink 1 payload is
+// exactly the base fields, a MAVLink 2 one at most all fields (trailing zeros truncated). A frame inside
+// another is looked for among bytes that are not a frame start for certain, where a 16-bit checksum alone
+// would match by chance once in 65,536 candidates with a declared id; a heartbeat-sized pattern in an
+// undeclared message's payload is common enough for that to happen on a busy link.
+bool plausible_inner(const Header& h, const MessageInfo& info) {
+    return h.version == Version::V1 ? h.payload_length == info.base_length : h.payload_length <= info.length;
+}
+
 }  // namespace
 
 const LinkStats* Parser::link(std::uint8_t sysid, std::uint8_t compid) const {
@@ -64,7 +82,7 @@ const LinkStats* Parser::link(std::uint8_t sysid, std::uint8_t compid) const {
 void Parser::push(std::span<const std::uint8_t> bytes, Sink sink) {
     std::size_t pos = 0;
     while (true) {
-        if (len_ == 0) {
+        if (len_ == 0 && signature_left_ == 0) {
             // Fast path between frames: skip noise in place, without copying it.
             const auto* start = bytes.data() + pos;
             const auto* end = bytes.data() + bytes.size();
@@ -77,7 +95,7 @@ void Parser::push(std::span<const std::uint8_t> bytes, Sink sink) {
             buf_[0] = bytes[pos++];
             len_ = 1;
         }
-        if (is_magic(buf_[0])) {
+        if (head() != Head::Noise) {
             const std::size_t need = required_length();
             if (len_ < need) {
                 const std::size_t n = std::min(need - len_, bytes.size() - pos);
@@ -87,72 +105,188 @@ void Parser::push(std::span<const std::uint8_t> bytes, Sink sink) {
                 len_ += n;
                 pos += n;
             }
-            if (resync_inside_candidate(need)) {
+            if (resync_inside_candidate(sink, need)) {
                 continue;
             }
             if (len_ < need) {
                 return;  // all bytes taken
             }
             if (required_length() != need) {
-                continue;  // the header is now complete: the required length grows
+                continue;  // more of the candidate is known now: the required length changes
             }
         }
         step(sink, false);
     }
 }
 
-// A frame that begins inside the candidate at buf_[0] may be complete before the candidate is: after a lost
-// byte (or a stray start byte in noise) the candidate's length comes from the wrong byte, and waiting for it
-// to fill would hold good frames back until unrelated later traffic arrives, on a quiet line for seconds. A
-// complete frame with a known id and a matching checksum inside the candidate proves the candidate damaged:
-// it is dropped up to that frame. Of such frames, the one that is complete first in the stream wins, and only
-// if it is complete before the candidate can be judged (`need` bytes), exactly as if the stream came one byte
-// at a time; so the outcome does not depend on how the stream is split, or on how many bytes are at hand.
+void Parser::finish(Sink sink) {
+    while (len_ > 0 || signature_left_ > 0) {
+        if (head() != Head::Noise && resync_inside_candidate(sink, required_length())) {
+            continue;
+        }
+        step(sink, true);
+    }
+}
+
+Parser::Head Parser::head() const {
+    if (signature_left_ > 0) {
+        return Head::Signature;
+    }
+    if (head_cached_) {
+        return head_cache_;
+    }
+    if (len_ == 0) {
+        return Head::Noise;
+    }
+    if (!is_magic(buf_[0])) {
+        head_cache_ = Head::Noise;
+    } else if (len_ < header_length(buf_[0])) {
+        return Head::Incomplete;  // looked at again as bytes arrive
+    } else {
+        const Header h = read_header(buf_.data());
+        head_cache_ = find_message(h.msgid) != nullptr ? Head::Known
+                      : h.unknown_flags()              ? Head::Unacceptable
+                                                       : Head::Unknown;
+    }
+    head_cached_ = true;  // until the front of the buffer is dropped
+    return head_cache_;
+}
+
+// Bytes of the head that nothing can verify: a signature, or a whole frame with an unknown message id.
+std::size_t Parser::unverifiable_length(Head kind) const {
+    switch (kind) {
+        case Head::Signature:
+            return signature_left_;
+        case Head::Unknown:
+            return read_header(buf_.data()).frame_length();
+        default:
+            return 0;
+    }
+}
+
+// Bytes needed before the head can be judged:
+//  - a frame with a known id: up to its checksum;
+//  - a frame with an unknown id: the whole frame and one byte of look-ahead, which must be a start byte;
+//    then, since its length byte cannot be trusted, also every candidate that starts inside it and could
+//    turn out a verified frame (a known id and a plausible length), so that such a frame is never given up
+//    for it;
+//  - a signature (not verified, so a lost byte in it would otherwise eat the start byte of the next frame):
+//    its 13 bytes and every candidate inside it that could turn out a verified frame;
+//  - an unknown id with an unknown incompatibility flag: only its header (it is given up at once).
+std::size_t Parser::required_length() const {
+    const Head kind = head();
+    switch (kind) {
+        case Head::Noise:
+            return 1;
+        case Head::Signature:
+            return pending_end(0, signature_left_, signature_left_);
+        case Head::Incomplete:
+        case Head::Unacceptable:
+            return header_length(buf_[0]);
+        case Head::Known:
+            return read_header(buf_.data()).checked_length();
+        case Head::Unknown: {
+            const std::size_t length = unverifiable_length(kind);
+            if (len_ <= length || !is_magic(buf_[length])) {
+                return length + 1;
+            }
+            return pending_end(1, length, length + 1);
+        }
+    }
+    return 1;
+}
+
+// The larger of `at_least` and the end of every candidate starting in [first, end) that could still turn
+// out to be a verified frame: up to its header while the header is incomplete, up to its checksum when its
+// id is known and its length plausible for it.
+std::size_t Parser::pending_end(std::size_t first, std::size_t end, std::size_t at_least) const {
+    std::size_t need = at_least;
+    for (std::size_t k = first; k < std::min(end, len_); ++k) {
+        if (!is_magic(buf_[k])) {
+            continue;
+        }
+        const std::size_t header = header_length(buf_[k]);
+        if (len_ - k < header) {
+            need = std::max(need, k + header);
+            continue;
+        }
+        const Header h = read_header(buf_.data() + k);
+        const MessageInfo* info = find_message(h.msgid);
+        if (info != nullptr && plausible_inner(h, *info)) {
+            need = std::max(need, k + h.checked_length());
+        }
+    }
+    return need;
+}
+
+// A frame that begins inside the head may be complete before the head can be judged: after a lost byte (or
+// a stray start byte in noise) the head's length comes from the wrong byte, and waiting for it to fill
+// would hold good frames back until unrelated later traffic arrives, on a quiet line for seconds. A
+// complete frame with a known id, a plausible length and a matching checksum inside the head proves the
+// head damaged: it is dropped up to that frame. Of such frames, the one that is complete first in the stream
+// wins, and only if it is complete before the head can be judged (`need` bytes), exactly as if the stream
+// came one byte at a time; so the outcome does not depend on how the stream is split, or on how many bytes
+// are at hand.
+//
+// A head that cannot be verified (unknown id, signature) also loses to a verified frame complete at the
+// moment it could be judged, and it waits for the candidates inside it (required_length()). But if a
+// verified frame that starts after it is complete first, nothing inside it can be verified before that
+// frame, which it does not overlap: the head stands.
+//
 // Each inner frame is checked once: checked_len_ is the end up to which frames were checked and found
 // wanting.
-bool Parser::resync_inside_candidate(std::size_t need) {
-    const std::size_t limit = std::min(len_, need - 1);  // inner frames must end at or before this
+bool Parser::resync_inside_candidate(Sink sink, std::size_t need) {
+    const Head kind = head();
+    const std::size_t unverifiable = unverifiable_length(kind);
+    // Inner frames must be complete at or before this.
+    const std::size_t limit = std::min(len_, unverifiable > 0 ? need : need - 1);
     if (limit <= checked_len_) {
         return false;
     }
-    std::size_t found = 0;
+    bool found = false;
+    std::size_t found_at = 0;
     std::size_t found_end = limit + 1;
-    for (std::size_t k = 1; k < limit; ++k) {
+    for (std::size_t k = kind == Head::Signature ? 0 : 1; k < limit; ++k) {
         if (!is_magic(buf_[k]) || len_ - k < header_length(buf_[k])) {
             continue;
         }
         const Header h = read_header(buf_.data() + k);
-        const std::size_t end = k + h.frame_length();
+        const std::size_t end = k + h.checked_length();
         // Skipped: not complete in time, not before one already found (ties go to the earlier start), or
         // checked before.
         if (end >= found_end || end <= checked_len_) {
             continue;
         }
         const MessageInfo* info = find_message(h.msgid);
-        if (info == nullptr) {
-            continue;
-        }
-        Crc16 crc;
-        crc.add(std::span<const std::uint8_t>(buf_.data() + k + 1, h.header_length - 1 + h.payload_length));
-        crc.add(info->crc_extra);
-        if (crc.value() == wire::get<std::uint16_t>(buf_.data() + k + h.header_length + h.payload_length)) {
-            found = k;
+        if (info != nullptr && plausible_inner(h, *info) && checksum_matches(buf_.data() + k, h, *info)) {
+            found = true;
+            found_at = k;
             found_end = end;
         }
     }
-    if (found > 0) {
-        account_failed_starts(found);
-        drop_front(found);
+    if (!found) {
+        checked_len_ = limit;
+        return false;
+    }
+    if (kind == Head::Signature) {
+        // The signature ends where the frame found begins, or was complete before it.
+        drop_front(std::min(found_at, signature_left_));
+        signature_left_ = 0;
         return true;
     }
-    checked_len_ = limit;
-    return false;
+    if (unverifiable > 0 && found_at >= unverifiable) {
+        accept(sink, unverifiable, nullptr);
+        return true;
+    }
+    account_failed_starts(found_at);
+    drop_front(found_at);
+    return true;
 }
 
 // The bytes before the good frame at buf_[k] are dropped in one go. They are accounted as if each start byte
-// among them had been judged on its own and failed, as step() and process_candidate() do: it opens a damaged
-// stretch of the length it claims unless one is already open, and every byte is discarded. The good frame
-// then resolves a stretch still open as `truncated` (accept()). So a damaged frame that lies between an open
+// among them had been judged on its own and failed, as step() and judge() do: it opens a damaged stretch of
+// the length it claims unless one is already open, and every byte is discarded. The good frame then
+// resolves a stretch still open as `truncated` (accept()). So a damaged frame that lies between an open
 // stretch and the good frame counts as damaged, not as noise, whether or not the good frame was found early.
 void Parser::account_failed_starts(std::size_t k) {
     std::size_t p = 0;
@@ -171,25 +305,9 @@ void Parser::account_failed_starts(std::size_t k) {
     }
 }
 
-void Parser::finish(Sink sink) {
-    while (len_ > 0) {
-        step(sink, true);
-    }
-}
-
-// Bytes needed before the candidate at buf_[0] can be judged: its header, then the whole frame, plus one
-// byte of look-ahead for a message id whose checksum cannot be verified.
-std::size_t Parser::required_length() const {
-    const std::size_t header = header_length(buf_[0]);
-    if (len_ < header) {
-        return header;
-    }
-    const Header h = read_header(buf_.data());
-    return h.frame_length() + (find_message(h.msgid) == nullptr ? 1 : 0);
-}
-
 void Parser::step(Sink sink, bool at_end) {
-    if (!is_magic(buf_[0])) {
+    const Head kind = head();
+    if (kind == Head::Noise) {
         const auto magic =
             std::find_if(buf_.begin(), buf_.begin() + static_cast<std::ptrdiff_t>(len_), is_magic);
         const auto n = static_cast<std::size_t>(magic - buf_.begin());
@@ -197,63 +315,69 @@ void Parser::step(Sink sink, bool at_end) {
         drop_front(n);
         return;
     }
-    const std::size_t need = required_length();
-    if (len_ >= need) {
-        process_candidate(sink, read_header(buf_.data()).frame_length());
+    if (len_ >= required_length()) {
+        judge(sink, kind);
         return;
     }
     if (!at_end) {
         return;
     }
-    // The stream ended inside this candidate.
-    if (len_ >= header_length(buf_[0])) {
-        const Header h = read_header(buf_.data());
-        if (find_message(h.msgid) == nullptr && len_ == h.frame_length()) {
-            // An unverifiable frame that ends exactly where the stream ends: nothing contradicts it.
-            accept(sink, h.frame_length(), nullptr);
-            return;
-        }
+    // The stream ended before the head could be judged.
+    if (kind == Head::Signature) {
+        drop_front(std::min(len_, signature_left_));
+        signature_left_ = 0;
+        return;
+    }
+    if (kind == Head::Unknown && len_ >= unverifiable_length(kind)) {
+        // An unverifiable frame that nothing after it contradicts, and no verified frame inside it.
+        accept(sink, unverifiable_length(kind), nullptr);
+        return;
     }
     mark_damaged(len_, DamageKind::Truncated);
     discard(1);
     drop_front(1);
 }
 
-void Parser::process_candidate(Sink sink, std::size_t frame_length) {
-    const Header h = read_header(buf_.data());
-    const MessageInfo* info = find_message(h.msgid);
-    bool valid = false;
-    if (info != nullptr) {
-        Crc16 crc;
-        crc.add(std::span<const std::uint8_t>(buf_.data() + 1, h.header_length - 1 + h.payload_length));
-        crc.add(info->crc_extra);
-        valid = crc.value() == wire::get<std::uint16_t>(buf_.data() + h.header_length + h.payload_length);
-    } else {
-        valid = is_magic(buf_[frame_length]);
-    }
-    if (!valid) {
-        mark_damaged(frame_length, DamageKind::BadChecksum);
-        discard(1);
-        drop_front(1);
+// The head with all the bytes it needs (required_length()), no verified frame found inside it.
+void Parser::judge(Sink sink, Head kind) {
+    if (kind == Head::Signature) {
+        drop_front(signature_left_);
+        signature_left_ = 0;
         return;
     }
-    accept(sink, frame_length, info);
+    const Header h = read_header(buf_.data());
+    if (kind == Head::Known) {
+        const MessageInfo* info = find_message(h.msgid);
+        if (checksum_matches(buf_.data(), h, *info)) {
+            accept(sink, h.checked_length(), info);
+            return;
+        }
+    } else if (kind == Head::Unknown && is_magic(buf_[h.frame_length()])) {
+        accept(sink, h.frame_length(), nullptr);
+        return;
+    }
+    mark_damaged(h.frame_length(), DamageKind::BadChecksum);
+    discard(1);
+    drop_front(1);
 }
 
-// A frame that passed its checks (or, for an unknown id, was not contradicted by the bytes after it).
+// A frame that passed its checks (or, for an unknown id, was not contradicted by the bytes after it). A
+// verified frame is taken up to its checksum; its signature, if it has one, follows as a head of its own.
 void Parser::accept(Sink sink, std::size_t frame_length, const MessageInfo* info) {
     const Header h = read_header(buf_.data());
     resolve_damage_by_good_frame();
     track_sequence(h.sysid, h.compid, h.seq);
-    if ((h.incompat_flags & ~kIncompatSigned) != 0) {
+    const std::size_t signature = info != nullptr && h.is_signed() ? kSignatureLength : 0;
+    if (h.unknown_flags()) {
         ++stats_.incompat_rejected;
         drop_front(frame_length);
+        signature_left_ = signature;
         return;
     }
-    deliver(sink, frame_length, info);
+    deliver(sink, frame_length, info, signature);
 }
 
-void Parser::deliver(Sink sink, std::size_t frame_length, const MessageInfo* info) {
+void Parser::deliver(Sink sink, std::size_t frame_length, const MessageInfo* info, std::size_t signature) {
     const Header h = read_header(buf_.data());
     frame_.version = h.version;
     frame_.incompat_flags = h.incompat_flags;
@@ -264,7 +388,7 @@ void Parser::deliver(Sink sink, std::size_t frame_length, const MessageInfo* inf
     frame_.msgid = h.msgid;
     frame_.wire_length = h.payload_length;
     frame_.payload_length = info != nullptr ? std::max(h.payload_length, info->length) : h.payload_length;
-    frame_.is_signed = (h.incompat_flags & kIncompatSigned) != 0;
+    frame_.is_signed = h.is_signed();
     frame_.checksum_verified = info != nullptr;
     std::memcpy(frame_.payload.data(), buf_.data() + h.header_length, h.payload_length);
     std::fill(frame_.payload.begin() + h.payload_length, frame_.payload.end(), std::uint8_t{0});
@@ -277,6 +401,7 @@ void Parser::deliver(Sink sink, std::size_t frame_length, const MessageInfo* inf
         ++stats_.signed_frames;
     }
     drop_front(frame_length);
+    signature_left_ = signature;
     sink(frame_);
 }
 
@@ -335,6 +460,7 @@ void Parser::drop_front(std::size_t n) {
     std::memmove(buf_.data(), buf_.data() + n, len_ - n);
     len_ -= n;
     checked_len_ = 0;
+    head_cached_ = false;
 }
 
 }  // namespace airseg::mavlink

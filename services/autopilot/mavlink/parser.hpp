@@ -4,25 +4,34 @@
 // Contract: the caller feeds bytes in any chunking with push(bytes, on_frame); on_frame(const Frame&) is
 // called, synchronously and in stream order, for each frame found (the Frame reference is valid only during
 // the call). finish(on_frame) tells the parser the stream has ended. The parser owns one fixed buffer of
-// kMaxFrameLength + 1 bytes and never allocates after construction; it never reads a clock.
+// 2 * kMaxFrameLength bytes and never allocates after construction; it never reads a clock.
 //
-// What it accepts and how it recovers:
+// What it accepts and how it recovers. The rule behind it: a verified frame (known id, matching checksum) is
+// never given up for bytes that cannot be verified.
 //  - A frame with a known message id is delivered only when its checksum (with the message's CRC_EXTRA)
 //    matches. A MAVLink 2 payload shorter than the message is zero-extended (payload_view() has the full
 //    length); a longer one (fields of a newer definition) is delivered as received.
 //  - MAVLink 2 frames with an incompatibility flag other than "signed" are dropped (incompat_rejected), as
-//  the
-//    specification requires; compatibility flags are ignored. Signed frames are delivered with is_signed set;
-//    their 13-byte signature is skipped, not verified (signed_frames).
+//    the specification requires, once their checksum is verified; compatibility flags are ignored. A frame
+//    with such a flag and an unknown message id can be neither verified nor delivered: its start byte is
+//    given up at the header, as noise. Signed frames are delivered with is_signed set as soon as their
+//    checksum is complete (signed_frames); the 13 bytes after it are taken as the signature, not verified,
+//    unless a verified frame begins among them (a signature that lost a byte on the line).
 //  - A message id without a known CRC_EXTRA cannot be verified. Such a frame is delivered with
 //    checksum_verified == false (unknown_msgid) only when the byte right after it starts another frame (or
-//    the stream ends there); otherwise its start byte is treated as noise. This keeps a stray 0xFD/0xFE in
-//    line noise from swallowing good frames behind it.
+//    the stream ends there), and no verified frame begins inside it; otherwise its start byte is treated as
+//    noise. So a stray 0xFD/0xFE in line noise, or a damaged length byte, does not swallow good frames: a
+//    candidate with a known id and a plausible length (below) that starts inside an unknown frame is waited
+//    for (until it can be judged, or until a verified frame after the unknown one is complete, whichever
+//    comes first). Such an unknown frame may wait for later bytes; a verified frame after it is never held
+//    back by that.
 //  - After a bad checksum the parser rescans from the byte after the failed start byte, so a good frame that
 //    begins inside a damaged or cut-short one is still found. It does not wait for a cut-short candidate to
 //    fill up: as soon as a complete frame with a known id and a matching checksum lies inside a candidate,
 //    the candidate is given up and that frame delivered (a lost byte would otherwise make the candidate
-//    claim the wrong length and hold good frames back until unrelated later bytes arrive). This is decided
+//    claim the wrong length and hold good frames back until unrelated later bytes arrive). A frame inside
+//    another must also have a length its message can have (MAVLink 1: the base fields exactly; MAVLink 2:
+//    at most all fields), since a checksum alone matches by chance once in 65,536 candidates. This is decided
 //    as if the bytes came one at a time: the inner frame that is complete first wins, and only if it is
 //    complete before the candidate itself could be judged; every start byte before it counts as a failed
 //    candidate. Frames and counters therefore do not depend on how the stream is split into push() calls.
@@ -96,25 +105,39 @@ class Parser {
         void (*call_)(void*, const Frame&);
     };
     enum class DamageKind : std::uint8_t { BadChecksum, Truncated };
+    // What starts the buffer: noise before a start byte; the signature of the frame just delivered; a
+    // candidate frame whose header is incomplete, whose id is known (verifiable), unknown, or unknown with an
+    // unknown incompatibility flag (unacceptable).
+    enum class Head : std::uint8_t { Noise, Signature, Incomplete, Known, Unknown, Unacceptable };
 
     void push(std::span<const std::uint8_t> bytes, Sink sink);
     void finish(Sink sink);
-    void step(Sink sink, bool at_end);
+    Head head() const;
+    std::size_t unverifiable_length(Head kind) const;
     std::size_t required_length() const;
-    void process_candidate(Sink sink, std::size_t frame_length);
+    std::size_t pending_end(std::size_t first, std::size_t end, std::size_t at_least) const;
+    bool resync_inside_candidate(Sink sink, std::size_t need);
+    void account_failed_starts(std::size_t k);
+    void step(Sink sink, bool at_end);
+    void judge(Sink sink, Head kind);
     void accept(Sink sink, std::size_t frame_length, const MessageInfo* info);
-    void deliver(Sink sink, std::size_t frame_length, const MessageInfo* info);
+    void deliver(Sink sink, std::size_t frame_length, const MessageInfo* info, std::size_t signature);
     void track_sequence(std::uint8_t sysid, std::uint8_t compid, std::uint8_t seq);
     void mark_damaged(std::size_t span, DamageKind kind);
     void discard(std::size_t n);
     void drop_front(std::size_t n);
     void resolve_damage_by_good_frame();
-    bool resync_inside_candidate(std::size_t need);
-    void account_failed_starts(std::size_t k);
 
-    std::array<std::uint8_t, kMaxFrameLength + 1> buf_{};  // one frame candidate, plus one byte of look-ahead
+    // The head and what it needs to be judged: at most an unverifiable frame and a verified one starting in
+    // its last byte.
+    std::array<std::uint8_t, 2 * kMaxFrameLength> buf_{};
     std::size_t len_ = 0;
     std::size_t checked_len_ = 0;  // inner frames ending up to here were checked (resync_inside_candidate)
+    // How many of the first bytes of the buffer (and of those still to come) are presumed the signature of
+    // the frame just delivered.
+    std::size_t signature_left_ = 0;
+    mutable Head head_cache_ = Head::Noise;  // head(), once the candidate's header is complete
+    mutable bool head_cached_ = false;
     std::size_t damaged_left_ = 0;
     DamageKind damage_kind_ = DamageKind::BadChecksum;
     Frame frame_{};

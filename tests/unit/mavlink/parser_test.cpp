@@ -61,6 +61,30 @@ Bytes unknown_frame(std::uint32_t msgid, Bytes payload, std::uint8_t seq = 0) {
     return Bytes(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(n));
 }
 
+// A HEARTBEAT with a chosen sequence number (0xFD or 0xFE makes a start byte inside the frame).
+Bytes heartbeat_with_seq(std::uint8_t seq, std::uint32_t custom_mode) {
+    Heartbeat hb;
+    hb.custom_mode = custom_mode;
+    std::array<std::uint8_t, kMaxPayload> payload{};
+    const std::size_t length = encode_payload(hb, payload);
+    std::array<std::uint8_t, kMaxFrameLength> out{};
+    const std::size_t n =
+        encode_message(FrameHeader{Version::V2, seq, 1, 1, Heartbeat::kId, 0}, *find_message(Heartbeat::kId),
+                       std::span(payload).first(length), out);
+    return Bytes(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(n));
+}
+
+// The custom_mode of each HEARTBEAT delivered, and which frames were unverified.
+std::vector<std::uint32_t> heartbeats(const Collected& c) {
+    std::vector<std::uint32_t> out;
+    for (const Frame& f : c.frames) {
+        if (auto hb = decode<Heartbeat>(f)) {
+            out.push_back(hb->custom_mode);
+        }
+    }
+    return out;
+}
+
 TEST(MavlinkParser, GarbageBetweenFramesIsSkippedAndCounted) {
     Encoder e(1, 1);
     const Bytes stream =
@@ -318,6 +342,177 @@ TEST(MavlinkParser, StrayStartByteInNoiseDoesNotSwallowFrames) {
     ASSERT_EQ(c.frames.size(), 1u);
     EXPECT_EQ(decode<Heartbeat>(c.frames[0])->custom_mode, 5u);
     EXPECT_EQ(c.stats.unknown_msgid, 0u);
+}
+
+// A stray start byte in damaged bytes reads as a MAVLink 1 frame of an undeclared id whose claimed end falls
+// on a 0xFD inside the next, good frame (here its sequence number), so the look-ahead rule took it for a
+// frame followed by another: it was delivered unverified and the verified frame it overlaps was lost. Found
+// by comparing with the C library's parser on an ArduPilot-like stream (reference_compare_test.cpp: a
+// damaged AHRS2 frame whose payload held 0xFE and an undeclared id). A candidate that cannot be verified
+// now waits for every candidate with a known id that starts inside it, and loses to a verified one.
+TEST(MavlinkParser, UnverifiableCandidateEndingOnAStartByteInsideAVerifiedFrameDoesNotSwallowIt) {
+    const Bytes good = heartbeat_with_seq(0xFD, 7);
+    // 0xFE, length 5, seq, sysid, compid, message id 103 (undeclared), 3 more bytes: it claims 6 + 5 + 2 = 13
+    // bytes, 4 of them in the good frame, and the byte after its claimed end is the good frame's 0xFD.
+    const Bytes stray{kMagicV1, 5, 0x4B, 0x71, 0x1F, 103, 0x8B, 0xD9, 0xCA};
+    const Bytes stream = concat({stray, good, heartbeat_with_seq(0xFE, 8)});
+    for (std::size_t chunk = 0; chunk <= 97; ++chunk) {
+        const auto c = run(stream, chunk);
+        EXPECT_EQ(heartbeats(c), (std::vector<std::uint32_t>{7, 8})) << chunk;
+        EXPECT_EQ(c.stats.unknown_msgid, 0u) << chunk;
+        EXPECT_EQ(c.stats.frames_ok, 2u) << chunk;
+        EXPECT_EQ(c.stats.truncated, 1u) << chunk;  // the stray's claimed stretch, cut by the good frame
+        EXPECT_EQ(c.stats.garbage_bytes, 0u) << chunk;
+    }
+}
+
+// The same with a real frame of an undeclared message whose length byte was damaged (5 became 9): its
+// claimed end lies 4 bytes into the good frame after it, on that frame's 0xFD.
+TEST(MavlinkParser, UndeclaredFrameWithADamagedLengthDoesNotSwallowTheVerifiedFrameAfterIt) {
+    Bytes unknown = unknown_frame(12345, {1, 2, 3, 4, 5});
+    unknown[1] = 9;
+    const Bytes stream = concat({unknown, heartbeat_with_seq(0xFD, 7), heartbeat_with_seq(0xFE, 8)});
+    for (std::size_t chunk = 0; chunk <= 97; ++chunk) {
+        const auto c = run(stream, chunk);
+        EXPECT_EQ(heartbeats(c), (std::vector<std::uint32_t>{7, 8})) << chunk;
+        EXPECT_EQ(c.frames.size(), 2u) << chunk;
+        EXPECT_EQ(c.stats.unknown_msgid, 0u) << chunk;
+        EXPECT_EQ(c.stats.truncated, 1u) << chunk;
+        EXPECT_EQ(c.stats.bad_checksum, 0u) << chunk;
+        EXPECT_EQ(c.stats.garbage_bytes, 0u) << chunk;
+    }
+}
+
+// Bytes as received in the comparison with the C library (seed 137): a MISSION_CURRENT whose
+// incompatibility flags were hit (0x00 became 0x40), then an intact GPS_RAW_INT. The damaged frame's own
+// sequence number, 0xFD, reads as a signed frame of an undeclared id claiming 26 bytes, whose end falls on
+// the GPS frame's sequence number 0xFE. The C library gives the damaged frame up at its flag byte and decodes
+// the GPS frame; airseg lost it to the unverifiable candidate.
+TEST(MavlinkParser, SignedUnverifiableCandidateFromADamagedFrameDoesNotSwallowTheNextFrame) {
+    const Bytes damaged{0xFD, 0x0E, 0x40, 0x00, 0xFD, 0x01, 0x01, 0x2A, 0x00, 0x00, 0x6C, 0x00, 0xF7,
+                        0x11, 0x00, 0x00, 0x42, 0xB5, 0xAC, 0xE7, 0xA6, 0x0F, 0xE2, 0xC5, 0xC8, 0x0B};
+    const Bytes gps{0xFD, 0x33, 0x00, 0x00, 0xFE, 0x01, 0x01, 0x18, 0x00, 0x00, 0x30, 0x00, 0x00,
+                    0x00, 0x00, 0x00, 0x00, 0x00, 0xDD, 0x04, 0xA8, 0x40, 0x00, 0x00, 0x00, 0x00,
+                    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x3B, 0x00, 0x08, 0x00, 0x62, 0x00, 0x00,
+                    0xFC, 0xA2, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x96, 0x7B, 0x12, 0x1A,
+                    0xB5, 0xEE, 0x79, 0x2D, 0x00, 0x00, 0x00, 0x00, 0xC0, 0xC6, 0x5E};
+    const Bytes stream = concat({damaged, gps});
+    for (std::size_t chunk = 0; chunk <= 97; ++chunk) {
+        const auto c = run(stream, chunk);
+        ASSERT_EQ(c.frames.size(), 1u) << chunk;
+        EXPECT_EQ(c.frames[0].msgid, GpsRawInt::kId) << chunk;
+        EXPECT_EQ(c.frames[0].seq, 0xFE) << chunk;
+        EXPECT_EQ(c.stats.unknown_msgid, 0u) << chunk;
+    }
+}
+
+// Intact bytes from the comparison with the C library (seed 2, 50 MB): an AHRS2 (undeclared) whose payload
+// holds 0xFE 0x1C ...: a MAVLink 1 HEARTBEAT claiming 28 bytes, reaching into the SYS_STATUS after it, whose
+// checksum matches there by chance (one in 65,536). Waiting for candidates inside undeclared frames made
+// that coincidence deliver a HEARTBEAT that was never sent, and lose both real frames. A frame inside another
+// must have a length its message can have (a MAVLink 1 HEARTBEAT has 9 bytes).
+TEST(MavlinkParser, ChecksumMatchingByChanceInsideAnUndeclaredFrameDoesNotWin) {
+    const Bytes ahrs2{0xFD, 0x18, 0x00, 0x00, 0xCB, 0x01, 0x01, 0xB2, 0x00, 0x00, 0xE0, 0x09,
+                      0x18, 0x4B, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0xFE, 0x1C,
+                      0xDB, 0xD9, 0x00, 0x00, 0x00, 0x00, 0xC2, 0xF5, 0x60, 0x41, 0x3E, 0xF9};
+    const Bytes sys_status{0xFD, 0x28, 0x00, 0x00, 0xCC, 0x01, 0x01, 0x01, 0x00, 0x00, 0x00, 0x00, 0x00,
+                           0x00, 0x00, 0x00, 0x00, 0x00, 0x0A, 0xC2, 0x62, 0xBC, 0x8A, 0x27, 0x00, 0x00,
+                           0x95, 0x00, 0x3E, 0x00, 0x0F, 0x00, 0x2B, 0x3D, 0x31, 0x55, 0x3F, 0x00, 0x00,
+                           0x00, 0xBE, 0x3D, 0x00, 0x00, 0x00, 0x0A, 0x00, 0x00, 0x00, 0x64, 0xE4, 0x62};
+    const Bytes stream = concat({ahrs2, sys_status});
+    for (std::size_t chunk = 0; chunk <= 97; ++chunk) {
+        const auto c = run(stream, chunk);
+        ASSERT_EQ(c.frames.size(), 2u) << chunk;
+        EXPECT_EQ(c.frames[0].msgid, 178u) << chunk;
+        EXPECT_FALSE(c.frames[0].checksum_verified) << chunk;
+        EXPECT_EQ(c.frames[1].msgid, SysStatus::kId) << chunk;
+        EXPECT_TRUE(c.frames[1].checksum_verified) << chunk;
+        EXPECT_EQ(c.stats.garbage_bytes, 0u) << chunk;
+    }
+}
+
+// A signed frame whose signature lost a byte on the line: its checksum still matches, and the start byte of
+// the next frame was taken as the signature's last byte, losing that frame (the C library loses it too).
+// The signature is not verified, so a verified frame that starts inside it now wins over it.
+TEST(MavlinkParser, SignatureThatLostAByteDoesNotSwallowTheNextFrame) {
+    Encoder e(1, 1);
+    Bytes signed_frame = heartbeat_frame(e, 9);
+    signed_frame[2] = kIncompatSigned;
+    const auto* info = find_message(Heartbeat::kId);
+    Crc16 crc;
+    crc.add(std::span<const std::uint8_t>(signed_frame.data() + 1, signed_frame.size() - 3));
+    crc.add(info->crc_extra);
+    wire::put(signed_frame.data() + signed_frame.size() - 2, crc.value());
+    for (int i = 0; i < 12; ++i) {  // one signature byte short
+        signed_frame.push_back(static_cast<std::uint8_t>(0x30 + i));
+    }
+    const Bytes stream = concat({signed_frame, heartbeat_frame(e, 10), heartbeat_frame(e, 11)});
+    for (std::size_t chunk = 0; chunk <= 97; ++chunk) {
+        const auto c = run(stream, chunk);
+        EXPECT_EQ(heartbeats(c), (std::vector<std::uint32_t>{9, 10, 11})) << chunk;
+        ASSERT_EQ(c.frames.size(), 3u) << chunk;
+        EXPECT_TRUE(c.frames[0].is_signed) << chunk;
+        EXPECT_EQ(c.stats.signed_frames, 1u) << chunk;
+        EXPECT_EQ(c.stats.garbage_bytes, 0u) << chunk;
+    }
+    // One byte too many in the signature: that byte is noise, nothing is lost.
+    Bytes long_signature = signed_frame;
+    long_signature.insert(long_signature.end(), {0x3C, 0x3D});
+    const auto c = run(concat({long_signature, heartbeat_frame(e, 12)}));
+    EXPECT_EQ(heartbeats(c), (std::vector<std::uint32_t>{9, 12}));
+    EXPECT_EQ(c.stats.garbage_bytes, 1u);
+}
+
+// A start byte whose header has an undeclared id and an unknown incompatibility flag can be neither verified
+// nor delivered (the C library gives it up at the flag byte). It used to take the bytes its length claims
+// when a start byte followed them, and an undeclared frame that begins inside it was lost; it is now given
+// up at its header.
+TEST(MavlinkParser, UndeclaredIdWithUnknownIncompatibilityFlagIsGivenUpAtItsHeader) {
+    Encoder e(1, 1);
+    const Bytes unknown = unknown_frame(4000, {1, 2, 3});
+    // Claims 10 + 13 + 2 = 25 bytes: itself and the whole undeclared frame after it.
+    const Bytes stray{kMagicV2, 13, 0x04, 0x00, 0x00, 0x01, 0x01, 0x39, 0x30, 0x00};
+    const Bytes stream = concat({stray, unknown, heartbeat_frame(e, 3)});
+    for (std::size_t chunk = 0; chunk <= 97; ++chunk) {
+        const auto c = run(stream, chunk);
+        ASSERT_EQ(c.frames.size(), 2u) << chunk;
+        EXPECT_EQ(c.frames[0].msgid, 4000u) << chunk;
+        EXPECT_FALSE(c.frames[0].checksum_verified) << chunk;
+        EXPECT_EQ(heartbeats(c), (std::vector<std::uint32_t>{3})) << chunk;
+        EXPECT_EQ(c.stats.incompat_rejected, 0u) << chunk;
+        EXPECT_EQ(c.stats.unknown_msgid, 1u) << chunk;
+    }
+}
+
+// An undeclared frame holding a start byte that reads as a declared message (a MAVLink 1 AUTOPILOT_VERSION,
+// 68 bytes) must wait until that candidate can be judged, or until a verified frame after it is complete (the
+// candidate can then no longer be complete first). So the frame after it is not held back on a quiet line.
+TEST(MavlinkParser, UndeclaredFrameWaitingForACandidateInsideItDoesNotHoldBackTheFrameAfterIt) {
+    Encoder e(1, 1);
+    const Bytes unknown =
+        unknown_frame(12345, {0x00, kMagicV1, 60, 0x00, 0x01, 0x01, AutopilotVersion::kId, 0x00});
+    const Bytes stream = concat({unknown, heartbeat_frame(e, 5)});
+    for (std::size_t chunk = 1; chunk <= stream.size(); ++chunk) {
+        Parser parser;
+        std::vector<Frame> frames;
+        auto sink = [&](const Frame& f) { frames.push_back(f); };
+        for (std::size_t i = 0; i < stream.size(); i += chunk) {
+            parser.push(std::span(stream).subspan(i, std::min(chunk, stream.size() - i)), sink);
+        }
+        ASSERT_EQ(frames.size(), 2u) << chunk;  // no finish(): the line is quiet
+        EXPECT_EQ(frames[0].msgid, 12345u) << chunk;
+        EXPECT_EQ(decode<Heartbeat>(frames[1])->custom_mode, 5u) << chunk;
+    }
+    // Followed by another undeclared frame only, it waits for the candidate (or the end of the stream).
+    Parser parser;
+    std::vector<Frame> frames;
+    auto sink = [&](const Frame& f) { frames.push_back(f); };
+    parser.push(concat({unknown, unknown_frame(4000, {9})}), sink);
+    EXPECT_TRUE(frames.empty());
+    parser.finish(sink);
+    ASSERT_EQ(frames.size(), 2u);
+    EXPECT_EQ(frames[0].msgid, 12345u);
+    EXPECT_EQ(frames[1].msgid, 4000u);
 }
 
 TEST(MavlinkParser, SequenceGapsCountLostFramesPerSender) {
