@@ -152,7 +152,11 @@ void Driver::on_heartbeat(const mav::Heartbeat& hb, TimePoint now) {
     last_heartbeat_ = now;
     quiet_since_ = now;
     system_status_ = hb.system_status;
-    const bool booting = hb.system_status == kMavStateUninit || hb.system_status == kMavStateBoot ||
+    // APM:Rover 2.x reports MAV_STATE_UNINIT in HOLD (send_heartbeat() of its GCS_Mavlink.pde): in a running
+    // mode UNINIT is that quirk, not a board starting up.
+    const bool uninit_booting =
+        hb.system_status == kMavStateUninit && hb.custom_mode != static_cast<std::uint32_t>(RoverMode::Hold);
+    const bool booting = uninit_booting || hb.system_status == kMavStateBoot ||
                          hb.system_status == kMavStateCalibrating ||
                          hb.custom_mode == static_cast<std::uint32_t>(RoverMode::Initialising);
     if (!link_up_) {

@@ -716,6 +716,19 @@ TEST(Driver, ABoardWithoutLoiterUnlimGetsStopsAsWaypointsAndIsHeldOnArrival) {
     EXPECT_EQ(rig.rover.mode(), testing::kHold) << "arrived at the Stop: held there";
 }
 
+TEST(Driver, HoldReportedAsUninitByA2xBoardIsNoReboot) {
+    FakeRover::Options o = apm2_rover();
+    o.uninit_in_hold = true;
+    Rig rig(apm2_config(), o);
+    rig.bring_up();
+    ASSERT_EQ(rig.wait_result(rig.driver.request_state(VehicleState::Parking, rig.now())).result,
+              RequestResult::Ok);
+    rig.harness.run_for(seconds(5));
+    EXPECT_TRUE(rig.all<AutopilotRebooted>().empty());
+    EXPECT_TRUE(rig.driver.ready());
+    EXPECT_EQ(rig.driver.status().state, VehicleState::Parking);
+}
+
 std::vector<MissionItem> plan_with_speeds() {
     auto items = plan(8);
     for (std::size_t i = 0; i < items.size(); ++i) {

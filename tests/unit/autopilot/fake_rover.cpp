@@ -67,6 +67,9 @@ void FakeRover::send_heartbeat(TimePoint now) {
     hb.base_mode = 1;
     hb.custom_mode = mode_;
     hb.system_status = now < boot_done_ ? kGcsMavStateCalibrating : kMavStateStandby;
+    if (options_.uninit_in_hold && mode_ == kHold && now >= boot_done_) {
+        hb.system_status = 0;  // APM:Rover 2.x's HOLD
+    }
     send(hb);
     mav::SystemTime st;
     st.time_boot_ms = time_boot_ms(now);

@@ -42,6 +42,7 @@ class FakeRover {
         bool restart_mission_on_auto = false;  // AUTO starts the mission at item 1 (APM:Rover 2.x)
         bool change_speed_command = true;      // knows MAV_CMD_DO_CHANGE_SPEED (else UNSUPPORTED)
         bool loiter_unlim = true;              // stores NAV_LOITER_UNLIM (else MAV_MISSION_UNSUPPORTED)
+        bool uninit_in_hold = false;           // heartbeats say MAV_STATE_UNINIT in HOLD (APM:Rover 2.x)
     };
 
     explicit FakeRover(Options options, TimePoint now);
