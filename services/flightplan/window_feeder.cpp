@@ -18,7 +18,17 @@ std::optional<std::string> FeederConfig::validate() const {
     return std::nullopt;
 }
 
-WindowFeeder::WindowFeeder(FeederConfig config) : config_(config), confirmed_(config.window + 2u) {}
+WindowFeeder::WindowFeeder(FeederConfig config)
+    : config_(config), confirmed_(config.window + 1u + kWrapSlots) {}
+
+std::vector<MissionItem> WindowFeeder::slot_items(std::uint16_t slot, const MissionItem& item) const {
+    if (slot != wrap_slot())
+        return {item};
+    MissionItem jump;
+    jump.kind = MissionItem::Kind::JumpTo;
+    jump.jump_slot = kFirstRingSlot;
+    return {item, item, jump, item};
+}
 
 MissionItem WindowFeeder::Entry::item() const {
     MissionItem m;
@@ -31,7 +41,14 @@ MissionItem WindowFeeder::Entry::item() const {
 }
 
 bool WindowFeeder::confirmed(const Entry& e) const {
-    return mission_ok_ && e.slot < confirmed_.size() && confirmed_[e.slot] == e.item();
+    if (!mission_ok_ || e.slot + kWrapSlots > confirmed_.size())
+        return false;
+    const auto want = slot_items(e.slot, e.item());
+    for (std::size_t i = 0; i < want.size(); ++i) {
+        if (confirmed_[e.slot + i] != want[i])
+            return false;
+    }
+    return true;
 }
 
 void WindowFeeder::emit(FeederEvent::Kind kind, const Waypoint* wp, std::uint32_t generation,
@@ -72,7 +89,7 @@ void WindowFeeder::replace_plan(PlanFeed feed, TimePoint now) {
         refill(now);
         check_done();
     } else {
-        start_fresh(queue_.empty() ? std::uint16_t{1} : ring_next(queue_[0].slot), now);
+        start_fresh(queue_.empty() ? kFirstRingSlot : ring_next(queue_[0].slot), now);
     }
 }
 
@@ -105,7 +122,7 @@ void WindowFeeder::restart(TimePoint now) {
     stream_ended_ = false;
     done_ = false;
     // The new head goes in a slot the vehicle is not heading for; SetCurrent then points it there.
-    start_fresh(queue_.empty() ? std::uint16_t{1} : ring_next(queue_[0].slot), now);
+    start_fresh(queue_.empty() ? kFirstRingSlot : ring_next(queue_[0].slot), now);
 }
 
 void WindowFeeder::start_fresh(std::uint16_t first_slot, TimePoint now) {
@@ -133,7 +150,7 @@ void WindowFeeder::continue_with(PlanFeed feed, TimePoint now) {
     }
     if (queue_.empty()) {
         // Parked on the Stop item: the continuation goes into the next slot, then set-current points there.
-        start_fresh(stop_slot ? ring_next(*stop_slot) : std::uint16_t{1}, now);
+        start_fresh(stop_slot ? ring_next(*stop_slot) : kFirstRingSlot, now);
         return;
     }
     refill(now);
@@ -335,8 +352,7 @@ void WindowFeeder::check_starvation() {
 // ---- autopilot inputs ----------------------------------------------------------------------------------
 
 void WindowFeeder::on_reached(std::uint16_t slot, TimePoint now) {
-    if (slot == jump_slot())
-        return;
+    slot = ring_position(slot);
     if (need_set_current_) {
         ++counters_.ignored_reached;  // the autopilot's target is not (yet) the window's head
         return;
@@ -359,8 +375,7 @@ void WindowFeeder::on_reached(std::uint16_t slot, TimePoint now) {
 void WindowFeeder::on_current(std::uint16_t slot, TimePoint now) {
     if (queue_.empty() || !mission_ok_)
         return;
-    if (slot == jump_slot())
-        slot = 1;
+    slot = ring_position(slot);
     if (need_set_current_) {
         ap_target_ = slot;
         return;
@@ -602,10 +617,11 @@ std::optional<FeederRequest> WindowFeeder::next_write(std::size_t from, std::siz
             continue;
         WriteItems w;
         w.first_slot = queue_[i].slot;
-        w.items.push_back(queue_[i].item());
+        w.items = slot_items(queue_[i].slot, queue_[i].item());
         for (std::size_t j = i + 1;
              j < queue_.size() && queue_[j].slot == queue_[j - 1].slot + 1 && writable(j); ++j) {
-            w.items.push_back(queue_[j].item());
+            for (const auto& m : slot_items(queue_[j].slot, queue_[j].item()))
+                w.items.push_back(m);
         }
         return issue(std::move(w), now);
     }
@@ -624,20 +640,18 @@ std::optional<FeederRequest> WindowFeeder::poll_request(TimePoint now) {
     if (queue_.empty() || now < retry_not_before_ || failed_)
         return std::nullopt;
     if (!mission_ok_) {
-        UploadMission up;
-        up.items.resize(config_.window);
-        for (std::uint16_t s = 1; s <= config_.window; ++s) {
-            // Slots the window does not use get a Stop at the last position: harmless if ever reached.
-            MissionItem filler = queue_.back().item();
-            filler.kind = MissionItem::Kind::Stop;
-            up.items[s - 1] = filler;
-        }
+        // Slots the window does not use (slot 1 among them) get a Stop at the last position: harmless if
+        // ever reached.
+        MissionItem filler = queue_.back().item();
+        filler.kind = MissionItem::Kind::Stop;
+        std::vector<MissionItem> at(wrap_slot() + 1u, filler);  // by ring position; [0] unused
         for (const auto& e : queue_)
-            up.items[e.slot - 1] = e.item();
-        MissionItem jump;
-        jump.kind = MissionItem::Kind::JumpTo;
-        jump.jump_slot = 1;
-        up.items.push_back(jump);
+            at[e.slot] = e.item();
+        UploadMission up;
+        for (std::uint16_t s = 1; s <= wrap_slot(); ++s) {
+            for (const auto& m : slot_items(s, at[s]))
+                up.items.push_back(m);
+        }
         return issue(std::move(up), now);
     }
     if (auto w = next_write(0, 2, now))

@@ -3,9 +3,14 @@
 // of its mission while the plan has more (the circular waypoint queue of APM:Rover navigation, made
 // robust). Sans-IO: no autopilot protocol, no clock, no thread.
 //
-// Mission layout (see docs/flight-plan.md): slot 0 home (the driver's), slots 1..K a ring of plan
-// waypoints, slot K+1 a JumpTo(1). The current target is the window's head; the ring holds the next K
-// entries in ring order. When the vehicle reaches slot s, slot s is rewritten with the entry K ahead, so the
+// Mission layout (see docs/flight-plan.md): slot 0 home (the driver's), slot 1 unused (a Stop), then a ring
+// of K positions: slots 2..K, and the wrap W = slots K+1..K+4, written together as [wp, wp, JumpTo(2), wp].
+// After slot K the vehicle drives to W's waypoint as slot K+1; K+2, at the same point, is passed at once and
+// the jump takes it on to slot 2. The layout works with both ways ArduPilot has run a DO_JUMP: when the
+// mission gets to it (AP_Mission), and as soon as the waypoint before it becomes the target (APM:Rover 2.x,
+// where the do-commands after a waypoint also need a waypoint after them to run at all). Reports of slots
+// K+2..K+4 count as K+1. The current target is the window's head; the ring holds the next K entries in ring
+// order. When the vehicle reaches slot s, slot s is rewritten with the entry K ahead, so the
 // successor of the current target, in mission order, is always the next plan waypoint. When the plan ends,
 // the slot after the last waypoint holds a Stop item at the last position, so the vehicle stays there.
 //
@@ -110,8 +115,19 @@ class WindowFeeder {
     };
     enum class Mode : std::uint8_t { Unknown, Auto, Hold, Manual };
 
-    std::uint16_t ring_next(std::uint16_t slot) const { return slot >= config_.window ? 1 : slot + 1; }
-    std::uint16_t jump_slot() const { return static_cast<std::uint16_t>(config_.window + 1); }
+    static constexpr std::uint16_t kFirstRingSlot = 2;
+    static constexpr std::uint16_t kWrapSlots = 4;
+    /// W, the last ring position: slots K+1..K+4.
+    std::uint16_t wrap_slot() const { return static_cast<std::uint16_t>(config_.window + 1); }
+    std::uint16_t ring_next(std::uint16_t slot) const {
+        return slot >= wrap_slot() ? kFirstRingSlot : slot + 1;
+    }
+    /// A slot the autopilot reports, as a ring position (the wrap's slots are W).
+    std::uint16_t ring_position(std::uint16_t slot) const {
+        return slot > wrap_slot() && slot < wrap_slot() + kWrapSlots ? wrap_slot() : slot;
+    }
+    /// What a ring position holds on board for `item`: the item, or at W the whole wrap.
+    std::vector<MissionItem> slot_items(std::uint16_t slot, const MissionItem& item) const;
     bool confirmed(const Entry& e) const;
     void start_fresh(std::uint16_t first_slot, TimePoint now);
     void restart(TimePoint now);
@@ -140,8 +156,8 @@ class WindowFeeder {
     std::string plan_name_;
     std::uint32_t generation_ = 0;
     bool stream_ended_ = false;
-    std::deque<Entry> queue_;       // queue_[0] is the current target
-    std::uint16_t fresh_slot_ = 1;  // slot of the first entry when the queue starts empty
+    std::deque<Entry> queue_;                    // queue_[0] is the current target
+    std::uint16_t fresh_slot_ = kFirstRingSlot;  // slot of the first entry when the queue starts empty
     bool done_ = false;
     bool cleared_ = false;
 

@@ -1,6 +1,7 @@
 #pragma once
 // A small simulated autopilot for WindowFeeder tests: mission slots (0 = home), a current target, reaches one
-// target per step while in auto, follows JumpTo items, parks on Stop items and falls into HOLD when it passes
+// target per step while in auto, follows JumpTo items, passes a waypoint at the point just reached at once,
+// parks on Stop items and falls into HOLD when it passes
 // the last slot (ArduPilot Rover behaviour at the end of a mission). Reboots lose the mission. Every mode
 // change is reported, with its cause, as the autopilot driver reports it (mode_changes()).
 #include <cstdint>
@@ -20,6 +21,9 @@ namespace airseg::flightplan::test {
 class SimAutopilot {
   public:
     SimAutopilot() { reboot(); }
+    /// APM:Rover 2.x: a DO_JUMP runs as soon as the waypoint before it becomes the target (and only if a
+    /// waypoint follows it), so that waypoint is skipped.
+    bool early_jumps = false;
 
     RequestResult apply(const FeederRequest& r) {
         if (const auto* up = std::get_if<UploadMission>(&r.op)) {
@@ -73,9 +77,19 @@ class SimAutopilot {
         visited_.push_back(item.position);
         const std::uint16_t reached = current_;
         std::size_t next = current_ + 1u;
-        for (int guard = 0;
-             next < slots_.size() && slots_[next].kind == MissionItem::Kind::JumpTo && guard < 8; ++guard) {
-            next = slots_[next].jump_slot;
+        if (early_jumps && next + 2u < slots_.size() && slots_[next + 1u].kind == MissionItem::Kind::JumpTo) {
+            next = slots_[next + 1u].jump_slot;  // the waypoint before the jump is skipped
+            ++early_jumps_taken_;
+        }
+        for (int guard = 0; !early_jumps && next < slots_.size() && guard < 8; ++guard) {
+            if (slots_[next].kind == MissionItem::Kind::JumpTo) {
+                next = slots_[next].jump_slot;
+            } else if (slots_[next].kind == MissionItem::Kind::Waypoint &&
+                       slots_[next].position == item.position) {
+                ++next;  // a waypoint where the vehicle already is: passed at once (inside its radius)
+            } else {
+                break;
+            }
         }
         if (next >= slots_.size()) {
             set_mode(VehicleMode::Hold, ModeCause::Board);  // mission complete: ArduPilot Rover goes HOLD
@@ -108,6 +122,7 @@ class SimAutopilot {
     int end_of_mission_holds() const { return end_of_mission_holds_; }
     int hold_requests() const { return hold_requests_; }
     int writes() const { return writes_; }
+    int early_jumps_taken() const { return early_jumps_taken_; }
 
   private:
     void set_mode(VehicleMode mode, ModeCause cause) {
@@ -132,6 +147,7 @@ class SimAutopilot {
     int end_of_mission_holds_ = 0;
     int hold_requests_ = 0;
     int writes_ = 0;
+    int early_jumps_taken_ = 0;
 };
 
 /// A lazily generated straight-line plan of n waypoints; selected indices can carry hold actions.

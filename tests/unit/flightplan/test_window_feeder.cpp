@@ -57,6 +57,24 @@ TEST(FlightplanFeeder, LongPlanReachedOnceInOrderWithoutStarvation) {
     EXPECT_EQ(h.count(FeederEvent::Kind::PlanDone), 1u);
 }
 
+TEST(FlightplanFeeder, TheRingWrapsOnBoardsThatRunADoJumpEarlyAsOnThoseThatRunItLate) {
+    for (const bool early : {false, true}) {
+        Harness h;
+        h.ap.early_jumps = early;
+        h.feeder.replace_plan(test::synthetic(300), h.now);
+        ASSERT_LT(h.run_until_done(1000), 1000) << "early " << early;
+        EXPECT_EQ(h.reached, iota(0, 300)) << "early " << early;
+        expect_visited(h, 41.0, 0, 300);
+        EXPECT_EQ(h.ap.visited().size(), 300u)
+            << "each waypoint driven once (the wrap's copies passed at once)";
+        EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
+        EXPECT_EQ(h.ap.hold_requests(), 0);
+        if (early) {
+            EXPECT_GT(h.ap.early_jumps_taken(), 50) << "the wrap's jump was run early, every lap";
+        }
+    }
+}
+
 TEST(FlightplanFeeder, MinimumWindowOfThreeKeepsUp) {
     FeederConfig c;
     c.window = 3;
