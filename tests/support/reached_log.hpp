@@ -24,7 +24,11 @@ struct Reached {
     E7 at;
 };
 
-/// The simulator's log of reached items numbered `from` on (it pages by 500).
+inline bool same_place(const E7& a, const E7& b);
+
+/// The simulator's log of reached items numbered `from` on (it pages by 500). A point reached again at once
+/// (within half a simulated second) is one arrival: the flight plan's mission wraps through two copies of
+/// one waypoint (docs/flight-plan.md, "Mission layout"), and a board reaches the second where it stands.
 inline std::vector<Reached> reached_log(ControlClient& sim, std::uint64_t from = 0) {
     std::vector<Reached> out;
     for (;;) {
@@ -33,16 +37,22 @@ inline std::vector<Reached> reached_log(ControlClient& sim, std::uint64_t from =
             return out;
         }
         EXPECT_LE(page.value("first_kept", 0ull), from) << "the simulator's reached log overflowed";
+        std::uint64_t last = from;
         for (const auto& r : page["reached"]) {
-            out.push_back(
-                {r["n"].get<std::uint64_t>(),
-                 r["t"].get<double>(),
-                 {std::llround(r["lat"].get<double>() * 1e7), std::llround(r["lon"].get<double>() * 1e7)}});
+            const Reached e{
+                r["n"].get<std::uint64_t>(),
+                r["t"].get<double>(),
+                {std::llround(r["lat"].get<double>() * 1e7), std::llround(r["lon"].get<double>() * 1e7)}};
+            last = e.n;
+            if (!out.empty() && same_place(out.back().at, e.at) && e.t - out.back().t < 0.5) {
+                continue;
+            }
+            out.push_back(e);
         }
         if (page["reached"].size() < 500) {
             return out;
         }
-        from = out.back().n + 1;
+        from = last + 1;
     }
 }
 

@@ -111,7 +111,14 @@ class AutopilotE2e : public ::testing::Test {
     std::unique_ptr<Subprocess> daemon_;
 };
 
-TEST_F(AutopilotE2e, ReadyStatusStateChangesAndParameters) {
+// The same cases against each firmware profile of the simulator (docs/simulators.md): today's ArduPilot Rover
+// and an APM:Rover 2.x board (MAVLink 1 only, SET_MODE never acknowledged, MAV_STATE_UNINIT in HOLD).
+class AutopilotFirmwareE2e : public AutopilotE2e, public ::testing::WithParamInterface<std::string> {
+  protected:
+    AutopilotFirmwareE2e() { extra_sim_args_ = {"--firmware", GetParam()}; }
+};
+
+TEST_P(AutopilotFirmwareE2e, ReadyStatusStateChangesAndParameters) {
     ASSERT_TRUE(wait_until([&] { return ready(); }, kGenerous, kPoll)) << daemon_->err();
     const auto ap = autopilot_section();
     EXPECT_EQ(ap["link"], "up");
@@ -177,7 +184,7 @@ TEST_F(AutopilotE2e, ReadyStatusStateChangesAndParameters) {
     EXPECT_NEAR(list.json["params"]["WP_RADIUS"].get<double>(), wanted, 1e-4);
 }
 
-TEST_F(AutopilotE2e, UnplugShowsTheLinkDownAndReplugRecoversWithoutARestart) {
+TEST_P(AutopilotFirmwareE2e, UnplugShowsTheLinkDownAndReplugRecoversWithoutARestart) {
     ASSERT_TRUE(wait_until([&] { return ready(); }, kGenerous, kPoll)) << daemon_->err();
     const auto reconnects = autopilot_section()["reconnects"].get<unsigned>();
 
@@ -212,6 +219,9 @@ TEST_F(AutopilotBaudProbeE2e, ProbesTheConfiguredRatesAndKeepsTheOneThatWorks) {
     EXPECT_NE(daemon_->err().find("trying 115200 baud"), std::string::npos) << daemon_->err();
     EXPECT_EQ(ap["reconnects"], 0) << "a baud switch is not a reconnect";
 }
+
+INSTANTIATE_TEST_SUITE_P(Firmware, AutopilotFirmwareE2e, ::testing::Values("modern", "rover2"),
+                         [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
 
 }  // namespace
 }  // namespace airseg::test
