@@ -22,13 +22,22 @@ struct Reached {
     std::uint64_t n = 0;  ///< the simulator's event number
     double t = 0;         ///< simulated seconds
     E7 at;
+    std::uint16_t seq = 0;  ///< the mission slot
 };
 
-inline bool same_place(const E7& a, const E7& b);
+/// The flight plan's mission wraps through slot window+2, a point on the way from the last ring position to
+/// the first (docs/flight-plan.md, "Mission layout"): a board drives through it, and its arrival there is no
+/// plan waypoint.
+/// flightplan.window in config/airseg.yaml, which the system suite runs with.
+inline constexpr int kDefaultWindow = 5;
 
-/// The simulator's log of reached items numbered `from` on (it pages by 500). A point reached again at once
-/// (within half a simulated second) is one arrival: the flight plan's mission wraps through two copies of
-/// one waypoint (docs/flight-plan.md, "Mission layout"), and a board reaches the second where it stands.
+inline std::vector<Reached> plan_waypoints_of(std::vector<Reached> log, int window) {
+    const auto pass_through = static_cast<std::uint16_t>(window + 2);
+    std::erase_if(log, [&](const Reached& r) { return r.seq == pass_through; });
+    return log;
+}
+
+/// The simulator's log of reached items numbered `from` on (it pages by 500).
 inline std::vector<Reached> reached_log(ControlClient& sim, std::uint64_t from = 0) {
     std::vector<Reached> out;
     for (;;) {
@@ -37,22 +46,17 @@ inline std::vector<Reached> reached_log(ControlClient& sim, std::uint64_t from =
             return out;
         }
         EXPECT_LE(page.value("first_kept", 0ull), from) << "the simulator's reached log overflowed";
-        std::uint64_t last = from;
         for (const auto& r : page["reached"]) {
-            const Reached e{
-                r["n"].get<std::uint64_t>(),
-                r["t"].get<double>(),
-                {std::llround(r["lat"].get<double>() * 1e7), std::llround(r["lon"].get<double>() * 1e7)}};
-            last = e.n;
-            if (!out.empty() && same_place(out.back().at, e.at) && e.t - out.back().t < 0.5) {
-                continue;
-            }
-            out.push_back(e);
+            out.push_back(
+                {r["n"].get<std::uint64_t>(),
+                 r["t"].get<double>(),
+                 {std::llround(r["lat"].get<double>() * 1e7), std::llround(r["lon"].get<double>() * 1e7)},
+                 static_cast<std::uint16_t>(r.value("seq", 0))});
         }
         if (page["reached"].size() < 500) {
             return out;
         }
-        from = last + 1;
+        from = out.back().n + 1;
     }
 }
 

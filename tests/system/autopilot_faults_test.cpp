@@ -46,10 +46,12 @@ class SystemPlan : public ::testing::Test {
     /// `whole_log`: every reached event since the plan was loaded is checked (else the caller checked).
     void end_checks(const std::vector<E7>& expected, bool whole_log = true) {
         ASSERT_TRUE(wait_until([&] { return plan_done(); }, kGenerous, kPoll))
-            << plan_section(*bench).dump() << bench->logs();
+            << plan_section(*bench).dump() << bench->sim().json("state").dump()
+            << bench->sim().json("reached 0 100").dump() << bench->logs();
         EXPECT_EQ(plan_section(*bench).value("waypoints_reached", 0u), expected.size());
         if (whole_log) {
-            expect_reached_in_order(reached_log(bench->sim(), first_reached), expected);
+            expect_reached_in_order(
+                plan_waypoints_of(reached_log(bench->sim(), first_reached), kDefaultWindow), expected);
             if (HasFailure()) {
                 std::cout << bench->logs();
             }
@@ -96,7 +98,7 @@ TEST_F(SystemPlan, AutopilotUnpluggedAndReplugedMidPlan) {
             booted = m["t"].get<double>();
         }
     }
-    const auto log = reached_log(bench->sim(), first_reached);
+    const auto log = plan_waypoints_of(reached_log(bench->sim(), first_reached), kDefaultWindow);
     std::size_t unseen = 0;
     for (const auto& r : log) {
         unseen += r.t >= unplugged_t && r.t <= booted ? 1 : 0;
@@ -153,7 +155,7 @@ TEST_F(SystemPlan, AutopilotHeartbeatStall) {
     // waypoint it had seen unreached: 7 waypoints driven twice here). KNOWN LIMITATION (docs/reliability.md):
     // while the heartbeats are missing the daemon sends the board nothing, so a board that runs through its
     // window follows the ring's jump into slots not yet rewritten and drives those waypoints again (2 here).
-    const auto log = reached_log(bench->sim(), first_reached);
+    const auto log = plan_waypoints_of(reached_log(bench->sim(), first_reached), kDefaultWindow);
     const auto replays = expect_no_skip(log, expected);
     EXPECT_LT(replays, 5u) << "at most the stale ring slots, never a rewind: " << as_indices(log, expected);
     const auto stats = bench->sim().json("stats");
@@ -188,7 +190,8 @@ TEST_F(SystemPlan, DaemonKilledMidPlanResumesAtTheFirstUnreachedWaypoint) {
     commands_at_start = ground_commands(*bench);  // a new daemon counts from 0
     radio_commands(1);
     ASSERT_TRUE(wait_until([&] { return plan_done(); }, kGenerous, kPoll))
-        << plan_section(*bench).dump() << bench->logs();
+        << plan_section(*bench).dump() << bench->sim().json("state").dump()
+        << bench->sim().json("reached 0 100").dump() << bench->logs();
 
     // After the board's last boot: the first waypoint reached is the first the daemon had not seen reached.
     double booted = 0;
@@ -198,14 +201,14 @@ TEST_F(SystemPlan, DaemonKilledMidPlanResumesAtTheFirstUnreachedWaypoint) {
         }
     }
     std::vector<Reached> after;
-    for (const auto& r : reached_log(bench->sim(), first_reached)) {
+    for (const auto& r : plan_waypoints_of(reached_log(bench->sim(), first_reached), kDefaultWindow)) {
         if (r.t > booted) {
             after.push_back(r);
         }
     }
     expect_reached_in_order(after, expected, saved_next);
     // The board drove on alone between the kill and the reopen: those waypoints are driven again after it.
-    const auto whole = reached_log(bench->sim(), first_reached);
+    const auto whole = plan_waypoints_of(reached_log(bench->sim(), first_reached), kDefaultWindow);
     const auto replays = expect_no_skip(whole, expected);
     end_checks(expected, false);
     std::cout << "[ figures ] SIGKILL mid-plan at next_index " << saved_next << ": ready " << ready_s
@@ -247,10 +250,12 @@ TEST_F(SystemPlan, InvalidPlanRejectedNamingWhatAndWhereAndAValidOneReplacesTheR
     ASSERT_EQ(replaced.exit_code, 0) << replaced.out << replaced.err << bench->logs();
     ++tally.answered;
     EXPECT_EQ(Json::parse(replaced.out, nullptr, false).value("name", ""), "route-b");
-    ASSERT_TRUE(wait_until([&] { return plan_done(); }, kGenerous, kPoll)) << plan_section(*bench).dump();
+    ASSERT_TRUE(wait_until([&] { return plan_done(); }, kGenerous, kPoll))
+        << plan_section(*bench).dump() << bench->sim().json("state").dump()
+        << bench->sim().json("reached 0 100").dump() << bench->logs();
 
     // On the board: A from its start without a gap, at most the target it was heading for, then all of B.
-    const auto log = reached_log(bench->sim(), first_reached);
+    const auto log = plan_waypoints_of(reached_log(bench->sim(), first_reached), kDefaultWindow);
     std::size_t i = 0;
     while (i < log.size() && i < a.size() && same_place(log[i].at, a[i])) {
         ++i;

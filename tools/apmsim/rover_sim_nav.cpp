@@ -225,7 +225,15 @@ void RoverSim::on_target_reached(double distance, bool passed, TimePoint now) {
         load_item(static_cast<std::uint16_t>(store_.count()), now);  // RTL ends the mission
         return;
     }
+    const GeoPoint here = target_.value_or(GeoPoint{});
     load_item(static_cast<std::uint16_t>(seq + 1), now);
+    // The next item at the very point just reached is a leg of no length: ArduPilot takes it as passed at
+    // once (Location::line_path_proportion() gives the end of the line for two points closer than a
+    // millimetre), it does not turn round to drive back into WP_RADIUS.
+    if (target_ && mode_ == RoverMode::Auto && !loitering_ && distance_m(here, *target_) < 0.001 &&
+        current_seq_ != seq) {
+        on_target_reached(distance, true, now);
+    }
 }
 
 bool RoverSim::set_current(std::uint16_t seq, TimePoint now) {

@@ -672,15 +672,25 @@ void Driver::send_mode(std::uint32_t mode) {
         m.base_mode = kModeFlagCustomModeEnabled;
         m.custom_mode = mode;
         out_.send(m);
-        return;
+    } else {
+        mav::CommandLong m;
+        m.target_system = config_.target_sysid;
+        m.target_component = config_.target_compid;
+        m.command = kCmdDoSetMode;
+        m.param1 = kModeFlagCustomModeEnabled;
+        m.param2 = static_cast<float>(mode);
+        out_.send(m);
     }
-    mav::CommandLong m;
-    m.target_system = config_.target_sysid;
-    m.target_component = config_.target_compid;
-    m.command = kCmdDoSetMode;
-    m.param1 = kModeFlagCustomModeEnabled;
-    m.param2 = static_cast<float>(mode);
-    out_.send(m);
+    if (mode == static_cast<std::uint32_t>(RoverMode::Auto) && auto_check_.expected()) {
+        // Right behind the mode change, the slot the board is at: a board that restarts its mission on entering
+        // AUTO (APM:Rover 2.x) takes it in AUTO and drives on from there instead of heading for item 1 until
+        // the AutoEntryCheck sees the restart; to one that does not it is the slot it is already at.
+        mav::MissionSetCurrent c;
+        c.target_system = config_.target_sysid;
+        c.target_component = config_.target_compid;
+        c.seq = *auto_check_.expected();
+        out_.send(c);
+    }
 }
 
 void Driver::finish_mode(RequestResult r, std::string detail, TimePoint now) {
