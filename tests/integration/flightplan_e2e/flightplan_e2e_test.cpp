@@ -214,7 +214,7 @@ class FlightplanE2e : public ::testing::TestWithParam<std::string> {
     }
     double sim_time() { return control_->json("state").value("t", 0.0); }
     /// The board's reached log from event `from` on, without the wrap's pass-through point.
-    std::vector<Reached> board_log(std::uint64_t from) { return plan_waypoints_of(board_log(from), window_); }
+    std::vector<Reached> board_log(std::uint64_t from) { return plan_waypoints_of(reached_log(*control_, from), window_); }
     /// Where a finished plan leaves the vehicle: on NAV_LOITER_UNLIM in AUTO, or (a 2.x board, which has no
     /// such command) held by the daemon at the last waypoint.
     std::string mode_after_the_end() const { return GetParam() == "rover2" ? "HOLD" : "AUTO"; }
