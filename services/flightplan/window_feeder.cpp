@@ -129,6 +129,7 @@ void WindowFeeder::start_fresh(std::uint16_t first_slot, TimePoint now) {
     queue_.clear();
     fresh_slot_ = first_slot;
     need_set_current_ = true;
+    repoint_only_ = false;
     refill(now);
     announce_head();
     check_done();
@@ -337,6 +338,7 @@ void WindowFeeder::check_starvation() {
             // HOLD for that: once the write lands, set-current retargets it (reached reports until then say
             // nothing about the plan). Should the write fail, the vehicle is held (request_failed).
             need_set_current_ = true;
+            repoint_only_ = false;
             ++counters_.retargets;
             return;
         }
@@ -344,6 +346,7 @@ void WindowFeeder::check_starvation() {
         // write, then point it at the head again; reached reports until then say nothing about the plan.
         starving_ = true;
         need_set_current_ = true;
+        repoint_only_ = false;
         ++counters_.starvation_holds;
         emit(FeederEvent::Kind::WindowStarved, &queue_[0].wp, queue_[0].generation, queue_[0].element_path);
     }
@@ -353,7 +356,7 @@ void WindowFeeder::check_starvation() {
 
 void WindowFeeder::on_reached(std::uint16_t slot, TimePoint now) {
     slot = ring_position(slot);
-    if (need_set_current_) {
+    if (need_set_current_ && !repoint_only_) {
         ++counters_.ignored_reached;  // the autopilot's target is not (yet) the window's head
         return;
     }
@@ -401,6 +404,7 @@ void WindowFeeder::on_current(std::uint16_t slot, TimePoint now) {
     if (++current_mismatches_ >= 2) {
         ap_target_ = slot;
         need_set_current_ = true;
+        repoint_only_ = false;
         current_mismatches_ = 0;
     }
 }
@@ -473,7 +477,9 @@ void WindowFeeder::on_mode(VehicleMode mode, ModeCause cause, TimePoint) {
     }
     // The board's own HOLD: it ran out of items, took a DO_JUMP its own way, or a switch or failsafe held
     // it. What it now heads for is unknown: point it at the head again, then AUTO.
+    // Its reached reports still count meanwhile: every slot holds what it held (only the target may differ).
     need_set_current_ = true;
+    repoint_only_ = true;
     ap_target_.reset();
     interrupt(
         "the autopilot left AUTO for HOLD by itself (end of its mission, a failsafe or a mode switch); "
@@ -488,6 +494,7 @@ void WindowFeeder::on_autopilot_rebooted(TimePoint) {
     mode_ = Mode::Unknown;
     outstanding_.reset();
     need_set_current_ = true;
+    repoint_only_ = false;
     starving_ = false;
     if (!config_.resume_after_reboot && !queue_.empty() && !done_)
         paused_ = true;
@@ -546,6 +553,7 @@ void WindowFeeder::request_succeeded(const FeederRequest& request) {
             confirmed_[i + 1] = up->items[i];
         mission_ok_ = true;
         need_set_current_ = true;
+        repoint_only_ = false;
         ap_target_.reset();
     } else if (const auto* wr = std::get_if<WriteItems>(&request.op)) {
         for (std::size_t i = 0; i < wr->items.size(); ++i) {
@@ -555,8 +563,10 @@ void WindowFeeder::request_succeeded(const FeederRequest& request) {
         }
     } else if (const auto* sc = std::get_if<SetCurrent>(&request.op)) {
         ap_target_ = sc->slot;
-        if (!queue_.empty() && queue_[0].slot == sc->slot)
+        if (!queue_.empty() && queue_[0].slot == sc->slot) {
             need_set_current_ = false;
+            repoint_only_ = false;
+        }
         current_mismatches_ = 0;
     } else if (std::holds_alternative<HoldVehicle>(request.op)) {
         mode_ = Mode::Hold;

@@ -166,6 +166,7 @@ class WindowFeeder {
     std::vector<std::optional<MissionItem>> confirmed_;  // by slot, 0..K+1
     std::optional<std::uint16_t> ap_target_;             // the slot the autopilot is believed to head for
     bool need_set_current_ = false;
+    bool repoint_only_ = false;  // set-current due after the board's own HOLD: its reports still count
     Mode mode_ = Mode::Unknown;
     std::uint32_t current_mismatches_ = 0;
 

@@ -272,6 +272,25 @@ TEST(FlightplanFeeder, TheBoardsOwnHoldMidPlanIsUndoneAndThePlanGoesOnInOrder) {
     EXPECT_EQ(h.feeder.progress().interruptions, 1u);
 }
 
+TEST(FlightplanFeeder, AReachedReportThatCrossesTheBoardsOwnHoldStillCounts) {
+    Harness h;
+    h.feeder.replace_plan(test::synthetic(40), h.now);
+    for (int i = 0; i < 10; ++i)
+        h.step();
+    // The vehicle reaches its target and the board holds by itself; the reached report arrives after the
+    // mode change.
+    const auto reached = h.ap.step();
+    ASSERT_TRUE(reached.has_value());
+    h.ap.board_holds();
+    h.report_modes();
+    h.feeder.on_reached(*reached, h.now);
+    h.drain();
+    ASSERT_LT(h.run_until_done(200), 200);
+    EXPECT_EQ(h.reached, iota(0, 40));
+    expect_visited(h, 41.0, 0, 40);
+    EXPECT_EQ(h.ap.visited().size(), 40u) << "the waypoint reached before the HOLD is not driven again";
+}
+
 TEST(FlightplanFeeder, TheRcPilotTakingTheVehicleInterruptsThePlanUntilResume) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(60), h.now);
