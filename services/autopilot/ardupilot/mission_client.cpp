@@ -233,12 +233,12 @@ std::uint32_t MissionClient::enqueue(WorkItem w, TimePoint now) {
 }
 
 void MissionClient::reject(MissionOperation op, std::uint32_t id, MissionResult r, std::string detail) {
-    done_.push_back(MissionCompletion{id, op, r, std::move(detail), {}});
+    done_.push_back(MissionCompletion{id, op, r, std::move(detail), {}, {}});
 }
 
 void MissionClient::cancel_all(const std::string& why) {
     for (auto& w : work_) {
-        done_.push_back(MissionCompletion{w.id, w.op, MissionResult::Cancelled, why, {}});
+        done_.push_back(MissionCompletion{w.id, w.op, MissionResult::Cancelled, why, {}, {}});
     }
     work_.clear();
 }
