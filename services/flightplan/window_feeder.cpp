@@ -475,12 +475,19 @@ void WindowFeeder::on_mode(VehicleMode mode, ModeCause cause, TimePoint) {
         interrupt("the RC pilot took the vehicle (MANUAL); plan resume continues", true);
         return;
     }
-    // The board's own HOLD: it ran out of items, took a DO_JUMP its own way, or a switch or failsafe held
-    // it. What it now heads for is unknown: point it at the head again, then AUTO.
-    // Its reached reports still count meanwhile: every slot holds what it held (only the target may differ).
-    need_set_current_ = true;
-    repoint_only_ = true;
-    ap_target_.reset();
+    // The board's own HOLD: a failsafe, a mode switch, a DO_JUMP taken its own way, or the end of its
+    // mission. Every slot still holds what it held. If the board's target is the head (or the one after it,
+    // whose reached report may still be on its way) AUTO is all it needs: the board goes on from its own
+    // target (a board that restarts its mission on entering AUTO is set back by the driver). Otherwise it is
+    // pointed at the head first; its reached reports still count meanwhile.
+    const bool on_window =
+        ap_target_ && !queue_.empty() &&
+        (*ap_target_ == queue_[0].slot || (queue_.size() > 1 && *ap_target_ == queue_[1].slot));
+    if (!on_window) {
+        need_set_current_ = true;
+        repoint_only_ = true;
+        ap_target_.reset();
+    }
     interrupt(
         "the autopilot left AUTO for HOLD by itself (end of its mission, a failsafe or a mode switch); "
         "continuing at the next waypoint",

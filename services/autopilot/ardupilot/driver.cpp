@@ -580,6 +580,7 @@ std::uint32_t Driver::set_current(std::uint16_t slot, TimePoint now) {
     }
     const std::uint32_t id = next_id_++;
     auto_check_.retarget(slot);
+    current_reached_ = false;  // pointed there on purpose
     mission_ops_[missions_.set_current(slot, now)] = {id, RequestKind::SetCurrent, {}, slot};
     drain_clients(now);
     return id;
@@ -659,7 +660,7 @@ std::uint32_t Driver::request_state(VehicleState target, TimePoint now) {
     }
     mode_request_ = ModeRequest{id, target, mode, 0, now + config_.mode_timeout};
     if (target == VehicleState::WaypointNavigation) {
-        auto_check_.arm(reported_current_, now);
+        auto_check_.arm(board_slot(), now);
     }
     send_mode(mode);
     return id;
@@ -682,9 +683,9 @@ void Driver::send_mode(std::uint32_t mode) {
         out_.send(m);
     }
     if (mode == static_cast<std::uint32_t>(RoverMode::Auto) && auto_check_.expected()) {
-        // Right behind the mode change, the slot the board is at: a board that restarts its mission on entering
-        // AUTO (APM:Rover 2.x) takes it in AUTO and drives on from there instead of heading for item 1 until
-        // the AutoEntryCheck sees the restart; to one that does not it is the slot it is already at.
+        // Right behind the mode change, the slot the board is at: a board that restarts its mission on
+        // entering AUTO (APM:Rover 2.x) takes it in AUTO and drives on from there instead of heading for item
+        // 1 until the AutoEntryCheck sees the restart; to one that does not it is the slot it is already at.
         mav::MissionSetCurrent c;
         c.target_system = config_.target_sysid;
         c.target_component = config_.target_compid;

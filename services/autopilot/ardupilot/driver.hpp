@@ -179,6 +179,7 @@ class Driver {
     void tap_incoming(const mavlink::Frame& f);
     void on_mission_current(std::uint16_t seq, TimePoint now);
     void report_current(std::uint16_t seq);
+    std::uint16_t board_slot() const;
 
     // driver_speed.cpp: the speed of the leg being driven
     void update_speed(TimePoint now);
@@ -228,6 +229,7 @@ class Driver {
     Telemetry telemetry_;
     std::optional<std::pair<std::uint16_t, TimePoint>> last_reached_;
     std::uint16_t reported_current_ = 0;  // the mission slot last reported (MissionCurrentChanged)
+    bool current_reached_ = false;        // the board reported reported_current_ reached since
     AutoEntryCheck auto_check_;
     bool stop_as_waypoint_ = false;            // the board lacks NAV_LOITER_UNLIM: Stop items go as waypoints
     std::optional<TimePoint> stop_hold_sent_;  // HOLD sent on reaching such a Stop, until the board holds

@@ -193,7 +193,7 @@ void Driver::on_heartbeat(const mav::Heartbeat& hb, TimePoint now) {
     if (hb.custom_mode == static_cast<std::uint32_t>(RoverMode::Auto)) {
         if (mode_changed) {
             if (!auto_check_.active()) {
-                auto_check_.arm(reported_current_, now);  // entered AUTO without our asking
+                auto_check_.arm(board_slot(), now);  // entered AUTO without our asking
             }
             auto_check_.on_auto(now);
             update_speed(now);
@@ -232,9 +232,28 @@ void Driver::hold_at_stop(std::uint16_t slot, TimePoint now) {
     stop_hold_sent_ = now;
 }
 
+// The slot the board heads for: its last MISSION_CURRENT, or, when it has since reported that slot reached
+// (its MISSION_CURRENT may come only with the telemetry stream, as on APM:Rover 2.x), the next place in the
+// mission after it, jumps followed.
+std::uint16_t Driver::board_slot() const {
+    if (!current_reached_) {
+        return reported_current_;
+    }
+    std::size_t slot = reported_current_ + 1u;
+    for (std::size_t hops = 0; slot >= 1 && slot <= mission_.size() && hops <= mission_.size(); ++hops) {
+        const MissionItem& item = mission_[slot - 1];
+        if (item.kind != MissionItem::Kind::JumpTo) {
+            return static_cast<std::uint16_t>(slot);
+        }
+        slot = item.jump_slot;
+    }
+    return reported_current_;
+}
+
 void Driver::report_current(std::uint16_t seq) {
     if (seq != reported_current_) {
         reported_current_ = seq;
+        current_reached_ = false;
         emit(MissionCurrentChanged{seq});
     }
 }
@@ -297,6 +316,7 @@ void Driver::on_reached(std::uint16_t seq, TimePoint now) {
     }
     last_reached_ = std::pair{seq, now};
     auto_check_.on_reached(seq);
+    current_reached_ = seq == reported_current_;
     hold_at_stop(seq, now);
     emit(WaypointReached{seq});
 }

@@ -635,7 +635,10 @@ TEST_P(FlightplanE2e, TheBoardFallingIntoHoldMidPlanIsSeenSaidAndUndoneWithinFiv
     const auto reached = board_log(first);
     ASSERT_GE(reached.size(), expected.size());
     for (std::size_t i = 0; i < expected.size(); ++i) {
-        ASSERT_PRED2(same_place, reached[i].at, expected[i]) << "reached #" << i << " is not waypoint " << i;
+        ASSERT_PRED2(same_place, reached[i].at, expected[i])
+            << "reached #" << i << " is not waypoint " << i << "\n"
+            << control_->json("modes").dump() << "\n"
+            << daemon_->err();
     }
 }
 
