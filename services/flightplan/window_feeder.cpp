@@ -41,7 +41,7 @@ MissionItem WindowFeeder::Entry::item() const {
 }
 
 bool WindowFeeder::confirmed(const Entry& e) const {
-    if (!mission_ok_ || e.slot + kWrapSlots > confirmed_.size())
+    if (!mission_ok_ || static_cast<std::size_t>(e.slot) + kWrapSlots > confirmed_.size())
         return false;
     const auto want = slot_items(e.slot, e.item());
     for (std::size_t i = 0; i < want.size(); ++i) {
@@ -332,7 +332,7 @@ void WindowFeeder::check_starvation() {
     if (!confirmed(queue_[0])) {
         const auto* in_flight = outstanding_ ? std::get_if<WriteItems>(&outstanding_->request.op) : nullptr;
         if (in_flight && mode_ == Mode::Auto && in_flight->first_slot <= queue_[0].slot &&
-            queue_[0].slot < in_flight->first_slot + in_flight->items.size()) {
+            static_cast<std::size_t>(queue_[0].slot) < in_flight->first_slot + in_flight->items.size()) {
             // The vehicle reached its target while the write of the slot after it was on its way (a plan
             // replaced near the end of a leg): it heads for that slot's old content for one round trip. No
             // HOLD for that: once the write lands, set-current retargets it (reached reports until then say

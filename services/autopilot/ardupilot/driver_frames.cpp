@@ -224,7 +224,7 @@ void Driver::on_mission_current(std::uint16_t seq, TimePoint now) {
 // vehicle where the Stop is, as NAV_LOITER_UNLIM would have. The change is the driver's own (External for
 // the flight plan manager, whose plan has ended there).
 void Driver::hold_at_stop(std::uint16_t slot, TimePoint now) {
-    if (!stop_as_waypoint_ || slot < 1 || slot > mission_.size() ||
+    if (!stop_as_waypoint_ || slot < 1 || static_cast<std::size_t>(slot) > mission_.size() ||
         mission_[slot - 1].kind != MissionItem::Kind::Stop || state_ != VehicleState::WaypointNavigation) {
         return;
     }

@@ -38,7 +38,7 @@ void Driver::update_speed(TimePoint now) {
         return;  // a restarted mission is set back first: its slot is not the leg being driven
     }
     const std::uint16_t slot = reported_current_;
-    if (slot < 1 || slot > mission_.size()) {
+    if (slot < 1 || static_cast<std::size_t>(slot) > mission_.size()) {
         return;
     }
     const MissionItem& item = mission_[slot - 1];
