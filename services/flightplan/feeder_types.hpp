@@ -121,8 +121,8 @@ struct FeederProgress {
     StreamOrigin resume_origin;
     std::optional<std::uint64_t> resume_index;
     // Health counters.
-    std::string interruption;  // the last interruption (kept after the plan continued), "" if none
-    std::string failure;       // why the plan failed, "" unless state is Failed
+    std::string interruption{};  // the last interruption (kept after the plan continued), "" if none
+    std::string failure{};       // why the plan failed, "" unless state is Failed
     std::uint64_t interruptions = 0;
     std::uint64_t starvation_holds = 0;
     std::uint64_t retargets = 0;  // the vehicle reached its target while the next slot's write was in flight

@@ -67,7 +67,7 @@ struct MissionCompletion {
     MissionResult result = MissionResult::Success;
     std::string detail;
     std::vector<mavlink::MissionItemInt> items;  // Download: the whole mission, slot 0 (home) first
-    std::optional<std::uint8_t> refusal;         // Denied / NoSpace: the MAV_MISSION_RESULT the board sent
+    std::optional<std::uint8_t> refusal{};       // Denied / NoSpace: the MAV_MISSION_RESULT the board sent
 };
 
 struct MissionClientStats {

@@ -38,7 +38,7 @@ class FakeRover {
         std::size_t params = 40;
         std::size_t max_items = 400;
         /// Frames a position item may have; others get MAV_MISSION_UNSUPPORTED_FRAME (empty: any).
-        std::set<std::uint8_t> accepted_frames;
+        std::set<std::uint8_t> accepted_frames{};
         bool restart_mission_on_auto = false;  // AUTO starts the mission at item 1 (APM:Rover 2.x)
         bool change_speed_command = true;      // knows MAV_CMD_DO_CHANGE_SPEED (else UNSUPPORTED)
         bool loiter_unlim = true;              // stores NAV_LOITER_UNLIM (else MAV_MISSION_UNSUPPORTED)
