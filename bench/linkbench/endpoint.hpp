@@ -36,6 +36,8 @@ class BenchEndpoint {
 
     /// False when the protocol refuses the message for now (queue full); the workload retries later.
     virtual bool send_safe(std::span<const std::uint8_t> msg, TimePoint now) = 0;
+    /// A Safe message on the protocol's most urgent channel (commands and their answers).
+    virtual bool send_urgent(std::span<const std::uint8_t> msg, TimePoint now) = 0;
     /// `stream` tells independent Fast streams apart (a topic, where the protocol has them).
     virtual void send_fast(std::uint16_t stream, std::span<const std::uint8_t> msg, TimePoint now) = 0;
     virtual void handle_bytes(std::size_t path, std::span<const std::uint8_t> bytes, TimePoint now) = 0;

@@ -24,7 +24,12 @@ transport, over the same simulated radio pairs (half duplex, air rate = serial r
 Scenarios, for 57600 and 115200 baud, single pair and dual pair (split: each end transmits on its own pair):
   clean            run 1: bulk Safe A->B alone (1024-byte messages, 24 kept offered): goodput, stall;
                    run 2: the same bulk plus Fast A->B, 32 bytes at 10 Hz: Fast latency and delivery
+                   run 3: commands A->B (24 bytes, urgent channel) answered B->A with 1536 bytes (a
+                   status answer) while B pushes telemetry (48 B at 2 Hz, 37 B at 1 Hz), one at a time
+                   with 0.5 s between: command round trip p50 and p90
   corrupt=1e-5..3  the same with that probability of a corrupted byte, both directions
+  loss=N%          the same with N % of bytes lost independently (0.5, 1, 2, 5), both directions
+  ber=X            the same with bit error rate X (1e-5, 3e-5, 1e-4), both directions
   frameloss=N%     the same with N % of air packets lost, both directions
   outage=30s       the same with a 30 s outage of both directions starting at 20 s (90 s run)
   bidir            bulk Safe both ways (dual/single ratio of this row is a target)
@@ -59,6 +64,19 @@ std::vector<Scenario> scenarios(const Knobs& k) {
                 Scenario s = base;
                 s.impairment = label;
                 s.byte_corruption = p;
+                list.push_back(s);
+            }
+            for (auto [label, p] : {std::pair{"loss=0.5%", 0.005}, {"loss=1%", 0.01}, {"loss=2%", 0.02},
+                                    {"loss=5%", 0.05}}) {
+                Scenario s = base;
+                s.impairment = label;
+                s.byte_loss = p;
+                list.push_back(s);
+            }
+            for (auto [label, p] : {std::pair{"ber=1e-5", 1e-5}, {"ber=3e-5", 3e-5}, {"ber=1e-4", 1e-4}}) {
+                Scenario s = base;
+                s.impairment = label;
+                s.bit_error_rate = p;
                 list.push_back(s);
             }
             for (auto [label, p] :

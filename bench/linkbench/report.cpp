@@ -54,7 +54,8 @@ void print_table(std::ostream& os, const std::vector<Row>& rows) {
     os << "figures are ours / seed; goodput = intact Safe payload as % of one line's rate (baud/10 B/s)\n";
     os << std::left << std::setw(7) << "baud" << std::setw(8) << "mode" << std::setw(15) << "impairment"
        << std::right << std::setw(17) << "goodput %" << std::setw(19) << "fast p50 ms" << std::setw(19)
-       << "fast p99 ms" << std::setw(17) << "fast deliv %" << std::setw(15) << "max stall s" << '\n';
+       << "fast p99 ms" << std::setw(17) << "fast deliv %" << std::setw(15) << "max stall s" << std::setw(17)
+       << "cmd p50 s" << std::setw(17) << "cmd p90 s" << '\n';
     for (const Row& r : rows) {
         os << std::left << std::setw(7) << r.scenario.baud << std::setw(8) << to_string(r.scenario.mode)
            << std::setw(15) << r.scenario.impairment << std::right << std::setw(17)
@@ -62,7 +63,9 @@ void print_table(std::ostream& os, const std::vector<Row>& rows) {
            << pair(r, &ScenarioResult::fast_p50_ms, 0) << std::setw(19)
            << pair(r, &ScenarioResult::fast_p99_ms, 0) << std::setw(17)
            << pair(r, &ScenarioResult::fast_delivery_pct, 0) << std::setw(15)
-           << pair(r, &ScenarioResult::max_stall_s, 1) << '\n';
+           << pair(r, &ScenarioResult::max_stall_s, 1) << std::setw(17)
+           << pair(r, &ScenarioResult::cmd_p50_s, 2) << std::setw(17) << pair(r, &ScenarioResult::cmd_p90_s, 2)
+           << '\n';
     }
 }
 
@@ -115,6 +118,18 @@ std::vector<TargetCheck> check_targets(const std::vector<Row>& rows) {
                 "30 % frame loss: Safe delivered, stall <= 5 s", find(rows, baud, mode, "frameloss=30%"),
                 [](const ScenarioResult& r) { return r.safe_messages > 0 && r.max_stall_s <= 5.0; },
                 &ScenarioResult::max_stall_s);
+            add(
+                "1 % byte loss goodput >= 40 %", find(rows, baud, mode, "loss=1%"),
+                [](const ScenarioResult& r) { return r.goodput_pct >= 40.0; }, &ScenarioResult::goodput_pct);
+            add(
+                "2 % byte loss goodput >= 25 %", find(rows, baud, mode, "loss=2%"),
+                [](const ScenarioResult& r) { return r.goodput_pct >= 25.0; }, &ScenarioResult::goodput_pct);
+            add(
+                "2 % byte loss command round trip p50 <= 2 s", find(rows, baud, mode, "loss=2%"),
+                [](const ScenarioResult& r) { return r.cmd_p50_s <= 2.0; }, &ScenarioResult::cmd_p50_s);
+            add(
+                "5 % byte loss command round trip p50 <= 5 s", find(rows, baud, mode, "loss=5%"),
+                [](const ScenarioResult& r) { return r.cmd_p50_s <= 5.0; }, &ScenarioResult::cmd_p50_s);
             if (baud == 57600) {
                 add(
                     "Fast p99 <= 150 ms under saturating bulk", find(rows, baud, mode, "clean"),
@@ -175,6 +190,10 @@ void print_json(std::ostream& os, const std::vector<Row>& rows) {
             j[prefix + "fast_p99_ms"] = number(x.fast_p99_ms);
             j[prefix + "fast_delivery_pct"] = x.fast_delivery_pct;
             j[prefix + "max_stall_s"] = x.max_stall_s;
+            j[prefix + "cmd_p50_s"] = number(x.cmd_p50_s);
+            j[prefix + "cmd_p90_s"] = number(x.cmd_p90_s);
+            j[prefix + "cmd_sent"] = x.cmd_sent;
+            j[prefix + "cmd_answered"] = x.cmd_answered;
             j[prefix + "safe_messages"] = x.safe_messages;
             j[prefix + "damaged_deliveries"] = x.damaged_deliveries;
             j[prefix + "wire_ab_pct"] = x.wire_ab_pct;

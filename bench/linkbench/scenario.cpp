@@ -45,6 +45,9 @@ std::optional<std::uint32_t> check_payload(const std::vector<std::uint8_t>& p, s
 constexpr std::uint8_t kSaltSafeAB = 1;
 constexpr std::uint8_t kSaltSafeBA = 2;
 constexpr std::uint8_t kSaltFast = 3;
+constexpr std::uint8_t kSaltCommand = 4;
+constexpr std::uint8_t kSaltAnswer = 5;
+constexpr Duration kCommandPause = std::chrono::milliseconds(500);  // operator's pause between commands
 
 double percentile(std::vector<double> v, double q) {
     if (v.empty()) {
@@ -79,6 +82,8 @@ linksim::RadioConfig bench_radio(const Scenario& s, std::uint64_t seed) {
     c.seed = seed;
     for (auto& d : c.impairment) {
         d.byte_corruption = s.byte_corruption;
+        d.byte_loss = s.byte_loss;
+        d.bit_error_rate = s.bit_error_rate;
         d.frame_loss = s.frame_loss;
         if (s.outage) {
             d.outages.push_back(*s.outage);
@@ -244,6 +249,125 @@ ScenarioResult run_pass(const Scenario& s, const EndpointFactory& make, bool wit
     return result;
 }
 
+// Commands A→B, one at a time, each answered B→A at once; B pushes telemetry as airsegd does.
+void run_commands(const Scenario& s, const EndpointFactory& make, ScenarioResult& result) {
+    const TimePoint t0{};
+    const TimePoint end = t0 + s.duration;
+    const std::size_t paths = s.mode == LinkMode::dual ? 2 : 1;
+    std::vector<linksim::RadioModel> pairs;
+    for (std::size_t p = 0; p < paths; ++p) {
+        pairs.emplace_back(bench_radio(s, 2000 + p), t0);
+    }
+    std::array<std::unique_ptr<BenchEndpoint>, 2> ends{make({s.baud, s.mode, true, t0, s.pacing_factor}),
+                                                       make({s.baud, s.mode, false, t0, s.pacing_factor})};
+    std::array<std::array<PendingWrite, 2>, 2> pending{};
+
+    std::uint32_t next_id = 0;
+    bool in_flight = false;
+    TimePoint sent_at = t0;  // of the command in flight
+    TimePoint next_command = t0 + std::chrono::seconds(2);
+    std::vector<double> rtt;
+    std::vector<std::uint32_t> to_answer;
+    TimePoint next_vehicle = t0;
+    TimePoint next_link_stats = t0;
+    std::uint32_t telemetry_id = 0;
+
+    auto on_message = [&](Side to, const BenchMessage& m, TimePoint now) {
+        if (!m.safe) {
+            return;
+        }
+        if (to == Side::B) {
+            if (auto id = check_payload(m.bytes, kCommandBytes, kSaltCommand)) {
+                to_answer.push_back(*id);
+            } else {
+                ++result.damaged_deliveries;
+            }
+            return;
+        }
+        auto id = check_payload(m.bytes, kAnswerBytes, kSaltAnswer);
+        if (!id) {
+            ++result.damaged_deliveries;
+            return;
+        }
+        if (in_flight && *id + 1 == next_id) {
+            rtt.push_back(std::chrono::duration<double>(now - sent_at).count());
+            ++result.cmd_answered;
+            in_flight = false;
+            next_command = now + kCommandPause;
+        }
+    };
+
+    for (TimePoint now = t0; now <= end;) {
+        for (std::size_t p = 0; p < paths; ++p) {
+            for (Side side : {Side::A, Side::B}) {
+                auto bytes = pairs[p].poll_output(side, now);
+                if (!bytes.empty()) {
+                    ends[linksim::index(side)]->handle_bytes(p, bytes, now);
+                }
+            }
+        }
+        for (Side side : {Side::A, Side::B}) {
+            auto& e = *ends[linksim::index(side)];
+            if (e.poll_timeout() <= now) {
+                e.handle_timeout(now);
+            }
+            while (auto m = e.poll_message()) {
+                on_message(side, *m, now);
+            }
+        }
+        for (const std::uint32_t id : to_answer) {
+            ends[1]->send_urgent(make_payload(id, kAnswerBytes, kSaltAnswer), now);
+        }
+        to_answer.clear();
+        if (!in_flight && now >= next_command) {
+            if (ends[0]->send_urgent(make_payload(next_id, kCommandBytes, kSaltCommand), now)) {
+                ++next_id;
+                ++result.cmd_sent;
+                in_flight = true;
+                sent_at = now;
+            }
+        }
+        while (next_vehicle <= now) {
+            ends[1]->send_fast(0, make_payload(telemetry_id++, 48, kSaltFast), now);
+            next_vehicle += std::chrono::milliseconds(500);
+        }
+        while (next_link_stats <= now) {
+            ends[1]->send_fast(1, make_payload(telemetry_id++, 37, kSaltFast), now);
+            next_link_stats += std::chrono::seconds(1);
+        }
+        for (Side side : {Side::A, Side::B}) {
+            for (std::size_t p = 0; p < paths; ++p) {
+                auto& w = pending[linksim::index(side)][p];
+                while (true) {
+                    if (w.empty()) {
+                        auto frame = ends[linksim::index(side)]->poll_transmit(p, now);
+                        if (!frame) {
+                            break;
+                        }
+                        w = PendingWrite{std::move(*frame), 0};
+                    }
+                    w.written += pairs[p].push(side, std::span(w.bytes).subspan(w.written), now);
+                    if (!w.empty()) {
+                        break;
+                    }
+                }
+            }
+        }
+        TimePoint next = std::min({now + kStep, next_vehicle, next_link_stats, ends[0]->poll_timeout(),
+                                   ends[1]->poll_timeout()});
+        if (!in_flight) {
+            next = std::min(next, next_command);
+        }
+        now = std::max(next, now + std::chrono::microseconds(10));
+    }
+    // A command still unanswered long after it was sent counts; one sent just before the end does not.
+    if (in_flight && end - sent_at > std::chrono::seconds(5)) {
+        rtt.push_back(std::numeric_limits<double>::infinity());
+    }
+    result.cmd_p50_s = percentile(rtt, 0.50);
+    result.cmd_p90_s = percentile(rtt, 0.90);
+}
+
 }  // namespace
 
 ScenarioResult run_scenario(const Scenario& s, const EndpointFactory& make) {
@@ -256,6 +380,7 @@ ScenarioResult run_scenario(const Scenario& s, const EndpointFactory& make) {
     bulk.fast_p99_ms = mixed.fast_p99_ms;
     bulk.fast_delivery_pct = mixed.fast_delivery_pct;
     bulk.damaged_deliveries += mixed.damaged_deliveries;
+    run_commands(s, make, bulk);
     return bulk;
 }
 

@@ -16,6 +16,8 @@ struct Scenario {
     LinkMode mode = LinkMode::single;
     std::string impairment = "clean";       ///< label printed in the table
     double byte_corruption = 0.0;           ///< both directions, every pair
+    double byte_loss = 0.0;                 ///< independent byte loss, both directions, every pair
+    double bit_error_rate = 0.0;            ///< independent bit flips, both directions, every pair
     double frame_loss = 0.0;                ///< air packet loss, both directions, every pair
     std::optional<linksim::Outage> outage;  ///< both directions, every pair
     bool bidirectional = false;             ///< bulk Safe traffic both ways (otherwise A→B only)
@@ -33,6 +35,12 @@ struct ScenarioResult {
     double fast_p99_ms = 0.0;
     double fast_delivery_pct = 0.0;  ///< Fast messages sent (until 2 s before the end) that arrived
     double max_stall_s = 0.0;        ///< longest time without a Safe delivery A→B
+    /// Command round trips (third run): a status-sized exchange on the urgent channel while telemetry flows,
+    /// one command at a time; unanswered commands count as infinitely slow.
+    double cmd_p50_s = 0.0;
+    double cmd_p90_s = 0.0;
+    std::uint64_t cmd_sent = 0;
+    std::uint64_t cmd_answered = 0;
     std::uint64_t safe_messages = 0;
     std::uint64_t damaged_deliveries = 0;  ///< messages whose content differs from what was sent
     // Where the bytes went (diagnostics printed by --verbose):
@@ -48,8 +56,13 @@ using EndpointFactory = std::function<std::unique_ptr<BenchEndpoint>(const Endpo
 /// rate, Scenario::turnaround, 252-byte air packets, 2 KiB FIFO, 4 KiB host UART buffer.
 linksim::RadioConfig bench_radio(const Scenario& s, std::uint64_t seed);
 
-/// Two runs of the scenario: bulk Safe alone (goodput, stalls, wire use) and bulk plus Fast telemetry A→B at
-/// 10 Hz (Fast latency and delivery while bulk saturates the link).
+/// A command: kCommandBytes A→B; its answer: kAnswerBytes B→A (the size of airsegd's status answer).
+inline constexpr std::size_t kCommandBytes = 24;
+inline constexpr std::size_t kAnswerBytes = 1536;
+
+/// Three runs of the scenario: bulk Safe alone (goodput, stalls, wire use); bulk plus Fast telemetry A→B at
+/// 10 Hz (Fast latency and delivery while bulk saturates the link); commands A→B answered B→A while B pushes
+/// telemetry as airsegd does (48 bytes at 2 Hz, 37 bytes at 1 Hz): the command round trip.
 ScenarioResult run_scenario(const Scenario& s, const EndpointFactory& make);
 
 }  // namespace airseg::linkbench

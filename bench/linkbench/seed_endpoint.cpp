@@ -15,6 +15,10 @@ class SeedBenchEndpoint final : public BenchEndpoint {
     bool send_safe(std::span<const std::uint8_t> msg, TimePoint now) override {
         return seed_.send_safe(msg, now);
     }
+    // The seed has one Safe queue: commands wait behind whatever is queued.
+    bool send_urgent(std::span<const std::uint8_t> msg, TimePoint now) override {
+        return seed_.send_safe(msg, now);
+    }
     void send_fast(std::uint16_t /*stream*/, std::span<const std::uint8_t> msg, TimePoint now) override {
         seed_.send_fast(msg, now);
     }

@@ -6,6 +6,7 @@ namespace airseg::linkbench {
 namespace {
 
 // Priorities as the ground link uses them: Fast telemetry on 1, bulk Safe transfers on the lowest (3).
+constexpr std::uint8_t kCommandPriority = 0;
 constexpr std::uint8_t kFastPriority = 1;
 constexpr std::uint8_t kBulkPriority = 3;
 
@@ -29,6 +30,9 @@ class TransportBenchEndpoint final : public BenchEndpoint {
     bool send_safe(std::span<const std::uint8_t> msg, TimePoint now) override {
         const auto r = core_.send_safe(kBulkPriority, msg, now);
         return r == groundlink::SendResult::accepted;
+    }
+    bool send_urgent(std::span<const std::uint8_t> msg, TimePoint now) override {
+        return core_.send_safe(kCommandPriority, msg, now) == groundlink::SendResult::accepted;
     }
     void send_fast(std::uint16_t stream, std::span<const std::uint8_t> msg, TimePoint now) override {
         core_.send_fast(kFastPriority, stream, msg, now);
