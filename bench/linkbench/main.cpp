@@ -39,6 +39,7 @@ Scenarios, for 57600 and 115200 baud, single pair and dual pair (split: each end
   --duration S      seconds of simulated time per scenario (default 40; the outage runs 30 s longer)
   --turnaround-ms X  radio turnaround (default 1)
   --pacing F        the transport's link_rate as a fraction of baud/10 (default 1.0)
+  --only TEXT       only the scenarios whose "baud mode impairment" contains TEXT (e.g. "57600 single loss")
   --strict          exit status 1 when a target fails
 )";
 
@@ -66,8 +67,8 @@ std::vector<Scenario> scenarios(const Knobs& k) {
                 s.byte_corruption = p;
                 list.push_back(s);
             }
-            for (auto [label, p] : {std::pair{"loss=0.5%", 0.005}, {"loss=1%", 0.01}, {"loss=2%", 0.02},
-                                    {"loss=5%", 0.05}}) {
+            for (auto [label, p] :
+                 {std::pair{"loss=0.5%", 0.005}, {"loss=1%", 0.01}, {"loss=2%", 0.02}, {"loss=5%", 0.05}}) {
                 Scenario s = base;
                 s.impairment = label;
                 s.byte_loss = p;
@@ -108,6 +109,7 @@ int main(int argc, char** argv) {
     bool verbose = false;
     long seconds = 40;
     Knobs knobs;
+    std::string only;
     for (int i = 1; i < argc; ++i) {
         const std::string_view arg = argv[i];
         if (arg == "--json") {
@@ -116,6 +118,8 @@ int main(int argc, char** argv) {
             verbose = true;
         } else if (arg == "--strict") {
             strict = true;
+        } else if (arg == "--only" && i + 1 < argc) {
+            only = argv[++i];
         } else if (arg == "--duration" && i + 1 < argc) {
             const std::string_view v = argv[++i];
             auto [ptr, ec] = std::from_chars(v.data(), v.data() + v.size(), seconds);
@@ -154,6 +158,10 @@ int main(int argc, char** argv) {
     std::vector<Row> rows;
     knobs.length = std::chrono::seconds(seconds);
     for (const Scenario& s : scenarios(knobs)) {
+        const std::string name = std::to_string(s.baud) + " " + to_string(s.mode) + " " + s.impairment;
+        if (name.find(only) == std::string::npos) {
+            continue;
+        }
         rows.push_back({s, run_scenario(s, make_transport_endpoint), run_scenario(s, make_seed_endpoint)});
     }
     const auto checks = check_targets(rows);

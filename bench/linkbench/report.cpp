@@ -64,8 +64,8 @@ void print_table(std::ostream& os, const std::vector<Row>& rows) {
            << pair(r, &ScenarioResult::fast_p99_ms, 0) << std::setw(17)
            << pair(r, &ScenarioResult::fast_delivery_pct, 0) << std::setw(15)
            << pair(r, &ScenarioResult::max_stall_s, 1) << std::setw(17)
-           << pair(r, &ScenarioResult::cmd_p50_s, 2) << std::setw(17) << pair(r, &ScenarioResult::cmd_p90_s, 2)
-           << '\n';
+           << pair(r, &ScenarioResult::cmd_p50_s, 2) << std::setw(17)
+           << pair(r, &ScenarioResult::cmd_p90_s, 2) << '\n';
     }
 }
 

@@ -353,8 +353,8 @@ void run_commands(const Scenario& s, const EndpointFactory& make, ScenarioResult
                 }
             }
         }
-        TimePoint next = std::min({now + kStep, next_vehicle, next_link_stats, ends[0]->poll_timeout(),
-                                   ends[1]->poll_timeout()});
+        TimePoint next = std::min(
+            {now + kStep, next_vehicle, next_link_stats, ends[0]->poll_timeout(), ends[1]->poll_timeout()});
         if (!in_flight) {
             next = std::min(next, next_command);
         }

@@ -38,6 +38,7 @@ class CobsDeframer {
                 }
                 continue;
             }
+            last_encoded_ = buf_.size() + 1;
             if (overflow_) {
                 on_error();
             } else if (!buf_.empty()) {
@@ -51,11 +52,14 @@ class CobsDeframer {
             overflow_ = false;
         }
     }
+    /// Wire bytes (delimiter included, capped at max_encoded + 1) of the frame last handed to a callback.
+    [[nodiscard]] std::size_t last_encoded_bytes() const { return last_encoded_; }
 
   private:
     std::size_t max_encoded_;
     std::vector<std::uint8_t> buf_;
     bool overflow_ = false;
+    std::size_t last_encoded_ = 0;
 };
 
 }  // namespace airseg::groundlink

@@ -45,7 +45,7 @@ void encode_chunk(const Chunk& c, bool last, std::vector<std::uint8_t>& out) {
         out.insert(out.end(), a->bitmap.begin(), a->bitmap.end());
     } else if (const auto* r = std::get_if<ReportChunk>(&c)) {
         out.push_back(type_byte(kReport, 0, 0));
-        wire::put_u16(out, r->suggested_payload);
+        wire::put_u16(out, r->byte_error_ppm);
     }
 }
 
@@ -99,6 +99,15 @@ std::vector<std::uint8_t> encode_hello(const Hello& h) {
 }
 
 std::vector<std::uint8_t> seal(std::vector<std::uint8_t> frame, const FrameMac* mac, const MacContext& ctx) {
+    frame = seal_plain(std::move(frame), mac, ctx);
+    std::vector<std::uint8_t> out;
+    out.reserve(cobs_max_encoded(frame.size()));
+    cobs_encode(frame, out);
+    return out;
+}
+
+std::vector<std::uint8_t> seal_plain(std::vector<std::uint8_t> frame, const FrameMac* mac,
+                                     const MacContext& ctx) {
     Crc32 crc;
     if (mac != nullptr) {
         const MacTag tag = mac->tag(ctx, frame);
@@ -111,10 +120,7 @@ std::vector<std::uint8_t> seal(std::vector<std::uint8_t> frame, const FrameMac* 
     }
     crc.update(frame);
     wire::put_u32(frame, crc.value());
-    std::vector<std::uint8_t> out;
-    out.reserve(cobs_max_encoded(frame.size()));
-    cobs_encode(frame, out);
-    return out;
+    return frame;
 }
 
 std::optional<std::span<const std::uint8_t>> check_crc(std::span<const std::uint8_t> plain, bool keyed,
@@ -243,7 +249,7 @@ std::optional<std::vector<Chunk>> decode_chunks(std::span<const std::uint8_t> fr
             }
             case kReport: {
                 ReportChunk rep;
-                if ((b & 0x1FU) != 0 || !r.get_u16(rep.suggested_payload)) {
+                if ((b & 0x1FU) != 0 || !r.get_u16(rep.byte_error_ppm)) {
                     return std::nullopt;
                 }
                 chunks.emplace_back(rep);

@@ -15,7 +15,7 @@ namespace airseg::groundlink::frame {
 
 enum class Kind : std::uint8_t { data = 0, hello = 1 };
 
-inline constexpr std::uint8_t kProtocolVersion = 1;
+inline constexpr std::uint8_t kProtocolVersion = 2;
 inline constexpr std::size_t kCrcBytes = 4;
 inline constexpr std::size_t kDataHeaderBytes = 4;  // header byte + 24-bit frame number
 inline constexpr std::size_t kHelloBodyBytes = 18;  // version, sender nonce, echo nonce, flags
@@ -49,8 +49,13 @@ struct AckChunk {
     /// Bit i (byte i/8, bit i%8) set: segment next_expected + 1 + i was received.
     std::vector<std::uint8_t> bitmap;
 };
+inline constexpr std::uint16_t kReportBursty = 0x8000;
+inline constexpr double kReportRateUnit = 2e-6;
+
 struct ReportChunk {
-    std::uint16_t suggested_payload = 0;  ///< what the receiver's corruption measurement suggests
+    /// The byte error rate the receiver measures on frames from this end: bits 0-14 in units of two
+    /// millionths (saturating), bit 15 set when the errors come in bursts (kReportBursty).
+    std::uint16_t byte_error_ppm = 0;
 };
 using Chunk = std::variant<SafeChunk, FastChunk, AckChunk, ReportChunk>;
 
@@ -78,6 +83,10 @@ struct Hello {
     bool established = false;      ///< the sender holds a session (sender_nonce, echo_nonce)
 };
 std::vector<std::uint8_t> encode_hello(const Hello& h);
+
+/// Appends tag (keyed) and CRC (see seal); the frame as it goes into COBS or forward error correction.
+std::vector<std::uint8_t> seal_plain(std::vector<std::uint8_t> frame, const FrameMac* mac,
+                                     const MacContext& ctx);
 
 /// Appends tag (keyed) and CRC, then COBS-encodes with delimiter. Unkeyed links fold the two session nonces
 /// into the CRC instead, so frames of a stale session fail it.

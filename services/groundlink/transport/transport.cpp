@@ -170,8 +170,10 @@ void Transport::Impl::refresh(TimePoint now) {
     stats.rttvar_ms = std::chrono::duration<double, std::milli>(rtt.rttvar()).count();
     stats.rto_ms = std::chrono::duration<double, std::milli>(rtt.rto()).count();
     stats.rtt_samples = rtt.samples();
+    update_plan();
     stats.frame_payload = payload_cap();
-    stats.peer_suggested_payload = peer_suggested;
+    stats.byte_error_rate = meter.byte_error_rate().value_or(-1.0);
+    stats.peer_byte_error_rate = peer_error.value_or(-1.0);
     stats.frame_loss = sent_window > 0 ? std::min(1.0, lost_window / sent_window) : 0.0;
     std::uint64_t safe_depth = 0;
     std::uint64_t fast_depth = 0;

@@ -58,9 +58,13 @@ struct TransportConfig {
     /// max_frame_payload: chunk bytes per frame on a clean link.
     std::size_t max_frame_payload = 1024;
     /// min_frame_payload: floor of the adaptive frame size.
-    std::size_t min_frame_payload = 48;
-    /// adaptive_frame_size: follow the frame size the peer suggests from the corruption it measures.
+    std::size_t min_frame_payload = 16;
+    /// adaptive_frame_size: size frames for the byte error rate the peer measures (and reports) on this end's
+    /// frames: the goodput-optimal length, or forward error correction where it carries more.
     bool adaptive_frame_size = true;
+    /// fec: cut frames into shards with Reed–Solomon parity when the error rate makes it pay (needs
+    /// adaptive_frame_size). Shards are always decoded, whatever this says.
+    bool fec = true;
     /// latency_frame_payload: frame ceiling while Fast or non-bulk traffic is active (or frame loss is
     /// heavy), so a frame already on the air holds an urgent message back by at most this many bytes of air
     /// time.
@@ -190,9 +194,20 @@ struct LinkStats {
     double rttvar_ms = 0.0;
     double rto_ms = 0.0;
     std::uint64_t rtt_samples = 0;
-    std::size_t frame_payload = 0;           ///< current ceiling of chunk bytes per frame
-    std::size_t peer_suggested_payload = 0;  ///< from the peer's corruption measurement (0: none yet)
-    double frame_loss = 0.0;  ///< fraction of sent Safe segments declared lost (moving average)
+    std::size_t frame_payload = 0;  ///< current ceiling of chunk bytes per frame
+    /// The goodput-optimal payload for the error rate this end's frames meet (0: no estimate yet).
+    std::size_t peer_suggested_payload = 0;
+    /// Byte error rate of the frames this end hears (its own measurement; -1 before enough frames).
+    double byte_error_rate = -1.0;
+    /// Byte error rate the peer reports for this end's frames (-1: no report yet); what frames are sized for.
+    double peer_byte_error_rate = -1.0;
+    bool fec = false;                       ///< this end sends its frames as shards with parity now
+    std::size_t fec_shard_bytes = 0;        ///< data bytes per shard while fec
+    std::uint64_t fec_frames_sent = 0;      ///< frames sent as shards
+    std::uint64_t fec_frames_decoded = 0;   ///< frames rebuilt from received shards
+    std::uint64_t fec_frames_repaired = 0;  ///< ... of which needed parity (a data shard was lost)
+    std::uint64_t fec_shard_errors = 0;     ///< shards that failed their CRC-16
+    double frame_loss = 0.0;                ///< fraction of sent Safe segments declared lost (moving average)
 
     std::uint64_t frames_sent = 0;
     std::uint64_t frames_received = 0;  ///< valid, authenticated, not replayed

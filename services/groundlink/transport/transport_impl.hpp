@@ -9,9 +9,12 @@
 #include <vector>
 
 #include "services/groundlink/transport/cobs.hpp"
-#include "services/groundlink/transport/corruption_meter.hpp"
+#include "services/groundlink/transport/erasure_code.hpp"
+#include "services/groundlink/transport/error_rate_meter.hpp"
 #include "services/groundlink/transport/fast_queue.hpp"
 #include "services/groundlink/transport/fast_reassembly.hpp"
+#include "services/groundlink/transport/fec_frame.hpp"
+#include "services/groundlink/transport/fec_plan.hpp"
 #include "services/groundlink/transport/frame.hpp"
 #include "services/groundlink/transport/frame_mac.hpp"
 #include "services/groundlink/transport/replay_window.hpp"
@@ -50,7 +53,11 @@ class Transport::Impl {
 
     // transport_rx.cpp
     void handle_bytes(std::size_t path, std::span<const std::uint8_t> bytes, TimePoint now);
-    void on_plain_frame(std::size_t path, std::span<const std::uint8_t> plain, TimePoint now);
+    /// `wire_bytes`: the frame's size on the wire for the error meter (0: rebuilt from shards, not counted).
+    void on_plain_frame(std::size_t path, std::span<const std::uint8_t> plain, std::size_t wire_bytes,
+                        TimePoint now);
+    void on_shard(std::size_t path, std::span<const std::uint8_t> plain, std::size_t wire_bytes,
+                  TimePoint now);
     void on_hello(std::size_t path, const frame::Hello& h, std::size_t key, TimePoint now);
     void on_data_frame(std::span<const std::uint8_t> frame, TimePoint now);
     void on_authentic(std::size_t path, std::uint8_t peer_heard_mask, TimePoint now);
@@ -89,6 +96,13 @@ class Transport::Impl {
     bool add_data_chunk(std::vector<frame::Chunk>& chunks, std::vector<std::vector<std::uint8_t>>& storage,
                         std::size_t& room, bool first, TimePoint now);
     void account_sent(std::size_t path, std::size_t bytes, TimePoint now);
+    /// Seals a frame and encodes it for the wire: one COBS frame, or shards with parity under the FEC plan.
+    std::vector<std::uint8_t> to_wire(std::vector<std::uint8_t> plain, const FrameMac* key,
+                                      const MacContext& ctx);
+    /// The byte error rate this end's frames meet: the peer's report, or until one arrives this end's own
+    /// measurement (radio links are mostly symmetric); nullopt when neither exists.
+    [[nodiscard]] std::optional<double> tx_error_rate() const;
+    void update_plan();
     void mark_urgent(TimePoint now) { urgent_until = now + cfg.latency_hold; }
 
     TransportConfig cfg;
@@ -168,11 +182,20 @@ class Transport::Impl {
     double sent_window = 0.0;
     double lost_window = 0.0;
 
-    // Frame size adaptation.
-    CorruptionMeter meter;
-    std::size_t last_reported = 0;
+    // Frame size adaptation and forward error correction.
+    ErrorRateMeter meter;
+    std::optional<std::uint32_t> last_reported_ppm;  // in report units, bursty flag included
     TimePoint last_report_time{};
-    std::size_t peer_suggested = 0;
+    std::optional<double> peer_error;  // the peer's latest report
+    bool peer_bursty = false;
+    std::optional<double> plan_rate;  // the rate `plan` was made for
+    bool plan_bursty = false;
+    fec::FramePlan plan;
+    std::array<std::uint16_t, fec::kMaxShards + 1>
+        parity_cache{};  // by data shards, for plan; 0xFFFF unknown
+    std::uint8_t next_group = 0;
+    fec::ShardAssembler shards;
+    std::vector<std::uint8_t> rebuilt;  // a frame rebuilt from shards
 
     std::deque<Delivered> deliveries;
     std::deque<TransportEvent> events;

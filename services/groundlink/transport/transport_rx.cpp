@@ -14,7 +14,6 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
     Path& ps = paths[path];
     stats.bytes_received += bytes.size();
     stats.path[path].bytes_received += bytes.size();
-    meter.on_bytes(bytes.size());
     {
         ps.rx_rate = decayed_rate(ps.rx_rate, ps.rx_rate_time, now_) + static_cast<double>(bytes.size());
         ps.rx_rate_time = now_;
@@ -37,25 +36,52 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
     ps.deframer.feed(
         bytes,
         [&](std::vector<std::uint8_t>&& plain) {
+            const std::size_t wire = ps.deframer.last_encoded_bytes();
+            if (fec::is_shard(plain)) {
+                // Shards come in bursts of one frame: one change of sender per group, not per shard.
+                on_shard(path, plain, wire, now_);
+                return;
+            }
             turnaround();
-            on_plain_frame(path, plain, now_);
+            on_plain_frame(path, plain, wire, now_);
         },
         [&] {
             turnaround();
             ++stats.framing_errors;
-            meter.on_bad_frame();
+            meter.on_frame(ps.deframer.last_encoded_bytes(), false);
         });
     update_link_state();
     refresh(now_);
 }
 
-void Transport::Impl::on_plain_frame(std::size_t path, std::span<const std::uint8_t> plain, TimePoint now) {
+void Transport::Impl::on_shard(std::size_t path, std::span<const std::uint8_t> plain, std::size_t wire_bytes,
+                               TimePoint now) {
+    const auto result = shards.add(plain, now, rebuilt);
+    if (result == fec::ShardAssembler::Result::bad) {
+        ++stats.fec_shard_errors;
+        meter.on_frame(wire_bytes, false);
+        return;
+    }
+    meter.on_frame(wire_bytes, true);
+    if (result == fec::ShardAssembler::Result::complete) {
+        stats.fec_frames_decoded = shards.groups_decoded();
+        stats.fec_frames_repaired = shards.groups_repaired();
+        if (cfg.half_duplex) {
+            paths[path].air_debt = std::max(paths[path].air_debt, now_) + 2 * cfg.air_turnaround;
+        }
+        const std::vector<std::uint8_t> frame = std::move(rebuilt);
+        on_plain_frame(path, frame, 0, now);
+    }
+}
+
+void Transport::Impl::on_plain_frame(std::size_t path, std::span<const std::uint8_t> plain,
+                                     std::size_t wire_bytes, TimePoint now) {
     const bool keyed = mac != nullptr;
     const auto kind = frame::kind_of(plain);
     const std::size_t tag_bytes = keyed ? kMacTagBytes : 0;
     if (!kind) {
         ++stats.crc_errors;
-        meter.on_bad_frame();
+        meter.on_frame(wire_bytes, false);
         return;
     }
     MacContext ctx{};
@@ -66,10 +92,11 @@ void Transport::Impl::on_plain_frame(std::size_t path, std::span<const std::uint
     if (!body || body->size() < tag_bytes + 1) {
         ++stats.crc_errors;
         if (keyed || established || *kind == frame::Kind::hello) {
-            meter.on_bad_frame();
+            meter.on_frame(wire_bytes, false);
         }
         return;
     }
+    meter.on_frame(wire_bytes, true);
     const auto frame_bytes = body->first(body->size() - tag_bytes);
     const auto tag = body->subspan(body->size() - tag_bytes);
     if (*kind == frame::Kind::hello) {
@@ -152,7 +179,9 @@ void Transport::Impl::on_data_frame(std::span<const std::uint8_t> frame_bytes, T
         } else if (const auto* a = std::get_if<frame::AckChunk>(&c)) {
             on_ack(*a, now);
         } else if (const auto* r = std::get_if<frame::ReportChunk>(&c)) {
-            peer_suggested = r->suggested_payload;
+            peer_error = static_cast<double>(r->byte_error_ppm & 0x7FFFU) * frame::kReportRateUnit;
+            peer_bursty = (r->byte_error_ppm & frame::kReportBursty) != 0;
+            update_plan();
         }
     }
 }

@@ -95,12 +95,14 @@ bool Transport::Impl::lossy() const {
 
 std::size_t Transport::Impl::payload_cap() const {
     std::size_t cap = cfg.max_frame_payload;
-    if (cfg.adaptive_frame_size && peer_suggested > 0) {
-        cap = std::clamp(peer_suggested, cfg.min_frame_payload, cfg.max_frame_payload);
+    if (cfg.adaptive_frame_size && plan_rate) {
+        cap = std::clamp(plan.payload, cfg.min_frame_payload, cfg.max_frame_payload);
     }
-    // Under heavy frame loss small frames shorten each repair round trip, which bounds stalls.
-    if (lossy()) {
-        cap = std::min(cap, kLossyFramePayload);
+    // Under heavy frame loss small frames shorten each repair round trip, which bounds stalls (shards with
+    // parity already make each frame likely to arrive).
+    // Whole frames lost (not bytes): the error rate says little about them, so this size holds.
+    if (lossy() && !plan.fec) {
+        cap = kLossyFramePayload;
     }
     // Under urgent traffic they bound how long a frame already on its way holds the urgent message back; the
     // peer's urgent traffic waits for this end's frames on shared air, so it counts as well.
@@ -251,7 +253,7 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_hello(std::size_
     ps.next_hello = now + cfg.hello_interval;
     ps.last_hello = now;
     ++stats.hellos_sent;
-    return frame::seal(frame::encode_hello(h), keys[hello_key].get(), MacContext{});
+    return to_wire(frame::encode_hello(h), keys[hello_key].get(), MacContext{});
 }
 
 bool Transport::Impl::add_data_chunk(std::vector<frame::Chunk>& chunks,
@@ -356,7 +358,7 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
         // A probe: an empty frame, so the peer can report whether it hears this path.
         auto plain = frame::encode_data(header_flags(), static_cast<std::uint32_t>(next_frame_number), {});
         const MacContext ctx{my_nonce, peer_nonce, next_frame_number++};
-        return frame::seal(std::move(plain), mac, ctx);
+        return to_wire(std::move(plain), mac, ctx);
     }
 
     std::vector<frame::Chunk> chunks;
@@ -372,15 +374,17 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
             acked_channels.push_back(l);
         }
     }
-    if (const auto suggestion = meter.suggested_payload()) {
-        const auto s = std::min<std::size_t>(*suggestion, 0xFFFF);
-        const bool changed =
-            last_reported == 0 || std::abs(static_cast<double>(s) - static_cast<double>(last_reported)) >
-                                      0.1 * static_cast<double>(last_reported);
+    std::optional<std::uint32_t> report;  // committed only when the frame goes out
+    if (const auto rate = meter.byte_error_rate()) {
+        const auto ppm =
+            static_cast<std::uint32_t>(std::min(std::round(*rate / frame::kReportRateUnit), 32767.0)) |
+            (meter.bursty() ? frame::kReportBursty : 0U);
+        const bool changed = !last_reported_ppm ||
+                             std::abs(static_cast<double>(ppm) - static_cast<double>(*last_reported_ppm)) >
+                                 std::max(0.1 * static_cast<double>(*last_reported_ppm), 1.0);
         if (changed || now - last_report_time >= std::chrono::seconds(5)) {
-            chunks.emplace_back(frame::ReportChunk{static_cast<std::uint16_t>(s)});
-            last_reported = s;
-            last_report_time = now;
+            chunks.emplace_back(frame::ReportChunk{static_cast<std::uint16_t>(ppm)});
+            report = ppm;
         }
     }
     for (const auto& c : chunks) {
@@ -402,6 +406,10 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
     bulk_only = false;
     if (data_chunks == 0 && !ack_is_due && !keepalive_due) {
         return std::nullopt;  // only opportunistic content: wait for a frame worth sending
+    }
+    if (report) {
+        last_reported_ppm = report;
+        last_report_time = now;
     }
     for (const std::size_t l : acked_channels) {
         acks[l] = AckState{};
@@ -427,7 +435,7 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
     auto plain = frame::encode_data(
         header_flags(), static_cast<std::uint32_t>(next_frame_number & frame::kFrameNumberMask), chunks);
     const MacContext ctx{my_nonce, peer_nonce, next_frame_number++};
-    auto sealed = frame::seal(std::move(plain), mac, ctx);
+    auto sealed = to_wire(std::move(plain), mac, ctx);
     for (std::size_t q = 0; q < paths.size(); ++q) {
         if (q != path && cfg.path_mode == PathMode::redundant && carries_data(q)) {
             if (paths[q].mirror.size() >= kMirrorCap) {
@@ -437,6 +445,79 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
         }
     }
     return sealed;
+}
+
+}  // namespace airseg::groundlink
+
+namespace airseg::groundlink {
+
+std::optional<double> Transport::Impl::tx_error_rate() const {
+    if (peer_error) {
+        return peer_error;
+    }
+    return meter.byte_error_rate();
+}
+
+void Transport::Impl::update_plan() {
+    if (!cfg.adaptive_frame_size) {
+        return;
+    }
+    const auto rate = tx_error_rate();
+    if (!rate) {
+        return;
+    }
+    // Replanning costs binomial sums: only when the rate moved by a tenth or crossed zero.
+    const bool bursty = peer_error ? peer_bursty : meter.bursty();
+    if (plan_rate && (*rate == 0.0) == (*plan_rate == 0.0) &&
+        std::abs(*rate - *plan_rate) <= 0.1 * *plan_rate && bursty == plan_bursty) {
+        return;
+    }
+    plan_rate = rate;
+    plan_bursty = bursty;
+    // On half-duplex radios every frame also costs two changes of sender (acknowledgements come back in
+    // between); a group of shards pays them once.
+    const double turnaround_bytes =
+        cfg.half_duplex
+            ? 2.0 * std::chrono::duration<double>(cfg.air_turnaround).count() * cfg.link_rate_bytes_per_s
+            : 0.0;
+    const auto overhead = frame::frame_overhead(mac != nullptr) + frame::safe_chunk_overhead() +
+                          static_cast<std::size_t>(std::lround(turnaround_bytes));
+    // Parity sized for independent errors does not repair bursts (a lost air packet takes many shards).
+    plan =
+        fec::plan_frames(*rate, overhead, cfg.min_frame_payload, cfg.max_frame_payload, cfg.fec && !bursty);
+    parity_cache.fill(0xFFFF);
+    stats.fec = plan.fec;
+    stats.fec_shard_bytes = plan.shard_bytes;
+    stats.peer_suggested_payload = plan.payload;
+}
+
+std::vector<std::uint8_t> Transport::Impl::to_wire(std::vector<std::uint8_t> plain, const FrameMac* key,
+                                                   const MacContext& ctx) {
+    // Plain frames, unless the plan says shards or the frame is far longer than the plan's plain frames (a
+    // Safe segment cut before the error rate was known keeps its length when it is sent again).
+    const std::size_t plain_bytes = plain.size() + frame::frame_overhead(key != nullptr);
+    const bool oversize =
+        plan.shard_bytes > 0 && plain_bytes > 2 * (plan.payload + frame::frame_overhead(true));
+    if (!plan.fec && !oversize) {
+        return frame::seal(std::move(plain), key, ctx);
+    }
+    const auto sealed = frame::seal_plain(std::move(plain), key, ctx);
+    const std::size_t n = fec::data_shards_for(sealed.size(), plan.shard_bytes);
+    if (n > fec::kMaxShards) {
+        std::vector<std::uint8_t> out;
+        cobs_encode(sealed, out);
+        return out;
+    }
+    auto& parity = parity_cache[n];
+    if (parity == 0xFFFF) {
+        parity = static_cast<std::uint16_t>(
+            std::min(fec::parity_for(n, plan.shard_survival), fec::kMaxShards - n));
+    }
+    std::vector<std::uint8_t> out;
+    out.reserve((n + parity) * (plan.shard_bytes + fec::kShardOverhead));
+    fec::encode_frame(sealed, static_cast<std::uint8_t>(next_group++ & 0x3FU), plan.shard_bytes, parity, out);
+    ++stats.fec_frames_sent;
+    return out;
 }
 
 }  // namespace airseg::groundlink

@@ -192,7 +192,7 @@ TEST(GroundlinkFrame, ChunksRoundTripAndTheLastOmitsItsLength) {
     EXPECT_EQ(a.channel, 2);
     EXPECT_EQ(a.next_expected, 0xFFFE);
     EXPECT_EQ(a.bitmap, std::vector<std::uint8_t>{0x05});
-    EXPECT_EQ(std::get<frame::ReportChunk>((*got)[1]).suggested_payload, 321);
+    EXPECT_EQ(std::get<frame::ReportChunk>((*got)[1]).byte_error_ppm, 321);
     const auto& f = std::get<frame::FastChunk>((*got)[2]);
     EXPECT_EQ(f.topic, 0x1234);
     EXPECT_EQ(f.index, 2);

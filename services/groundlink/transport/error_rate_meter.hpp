@@ -1,0 +1,46 @@
+#pragma once
+// Receiver-side estimate of the byte error rate p (a byte lost, flipped or inserted) of the link direction
+// towards this end, from the frames it hears: a frame of T wire bytes arrives intact with probability
+// (1 − p)^T. Frames are kept per size class (powers of two) with good and bad counts, and p is the maximum
+// likelihood estimate over all classes, so frames of any mix of sizes (shards of 20 bytes, bulk frames of a
+// kilobyte) contribute what they tell. History decays by half every kWindowBytes bytes. The peer reports p to
+// the sender, which sizes its frames and switches forward error correction on from it (fec_plan.hpp).
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+
+namespace airseg::groundlink {
+
+class ErrorRateMeter {
+  public:
+    static constexpr double kMinBytes = 2000.0;      // no estimate below this many bytes
+    static constexpr double kMinFrames = 8.0;        // ... or this many frames
+    static constexpr double kWindowBytes = 40000.0;  // older history decays by half past this
+    static constexpr double kMaxRate = 0.25;         // estimates are capped here
+    static constexpr double kBurstRatio = 2.0;  // P(bad | bad before) / P(bad) beyond which errors are bursty
+
+    void on_frame(std::size_t wire_bytes, bool good);
+
+    /// The estimated byte error rate, nullopt before enough frames were heard.
+    [[nodiscard]] std::optional<double> byte_error_rate() const;
+    /// Bad frames come in runs (a lost air packet takes several frames with it) rather than one by one:
+    /// parity sized for independent errors would not repair them.
+    [[nodiscard]] bool bursty() const;
+
+  private:
+    static constexpr std::size_t kClasses = 16;
+    struct SizeClass {
+        double good = 0.0;
+        double bad = 0.0;
+        double bytes = 0.0;
+    };
+    std::array<SizeClass, kClasses> classes_{};
+    double bytes_ = 0.0;
+    double frames_ = 0.0;
+    bool last_bad_ = false;
+    double after_bad_ = 0.0;      // frames that followed a bad one
+    double bad_after_bad_ = 0.0;  // ... and were bad too
+};
+
+}  // namespace airseg::groundlink

@@ -1,0 +1,99 @@
+#include "services/groundlink/transport/fec_plan.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "services/groundlink/transport/erasure_code.hpp"
+#include "services/groundlink/transport/fec_frame.hpp"
+
+namespace airseg::groundlink::fec {
+namespace {
+
+// The sealed frame's bytes besides its chunks: the plain overhead without COBS code byte and delimiter.
+std::size_t sealed_overhead(std::size_t frame_overhead) {
+    return frame_overhead > 2 ? frame_overhead - 2 : 0;
+}
+
+double plain_efficiency(double p, double payload, double overhead) {
+    return payload / (payload + overhead) * std::pow(1.0 - p, payload + overhead);
+}
+
+}  // namespace
+
+double optimal_length(double p, double overhead) {
+    const double lambda = -std::log1p(-p);
+    return (-overhead + std::sqrt(overhead * overhead + 4.0 * overhead / lambda)) / 2.0;
+}
+
+std::size_t parity_for(std::size_t n, double survival, double success) {
+    if (survival >= 1.0) {
+        return 0;
+    }
+    if (survival <= 0.0) {
+        return kMaxShards;
+    }
+    const double ls = std::log(survival);
+    const double lf = std::log1p(-survival);
+    for (std::size_t total = n; total <= kMaxShards; ++total) {
+        // P(at least n of `total` arrive), summed in log space from the binomial terms.
+        double p_ok = 0.0;
+        for (std::size_t k = n; k <= total; ++k) {
+            const double log_term = std::lgamma(static_cast<double>(total) + 1) -
+                                    std::lgamma(static_cast<double>(k) + 1) -
+                                    std::lgamma(static_cast<double>(total - k) + 1) +
+                                    static_cast<double>(k) * ls + static_cast<double>(total - k) * lf;
+            p_ok += std::exp(log_term);
+        }
+        if (p_ok >= success) {
+            return total - n;
+        }
+    }
+    return kMaxShards;
+}
+
+FramePlan plan_frames(double p, std::size_t frame_overhead, std::size_t min_payload, std::size_t max_payload,
+                      bool allow_fec) {
+    FramePlan plain;
+    if (p <= 0.0) {
+        plain.payload = max_payload;
+        return plain;
+    }
+    const auto h = static_cast<double>(frame_overhead);
+    plain.payload = static_cast<std::size_t>(
+        std::clamp(optimal_length(p, h), static_cast<double>(min_payload), static_cast<double>(max_payload)));
+    plain.efficiency = plain_efficiency(p, static_cast<double>(plain.payload), h);
+    if (!allow_fec) {
+        return plain;
+    }
+
+    FramePlan fec;
+    fec.fec = true;
+    const auto shard_overhead = static_cast<double>(kShardOverhead);
+    fec.shard_bytes = static_cast<std::size_t>(std::clamp(std::round(optimal_length(p, shard_overhead)),
+                                                          static_cast<double>(kMinShardBytes),
+                                                          static_cast<double>(kMaxShardBytes)));
+    const auto s = static_cast<double>(fec.shard_bytes);
+    // A shard also dies with the delimiter before it (the two frames merge), and the rate is an estimate:
+    // parity is sized for a twentieth more loss than measured.
+    fec.shard_survival = std::pow(1.0 - p, kRateMargin * (s + shard_overhead + 1.0));
+    // The largest frame whose group fits in 255 shards, within max_payload.
+    const std::size_t sealed_extra = sealed_overhead(frame_overhead) + 1;  // + the padding count
+    std::size_t n = data_shards_for(max_payload + sealed_overhead(frame_overhead), fec.shard_bytes);
+    n = std::min(n, kMaxShards);
+    std::size_t k = parity_for(n, fec.shard_survival);
+    while (n > 1 && n + k > kMaxShards) {
+        n = n * 3 / 4;
+        k = parity_for(n, fec.shard_survival);
+    }
+    plain.shard_bytes = fec.shard_bytes;
+    plain.shard_survival = fec.shard_survival;
+    if (n + k > kMaxShards || n * fec.shard_bytes <= sealed_extra + min_payload) {
+        return plain;
+    }
+    fec.payload = std::min(max_payload, n * fec.shard_bytes - sealed_extra);
+    fec.efficiency = static_cast<double>(fec.payload) / (static_cast<double>(n + k) * (s + shard_overhead)) *
+                     kGroupSuccess;
+    return fec.efficiency > kFecAdvantage * plain.efficiency ? fec : plain;
+}
+
+}  // namespace airseg::groundlink::fec
