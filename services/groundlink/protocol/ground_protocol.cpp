@@ -1,5 +1,7 @@
 #include "services/groundlink/protocol/ground_protocol.hpp"
 
+#include "services/groundlink/protocol/deflate_codec.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -178,6 +180,29 @@ Telemetry decode_telemetry(Reader& r) {
 
 }  // namespace
 
+namespace {
+
+// A command or result: its CBOR, compressed when that saves bytes (a short one rarely compresses).
+void encode_payload(Writer& w, MessageType plain, MessageType deflated, std::uint32_t request_id,
+                    const nlohmann::json& value) {
+    constexpr std::size_t kWorthCompressing = 48;
+    const auto cbor = nlohmann::json::to_cbor(value);
+    if (cbor.size() >= kWorthCompressing) {
+        const auto packed = deflate_payload(cbor);
+        if (!packed.empty() && packed.size() < cbor.size()) {
+            w.u8(static_cast<std::uint8_t>(deflated));
+            w.le(request_id, 4);
+            w.bytes(packed);
+            return;
+        }
+    }
+    w.u8(static_cast<std::uint8_t>(plain));
+    w.le(request_id, 4);
+    w.bytes(cbor);
+}
+
+}  // namespace
+
 std::vector<std::uint8_t> encode(const Message& message) {
     Writer w;
     w.u8(kVersion);
@@ -200,13 +225,10 @@ std::vector<std::uint8_t> encode(const Message& message) {
                 const auto n = std::min(m.text.size(), kMaxEventText);
                 w.bytes(std::span(reinterpret_cast<const std::uint8_t*>(m.text.data()), n));
             } else if constexpr (std::is_same_v<T, Command>) {
-                w.u8(static_cast<std::uint8_t>(MessageType::command));
-                w.le(m.request_id, 4);
-                w.bytes(nlohmann::json::to_cbor(m.request));
+                encode_payload(w, MessageType::command, MessageType::command_deflated, m.request_id,
+                               m.request);
             } else if constexpr (std::is_same_v<T, Result>) {
-                w.u8(static_cast<std::uint8_t>(MessageType::result));
-                w.le(m.request_id, 4);
-                w.bytes(nlohmann::json::to_cbor(m.answer));
+                encode_payload(w, MessageType::result, MessageType::result_deflated, m.request_id, m.answer);
             } else if constexpr (std::is_same_v<T, Joystick>) {
                 w.u8(static_cast<std::uint8_t>(MessageType::joystick));
                 w.le(twos(clamp_round<std::int64_t>(m.steering * 10000, -10000, 10000), 2), 2);
@@ -279,18 +301,33 @@ DecodeResult decode(std::span<const std::uint8_t> bytes) {
             return out;
         }
         case MessageType::command:
-        case MessageType::result: {
+        case MessageType::result:
+        case MessageType::command_deflated:
+        case MessageType::result_deflated: {
             if (body < 5) {
                 out.error = "command/result body too short";
                 return out;
             }
             const auto id = static_cast<std::uint32_t>(r.le(4));
+            const bool deflated = type == static_cast<std::uint8_t>(MessageType::command_deflated) ||
+                                  type == static_cast<std::uint8_t>(MessageType::result_deflated);
+            std::optional<std::vector<std::uint8_t>> inflated;
+            if (deflated) {
+                inflated = inflate_payload(r.rest());
+                if (!inflated) {
+                    out.error =
+                        "compressed command/result payload does not inflate (damaged, or larger than " +
+                        std::to_string(kMaxInflated) + " bytes)";
+                    return out;
+                }
+            }
             nlohmann::json value;
-            if (!cbor(r.rest(), value)) {
+            if (!cbor(inflated ? std::span<const std::uint8_t>(*inflated) : r.rest(), value)) {
                 out.error = "command/result payload is not valid CBOR (or nested deeper than 32)";
                 return out;
             }
-            if (type == static_cast<std::uint8_t>(MessageType::command)) {
+            if (type == static_cast<std::uint8_t>(MessageType::command) ||
+                type == static_cast<std::uint8_t>(MessageType::command_deflated)) {
                 out.message = Command{id, std::move(value)};
             } else {
                 out.message = Result{id, std::move(value)};

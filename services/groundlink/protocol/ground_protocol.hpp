@@ -34,6 +34,8 @@ enum class MessageType : std::uint8_t {
     result = 0x11,
     joystick = 0x12,
     reception = 0x13,
+    command_deflated = 0x14,  ///< a command whose CBOR is compressed (deflate_codec.hpp)
+    result_deflated = 0x15,   ///< a result whose CBOR is compressed
 };
 
 /// One vehicle telemetry sample. Units are chosen so the whole message fits 29 bytes.

@@ -14,8 +14,9 @@ namespace airseg::groundlink {
 
 class ErrorRateMeter {
   public:
-    static constexpr double kMinBytes = 2000.0;      // no estimate below this many bytes
-    static constexpr double kMinFrames = 8.0;        // ... or this many frames
+    static constexpr double kMinBytes = 300.0;       // no estimate below this many bytes
+    static constexpr double kMinFrames = 4.0;        // ... or this many frames (early estimates are rough,
+                                                     // but a new session needs one within its first command)
     static constexpr double kWindowBytes = 40000.0;  // older history decays by half past this
     static constexpr double kMaxRate = 0.25;         // estimates are capped here
     static constexpr double kBurstRatio = 2.0;  // P(bad | bad before) / P(bad) beyond which errors are bursty

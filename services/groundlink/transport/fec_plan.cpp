@@ -34,7 +34,10 @@ std::size_t parity_for(std::size_t n, double survival, double success) {
     }
     const double ls = std::log(survival);
     const double lf = std::log1p(-survival);
-    for (std::size_t total = n; total <= kMaxShards; ++total) {
+    // At fewer than n / survival shards the mean falls short of n and the success stays below one half: the
+    // search starts just under there.
+    const auto from = static_cast<std::size_t>(std::max(static_cast<double>(n), static_cast<double>(n) / survival - 2.0));
+    for (std::size_t total = from; total <= kMaxShards; ++total) {
         // P(at least n of `total` arrive), summed in log space from the binomial terms.
         double p_ok = 0.0;
         for (std::size_t k = n; k <= total; ++k) {
@@ -49,6 +52,28 @@ std::size_t parity_for(std::size_t n, double survival, double success) {
         }
     }
     return kMaxShards;
+}
+
+double shard_survival(double p, std::size_t shard_bytes) {
+    return std::pow(1.0 - p, kRateMargin * (static_cast<double>(shard_bytes + kShardOverhead) + 1.0));
+}
+
+ShardGeometry fit_frame(std::size_t sealed_bytes, double p, std::size_t shard_bytes) {
+    ShardGeometry g;
+    for (g.shard_bytes = shard_bytes; g.shard_bytes <= kMaxShardBytes; ++g.shard_bytes) {
+        g.data = data_shards_for(sealed_bytes, g.shard_bytes);
+        if (g.data > kMaxShards) {
+            continue;
+        }
+        g.parity = parity_for(g.data, shard_survival(p, g.shard_bytes));
+        if (g.data + g.parity <= kMaxShards) {
+            return g;
+        }
+    }
+    g.shard_bytes = kMaxShardBytes;
+    g.data = data_shards_for(sealed_bytes, g.shard_bytes);
+    g.parity = g.data < kMaxShards ? kMaxShards - g.data : 0;
+    return g;
 }
 
 FramePlan plan_frames(double p, std::size_t frame_overhead, std::size_t min_payload, std::size_t max_payload,
@@ -73,9 +98,7 @@ FramePlan plan_frames(double p, std::size_t frame_overhead, std::size_t min_payl
                                                           static_cast<double>(kMinShardBytes),
                                                           static_cast<double>(kMaxShardBytes)));
     const auto s = static_cast<double>(fec.shard_bytes);
-    // A shard also dies with the delimiter before it (the two frames merge), and the rate is an estimate:
-    // parity is sized for a twentieth more loss than measured.
-    fec.shard_survival = std::pow(1.0 - p, kRateMargin * (s + shard_overhead + 1.0));
+    fec.shard_survival = shard_survival(p, fec.shard_bytes);
     // The largest frame whose group fits in 255 shards, within max_payload.
     const std::size_t sealed_extra = sealed_overhead(frame_overhead) + 1;  // + the padding count
     std::size_t n = data_shards_for(max_payload + sealed_overhead(frame_overhead), fec.shard_bytes);

@@ -23,6 +23,19 @@ inline constexpr double kFecAdvantage = 1.05;
 /// arrive with probability `success`; 0 when none are needed, and a value past 255 − n when no k suffices.
 [[nodiscard]] std::size_t parity_for(std::size_t n, double survival, double success = kGroupSuccess);
 
+/// Probability that a shard of `shard_bytes` data arrives intact at byte error rate p. A shard also dies
+/// with the delimiter before it (the two frames merge), and p is an estimate: kRateMargin more is assumed.
+[[nodiscard]] double shard_survival(double p, std::size_t shard_bytes);
+
+struct ShardGeometry {
+    std::size_t shard_bytes = 0;
+    std::size_t data = 0;
+    std::size_t parity = 0;
+};
+/// Shards for a sealed frame of `sealed_bytes` at rate p: shards of `shard_bytes`, or longer ones where the
+/// group would need more than 255 shards (a long frame on a bad link).
+[[nodiscard]] ShardGeometry fit_frame(std::size_t sealed_bytes, double p, std::size_t shard_bytes);
+
 struct FramePlan {
     bool fec = false;
     std::size_t payload = 0;  ///< chunk bytes per frame

@@ -502,20 +502,21 @@ std::vector<std::uint8_t> Transport::Impl::to_wire(std::vector<std::uint8_t> pla
         return frame::seal(std::move(plain), key, ctx);
     }
     const auto sealed = frame::seal_plain(std::move(plain), key, ctx);
-    const std::size_t n = fec::data_shards_for(sealed.size(), plan.shard_bytes);
-    if (n > fec::kMaxShards) {
-        std::vector<std::uint8_t> out;
-        cobs_encode(sealed, out);
-        return out;
+    std::size_t n = fec::data_shards_for(sealed.size(), plan.shard_bytes);
+    fec::ShardGeometry g{plan.shard_bytes, n, 0};
+    if (n <= fec::kMaxShards) {
+        auto& parity = parity_cache[n];
+        if (parity == 0xFFFF) {
+            parity = static_cast<std::uint16_t>(fec::parity_for(n, plan.shard_survival));
+        }
+        g.parity = parity;
     }
-    auto& parity = parity_cache[n];
-    if (parity == 0xFFFF) {
-        parity = static_cast<std::uint16_t>(
-            std::min(fec::parity_for(n, plan.shard_survival), fec::kMaxShards - n));
+    if (g.data + g.parity > fec::kMaxShards) {
+        g = fec::fit_frame(sealed.size(), *plan_rate, plan.shard_bytes);
     }
     std::vector<std::uint8_t> out;
-    out.reserve((n + parity) * (plan.shard_bytes + fec::kShardOverhead));
-    fec::encode_frame(sealed, static_cast<std::uint8_t>(next_group++ & 0x3FU), plan.shard_bytes, parity, out);
+    out.reserve((g.data + g.parity) * (g.shard_bytes + fec::kShardOverhead));
+    fec::encode_frame(sealed, static_cast<std::uint8_t>(next_group++ & 0x3FU), g.shard_bytes, g.parity, out);
     ++stats.fec_frames_sent;
     return out;
 }

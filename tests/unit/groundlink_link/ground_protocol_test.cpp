@@ -1,5 +1,7 @@
 #include "services/groundlink/protocol/ground_protocol.hpp"
 
+#include "services/groundlink/protocol/deflate_codec.hpp"
+
 #include <gtest/gtest.h>
 
 #include <random>
@@ -104,6 +106,71 @@ TEST(GroundProtocol, OtherMessagesRoundTrip) {
         ASSERT_TRUE(d.message) << d.error;
         EXPECT_EQ(*d.message, m);
     }
+}
+
+// A status answer as airsegd sends it: the CBOR is about 1.5 KB, the message on the radio a fraction.
+TEST(GroundProtocol, AStatusAnswerIsCompressedToAFewHundredBytesAndRoundTrips) {
+    nlohmann::json status = {
+        {"autopilot",
+         {{"link", "up"},
+          {"mode", "AUTO"},
+          {"state", "DIRECTED"},
+          {"ready", true},
+          {"reboots", 0},
+          {"position", {{"lat", 41.27612}, {"lon", 1.98711}, {"alt", 3.2}}}}},
+        {"groundlink",
+         {{"link", "up"},
+          {"frames_sent", 18234},
+          {"frames_received", 9932},
+          {"crc_errors", 311},
+          {"framing_errors", 2817},
+          {"rtt_ms", 412.5},
+          {"loss", 0.04},
+          {"mode", "single"}}},
+        {"plan", {{"state", "running"}, {"name", "rover-survey"}, {"window", 5}, {"waypoints_reached", 12}}},
+        {"services",
+         {{"autopilot", {{"health", "up"}, {"error", ""}, {"since", "2026-11-25T14:10:02.982Z"}}}}},
+        {"uptime_s", 5123.4},
+        {"version", "0.1.0"}};
+    for (int i = 0; i < 40; ++i) {
+        status["groundlink"]["per_kind"]["counter_" + std::to_string(i)] = i * 7;  // bulk of a real document
+    }
+    const Result answer{9, {{"ok", true}, {"result", status}}};
+    const auto cbor = nlohmann::json::to_cbor(answer.answer);
+    const auto wire = encode(answer);
+    EXPECT_EQ(wire[1], static_cast<std::uint8_t>(MessageType::result_deflated));
+    EXPECT_LT(wire.size(), cbor.size() / 2) << "cbor " << cbor.size() << " bytes";
+    const auto back = decode(wire);
+    ASSERT_TRUE(back.message) << back.error;
+    EXPECT_EQ(*back.message, Message(answer));
+
+    // A short command stays plain CBOR: compressing it would not pay.
+    const auto status_cmd = encode(Command{1, {{"cmd", "status"}}});
+    EXPECT_EQ(status_cmd[1], static_cast<std::uint8_t>(MessageType::command));
+}
+
+TEST(GroundProtocol, ADamagedCompressedPayloadIsNamedNotDecoded) {
+    nlohmann::json big;
+    for (int i = 0; i < 50; ++i) {
+        big["key_" + std::to_string(i)] = "value " + std::to_string(i);
+    }
+    auto wire = encode(Command{3, {{"cmd", "plan.load"}, {"plan", big}}});
+    ASSERT_EQ(wire[1], static_cast<std::uint8_t>(MessageType::command_deflated));
+    auto truncated = wire;
+    truncated.resize(truncated.size() / 2);
+    const auto d = decode(truncated);
+    EXPECT_FALSE(d.message);
+    EXPECT_NE(d.error.find("does not inflate"), std::string::npos) << d.error;
+    // A stream that would inflate beyond the limit is refused, not allocated.
+    const std::vector<std::uint8_t> zeros(kMaxInflated + 1024, 0);
+    auto bomb = std::vector<std::uint8_t>{
+        kVersion, static_cast<std::uint8_t>(MessageType::result_deflated), 1, 0, 0, 0};
+    const auto packed = deflate_payload(zeros);
+    bomb.insert(bomb.end(), packed.begin(), packed.end());
+    EXPECT_LT(packed.size(), 2048U);
+    const auto refused = decode(bomb);
+    EXPECT_FALSE(refused.message);
+    EXPECT_NE(refused.error.find("larger than"), std::string::npos) << refused.error;
 }
 
 TEST(GroundProtocol, UnknownTypesAreSkippedNotErrors) {
