@@ -414,6 +414,17 @@ void GroundlinkService::publish_status() {
     g["loss"] = std::round(s.frame_loss * 1000) / 1000;
     g["goodput_bps"] = std::round(goodput_bps_);
     g["frame_payload"] = s.frame_payload;
+    auto rate = [](double r) {
+        return r < 0 ? nlohmann::json(nullptr) : nlohmann::json(std::round(r * 1e6) / 1e6);
+    };
+    g["byte_error_rate"] = rate(s.byte_error_rate);
+    g["peer_byte_error_rate"] = rate(s.peer_byte_error_rate);
+    g["fec"] = {{"active", s.fec},
+                {"shard_bytes", s.fec_shard_bytes},
+                {"frames_sent", s.fec_frames_sent},
+                {"frames_decoded", s.fec_frames_decoded},
+                {"frames_repaired", s.fec_frames_repaired},
+                {"shard_errors", s.fec_shard_errors}};
     g["frames_sent"] = s.frames_sent;
     g["frames_received"] = s.frames_received;
     g["crc_errors"] = s.crc_errors;

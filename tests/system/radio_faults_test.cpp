@@ -6,6 +6,7 @@
 #include <termios.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <random>
 
 #include "tests/system/system_checks.hpp"
@@ -70,6 +71,50 @@ TEST(SystemRadio, ByteCorruptionIsCaughtByTheCrcAndEveryCommandAnsweredOnce) {
     EXPECT_GT(counter(stats, "/ba/bytes_corrupted"), 0u) << stats.dump();
     EXPECT_GT(counter(after, "/groundlink/crc_errors") + counter(after, "/groundlink/framing_errors"), 0u)
         << "the damaged frames the daemon received are counted: " << g.dump();
+    expect_daemon_alive(bench);
+}
+
+// Weak signal on a radio without error correction: 2 % of the bytes lost independently, each way. Every
+// `airsegctl status` (a new session each: handshake, command, compressed answer) is answered, the frames are
+// protected by forward error correction, and the median answer comes within 3 s (docs/ground-link.md,
+// "Forward error correction").
+TEST(SystemRadio, TwoPercentByteLossStatusAnsweredInSeconds) {
+    BenchOptions o;
+    o.link_args = {"--loss", "0.02"};
+    SystemBench bench(o);
+    ASSERT_TRUE(bench.wait_ready()) << bench.logs();
+    std::vector<double> took;
+    int answered = 0;
+    for (int i = 0; i < 20; ++i) {
+        const auto t = std::chrono::steady_clock::now();
+        const auto r = bench.ctl({"status"}, 60'000);
+        took.push_back(seconds_since(t));
+        const auto doc = Json::parse(r.out, nullptr, false);
+        if (r.exit_code == 0 && doc.is_object() && doc.contains("groundlink")) {
+            ++answered;
+        } else {
+            ADD_FAILURE() << "status " << i << " exit " << r.exit_code << ": " << r.err;
+        }
+    }
+    std::vector<double> sorted = took;
+    std::sort(sorted.begin(), sorted.end());
+    const double median = (sorted[9] + sorted[10]) / 2;
+    const auto doc = bench.status();
+    const auto& g = doc["groundlink"];
+    const auto stats = bench.link().json("stats");
+    std::cout << "[ figures ] 2 % byte loss: " << answered << "/20 status answered; median " << median
+              << " s, fastest " << sorted.front() << " s, slowest " << sorted.back()
+              << " s; daemon byte error rate " << g.value("byte_error_rate", Json()).dump() << ", fec "
+              << g.value("fec", Json()).dump() << "; radio bytes lost ab " << counter(stats, "/ab/bytes_lost")
+              << " ba " << counter(stats, "/ba/bytes_lost") << "\n";
+    EXPECT_EQ(answered, 20);
+    EXPECT_GT(counter(stats, "/ab/bytes_lost") + counter(stats, "/ba/bytes_lost"), 0u) << stats.dump();
+    EXPECT_TRUE(g["fec"].value("active", false)) << g.dump();
+    EXPECT_GT(counter(doc, "/groundlink/fec/frames_decoded"), 0u) << g.dump();
+    EXPECT_NEAR(g.value("byte_error_rate", 0.0), 0.02, 0.01) << g.dump();
+#ifndef AIRSEG_SLOWED_BUILD
+    EXPECT_LE(median, 3.0);
+#endif
     expect_daemon_alive(bench);
 }
 
