@@ -13,6 +13,7 @@ constexpr double kFairShare = 0.45;  // of link_rate, below which an end is not 
 // Share of recent Safe segments declared lost above which frames stay at most kLossyFramePayload.
 constexpr double kLossyFraction = 0.15;
 constexpr std::size_t kLossyFramePayload = 192;
+constexpr std::size_t kUnmeasuredFramePayload = 256;
 // Share of recent Safe segments declared lost above which a segment lost twice is sent twice in a row.
 constexpr double kRepeatFraction = 0.25;
 constexpr unsigned kUnansweredHellosBeforeEchoingNothing = 3;
@@ -95,8 +96,11 @@ bool Transport::Impl::lossy() const {
 
 std::size_t Transport::Impl::payload_cap() const {
     std::size_t cap = cfg.max_frame_payload;
-    if (cfg.adaptive_frame_size && plan_rate) {
-        cap = std::clamp(plan.payload, cfg.min_frame_payload, cfg.max_frame_payload);
+    if (cfg.adaptive_frame_size) {
+        // Until the error rate is known, frames stay short: a Safe segment keeps the length it was cut at
+        // when it is sent again, and a long one cut blind may never get through a bad link.
+        cap = plan_rate ? std::clamp(plan.payload, cfg.min_frame_payload, cfg.max_frame_payload)
+                        : std::min(cap, kUnmeasuredFramePayload);
     }
     // Under heavy frame loss small frames shorten each repair round trip, which bounds stalls (shards with
     // parity already make each frame likely to arrive).
