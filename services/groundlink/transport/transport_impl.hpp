@@ -186,6 +186,7 @@ class Transport::Impl {
     ErrorRateMeter meter;
     std::optional<std::uint32_t> last_reported_ppm;  // in report units, bursty flag included
     TimePoint last_report_time{};
+    bool shards_heard_since_report = false;
     std::optional<double> peer_error;  // the peer's latest report
     bool peer_bursty = false;
     std::optional<double> plan_rate;  // the rate `plan` was made for

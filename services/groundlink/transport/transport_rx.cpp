@@ -63,6 +63,7 @@ void Transport::Impl::on_shard(std::size_t path, std::span<const std::uint8_t> p
         return;
     }
     meter.on_frame(wire_bytes, true);
+    shards_heard_since_report = true;
     if (result == fec::ShardAssembler::Result::complete) {
         stats.fec_frames_decoded = shards.groups_decoded();
         stats.fec_frames_repaired = shards.groups_repaired();

@@ -386,7 +386,10 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
         const bool changed = !last_reported_ppm ||
                              std::abs(static_cast<double>(ppm) - static_cast<double>(*last_reported_ppm)) >
                                  std::max(0.1 * static_cast<double>(*last_reported_ppm), 1.0);
-        if (changed || now - last_report_time >= std::chrono::seconds(5)) {
+        // A clean link needs no report (the peer assumes the link symmetric and measures it clean too),
+        // unless an error rate was reported before or the peer protects its frames with shards anyway.
+        const bool worth_it = ppm != 0 || last_reported_ppm.value_or(0) != 0 || shards_heard_since_report;
+        if (worth_it && (changed || now - last_report_time >= std::chrono::seconds(5))) {
             chunks.emplace_back(frame::ReportChunk{static_cast<std::uint16_t>(ppm)});
             report = ppm;
         }
@@ -414,6 +417,7 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
     if (report) {
         last_reported_ppm = report;
         last_report_time = now;
+        shards_heard_since_report = false;
     }
     for (const std::size_t l : acked_channels) {
         acks[l] = AckState{};
