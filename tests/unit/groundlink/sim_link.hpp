@@ -19,6 +19,7 @@ namespace airseg::groundlink::test {
 struct Impairments {
     double loss = 0.0;          ///< a written frame vanishes
     double byte_corrupt = 0.0;  ///< each byte is replaced by a random one
+    double byte_loss = 0.0;     ///< each byte vanishes (drawn only when set, so other seeds keep their runs)
     double duplicate = 0.0;     ///< a written frame arrives twice
     double reorder = 0.0;       ///< a written frame is held back by up to reorder_delay
     double garbage = 0.0;       ///< random bytes are inserted before a frame
@@ -175,6 +176,9 @@ class SimLink {
             }
         }
         for (std::uint8_t b : bytes) {
+            if (imp.byte_loss > 0.0 && uni() < imp.byte_loss) {
+                continue;
+            }
             out.push_back(uni() < imp.byte_corrupt ? static_cast<std::uint8_t>(rng_()) : b);
         }
         TimePoint at = start + air + imp.latency;

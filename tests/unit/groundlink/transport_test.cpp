@@ -489,6 +489,40 @@ TEST(GroundlinkTransport, FrameSizeShrinksUnderCorruption) {
     EXPECT_GT(count_safe(link.b(), 3), 50U);
 }
 
+// 2 % of the bytes lost each way: a 1000-byte segment would never arrive whole, so the ends measure the error
+// rate, report it, and the sender switches to shards with parity; messages keep arriving, in order.
+TEST(GroundlinkTransport, UnderByteLossFramesTravelAsShardsAndMessagesGetThrough) {
+    test::Impairments lossy;
+    lossy.byte_loss = 0.02;
+    SimLink link(base_config(1), base_config(2), one_path(lossy), 21);
+    for (std::uint32_t i = 0; i < 40; ++i) {
+        link.a().core->send_safe(3, pattern(1000, i), link.now());
+    }
+    link.run_for(60s);
+    const auto& a = link.a().core->stats();
+    const auto& b = link.b().core->stats();
+    EXPECT_NEAR(b.byte_error_rate, 0.02, 0.008) << "b measures a's frames";
+    EXPECT_NEAR(a.peer_byte_error_rate, b.byte_error_rate, 0.004) << "and reports it";
+    EXPECT_TRUE(a.fec);
+    EXPECT_GT(a.fec_frames_sent, 20U);
+    EXPECT_GT(b.fec_frames_repaired, 10U) << "parity rebuilt frames whose data shards were hit";
+    EXPECT_GE(count_safe(link.b(), 3), 25U) << "most of 40 KB in a minute at 5760 B/s";
+
+    // The same link without forward error correction: small plain frames, far fewer messages.
+    auto plain_a = base_config(1);
+    plain_a.fec = false;
+    auto plain_b = base_config(2);
+    plain_b.fec = false;
+    SimLink plain(plain_a, plain_b, one_path(lossy), 21);
+    for (std::uint32_t i = 0; i < 40; ++i) {
+        plain.a().core->send_safe(3, pattern(1000, i), plain.now());
+    }
+    plain.run_for(60s);
+    EXPECT_FALSE(plain.a().core->stats().fec);
+    EXPECT_EQ(plain.a().core->stats().fec_frames_sent, 0U);
+    EXPECT_LT(count_safe(plain.b(), 3), count_safe(link.b(), 3));
+}
+
 TEST(GroundlinkTransport, AnEndThatHearsNoAcknowledgementsProbesInsteadOfFillingTheAir) {
     // b hears a but a hears nothing for a minute: a's window goes out once, then one probe per timeout. If
     // every outstanding segment timed out in turn, a would resend its window at the full link rate and, with
