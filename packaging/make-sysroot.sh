@@ -22,6 +22,19 @@ ensure_packages mmdebstrap dpkg-dev
 include=$(IFS=,; echo "libc6-dev,libstdc++-12-dev,${AIRSEG_DEV_PACKAGES[*]}")
 hook="$(cd "$(dirname "$0")" && pwd)/sysroot-dpkg-db.sh"
 
+# Some -dev packages link their .so to an absolute path (zlib1g-dev: libz.so -> /lib/<triplet>/libz.so.1),
+# which from the host points outside the sysroot: the linker would skip it and link the static archive.
+# Every absolute link becomes relative to its place in the sysroot.
+relative_symlinks() {
+  local root=$1 link target
+  while IFS= read -r -d '' link; do
+    target=$(readlink "$link")
+    case $target in
+      /*) ln -sfn "$(realpath -m --relative-to="$(dirname "$link")" "$root$target")" "$link" ;;
+    esac
+  done < <(find "$root" -type l -print0)
+}
+
 attempt() {
   rm -rf "$dir.tmp"
   mmdebstrap --quiet --variant=extract --arch="$arch" --include="$include" \
@@ -40,6 +53,7 @@ fi
 # qemu-arm -L SYSROOT looks up every absolute path in the sysroot first: device nodes there
 # (mmdebstrap's /dev) would shadow the host's, and /dev/ptmx would fail with ENODEV.
 rm -rf "$dir.tmp/dev" "$dir.tmp/tmp" "$dir.tmp/run" "$dir.tmp/proc" "$dir.tmp/sys"
+relative_symlinks "$dir.tmp"
 rm -rf "$dir"
 mv "$dir.tmp" "$dir"
 # The recorded file lists name the directory the sysroot was built in; keep them true.
