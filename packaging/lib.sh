@@ -7,6 +7,10 @@ AIRSEG_SYSROOTS=${AIRSEG_SYSROOTS:-$AIRSEG_ROOT/sysroots}
 log() { printf '%s: %s\n' "$(basename "$0")" "$*" >&2; }
 die() { log "error: $*"; exit 1; }
 
+# Every architecture the packages are built for (build-debs.sh without arguments).
+# shellcheck disable=SC2034
+AIRSEG_ARCHES=(amd64 armhf armel)
+
 # GNU triplet of a Debian architecture this project builds for.
 arch_triplet() {
   case "$1" in
