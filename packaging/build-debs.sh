@@ -2,12 +2,12 @@
 # build-debs.sh [--no-check] [--no-debug-info] [--clean] [ARCH...]
 #
 # Builds the airseg .debs (airsegd, airseg-client, airseg-sim, and the transitional airseg) for each
-# ARCH (default: every one, amd64 armhf armel) on Debian 12 from Debian packages only, and writes them
-# to dist/. amd64 is built natively; armhf and armel are cross-built with the
+# ARCH (default: every one, amd64 armhf armel arm64) on Debian 12 from Debian packages only, and writes
+# them to dist/. amd64 is built natively; armhf, armel and arm64 are cross-built with the
 # Debian cross compilers against a sysroot (packaging/make-sysroot.sh), without multiarch:
 # `dpkg-buildpackage -a ARCH -d` with AIRSEG_SYSROOT pointing at the sysroot.
 #
-# The tests run during each build (under qemu-arm for ARM) unless --no-check is given. Each
+# The tests run during each build (under qemu-arm or qemu-aarch64 for ARM) unless --no-check is given. Each
 # architecture's packages are checked afterwards (packaging/check-deb.sh: lintian, contents, fields,
 # ELF format, and on amd64 the manual pages against each program's --help).
 # --no-debug-info compiles with -g0 and makes no -dbgsym package: about a quarter less compile time
@@ -83,11 +83,11 @@ build_one() {
     ensure_packages $(cross_tools "$arch")
     sysroot="$AIRSEG_SYSROOTS/$arch"
     "$AIRSEG_ROOT/packaging/ensure-sysroot.sh" "$arch" "$sysroot"
-    if [ "$check" = 1 ] && ! enable_arm_binfmt; then
-      log "warning: binfmt_misc for qemu-arm is not available; tests that spawn helper programs may fail"
+    if [ "$check" = 1 ] && ! enable_arm_binfmt "$arch"; then
+      log "warning: binfmt_misc for $(qemu_for "$arch") is not available; tests that spawn helper programs may fail"
     fi
     dpkg_args+=(-a "$arch" -d)
-    # The tests do run: ctest through qemu-arm, helper programs through binfmt_misc.
+    # The tests do run: ctest through qemu-user, helper programs through binfmt_misc.
     [ "$check" = 0 ] || opts="$opts crossbuildcanrunhostbinaries"
     # dpkg-architecture checks that CC builds for the host architecture.
     env+=(CC="$(arch_triplet "$arch")-gcc" CXX="$(arch_triplet "$arch")-g++")
