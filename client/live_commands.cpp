@@ -42,6 +42,14 @@ bool wait_for_link(RadioClient& radio, const LiveOptions& o,
 
 }  // namespace
 
+std::string notes_text(const LiveOptions& o) {
+    std::string out;
+    for (const auto& note : o.notes) {
+        out += "\n" + note;
+    }
+    return out.empty() ? out : out + "\n";
+}
+
 void install_stop_handlers() {
     std::signal(SIGINT, [](int) { g_stop = 1; });
     std::signal(SIGTERM, [](int) { g_stop = 1; });
@@ -71,7 +79,7 @@ int run_radio_watch(RadioClient& radio, const LiveOptions& o) {
             std::cout << state.to_json(now).dump() << "\n" << std::flush;
         } else if (tty) {
             // Home, then each line cleared to its end, then the rest of the screen: no flicker.
-            std::string screen = state.render(now);
+            std::string screen = state.render(now) + notes_text(o);
             std::string framed = "\x1b[H";
             for (std::size_t start = 0; start < screen.size();) {
                 const auto nl = screen.find('\n', start);
@@ -80,7 +88,7 @@ int run_radio_watch(RadioClient& radio, const LiveOptions& o) {
             }
             std::cout << framed << "\x1b[J" << std::flush;
         } else {
-            std::cout << state.render(now) << "\n" << std::flush;
+            std::cout << state.render(now) << notes_text(o) << "\n" << std::flush;
         }
     }
     if (tty && !o.json) {

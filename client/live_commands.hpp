@@ -3,6 +3,7 @@
 // place), log (events and autopilot texts as they come) and joystick (operator input at a fixed rate).
 #include <chrono>
 #include <string>
+#include <vector>
 
 #include "client/radio_client.hpp"
 
@@ -14,6 +15,8 @@ struct LiveOptions {
     std::chrono::milliseconds refresh{500};
     /// Stop after this long (0: until Ctrl-C); for scripts and tests.
     std::chrono::milliseconds duration{0};
+    /// watch --note: lines shown under the live view on every refresh (the demo's hints stay on screen).
+    std::vector<std::string> notes;
 };
 
 /// Exit codes as everywhere in airsegctl: 0 done, 1 refused, 2 usage, 3 no link.
@@ -25,6 +28,9 @@ struct JoystickOptions {
     double rate_hz = 10;
 };
 int run_joystick(RadioClient& radio, const LiveOptions& options, const JoystickOptions& joystick);
+
+/// The --note lines as shown under a live view (empty without notes).
+std::string notes_text(const LiveOptions& options);
 
 /// Installs SIGINT/SIGTERM handlers that end the live commands cleanly.
 void install_stop_handlers();

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <unistd.h>
+#include <algorithm>
 #include <csignal>
 #include <cstdlib>
 #include <functional>
@@ -20,6 +21,7 @@
 #include "client/radio_client.hpp"
 #include "client/status_view.hpp"
 #include "client/vehicle_commands.hpp"
+#include "services/common/nearest_word.hpp"
 
 namespace {
 
@@ -51,10 +53,11 @@ const char* kUsageText =
     "\n"
     "Commands:\n"
     "  status             health of every service and the vehicle's state\n"
-    "  watch [--interval MS] [--duration MS]\n"
+    "  watch [--interval MS] [--duration MS] [--note TEXT]...\n"
     "                     a live view refreshed in place until Ctrl-C: over the radio from the telemetry\n"
     "                     the vehicle pushes (state, position, speed, battery, plan, link, events), locally\n"
-    "                     from the status document every --interval (default 1000 ms)\n"
+    "                     from the status document every --interval (default 1000 ms); each --note is a\n"
+    "                     line kept under the view\n"
     "  state STATE        PARKING | DIRECTED | MANUAL_NAVIGATION | WAYPOINT_NAVIGATION\n"
     "  param get NAME | param set NAME VALUE | param list\n"
     "                     the autopilot's parameters\n"
@@ -80,8 +83,17 @@ struct Options {
     std::vector<std::string> positional;
 };
 
+// The names a mistyped word is compared with, for "did you mean".
+const std::vector<std::string> kOptionNames{"--local", "--socket", "--link",    "--baud", "--mode",   "--udp",
+                                            "--key",   "--json",   "--timeout", "--help", "--version"};
+const std::vector<std::string> kCommandNames{"status", "watch",    "state",   "param", "rates",
+                                             "log",    "joystick", "request", "plan"};
+const std::vector<std::string> kLiveOptionNames{"--duration", "--interval", "--device", "--rate", "--note"};
+
+/// A bad command line in one line and where the help is: the whole help would push the reason off the
+/// screen.
 int usage_error(const std::string& message) {
-    std::cerr << "airsegctl: " << message << "\n\n" << kUsageText;
+    std::cerr << "airsegctl: " << message << "; see airsegctl --help\n";
     return kUsage;
 }
 
@@ -159,7 +171,7 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
             o.timeout_ms = ms;
         } else if (a.starts_with("-") && a.size() > 1) {
             if (o.positional.empty()) {
-                return usage_error("unknown option '" + a + "'");
+                return usage_error("unknown option '" + a + "'" + airseg::did_you_mean(a, kOptionNames));
             }
             o.positional.push_back(a);  // an option of the command itself (watch --duration MS, ...)
         } else {
@@ -203,11 +215,11 @@ int show_answer(const Options& o, const airseg::client::LocalAnswer& a,
 /// The local live view: the status document redrawn in place on a terminal, appended otherwise (for logs).
 int watch(const Options& o, const std::function<airseg::client::LocalAnswer(const nlohmann::json&)>& request,
           airseg::client::RadioClient* radio, std::chrono::milliseconds interval,
-          std::chrono::milliseconds duration) {
+          const airseg::client::LiveOptions& live) {
     const bool tty = ::isatty(STDOUT_FILENO) == 1;
     const auto began = std::chrono::steady_clock::now();
     while (!airseg::client::stop_requested() &&
-           (duration.count() == 0 || std::chrono::steady_clock::now() - began < duration)) {
+           (live.duration.count() == 0 || std::chrono::steady_clock::now() - began < live.duration)) {
         const auto started = std::chrono::steady_clock::now();
         auto answer = request({{"cmd", "status"}});
         std::string screen;
@@ -227,6 +239,7 @@ int watch(const Options& o, const std::function<airseg::client::LocalAnswer(cons
                           value.dump() + "\n";
             }
         }
+        screen += airseg::client::notes_text(live);
         std::cout << (tty ? "\x1b[H\x1b[2J" : "") << screen << std::flush;
         // Wait out the rest of the interval; over the radio keep the link serviced meanwhile.
         while (!airseg::client::stop_requested() && std::chrono::steady_clock::now() - started < interval) {
@@ -270,10 +283,15 @@ int live_command(const Options& o, Requester& client, airseg::client::RadioClien
             live.duration = std::chrono::milliseconds(static_cast<long>(n));
         } else if (a == "--interval" && cmd == "watch" && numeric) {
             interval_ms = static_cast<long>(n);
+        } else if (a == "--note" && cmd == "watch") {
+            live.notes.push_back(v);
         } else if (a == "--device" && cmd == "joystick") {
             stick.device = v;
         } else if (a == "--rate" && cmd == "joystick" && numeric && n <= 50) {
             stick.rate_hz = n;
+        } else if (std::find(kLiveOptionNames.begin(), kLiveOptionNames.end(), a) == kLiveOptionNames.end()) {
+            return usage_error(cmd + ": unknown option '" + a + "'" +
+                               airseg::did_you_mean(a, kLiveOptionNames));
         } else {
             return usage_error(cmd + ": bad option or value: " + a + " " + v);
         }
@@ -288,7 +306,7 @@ int live_command(const Options& o, Requester& client, airseg::client::RadioClien
         }
         return watch(
             o, [&](const nlohmann::json& r) { return client.request(r); }, nullptr,
-            std::chrono::milliseconds(interval_ms), live.duration);
+            std::chrono::milliseconds(interval_ms), live);
     }
     if (radio == nullptr) {
         return usage_error(cmd + " needs the radio link (--link or --udp): the vehicle pushes it");
@@ -355,5 +373,5 @@ int main(int argc, char** argv) {
         }
         return show_answer(o, client.request(*plan.request), plan.render);
     }
-    return usage_error("unknown command '" + cmd + "'");
+    return usage_error("unknown command '" + cmd + "'" + airseg::did_you_mean(cmd, kCommandNames));
 }

@@ -4,6 +4,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "services/common/nearest_word.hpp"
+
 namespace airseg::client {
 
 namespace {
@@ -95,6 +97,10 @@ PlanCommand plan_command(const std::vector<std::string>& args, bool local) {
         for (std::size_t i = 1; i < args.size(); ++i) {
             if (args[i] == "--paused") {
                 paused = true;
+            } else if (args[i].starts_with("--")) {
+                out.error = "plan load: unknown option '" + args[i] + "'" +
+                            did_you_mean(args[i], std::vector<std::string>{"--paused"});
+                return out;
             } else {
                 files.push_back(args[i]);
             }
@@ -126,7 +132,10 @@ PlanCommand plan_command(const std::vector<std::string>& args, bool local) {
             }
         }
     } else {
-        out.error = "unknown plan subcommand '" + sub + "' (load, append, show, skip, pause, resume)";
+        out.error =
+            "unknown plan subcommand '" + sub + "'" +
+            did_you_mean(sub, std::vector<std::string>{"load", "append", "show", "skip", "pause", "resume"}) +
+            " (load, append, show, skip, pause, resume)";
     }
     return out;
 }

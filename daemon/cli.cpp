@@ -5,6 +5,8 @@
 
 #include <sstream>
 
+#include "services/common/nearest_word.hpp"
+
 namespace airseg::daemon {
 namespace po = boost::program_options;
 
@@ -26,6 +28,21 @@ po::options_description describe() {
         ("help,h", "print this help and exit");
     // clang-format on
     return d;
+}
+
+/// A bad command line in one line, with the near miss of a mistyped option and where the help is: the
+/// whole help would push the reason off the screen.
+std::string usage_error(const std::string& message, const std::string& word = {}) {
+    std::string hint;
+    if (word.starts_with("--")) {
+        std::vector<std::string> names;
+        const auto options = describe();  // named: a temporary would die before the loop reads it
+        for (const auto& option : options.options()) {
+            names.push_back("--" + option->long_name());
+        }
+        hint = did_you_mean(word.substr(0, word.find('=')), names);
+    }
+    return fmt::format("airsegd: {}{}; see airsegd --help\n", message, hint);
 }
 
 }  // namespace
@@ -57,10 +74,15 @@ CliResult parse_cli(int argc, const char* const* argv) {
     try {
         po::store(po::command_line_parser(argc, argv).options(describe()).run(), vm);
         po::notify(vm);
+    } catch (const po::unknown_option& e) {
+        result.action = CliResult::Action::Exit;
+        result.exit_code = 2;
+        result.output = usage_error(e.what(), e.get_option_name());
+        return result;
     } catch (const po::error& e) {
         result.action = CliResult::Action::Exit;
         result.exit_code = 2;
-        result.output = fmt::format("airsegd: {}\n\n{}", e.what(), usage_text());
+        result.output = usage_error(e.what());
         return result;
     }
     if (vm.count("help")) {
@@ -85,8 +107,8 @@ CliResult parse_cli(int argc, const char* const* argv) {
         if (std::find(kLevels.begin(), kLevels.end(), level) == kLevels.end()) {
             result.action = CliResult::Action::Exit;
             result.exit_code = 2;
-            result.output = fmt::format("airsegd: --log-level: '{}' is not one of {}\n\n{}", level,
-                                        fmt::join(kLevels, ", "), usage_text());
+            result.output = usage_error(fmt::format("--log-level: '{}' is not one of {}{}", level,
+                                                    fmt::join(kLevels, ", "), did_you_mean(level, kLevels)));
             return result;
         }
         o.log_level = level;

@@ -4,13 +4,19 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
+#include <system_error>
 
 #include "daemon/autopilot_setup.hpp"
+#include "daemon/config_paths.hpp"
 #include "daemon/config_schema.hpp"
+#include "services/common/nearest_word.hpp"
 
 namespace airseg::daemon {
 namespace {
@@ -22,27 +28,11 @@ std::string location(const std::string& source, const YAML::Mark& mark) {
     return fmt::format("{}:{}:{}", source, mark.line + 1, mark.column + 1);
 }
 
-std::size_t edit_distance(const std::string& a, const std::string& b) {
-    std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
-    for (std::size_t j = 0; j <= b.size(); ++j) {
-        prev[j] = j;
-    }
-    for (std::size_t i = 1; i <= a.size(); ++i) {
-        cur[0] = i;
-        for (std::size_t j = 1; j <= b.size(); ++j) {
-            cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
-        }
-        std::swap(prev, cur);
-    }
-    return prev[b.size()];
-}
-
 /// "did you mean 'autopilot.port'?" for a near miss among the keys of the same section.
 std::string suggestion(const std::string& path) {
     const auto dot = path.rfind('.');
     const std::string section = dot == std::string::npos ? "" : path.substr(0, dot + 1);
-    std::string best;
-    std::size_t best_distance = 3;  // only close misses are worth suggesting
+    std::vector<std::string> candidates;
     for (const auto& spec : config_schema()) {
         std::string candidate = spec.path;
         if (!candidate.starts_with(section)) {
@@ -53,13 +43,9 @@ std::string suggestion(const std::string& path) {
         if (next_dot != std::string::npos) {
             candidate = candidate.substr(0, next_dot);
         }
-        const auto d = edit_distance(path, candidate);
-        if (d < best_distance) {
-            best_distance = d;
-            best = candidate;
-        }
+        candidates.push_back(std::move(candidate));
     }
-    return best.empty() ? "" : fmt::format(" (did you mean '{}'?)", best);
+    return did_you_mean(path, candidates);
 }
 
 class Walker {
@@ -176,6 +162,9 @@ void check_consistency(const Config& c, const std::string& source,
         errors.push_back({at("groundlink.monitor_key_file"), "groundlink.monitor_key_file",
                           "needs groundlink.key_file (the control key)"});
     }
+    for (auto& problem : port_problems(c)) {
+        errors.push_back({at(problem.key), problem.key, std::move(problem.message)});
+    }
     // The autopilot layer's own rules, reported at the key they name.
     for (const auto& problem : autopilot_setup(c).problems) {
         const std::string key = problem_key(problem);
@@ -196,38 +185,93 @@ std::string ConfigError::to_string() const {
     return fmt::format("{}: {}: {}", where, key, message);
 }
 
-ConfigResult load_config_text(std::string_view text, const std::string& source,
-                              const std::vector<std::string>& overrides) {
+namespace {
+
+struct Source {
+    std::string text;
+    std::string name;  // a file name, in error locations
+};
+
+/// Reads a whole file; on failure the error names the file and the cause (permission denied, ...).
+std::optional<Source> read_source(const std::string& path, std::vector<ConfigError>& errors) {
+    std::ifstream in(path);
+    if (!in) {
+        const int error = errno;
+        errors.push_back({path, "",
+                          fmt::format("cannot read the configuration file: {}",
+                                      error != 0 ? std::generic_category().message(error) : "unreadable")});
+        return std::nullopt;
+    }
+    std::stringstream buffer;
+    buffer << in.rdbuf();
+    return Source{buffer.str(), path};
+}
+
+/// Each source in order over the defaults (a key in a later one wins), then the overrides, then the rules
+/// between keys. `main` names the configuration where no single key is to blame.
+ConfigResult load_sources(const std::vector<Source>& sources, const std::string& main,
+                          const std::vector<std::string>& overrides, std::vector<ConfigError> errors = {}) {
     ConfigResult result;
+    result.errors = std::move(errors);
     std::map<std::string, std::string> where;
-    try {
-        const YAML::Node root = YAML::Load(std::string(text));
-        if (root.IsDefined() && !root.IsNull()) {
-            Walker(source, result.config, result.errors, where).walk(root, "");
+    for (const auto& source : sources) {
+        try {
+            const YAML::Node root = YAML::Load(source.text);
+            if (root.IsDefined() && !root.IsNull()) {
+                Walker(source.name, result.config, result.errors, where).walk(root, "");
+            }
+        } catch (const YAML::ParserException& e) {
+            result.errors.push_back(
+                {location(source.name, e.mark), "", fmt::format("YAML syntax error: {}", e.msg)});
         }
-    } catch (const YAML::ParserException& e) {
-        result.errors.push_back({location(source, e.mark), "", fmt::format("YAML syntax error: {}", e.msg)});
-        return result;
     }
     for (const auto& o : overrides) {
         apply_override(o, result.config, result.errors, where);
     }
     if (result.errors.empty()) {
-        check_consistency(result.config, source, where, result.errors);
+        check_consistency(result.config, main, where, result.errors);
     }
     return result;
 }
 
+}  // namespace
+
+ConfigResult load_config_text(std::string_view text, const std::string& source,
+                              const std::vector<std::string>& overrides) {
+    return load_sources({Source{std::string(text), source}}, source, overrides);
+}
+
+std::vector<std::string> drop_in_files(const std::string& path) {
+    namespace fs = std::filesystem;
+    std::vector<std::string> files;
+    std::error_code ec;
+    const fs::path dir = fs::path(path).parent_path() / "conf.d";
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+        // Editors' backups (x.yaml~, .x.yaml.swp) and dpkg's leftovers (x.yaml.dpkg-old) end otherwise.
+        const auto name = it->path().filename().string();
+        if (it->path().extension() == ".yaml" && !name.starts_with(".")) {
+            files.push_back(it->path().string());
+        }
+    }
+    std::sort(files.begin(), files.end());
+    return files;
+}
+
 ConfigResult load_config_file(const std::string& path, const std::vector<std::string>& overrides) {
-    std::ifstream in(path);
-    if (!in) {
+    std::vector<ConfigError> errors;
+    auto main = read_source(path, errors);
+    if (!main) {
         ConfigResult result;
-        result.errors.push_back({path, "", "cannot read the configuration file"});
+        result.errors = std::move(errors);
         return result;
     }
-    std::stringstream buffer;
-    buffer << in.rdbuf();
-    return load_config_text(buffer.str(), path, overrides);
+    std::vector<Source> sources{std::move(*main)};
+    for (const auto& file : drop_in_files(path)) {
+        if (auto source = read_source(file, errors)) {
+            sources.push_back(std::move(*source));
+        }
+    }
+    return load_sources(sources, path, overrides, std::move(errors));
 }
 
 std::vector<ConfigChange> diff_config(const Config& before, const Config& after) {

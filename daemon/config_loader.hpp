@@ -23,8 +23,13 @@ struct ConfigResult {
     bool ok() const { return errors.empty(); }
 };
 
-/// Loads `path`, then applies each "key=value" override in order.
+/// Loads `path`, then the drop-in files beside it (drop_in_files), then applies each "key=value" override
+/// in order. A key set again later wins; every error names the file (or --set) it is in.
 ConfigResult load_config_file(const std::string& path, const std::vector<std::string>& overrides = {});
+
+/// The local settings merged over `path`: conf.d/*.yaml in the same directory, in name order, so that the
+/// packaged file stays as shipped and upgrades never ask about it.
+std::vector<std::string> drop_in_files(const std::string& path);
 
 /// Same from text; `source` names it in error locations.
 ConfigResult load_config_text(std::string_view text, const std::string& source,

@@ -7,6 +7,7 @@
 #include "daemon/app.hpp"
 #include "daemon/cli.hpp"
 #include "daemon/config_loader.hpp"
+#include "daemon/config_paths.hpp"
 #include "daemon/logging.hpp"
 
 namespace {
@@ -31,7 +32,16 @@ int main(int argc, char** argv) {
         return kExitConfig;
     }
     if (cli.options.check_config) {
-        std::cout << "airsegd: " << cli.options.config_path << ": configuration is valid\n";
+        // Valid, yet bound to fail under the unit's ProtectSystem=strict: said, not refused (a run by hand,
+        // the demo, may write anywhere).
+        for (const auto& w : unwritable_path_warnings(loaded.config)) {
+            std::cerr << "airsegd: warning: " << w.key << ": " << w.message << "\n";
+        }
+        std::cout << "airsegd: " << cli.options.config_path;
+        for (const auto& drop_in : drop_in_files(cli.options.config_path)) {
+            std::cout << " + " << drop_in;
+        }
+        std::cout << ": configuration is valid\n";
         return 0;
     }
     if (cli.options.log_level) {

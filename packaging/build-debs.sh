@@ -1,13 +1,15 @@
 #!/bin/bash
-# build-debs.sh [--no-check] [--no-debug-info] [--clean] ARCH...
+# build-debs.sh [--no-check] [--no-debug-info] [--clean] [ARCH...]
 #
-# Builds the airseg .deb for each ARCH (amd64, armhf, armel) on Debian 12 from Debian packages
-# only, and writes it to dist/. amd64 is built natively; armhf and armel are cross-built with the
+# Builds the airseg .debs (airsegd, airseg-client, airseg-sim, and the transitional airseg) for each
+# ARCH (default: every one, amd64 armhf armel arm64) on Debian 12 from Debian packages only, and writes
+# them to dist/. amd64 is built natively; armhf, armel and arm64 are cross-built with the
 # Debian cross compilers against a sysroot (packaging/make-sysroot.sh), without multiarch:
 # `dpkg-buildpackage -a ARCH -d` with AIRSEG_SYSROOT pointing at the sysroot.
 #
-# The tests run during each build (under qemu-arm for ARM) unless --no-check is given. Each
-# package is checked afterwards (packaging/check-deb.sh: lintian, fields, ELF format).
+# The tests run during each build (under qemu-arm or qemu-aarch64 for ARM) unless --no-check is given. Each
+# architecture's packages are checked afterwards (packaging/check-deb.sh: lintian, contents, fields,
+# ELF format, and on amd64 the manual pages against each program's --help).
 # --no-debug-info compiles with -g0 and makes no -dbgsym package: about a quarter less compile time
 # for CI, and the same machine code (GCC's -g never changes the generated code).
 # Work directories: build-pkg-ARCH/. AIRSEG_SOURCE_DIR packages another tree. Missing build tools
@@ -31,12 +33,12 @@ for a in "$@"; do
     --no-check) check=0 ;;
     --no-debug-info) debug_info=0 ;;
     --clean) clean=1 ;;
-    -h|--help) sed -n '2,21p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
     -*) die "unknown option $a" ;;
     *) arch_triplet "$a" >/dev/null; arches+=("$a") ;;
   esac
 done
-[ ${#arches[@]} -gt 0 ] || die "usage: $0 [--no-check] [--no-debug-info] [--clean] ARCH... (amd64 armhf armel)"
+[ ${#arches[@]} -gt 0 ] || arches=("${AIRSEG_ARCHES[@]}")
 
 build_arch=$(dpkg --print-architecture)
 [ "$build_arch" = amd64 ] || die "this script builds on amd64 (this machine is $build_arch)"
@@ -81,11 +83,11 @@ build_one() {
     ensure_packages $(cross_tools "$arch")
     sysroot="$AIRSEG_SYSROOTS/$arch"
     "$AIRSEG_ROOT/packaging/ensure-sysroot.sh" "$arch" "$sysroot"
-    if [ "$check" = 1 ] && ! enable_arm_binfmt; then
-      log "warning: binfmt_misc for qemu-arm is not available; tests that spawn helper programs may fail"
+    if [ "$check" = 1 ] && ! enable_arm_binfmt "$arch"; then
+      log "warning: binfmt_misc for $(qemu_for "$arch") is not available; tests that spawn helper programs may fail"
     fi
     dpkg_args+=(-a "$arch" -d)
-    # The tests do run: ctest through qemu-arm, helper programs through binfmt_misc.
+    # The tests do run: ctest through qemu-user, helper programs through binfmt_misc.
     [ "$check" = 0 ] || opts="$opts crossbuildcanrunhostbinaries"
     # dpkg-architecture checks that CC builds for the host architecture.
     env+=(CC="$(arch_triplet "$arch")-gcc" CXX="$(arch_triplet "$arch")-g++")
@@ -99,7 +101,7 @@ build_one() {
   if [ -d "$obj" ] && [ "$(cat "$obj/.airseg-build-options" 2>/dev/null)" != "$key" ]; then
     rm -rf "$obj"
   fi
-  rm -f "$work"/airseg*_"$arch".* "$work"/airseg*_"$arch".*deb
+  rm -f "$work"/*.deb "$work"/*.ddeb "$work"/*.buildinfo "$work"/*.changes
   local start=$SECONDS
   # debhelper gives the build a HOME of its own inside debian/, which would start ccache empty.
   export CCACHE_DIR=${CCACHE_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/ccache}
@@ -114,12 +116,20 @@ build_one() {
     # ctest's closing lines, for whoever reads this output.
     grep -E '^[0-9]+% tests passed|^Total Test time' "$work/build.log" | sed "s/^/$arch: /" || true
   fi
-  rm -f "$AIRSEG_ROOT"/dist/airseg_*_"$arch".deb "$AIRSEG_ROOT"/dist/debug/airseg-dbgsym_*_"$arch".*deb
-  cp "$work/airseg_${version}_$arch.deb" "$AIRSEG_ROOT/dist/"
-  # Debug symbols (for crash analysis on the vehicle) apart from the packages to install.
+  # The packages to install in dist/, debug symbols (for crash analysis on the vehicle) apart in dist/debug/.
   mkdir -p "$AIRSEG_ROOT/dist/debug"
-  cp "$work"/airseg-dbgsym_"$version"_"$arch".*deb "$AIRSEG_ROOT/dist/debug/" 2>/dev/null || true
-  "$AIRSEG_ROOT/packaging/check-deb.sh" "$arch" "$AIRSEG_ROOT/dist/airseg_${version}_$arch.deb"
+  local -a debs=()
+  local deb
+  rm -f "$AIRSEG_ROOT"/dist/debug/*-dbgsym_*_"$arch".*deb
+  for deb in "$work"/*_"$version"_"$arch".*deb "$work"/*_"$version"_all.deb; do
+    [ -f "$deb" ] || continue
+    case "$deb" in
+      *-dbgsym_*) cp "$deb" "$AIRSEG_ROOT/dist/debug/" ;;
+      *) rm -f "$AIRSEG_ROOT"/dist/"$(basename "${deb%%_*}")"_*_"$arch".deb
+         cp "$deb" "$AIRSEG_ROOT/dist/"; debs+=("$AIRSEG_ROOT/dist/$(basename "$deb")") ;;
+    esac
+  done
+  "$AIRSEG_ROOT/packaging/check-deb.sh" "$arch" "${debs[@]}"
 }
 
 for arch in "${arches[@]}"; do

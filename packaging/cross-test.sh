@@ -1,11 +1,11 @@
 #!/bin/bash
 # cross-test.sh ARCH [CTEST_ARGS...]
 #
-# Cross-builds the whole test suite for ARCH (armhf, armel) with packaging/toolchain-ARCH.cmake
-# against sysroots/ARCH, and runs it with ctest under qemu-arm-static -L SYSROOT (the toolchain
-# file's CMAKE_CROSSCOMPILING_EMULATOR, which gtest_discover_tests also uses to list the cases).
-# Tests that spawn helper programs (simulators) start ARM binaries: binfmt_misc hands those to
-# qemu-arm, and QEMU_LD_PREFIX (set here) points it at the sysroot.
+# Cross-builds the whole test suite for ARCH (armhf, armel, arm64) with packaging/toolchain-ARCH.cmake
+# against sysroots/ARCH, and runs it with ctest under qemu-arm-static (arm64: qemu-aarch64-static)
+# -L SYSROOT (the toolchain file's CMAKE_CROSSCOMPILING_EMULATOR, which gtest_discover_tests also uses
+# to list the cases). Tests that spawn helper programs (simulators) start ARM binaries: binfmt_misc
+# hands those to qemu, and QEMU_LD_PREFIX (set here) points it at the sysroot.
 #
 # Build directory: build-pkg-cross-ARCH (AIRSEG_BUILD_DIR to change). AIRSEG_SOURCE_DIR builds
 # another source tree (default: this one). AIRSEG_TARGETS="a b" builds only those targets (then
@@ -15,7 +15,7 @@ set -euo pipefail
 
 [ $# -ge 1 ] || die "usage: $0 ARCH [CTEST_ARGS...]"
 arch=$1; shift
-case "$arch" in armhf|armel) ;; *) die "cross-test.sh runs armhf or armel, not '$arch'" ;; esac
+case "$arch" in armhf|armel|arm64) ;; *) die "cross-test.sh runs armhf, armel or arm64, not '$arch'" ;; esac
 src=${AIRSEG_SOURCE_DIR:-$AIRSEG_ROOT}
 build=${AIRSEG_BUILD_DIR:-$AIRSEG_ROOT/build-pkg-cross-$arch}
 sysroot=$AIRSEG_SYSROOTS/$arch
@@ -24,8 +24,8 @@ jobs=${AIRSEG_JOBS:-2}
 # shellcheck disable=SC2046
 ensure_packages cmake ninja-build pkgconf ccache $(cross_tools "$arch")
 "$AIRSEG_ROOT/packaging/ensure-sysroot.sh" "$arch" "$sysroot"
-if enable_arm_binfmt; then
-  log "binfmt_misc runs ARM programs through qemu-arm"
+if enable_arm_binfmt "$arch"; then
+  log "binfmt_misc runs $arch programs through $(qemu_for "$arch")"
 else
   log "warning: binfmt_misc is not available: only test binaries run (through the emulator);" \
       "a test that spawns an ARM helper program fails"

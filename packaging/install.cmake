@@ -47,9 +47,9 @@ set(_airseg_man_dir ${CMAKE_CURRENT_LIST_DIR}/man)
 set(_airseg_programs
     "airsegd|${CMAKE_INSTALL_SBINDIR}|airsegd.8"
     "airsegctl|${CMAKE_INSTALL_BINDIR}|airsegctl.1"
-    "airseg-apmsim|${CMAKE_INSTALL_BINDIR}|-"
-    "airseg-linksim|${CMAKE_INSTALL_BINDIR}|-"
-    "airseg-mavdump|${CMAKE_INSTALL_BINDIR}|-")
+    "airseg-apmsim|${CMAKE_INSTALL_BINDIR}|airseg-apmsim.1"
+    "airseg-linksim|${CMAKE_INSTALL_BINDIR}|airseg-linksim.1"
+    "airseg-mavdump|${CMAKE_INSTALL_BINDIR}|airseg-mavdump.1")
 foreach(entry IN LISTS _airseg_programs)
   string(REPLACE "|" ";" entry "${entry}")
   list(GET entry 0 program)

@@ -7,13 +7,18 @@ AIRSEG_SYSROOTS=${AIRSEG_SYSROOTS:-$AIRSEG_ROOT/sysroots}
 log() { printf '%s: %s\n' "$(basename "$0")" "$*" >&2; }
 die() { log "error: $*"; exit 1; }
 
+# Every architecture the packages are built for (build-debs.sh without arguments).
+# shellcheck disable=SC2034
+AIRSEG_ARCHES=(amd64 armhf armel arm64)
+
 # GNU triplet of a Debian architecture this project builds for.
 arch_triplet() {
   case "$1" in
     amd64) echo x86_64-linux-gnu ;;
     armhf) echo arm-linux-gnueabihf ;;
     armel) echo arm-linux-gnueabi ;;
-    *) die "unsupported architecture '$1' (expected amd64, armhf or armel)" ;;
+    arm64) echo aarch64-linux-gnu ;;
+    *) die "unsupported architecture '$1' (expected amd64, armhf, armel or arm64)" ;;
   esac
 }
 
@@ -49,20 +54,32 @@ cross_tools() {
   case "$1" in
     armhf) echo g++-arm-linux-gnueabihf ;;
     armel) echo g++-arm-linux-gnueabi ;;
+    arm64) echo g++-aarch64-linux-gnu ;;
   esac
   echo mmdebstrap qemu-user-static binfmt-support
 }
 
-# Lets the kernel hand ARM ELF files to qemu-arm-static, so that a test which spawns a helper
+# The qemu-user emulator that runs ARCH's programs: qemu-arm for armhf and armel, qemu-aarch64 for arm64.
+qemu_for() {
+  case "$1" in
+    arm64) echo qemu-aarch64 ;;
+    *) echo qemu-arm ;;
+  esac
+}
+
+# Lets the kernel hand ARCH's ELF files to qemu-user-static, so that a test which spawns a helper
 # binary (a simulator) runs it under the emulator too. Returns non-zero when that is impossible
 # (no root, no binfmt_misc); tests then run only through CMAKE_CROSSCOMPILING_EMULATOR.
 enable_arm_binfmt() {
-  if [ -r /proc/sys/fs/binfmt_misc/qemu-arm ] && grep -qx enabled /proc/sys/fs/binfmt_misc/qemu-arm; then
+  local qemu entry
+  qemu=$(qemu_for "${1:-armhf}")
+  entry=/proc/sys/fs/binfmt_misc/$qemu
+  if [ -r "$entry" ] && grep -qx enabled "$entry"; then
     return 0
   fi
   [ "$(id -u)" -eq 0 ] || return 1
-  update-binfmts --enable qemu-arm >/dev/null 2>&1 || true
-  [ -r /proc/sys/fs/binfmt_misc/qemu-arm ] && grep -qx enabled /proc/sys/fs/binfmt_misc/qemu-arm
+  update-binfmts --enable "$qemu" >/dev/null 2>&1 || true
+  [ -r "$entry" ] && grep -qx enabled "$entry"
 }
 
 ccache_launcher_args() {

@@ -1,7 +1,7 @@
 #!/bin/bash
 # make-sysroot.sh ARCH [DIR]
 #
-# Builds a Debian 12 sysroot for ARCH (armhf, armel) holding the project's -dev packages, for the
+# Builds a Debian 12 sysroot for ARCH (armhf, armel, arm64) holding the project's -dev packages, for the
 # cross compilers (--sysroot), for qemu-arm-static (-L) and for dpkg-shlibdeps (see
 # sysroot-dpkg-db.sh). Default DIR: sysroots/ARCH at the top of the tree. Takes about 10 s.
 # Set AIRSEG_MIRROR to use another Debian mirror.

@@ -1,9 +1,9 @@
-# Cross-compiling for 32-bit ARM Debian against a sysroot made by packaging/make-sysroot.sh.
-# Included by toolchain-armhf.cmake / toolchain-armel.cmake, which set AIRSEG_TARGET_TRIPLET and
-# AIRSEG_TARGET_ARCH first.
+# Cross-compiling for ARM Debian (armhf, armel, arm64) against a sysroot made by packaging/make-sysroot.sh.
+# Included by toolchain-armhf.cmake / toolchain-armel.cmake / toolchain-arm64.cmake, which set
+# AIRSEG_TARGET_TRIPLET and AIRSEG_TARGET_ARCH first (arm64 also AIRSEG_TARGET_PROCESSOR and AIRSEG_QEMU).
 #
 # AIRSEG_SYSROOT (cache variable or environment) names the sysroot; default: sysroots/<arch> at
-# the top of the tree. Test executables run through qemu-arm-static -L <sysroot>.
+# the top of the tree. Test executables run through qemu-arm-static (qemu-aarch64-static) -L <sysroot>.
 
 if(NOT AIRSEG_SYSROOT)
   if(DEFINED ENV{AIRSEG_SYSROOT} AND NOT "$ENV{AIRSEG_SYSROOT}" STREQUAL "")
@@ -19,7 +19,13 @@ endif()
 list(APPEND CMAKE_TRY_COMPILE_PLATFORM_VARIABLES AIRSEG_SYSROOT)
 
 set(CMAKE_SYSTEM_NAME Linux)
-set(CMAKE_SYSTEM_PROCESSOR arm)
+if(NOT AIRSEG_TARGET_PROCESSOR)
+  set(AIRSEG_TARGET_PROCESSOR arm)
+endif()
+if(NOT AIRSEG_QEMU)
+  set(AIRSEG_QEMU qemu-arm)
+endif()
+set(CMAKE_SYSTEM_PROCESSOR ${AIRSEG_TARGET_PROCESSOR})
 set(CMAKE_LIBRARY_ARCHITECTURE ${AIRSEG_TARGET_TRIPLET})
 set(CMAKE_C_COMPILER ${AIRSEG_TARGET_TRIPLET}-gcc)
 set(CMAKE_CXX_COMPILER ${AIRSEG_TARGET_TRIPLET}-g++)
@@ -50,5 +56,5 @@ set(CMAKE_C_STANDARD_LIBRARIES "-Wl,--push-state,--as-needed,-latomic,--pop-stat
 # ctest (and gtest_discover_tests, which lists the cases by running each test binary) runs ARM
 # executables through this emulator. QEMU_LD_PREFIX makes binaries those tests spawn through
 # binfmt_misc find the same sysroot; packaging/cross-test.sh sets it.
-find_program(AIRSEG_QEMU_ARM qemu-arm-static qemu-arm REQUIRED)
-set(CMAKE_CROSSCOMPILING_EMULATOR "${AIRSEG_QEMU_ARM};-L;${AIRSEG_SYSROOT}")
+find_program(AIRSEG_QEMU_PROGRAM ${AIRSEG_QEMU}-static ${AIRSEG_QEMU} REQUIRED)
+set(CMAKE_CROSSCOMPILING_EMULATOR "${AIRSEG_QEMU_PROGRAM};-L;${AIRSEG_SYSROOT}")

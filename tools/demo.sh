@@ -1,13 +1,30 @@
 #!/usr/bin/env bash
+# tools/demo.sh [--resume] [--duration MS]
+#
 # The bench on one machine: airseg-linksim (a 57600-baud radio pair with a little loss) between airsegd and
 # the ground, the simulated autopilot when it is built (airseg-apmsim), airsegd on config/airseg.yaml, and
 # airsegctl's live view over the radio in the foreground. Ctrl-C stops everything.
-# Everything runs under build/demo/ (ptys, sockets, state, logs); no root is needed.
+# Everything runs under build/demo/ (ptys, sockets, state, logs; AIRSEG_DEMO_DIR to put it elsewhere); no
+# root is needed. Each run starts clean: a flight plan left by an earlier run is dropped unless --resume is
+# given (airsegd would otherwise drive it again at once). --duration MS ends the demo by itself (for tests).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+resume=0
+watch_args=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --resume) resume=1; shift ;;
+    --duration) watch_args+=(--duration "${2:?--duration needs MS}"); shift 2 ;;
+    -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
+    *) echo "demo: unknown argument '$1'; see tools/demo.sh --help" >&2; exit 2 ;;
+  esac
+done
 build=${AIRSEG_BUILD_DIR:-build}
-run_dir="$(pwd)/$build/demo"
+run_dir=${AIRSEG_DEMO_DIR:-"$(pwd)/$build/demo"}
 mkdir -p "$run_dir"
+if [ "$resume" = 0 ]; then
+  rm -rf "$run_dir/state"
+fi
 pids=()
 cleanup() {
   for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done
@@ -39,6 +56,9 @@ fi
   > "$run_dir/airsegd.log" 2>&1 &
 pids+=($!)
 
-echo "demo: logs in $run_dir; on-board status: $build/client/airsegctl --local --socket $run_dir/status.sock status"
-echo "demo: a flight plan: $build/client/airsegctl --local --socket $run_dir/status.sock plan load config/plans/rover-survey.yaml"
-"$build/client/airsegctl" --link "$run_dir/radio-ground" --baud 57600 --timeout 5000 watch
+ctl="$build/client/airsegctl --local --socket $run_dir/status.sock"
+# The hints stay under the live view (printed before it, the view's first refresh would clear them).
+"$build/client/airsegctl" --link "$run_dir/radio-ground" --baud 57600 --timeout 5000 watch "${watch_args[@]}" \
+  --note "demo: logs in $run_dir; Ctrl-C stops it all" \
+  --note "demo: from another terminal: $ctl status" \
+  --note "demo: a flight plan:        $ctl plan load config/plans/rover-survey.yaml"

@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "services/common/nearest_word.hpp"
 #include "services/flightplan/plan_validator.hpp"
 
 namespace airseg::flightplan {
@@ -117,7 +118,8 @@ void Loader::check_keys(const YAML::Node& map, const std::string& path,
             std::string list;
             for (auto a : allowed)
                 list += (list.empty() ? "" : ", ") + std::string(a);
-            error(it->first, path + "." + key, "unknown field (expected one of: " + list + ")");
+            error(it->first, path + "." + key,
+                  "unknown field" + did_you_mean(key, allowed) + " (expected one of: " + list + ")");
         }
     }
 }
@@ -420,8 +422,11 @@ void Loader::parse_element(const YAML::Node& item, std::uint32_t parent, const s
                 plan_.nodes[id].goto_target_name = *target;
         }
     } else {
+        static constexpr std::string_view kKinds[] = {"waypoint", "hold",   "scan",  "orbit",
+                                                      "speed",    "repeat", "block", "goto"};
         error(item.begin()->first, where,
-              "unknown element (expected one of: waypoint, hold, scan, orbit, speed, repeat, block, goto)");
+              "unknown element" + did_you_mean(kind, kKinds) +
+                  " (expected one of: waypoint, hold, scan, orbit, speed, repeat, block, goto)");
     }
 }
 

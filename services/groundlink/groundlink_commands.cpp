@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "services/flightplan/plan_progress.hpp"
+#include "services/groundlink/event_text.hpp"
 #include "services/groundlink/groundlink_messages.hpp"
 #include "services/groundlink/groundlink_service.hpp"
 
@@ -15,14 +16,6 @@ namespace {
 
 double rounded(double v) {
     return std::round(v * 1000) / 1000;
-}
-
-protocol::Event::Severity severity_of(int mav_severity) {
-    // MAV_SEVERITY: 0..3 emergency..error, 4 warning, 5.. notice, info, debug.
-    if (mav_severity <= 3) {
-        return protocol::Event::Severity::error;
-    }
-    return mav_severity == 4 ? protocol::Event::Severity::warning : protocol::Event::Severity::info;
 }
 
 }  // namespace
@@ -135,16 +128,11 @@ void GroundlinkService::subscribe_bus() {
             arm_telemetry();
             publish_status();
         }));
-    subscriptions_.push_back(
-        bus.subscribe<autopilot::ModeChanged>(strand(), [this](const autopilot::ModeChanged& m) {
-            send_event(Sev::info,
-                       fmt::format("{} -> {} ({} -> {}{})", autopilot::to_string(m.from),
-                                   autopilot::to_string(m.to), m.from_mode, m.to_mode,
-                                   m.cause == autopilot::ModeChangeCause::External ? ", external" : ""));
-        }));
+    subscriptions_.push_back(bus.subscribe<autopilot::ModeChanged>(
+        strand(), [this](const autopilot::ModeChanged& m) { send_event(Sev::info, mode_change_text(m)); }));
     subscriptions_.push_back(
         bus.subscribe<autopilot::StatusText>(strand(), [this](const autopilot::StatusText& t) {
-            send_event(severity_of(t.severity), "autopilot: " + t.text);
+            send_event(status_text_severity(t.severity, t.text), "autopilot: " + t.text);
         }));
     subscriptions_.push_back(bus.subscribe<autopilot::LinkUp>(
         strand(), [this](const autopilot::LinkUp&) { send_event(Sev::info, "autopilot link up"); }));

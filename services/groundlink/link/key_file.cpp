@@ -1,19 +1,58 @@
 #include "services/groundlink/link/key_file.hpp"
 
+#include <fcntl.h>
 #include <fmt/format.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cctype>
-#include <fstream>
-#include <iterator>
+#include <cerrno>
+#include <system_error>
 
 namespace airseg::groundlink {
 
+namespace {
+
+/// The cause in the operator's words. Permission denied is the usual one on a vehicle: the key was
+/// copied as root, and the daemon runs as user airseg.
+std::string cannot_read(const std::string& path, int error) {
+    if (error == EACCES || error == EPERM) {
+        return fmt::format(
+            "key file {}: permission denied: the user airsegd runs as cannot read it (the service runs as "
+            "airseg: chown airseg {})",
+            path, path);
+    }
+    return fmt::format("key file {}: cannot read it: {}", path, std::generic_category().message(error));
+}
+
+}  // namespace
+
 KeyFileResult read_key_file(const std::string& path) {
     KeyFileResult out;
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY);
+    if (fd < 0) {
+        out.error = cannot_read(path, errno);
+        return out;
+    }
     struct stat st {};
-    if (::stat(path.c_str(), &st) != 0) {
-        out.error = fmt::format("key file {}: cannot read it", path);
+    std::string content;
+    int read_error = ::fstat(fd, &st) == 0 ? 0 : errno;
+    // A key is 32 bytes, or 64 hexadecimal characters with some whitespace: a few KiB is plenty.
+    char buffer[4096];
+    while (read_error == 0 && content.size() <= sizeof buffer) {
+        const auto n = ::read(fd, buffer, sizeof buffer);
+        if (n < 0 && errno == EINTR) {
+            continue;
+        }
+        if (n <= 0) {
+            read_error = n < 0 ? errno : 0;
+            break;
+        }
+        content.append(buffer, static_cast<std::size_t>(n));
+    }
+    ::close(fd);
+    if (read_error != 0) {
+        out.error = cannot_read(path, read_error);
         return out;
     }
     if ((st.st_mode & 077) != 0) {
@@ -22,8 +61,6 @@ KeyFileResult read_key_file(const std::string& path) {
                         path, st.st_mode & 07777, path);
         return out;
     }
-    std::ifstream in(path, std::ios::binary);
-    const std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     std::array<std::uint8_t, 32> key{};
     if (content.size() == key.size()) {
         for (std::size_t i = 0; i < key.size(); ++i) {

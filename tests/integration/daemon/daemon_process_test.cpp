@@ -225,6 +225,24 @@ TEST_F(DaemonProcess, ClientExitCodes) {
     EXPECT_NE(help.out.find("Exit codes"), std::string::npos);
 }
 
+// A usage error is one line with the near miss and where the help is, not the whole help.
+TEST_F(DaemonProcess, ClientUsageErrorsAreOneLineWithTheNearMiss) {
+    const std::vector<std::pair<std::vector<std::string>, std::string>> cases{
+        {{"stauts"}, "did you mean 'status'?"},
+        {{"--jsn", "status"}, "did you mean '--json'?"},
+        {{"watch", "--duratoin", "100"}, "did you mean '--duration'?"},
+        {{"plan", "laod", "x.yaml"}, "did you mean 'load'?"},
+        {{"plan", "load", "x.yaml", "--pasued"}, "did you mean '--paused'?"},
+    };
+    for (const auto& [args, hint] : cases) {
+        const auto r = ctl(args);
+        EXPECT_EQ(r.exit_code, 2) << args[0];
+        EXPECT_NE(r.err.find(hint), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("see airsegctl --help"), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "not one line: " << r.err;
+    }
+}
+
 TEST_F(DaemonProcess, UnknownCommandsAreRefusedByTheDaemon) {
     Subprocess daemon(daemon_args(), env(), dir.path());
     ASSERT_TRUE(notify.wait_for("READY=1", 10s)) << daemon.err();

@@ -75,7 +75,7 @@ TEST(FlightplanLoader, ReportsEveryErrorAtOnceWithLocation) {
         "geofence, reactions, elements, blocks)",
         "broken.yaml:5:23: plan.elements[0].waypoint.lat: must be between -90 and 90 (got 95)",
         "broken.yaml:8:18: plan.elements[1].scan.spacing: must be > 0 (got 0)",
-        "broken.yaml:9:39: plan.elements[2].waypoint.sped: unknown field (expected one of: name, lat, lon, "
+        "broken.yaml:9:39: plan.elements[2].waypoint.sped: unknown field (did you mean 'speed'?) (expected one of: name, lat, lon, "
         "alt, "
         "speed, radius)",
         "broken.yaml:11:13: plan.elements[4].hold: needs exactly one of: seconds, until_released: true",
