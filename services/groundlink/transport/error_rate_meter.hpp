@@ -42,6 +42,11 @@ class ErrorRateMeter {
     bool last_bad_ = false;
     double after_bad_ = 0.0;      // frames that followed a bad one
     double bad_after_bad_ = 0.0;  // ... and were bad too
+    // The estimate is asked for after every input but changes only with a frame: computed once per change
+    // (boards without an FPU pay for every exp()).
+    mutable bool stale_ = true;
+    mutable std::optional<double> estimate_;
+    [[nodiscard]] std::optional<double> estimate() const;
 };
 
 }  // namespace airseg::groundlink

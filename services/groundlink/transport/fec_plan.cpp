@@ -32,20 +32,22 @@ std::size_t parity_for(std::size_t n, double survival, double success) {
     if (survival <= 0.0) {
         return kMaxShards;
     }
-    const double ls = std::log(survival);
-    const double lf = std::log1p(-survival);
+    const double ratio = survival / (1.0 - survival);
     // At fewer than n / survival shards the mean falls short of n and the success stays below one half: the
     // search starts just under there.
-    const auto from = static_cast<std::size_t>(std::max(static_cast<double>(n), static_cast<double>(n) / survival - 2.0));
+    const auto from =
+        static_cast<std::size_t>(std::max(static_cast<double>(n), static_cast<double>(n) / survival - 2.0));
     for (std::size_t total = from; total <= kMaxShards; ++total) {
-        // P(at least n of `total` arrive), summed in log space from the binomial terms.
+        // P(at least n of `total` arrive): the binomial term at n from logarithms (once: boards without an
+        // FPU pay dearly for every lgamma), the rest by the ratio of neighbouring terms.
+        const auto t = static_cast<double>(total);
+        const auto k0 = static_cast<double>(n);
+        double term = std::exp(std::lgamma(t + 1) - std::lgamma(k0 + 1) - std::lgamma(t - k0 + 1) +
+                               k0 * std::log(survival) + (t - k0) * std::log1p(-survival));
         double p_ok = 0.0;
         for (std::size_t k = n; k <= total; ++k) {
-            const double log_term = std::lgamma(static_cast<double>(total) + 1) -
-                                    std::lgamma(static_cast<double>(k) + 1) -
-                                    std::lgamma(static_cast<double>(total - k) + 1) +
-                                    static_cast<double>(k) * ls + static_cast<double>(total - k) * lf;
-            p_ok += std::exp(log_term);
+            p_ok += term;
+            term *= static_cast<double>(total - k) / static_cast<double>(k + 1) * ratio;
         }
         if (p_ok >= success) {
             return total - n;
