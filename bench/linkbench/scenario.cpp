@@ -94,24 +94,82 @@ linksim::RadioConfig bench_radio(const Scenario& s, std::uint64_t seed) {
 
 namespace {
 
+// Two ends joined by the scenario's radio pairs, with a blocking-write model of each host UART; both runs
+// drive it the same way: deliver what the radios output, then write what the ends have to send.
+struct Wiring {
+    Wiring(const Scenario& s, const EndpointFactory& make, std::uint64_t seed, TimePoint t0)
+        : paths(s.mode == LinkMode::dual ? 2 : 1),
+          ends{make({s.baud, s.mode, true, t0, s.pacing_factor}),
+               make({s.baud, s.mode, false, t0, s.pacing_factor})} {
+        for (std::size_t p = 0; p < paths; ++p) {
+            pairs.emplace_back(bench_radio(s, seed + p), t0);
+        }
+    }
+    [[nodiscard]] bool ready() const { return ends[0] && ends[1]; }
+
+    /// Radio output to the ends, due timeouts, then every delivered message to `on_message(side, m, now)`.
+    template <typename OnMessage>
+    void deliver(TimePoint now, OnMessage&& on_message) {
+        for (std::size_t p = 0; p < paths; ++p) {
+            for (Side side : {Side::A, Side::B}) {
+                auto bytes = pairs[p].poll_output(side, now);
+                if (!bytes.empty()) {
+                    ends[linksim::index(side)]->handle_bytes(p, bytes, now);
+                }
+            }
+        }
+        for (Side side : {Side::A, Side::B}) {
+            auto& e = *ends[linksim::index(side)];
+            if (e.poll_timeout() <= now) {
+                e.handle_timeout(now);
+            }
+            while (auto m = e.poll_message()) {
+                on_message(side, *m, now);
+            }
+        }
+    }
+
+    /// Frames the ends have ready, into the UARTs until one is full (the write blocks until it drains).
+    void transmit(TimePoint now) {
+        for (Side side : {Side::A, Side::B}) {
+            for (std::size_t p = 0; p < paths; ++p) {
+                auto& w = pending[linksim::index(side)][p];
+                while (true) {
+                    if (w.empty()) {
+                        auto frame = ends[linksim::index(side)]->poll_transmit(p, now);
+                        if (!frame) {
+                            break;
+                        }
+                        w = PendingWrite{std::move(*frame), 0};
+                    }
+                    w.written += pairs[p].push(side, std::span(w.bytes).subspan(w.written), now);
+                    if (!w.empty()) {
+                        break;
+                    }
+                }
+            }
+        }
+    }
+
+    std::size_t paths;
+    std::vector<linksim::RadioModel> pairs;
+    std::array<std::unique_ptr<BenchEndpoint>, 2> ends;
+    std::array<std::array<PendingWrite, 2>, 2> pending{};  // [side][path]
+};
+
 // One simulated run. Without Fast traffic it measures bulk goodput and stalls; with it, Fast latency and
 // delivery while the same bulk load saturates the link.
 ScenarioResult run_pass(const Scenario& s, const EndpointFactory& make, bool with_fast) {
     ScenarioResult result;
     const TimePoint t0{};
     const TimePoint end = t0 + s.duration;
-    const std::size_t paths = s.mode == LinkMode::dual ? 2 : 1;
 
-    std::vector<linksim::RadioModel> pairs;
-    for (std::size_t p = 0; p < paths; ++p) {
-        pairs.emplace_back(bench_radio(s, 1000 + p), t0);
-    }
-    std::array<std::unique_ptr<BenchEndpoint>, 2> ends{make({s.baud, s.mode, true, t0, s.pacing_factor}),
-                                                       make({s.baud, s.mode, false, t0, s.pacing_factor})};
-    if (!ends[0] || !ends[1]) {
+    Wiring wiring(s, make, 1000, t0);
+    if (!wiring.ready()) {
         return result;
     }
-    std::array<std::array<PendingWrite, 2>, 2> pending{};  // [side][path]
+    auto& ends = wiring.ends;
+    auto& pairs = wiring.pairs;
 
     std::array<std::uint32_t, 2> next_safe_id{0, 0};
     std::array<std::vector<bool>, 2> safe_seen;  // by receiving side
@@ -167,23 +225,7 @@ ScenarioResult run_pass(const Scenario& s, const EndpointFactory& make, bool wit
     };
 
     for (TimePoint now = t0; now <= end;) {
-        for (std::size_t p = 0; p < paths; ++p) {
-            for (Side side : {Side::A, Side::B}) {
-                auto bytes = pairs[p].poll_output(side, now);
-                if (!bytes.empty()) {
-                    ends[linksim::index(side)]->handle_bytes(p, bytes, now);
-                }
-            }
-        }
-        for (Side side : {Side::A, Side::B}) {
-            auto& e = *ends[linksim::index(side)];
-            if (e.poll_timeout() <= now) {
-                e.handle_timeout(now);
-            }
-            while (auto m = e.poll_message()) {
-                on_message(side, *m, now);
-            }
-        }
+        wiring.deliver(now, on_message);
         // Workload: Fast telemetry A→B at 10 Hz, bulk Safe kept offered.
         while (with_fast && next_fast <= now) {
             const auto payload = make_payload(next_fast_id, kFastSize, kSaltFast);
@@ -206,24 +248,7 @@ ScenarioResult run_pass(const Scenario& s, const EndpointFactory& make, bool wit
                 ++id;
             }
         }
-        for (Side side : {Side::A, Side::B}) {
-            for (std::size_t p = 0; p < paths; ++p) {
-                auto& w = pending[linksim::index(side)][p];
-                while (true) {
-                    if (w.empty()) {
-                        auto frame = ends[linksim::index(side)]->poll_transmit(p, now);
-                        if (!frame) {
-                            break;
-                        }
-                        w = PendingWrite{std::move(*frame), 0};
-                    }
-                    w.written += pairs[p].push(side, std::span(w.bytes).subspan(w.written), now);
-                    if (!w.empty()) {
-                        break;  // UART buffer full: the write blocks until it drains
-                    }
-                }
-            }
-        }
+        wiring.transmit(now);
         const TimePoint fast_due = with_fast ? next_fast : kNever;
         TimePoint next = std::min({now + kStep, fast_due, ends[0]->poll_timeout(), ends[1]->poll_timeout()});
         now = std::max(next, now + std::chrono::microseconds(10));
@@ -253,14 +278,8 @@ ScenarioResult run_pass(const Scenario& s, const EndpointFactory& make, bool wit
 void run_commands(const Scenario& s, const EndpointFactory& make, ScenarioResult& result) {
     const TimePoint t0{};
     const TimePoint end = t0 + s.duration;
-    const std::size_t paths = s.mode == LinkMode::dual ? 2 : 1;
-    std::vector<linksim::RadioModel> pairs;
-    for (std::size_t p = 0; p < paths; ++p) {
-        pairs.emplace_back(bench_radio(s, 2000 + p), t0);
-    }
-    std::array<std::unique_ptr<BenchEndpoint>, 2> ends{make({s.baud, s.mode, true, t0, s.pacing_factor}),
-                                                       make({s.baud, s.mode, false, t0, s.pacing_factor})};
-    std::array<std::array<PendingWrite, 2>, 2> pending{};
+    Wiring wiring(s, make, 2000, t0);
+    auto& ends = wiring.ends;
 
     std::uint32_t next_id = 0;
     bool in_flight = false;
@@ -298,23 +317,7 @@ void run_commands(const Scenario& s, const EndpointFactory& make, ScenarioResult
     };
 
     for (TimePoint now = t0; now <= end;) {
-        for (std::size_t p = 0; p < paths; ++p) {
-            for (Side side : {Side::A, Side::B}) {
-                auto bytes = pairs[p].poll_output(side, now);
-                if (!bytes.empty()) {
-                    ends[linksim::index(side)]->handle_bytes(p, bytes, now);
-                }
-            }
-        }
-        for (Side side : {Side::A, Side::B}) {
-            auto& e = *ends[linksim::index(side)];
-            if (e.poll_timeout() <= now) {
-                e.handle_timeout(now);
-            }
-            while (auto m = e.poll_message()) {
-                on_message(side, *m, now);
-            }
-        }
+        wiring.deliver(now, on_message);
         for (const std::uint32_t id : to_answer) {
             ends[1]->send_urgent(make_payload(id, kAnswerBytes, kSaltAnswer), now);
         }
@@ -335,24 +338,7 @@ void run_commands(const Scenario& s, const EndpointFactory& make, ScenarioResult
             ends[1]->send_fast(1, make_payload(telemetry_id++, 37, kSaltFast), now);
             next_link_stats += std::chrono::seconds(1);
         }
-        for (Side side : {Side::A, Side::B}) {
-            for (std::size_t p = 0; p < paths; ++p) {
-                auto& w = pending[linksim::index(side)][p];
-                while (true) {
-                    if (w.empty()) {
-                        auto frame = ends[linksim::index(side)]->poll_transmit(p, now);
-                        if (!frame) {
-                            break;
-                        }
-                        w = PendingWrite{std::move(*frame), 0};
-                    }
-                    w.written += pairs[p].push(side, std::span(w.bytes).subspan(w.written), now);
-                    if (!w.empty()) {
-                        break;
-                    }
-                }
-            }
-        }
+        wiring.transmit(now);
         TimePoint next = std::min(
             {now + kStep, next_vehicle, next_link_stats, ends[0]->poll_timeout(), ends[1]->poll_timeout()});
         if (!in_flight) {
