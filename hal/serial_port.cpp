@@ -8,6 +8,7 @@
 #include <array>
 #include <cerrno>
 #include <deque>
+#include <iterator>
 
 #include "hal/io_errors.hpp"
 #include "hal/serial_termios.hpp"
@@ -107,7 +108,16 @@ class SerialPort::Impl : public std::enable_shared_from_this<Impl> {
         queued_bytes_ += bytes.size();
         write_queue_.push_back(std::move(bytes));
         if (!writing_) {
-            do_write();
+            // Deferred by one turn of the event loop, so everything queued in this turn leaves in one write,
+            // back to back as a UART sends it: two frames meant together (a mode change and the mission slot
+            // right behind it) are not split by whatever else the loop runs, which the board would see as a
+            // gap between them.
+            writing_ = true;
+            boost::asio::post(executor_, [self = shared_from_this(), gen = generation_] {
+                if (gen == self->generation_) {
+                    self->do_write();
+                }
+            });
         }
         return WriteResult::Queued;
     }
@@ -127,6 +137,11 @@ class SerialPort::Impl : public std::enable_shared_from_this<Impl> {
     struct Handlers {
         BytesHandler on_bytes;
         ErrorHandler on_error;
+    };
+    struct Batch {
+        std::vector<std::vector<std::uint8_t>> frames;
+        std::vector<boost::asio::const_buffer> buffers;
+        std::size_t size = 0;
     };
 
     void do_read() {
@@ -153,14 +168,22 @@ class SerialPort::Impl : public std::enable_shared_from_this<Impl> {
         }
     }
 
+    // Everything queued goes out in one gathered write.
     void do_write() {
         writing_ = true;
-        auto buffer = std::make_shared<std::vector<std::uint8_t>>(std::move(write_queue_.front()));
-        write_queue_.pop_front();
+        auto batch = std::make_shared<Batch>();
+        batch->frames.assign(std::make_move_iterator(write_queue_.begin()),
+                             std::make_move_iterator(write_queue_.end()));
+        write_queue_.clear();
+        for (const auto& f : batch->frames) {
+            batch->buffers.emplace_back(f.data(), f.size());
+            batch->size += f.size();
+        }
         boost::asio::async_write(
-            stream_, boost::asio::buffer(*buffer),
-            [self = shared_from_this(), gen = generation_, buffer](
-                boost::system::error_code ec, std::size_t) { self->on_write(gen, ec, buffer->size()); });
+            stream_, batch->buffers,
+            [self = shared_from_this(), gen = generation_, batch](boost::system::error_code ec, std::size_t) {
+                self->on_write(gen, ec, batch->size);
+            });
     }
 
     void on_write(std::uint64_t gen, boost::system::error_code ec, std::size_t size) {

@@ -196,6 +196,28 @@ TEST_F(HalSerialPortTest, LargeWritesArriveInOrder) {
     EXPECT_EQ(at_master, expected);
 }
 
+TEST_F(HalSerialPortTest, FramesQueuedInOneTurnLeaveTogetherInOneWrite) {
+    SerialPort port(io_.get_executor());
+    open_and_read(port, config_for(pty_));
+    const auto mode = pattern_bytes(41, 1);
+    const auto slot = pattern_bytes(14, 2);
+    const auto third = pattern_bytes(30, 3);
+    ASSERT_EQ(port.write(mode), WriteResult::Queued);
+    ASSERT_EQ(port.write(slot), WriteResult::Queued);
+    ASSERT_EQ(port.write(third), WriteResult::Queued);
+    std::vector<std::uint8_t> at_master;
+    drain(pty_.master(), at_master);
+    EXPECT_TRUE(at_master.empty()) << "written before the turn ended";
+    // One handler: the deferred write. Written one after another, the second frame would wait for the
+    // first one's completion handler and the third for the second's.
+    ASSERT_EQ(io_.poll_one(), 1u);
+    drain(pty_.master(), at_master);
+    std::vector<std::uint8_t> expected = mode;
+    expected.insert(expected.end(), slot.begin(), slot.end());
+    expected.insert(expected.end(), third.begin(), third.end());
+    EXPECT_EQ(at_master, expected);
+}
+
 TEST_F(HalSerialPortTest, WriteQueueIsBounded) {
     SerialPort port(io_.get_executor());
     auto c = config_for(pty_);
