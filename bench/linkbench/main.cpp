@@ -15,7 +15,8 @@ namespace {
 using namespace airseg;
 using namespace airseg::linkbench;
 
-constexpr const char* kUsage = R"(usage: linkbench [--json] [--verbose] [--duration SECONDS] [--strict]
+constexpr const char* kUsage =
+    R"(usage: linkbench [--json] [--verbose] [--duration SECONDS] [--seed N] [--strict]
 
 Runs every scenario on airseg's ground-link transport ("ours") and on a model of the seed's MAREA serial
 transport, over the same simulated radio pairs (half duplex, air rate = serial rate, 1 ms turnaround,
@@ -40,6 +41,8 @@ Scenarios, for 57600 and 115200 baud, single pair and dual pair (split: each end
   --turnaround-ms X  radio turnaround (default 1)
   --pacing F        the transport's link_rate as a fraction of baud/10 (default 1.0)
   --only TEXT       only the scenarios whose "baud mode impairment" contains TEXT (e.g. "57600 single loss")
+  --seed N          seed of the radios' impairments (default 1000): the figures of one run are one draw of
+                    the radios' randomness; other seeds show how much a figure (a longest stall) varies
   --strict          exit status 1 when a target fails
 )";
 
@@ -47,6 +50,7 @@ struct Knobs {
     Duration length = std::chrono::seconds(40);
     Duration turnaround = std::chrono::milliseconds(1);
     double pacing_factor = 1.0;
+    std::uint64_t seed = 1000;
 };
 
 std::vector<Scenario> scenarios(const Knobs& k) {
@@ -59,6 +63,7 @@ std::vector<Scenario> scenarios(const Knobs& k) {
             base.duration = k.length;
             base.turnaround = k.turnaround;
             base.pacing_factor = k.pacing_factor;
+            base.seed = k.seed;
             list.push_back(base);
             for (auto [label, p] :
                  {std::pair{"corrupt=1e-5", 1e-5}, {"corrupt=1e-4", 1e-4}, {"corrupt=1e-3", 1e-3}}) {
@@ -126,6 +131,13 @@ int main(int argc, char** argv) {
             if (ec != std::errc{} || ptr != v.data() + v.size() || seconds < 5 || seconds > 3600) {
                 std::cerr << "linkbench: --duration wants whole seconds within [5, 3600], got '" << v
                           << "'\n";
+                return 2;
+            }
+        } else if (arg == "--seed" && i + 1 < argc) {
+            const std::string_view v = argv[++i];
+            auto [ptr, ec] = std::from_chars(v.data(), v.data() + v.size(), knobs.seed);
+            if (ec != std::errc{} || ptr != v.data() + v.size()) {
+                std::cerr << "linkbench: --seed wants a whole number, got '" << v << "'\n";
                 return 2;
             }
         } else if ((arg == "--turnaround-ms" || arg == "--pacing") && i + 1 < argc) {

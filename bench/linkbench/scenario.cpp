@@ -164,7 +164,7 @@ ScenarioResult run_pass(const Scenario& s, const EndpointFactory& make, bool wit
     const TimePoint t0{};
     const TimePoint end = t0 + s.duration;
 
-    Wiring wiring(s, make, 1000, t0);
+    Wiring wiring(s, make, s.seed, t0);
     if (!wiring.ready()) {
         return result;
     }
@@ -278,7 +278,7 @@ ScenarioResult run_pass(const Scenario& s, const EndpointFactory& make, bool wit
 void run_commands(const Scenario& s, const EndpointFactory& make, ScenarioResult& result) {
     const TimePoint t0{};
     const TimePoint end = t0 + s.duration;
-    Wiring wiring(s, make, 2000, t0);
+    Wiring wiring(s, make, s.seed + 1000, t0);
     auto& ends = wiring.ends;
 
     std::uint32_t next_id = 0;

@@ -24,7 +24,8 @@ struct Scenario {
     Duration duration = std::chrono::seconds(60);
     Duration turnaround = std::chrono::milliseconds(1);  ///< radio dead air when the sending side changes
     double pacing_factor =
-        1.0;  ///< the transport's link_rate as a fraction of baud/10 (the seed never paces)
+        1.0;                    ///< the transport's link_rate as a fraction of baud/10 (the seed never paces)
+    std::uint64_t seed = 1000;  ///< of the radios' impairments: the same seed gives the same figures
 };
 
 struct ScenarioResult {

@@ -1,5 +1,6 @@
 #include "services/groundlink/transport/error_rate_meter.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 
@@ -30,7 +31,12 @@ void ErrorRateMeter::on_frame(std::size_t wire_bytes, bool good) {
         frames_ /= 2;
         after_bad_ /= 2;
         bad_after_bad_ /= 2;
+        vanished_ /= 2;
     }
+}
+
+void ErrorRateMeter::on_vanished(double frames) {
+    vanished_ = std::max(0.0, vanished_ + frames);
 }
 
 std::optional<double> ErrorRateMeter::byte_error_rate() const {
@@ -87,6 +93,9 @@ bool ErrorRateMeter::bursty() const {
     double bad = 0.0;
     for (const auto& k : classes_) {
         bad += k.bad;
+    }
+    if (vanished_ >= kMinVanished && vanished_ > kVanishedRatio * bad) {
+        return true;
     }
     if (after_bad_ < 20.0 || frames_ <= 0.0) {
         return false;

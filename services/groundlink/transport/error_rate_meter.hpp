@@ -14,19 +14,27 @@ namespace airseg::groundlink {
 
 class ErrorRateMeter {
   public:
-    static constexpr double kMinBytes = 300.0;       // no estimate below this many bytes
-    static constexpr double kMinFrames = 4.0;        // ... or this many frames (early estimates are rough,
+    static constexpr double kMinBytes = 100.0;       // no estimate below this many bytes
+    static constexpr double kMinFrames = 3.0;        // ... or this many frames (early estimates are rough,
                                                      // but a new session needs one within its first command)
     static constexpr double kWindowBytes = 40000.0;  // older history decays by half past this
     static constexpr double kMaxRate = 0.25;         // estimates are capped here
     static constexpr double kBurstRatio = 2.0;  // P(bad | bad before) / P(bad) beyond which errors are bursty
+    // Frames vanished per damaged frame heard beyond which errors are bursty, once kMinVanished vanished.
+    static constexpr double kVanishedRatio = 0.3;
+    static constexpr double kMinVanished = 4.0;
 
     void on_frame(std::size_t wire_bytes, bool good);
+    /// Frames (or shards) that never arrived at all, seen as a gap in their numbering; negative when one
+    /// counted so arrives after all. A byte error loses a whole frame only when it hits a delimiter, once
+    /// in a frame's length of errors; a lost air packet takes whole frames with it as often as it damages
+    /// one.
+    void on_vanished(double frames);
 
     /// The estimated byte error rate, nullopt before enough frames were heard.
     [[nodiscard]] std::optional<double> byte_error_rate() const;
-    /// Bad frames come in runs (a lost air packet takes several frames with it) rather than one by one:
-    /// parity sized for independent errors would not repair them.
+    /// Bad frames come in runs, or whole frames vanish (a lost air packet takes several frames with it),
+    /// rather than bytes going bad one by one: parity sized for independent errors would not repair them.
     [[nodiscard]] bool bursty() const;
 
   private:
@@ -42,6 +50,7 @@ class ErrorRateMeter {
     bool last_bad_ = false;
     double after_bad_ = 0.0;      // frames that followed a bad one
     double bad_after_bad_ = 0.0;  // ... and were bad too
+    double vanished_ = 0.0;
     // The estimate is asked for after every input but changes only with a frame: computed once per change
     // (boards without an FPU pay for every exp()).
     mutable bool stale_ = true;

@@ -9,6 +9,11 @@
 namespace airseg::groundlink::fec {
 namespace {
 
+// A group is written at once, and small shards with much parity are several times their frame on the wire:
+// past about three of the longest plain frames a group overruns a radio's buffer (2 KiB on a SiK radio)
+// while the air is busy with the other end, and every group it overruns is lost.
+constexpr std::size_t kGroupWireFrames = 3;
+
 // The sealed frame's bytes besides its chunks: the plain overhead without COBS code byte and delimiter.
 std::size_t sealed_overhead(std::size_t frame_overhead) {
     return frame_overhead > 2 ? frame_overhead - 2 : 0;
@@ -101,18 +106,22 @@ FramePlan plan_frames(double p, std::size_t frame_overhead, std::size_t min_payl
                                                           static_cast<double>(kMaxShardBytes)));
     const auto s = static_cast<double>(fec.shard_bytes);
     fec.shard_survival = shard_survival(p, fec.shard_bytes);
-    // The largest frame whose group fits in 255 shards, within max_payload.
+    // The largest frame whose group fits in 255 shards and in kGroupWireFrames of the longest plain frames,
+    // within max_payload.
     const std::size_t sealed_extra = sealed_overhead(frame_overhead) + 1;  // + the padding count
+    const std::size_t wire_budget = kGroupWireFrames * (max_payload + frame_overhead);
+    const auto group_wire = [&](std::size_t shards) { return shards * (fec.shard_bytes + kShardOverhead); };
     std::size_t n = data_shards_for(max_payload + sealed_overhead(frame_overhead), fec.shard_bytes);
     n = std::min(n, kMaxShards);
     std::size_t k = parity_for(n, fec.shard_survival);
-    while (n > 1 && n + k > kMaxShards) {
+    while (n > 1 && (n + k > kMaxShards || group_wire(n + k) > wire_budget)) {
         n = n * 3 / 4;
         k = parity_for(n, fec.shard_survival);
     }
     plain.shard_bytes = fec.shard_bytes;
     plain.shard_survival = fec.shard_survival;
-    if (n + k > kMaxShards || n * fec.shard_bytes <= sealed_extra + min_payload) {
+    if (n + k > kMaxShards || group_wire(n + k) > wire_budget ||
+        n * fec.shard_bytes <= sealed_extra + min_payload) {
         return plain;
     }
     fec.payload = std::min(max_payload, n * fec.shard_bytes - sealed_extra);

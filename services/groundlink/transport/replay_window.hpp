@@ -56,6 +56,15 @@ class ReplayWindow {
 
     void reset() { *this = ReplayWindow{}; }
 
+    /// Frame numbers skipped by `n`, a fresh number: positive when it is beyond the largest by more than
+    /// one, -1 when it fills an earlier gap (it came late, by another path).
+    [[nodiscard]] std::int64_t skipped_by(std::uint64_t n) const {
+        if (!any_) {
+            return 0;
+        }
+        return n > largest_ ? static_cast<std::int64_t>(n - largest_ - 1) : -1;
+    }
+
   private:
     std::uint64_t largest_ = 0;
     std::uint64_t seen_ = 0;  // bit k: largest_ - k was received

@@ -1,6 +1,7 @@
 #include "services/groundlink/transport/safe_sender.hpp"
 
 #include <algorithm>
+#include <utility>
 
 namespace airseg::groundlink {
 
@@ -37,14 +38,15 @@ SafeSender::Segment SafeSender::take_lost(TimePoint now, bool repeat_twice_lost)
         }
         ++s.transmissions;
         s.last_sent = now;
-        if (repeat_twice_lost && s.transmissions >= 3 && !s.repeated) {
-            // Lost twice already on a link losing many frames: it goes out twice in a row (stays marked lost
-            // for the next frame), which shortens the longest stalls at a small cost.
-            s.repeated = true;
-        } else {
-            s.repeated = false;
-            s.lost = false;
-            --lost_count_;
+        s.lost = false;
+        --lost_count_;
+        const bool second_copy = std::exchange(s.second_copy, false);
+        if (repeat_twice_lost && s.transmissions >= 3 && !second_copy) {
+            // Lost twice already on a link losing many frames: it goes out again in the next frame
+            // (frame_done()), which shortens the longest stalls at a small cost. Not in the same frame: both
+            // copies would share its fate.
+            s.repeat_due = true;
+            repeats_due_ = true;
         }
         return Segment{static_cast<std::uint16_t>(una_ + i), s.end, s.data, true};
     }
@@ -180,6 +182,19 @@ std::size_t SafeSender::on_timeout(TimePoint now, Duration rto) {
     return 1;
 }
 
+void SafeSender::frame_done() {
+    if (!std::exchange(repeats_due_, false)) {
+        return;
+    }
+    for (auto& s : inflight_) {
+        if (std::exchange(s.repeat_due, false) && !s.acked && !s.lost) {
+            s.lost = true;
+            s.second_copy = true;
+            ++lost_count_;
+        }
+    }
+}
+
 TimePoint SafeSender::next_timeout(Duration rto) const {
     if (probe_) {
         const InFlight& p = inflight_[static_cast<std::size_t>(*probe_ - una_)];
@@ -205,6 +220,7 @@ std::size_t SafeSender::reset() {
     cut_fragments_ = 0;
     una_ = next_ = 0;
     lost_count_ = 0;
+    repeats_due_ = false;
     probe_.reset();
     bytes_held_ = 0;
     for (const auto& m : queue_) {

@@ -35,12 +35,14 @@ class SafeSender {
     /// Size of the data of the lowest lost segment (it is resent as it was cut).
     [[nodiscard]] std::size_t lost_size() const;
     /// Resends the lowest lost segment; with `repeat_twice_lost`, a segment already lost twice is sent in two
-    /// consecutive frames.
+    /// consecutive frames (the second once frame_done() says the first is complete).
     Segment take_lost(TimePoint now, bool repeat_twice_lost = false);
     /// Cuts the next segment with at most `max_data` bytes; nullopt when the window is closed, nothing is
     /// queued, or `max_data` is too small to keep the message within 255 fragments (`force`: then cut the
     /// smallest segment that does).
     std::optional<Segment> take_new(std::size_t max_data, bool force, TimePoint now);
+    /// The frame being filled is complete: second copies of repeated segments become due for the next.
+    void frame_done();
 
     struct AckResult {
         std::size_t newly_acked = 0;
@@ -74,7 +76,8 @@ class SafeSender {
         bool acked = false;
         bool lost = false;
         std::uint32_t transmissions = 0;
-        bool repeated = false;  // the second copy of a repeat is still due
+        bool repeat_due = false;   // a second copy goes in the next frame
+        bool second_copy = false;  // marked lost for that second copy
         TimePoint last_sent{};
     };
     void mark_acked(InFlight& s, AckResult& r, TimePoint now, TimePoint& newest_acked_send);
@@ -90,6 +93,7 @@ class SafeSender {
     std::uint64_t una_ = 0;
     std::uint64_t next_ = 0;
     std::size_t lost_count_ = 0;
+    bool repeats_due_ = false;
     std::optional<std::uint64_t> probe_;  // sequence of the segment resent on the last timeout, until an ack
 };
 

@@ -150,6 +150,10 @@ class Transport::Impl {
         double tx_rate = 0.0;  // bytes/s written to the path, same average
         TimePoint tx_rate_time{};
         std::size_t last_frame = 0;  // bytes of the latest frame written
+        // The last good shard heard (group, index) and the damaged frames heard since: a gap in a group's
+        // indices beyond those is shards that never arrived (lost whole, with an air packet).
+        std::optional<std::pair<std::uint8_t, std::uint8_t>> last_shard;
+        std::size_t bad_since_shard = 0;
     };
     std::vector<Path> paths;
     std::uint8_t peer_mask = 0;
@@ -184,6 +188,7 @@ class Transport::Impl {
 
     // Frame size adaptation and forward error correction.
     ErrorRateMeter meter;
+    std::size_t damaged_since_numbered = 0;  // damaged frames heard since the last data frame read whole
     std::optional<std::uint32_t> last_reported_ppm;  // in report units, bursty flag included
     TimePoint last_report_time{};
     bool shards_heard_since_report = false;

@@ -5,6 +5,11 @@
 #include "services/groundlink/transport/transport_impl.hpp"
 
 namespace airseg::groundlink {
+namespace {
+
+constexpr std::int64_t kVanishedPerGap = 4;  // frames counted vanished for one gap in the numbering at most
+
+}  // namespace
 
 void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_t> bytes, TimePoint now) {
     now_ = std::max(now_, now);
@@ -48,6 +53,8 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
         [&] {
             turnaround();
             ++stats.framing_errors;
+            ++ps.bad_since_shard;
+            ++damaged_since_numbered;
             meter.on_frame(ps.deframer.last_encoded_bytes(), false);
         });
     update_link_state();
@@ -56,12 +63,29 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
 
 void Transport::Impl::on_shard(std::size_t path, std::span<const std::uint8_t> plain, std::size_t wire_bytes,
                                TimePoint now) {
+    Path& ps = paths[path];
     const auto result = shards.add(plain, now, rebuilt);
     if (result == fec::ShardAssembler::Result::bad) {
         ++stats.fec_shard_errors;
+        ++ps.bad_since_shard;
         meter.on_frame(wire_bytes, false);
         return;
     }
+    // Shards lost whole are as lost as damaged ones, and they are what tells lost air packets (runs of
+    // missing shards) from byte errors to the meter.
+    const auto group = static_cast<std::uint8_t>(plain[0] & 0x3FU);
+    const std::uint8_t index = plain[1];
+    std::size_t gap = index;  // a group's first shard heard: those before it never arrived
+    if (ps.last_shard && ps.last_shard->first == group) {
+        gap = index > ps.last_shard->second ? index - ps.last_shard->second - 1U : 0U;
+    }
+    const std::size_t unheard = gap - std::min(gap, ps.bad_since_shard);
+    for (std::size_t i = 0; i < unheard; ++i) {
+        meter.on_frame(wire_bytes, false);
+    }
+    meter.on_vanished(static_cast<double>(unheard));
+    ps.last_shard = std::pair{group, index};
+    ps.bad_since_shard = 0;
     meter.on_frame(wire_bytes, true);
     shards_heard_since_report = true;
     if (result == fec::ShardAssembler::Result::complete) {
@@ -82,6 +106,7 @@ void Transport::Impl::on_plain_frame(std::size_t path, std::span<const std::uint
     const std::size_t tag_bytes = keyed ? kMacTagBytes : 0;
     if (!kind) {
         ++stats.crc_errors;
+        ++damaged_since_numbered;
         meter.on_frame(wire_bytes, false);
         return;
     }
@@ -93,6 +118,7 @@ void Transport::Impl::on_plain_frame(std::size_t path, std::span<const std::uint
     if (!body || body->size() < tag_bytes + 1) {
         ++stats.crc_errors;
         if (keyed || established || *kind == frame::Kind::hello) {
+            ++damaged_since_numbered;
             meter.on_frame(wire_bytes, false);
         }
         return;
@@ -138,6 +164,15 @@ void Transport::Impl::on_plain_frame(std::size_t path, std::span<const std::uint
         ++stats.replays;
         return;
     }
+    // A long silence skips many numbers at once; a few tell as much.
+    // Damaged frames heard since the last numbered one account for part of a gap (their numbers could not
+    // be read); the rest never arrived.
+    const std::int64_t skipped = rx_window.skipped_by(number);
+    const std::int64_t unheard =
+        skipped < 0 ? -1
+                    : std::max<std::int64_t>(0, skipped - static_cast<std::int64_t>(damaged_since_numbered));
+    meter.on_vanished(static_cast<double>(std::min(unheard, kVanishedPerGap)));
+    damaged_since_numbered = 0;
     rx_window.accept(number);
     on_authentic(path, frame::heard_mask_of(frame_bytes), now);
     peer_urgent = frame::urgent_of(frame_bytes);

@@ -14,6 +14,8 @@ constexpr double kFairShare = 0.45;  // of link_rate, below which an end is not 
 constexpr double kLossyFraction = 0.15;
 constexpr std::size_t kLossyFramePayload = 192;
 constexpr std::size_t kUnmeasuredFramePayload = 256;
+// Safe segments sent before the share lost says anything.
+constexpr double kLossJudgedAfter = 20.0;
 // Share of recent Safe segments declared lost above which a segment lost twice is sent twice in a row.
 constexpr double kRepeatFraction = 0.25;
 constexpr unsigned kUnansweredHellosBeforeEchoingNothing = 3;
@@ -91,16 +93,21 @@ bool Transport::Impl::keeps_alive(std::size_t path) const {
 }
 
 bool Transport::Impl::lossy() const {
-    return sent_window >= 20.0 && lost_window > kLossyFraction * sent_window;
+    return sent_window >= kLossJudgedAfter && lost_window > kLossyFraction * sent_window;
 }
 
 std::size_t Transport::Impl::payload_cap() const {
     std::size_t cap = cfg.max_frame_payload;
     if (cfg.adaptive_frame_size) {
-        // Until the error rate is known, frames stay short: a Safe segment keeps the length it was cut at
-        // when it is sent again, and a long one cut blind may never get through a bad link.
+        // Until the error rate is known, and until enough Safe segments went out to tell whether whole
+        // frames are lost (which the error rate does not see), frames stay short: a Safe segment keeps the
+        // length it was cut at when it is sent again, and a long one cut blind may never get through a bad
+        // link (a kilobyte spans five air packets: at 30 % packet loss one try in six arrives).
         cap = plan_rate ? std::clamp(plan.payload, cfg.min_frame_payload, cfg.max_frame_payload)
                         : std::min(cap, kUnmeasuredFramePayload);
+        if (sent_window < kLossJudgedAfter) {
+            cap = std::min(cap, kUnmeasuredFramePayload);
+        }
     }
     // Under heavy frame loss small frames shorten each repair round trip, which bounds stalls (shards with
     // parity already make each frame likely to arrive).
@@ -411,6 +418,9 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
 
     bulk_blocked = false;
     bulk_only = false;
+    for (auto& tx : senders) {
+        tx.frame_done();
+    }
     if (data_chunks == 0 && !ack_is_due && !keepalive_due) {
         return std::nullopt;  // only opportunistic content: wait for a frame worth sending
     }

@@ -251,5 +251,16 @@ TEST(GroundlinkReplayWindow, RejectsDuplicatesAndTooOldAndReconstructsAcrossTheW
     EXPECT_EQ(wrap.reconstruct(static_cast<std::uint32_t>((base - 2) & 0xFFFFFFU)), base - 2);
 }
 
+TEST(GroundlinkReplayWindow, SaysHowManyNumbersAFrameSkippedAndWhenOneFillsAGap) {
+    ReplayWindow w;
+    EXPECT_EQ(w.skipped_by(7), 0);  // the first frame heard: nothing to compare with
+    w.accept(7);
+    EXPECT_EQ(w.skipped_by(8), 0);
+    w.accept(8);
+    EXPECT_EQ(w.skipped_by(12), 3);  // 9, 10 and 11 never arrived (yet)
+    w.accept(12);
+    EXPECT_EQ(w.skipped_by(10), -1);  // one of them did, late
+}
+
 }  // namespace
 }  // namespace airseg::groundlink

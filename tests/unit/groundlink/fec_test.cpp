@@ -142,6 +142,62 @@ TEST(GroundlinkFec, TheMeterEstimatesTheByteErrorRateFromFramesOfAnySize) {
     EXPECT_FALSE(fresh.byte_error_rate().has_value());
 }
 
+TEST(GroundlinkFec, FramesVanishingWholeMakeTheMeterBurstyAndBytesGoingBadDoNot) {
+    std::mt19937 rng(9);
+    std::bernoulli_distribution coin(0.3);
+    // Air packets lost: about as many frames vanish as arrive damaged.
+    ErrorRateMeter packets;
+    for (int i = 0; i < 400; ++i) {
+        const bool hit = coin(rng);
+        packets.on_frame(180, !hit);
+        if (hit) {
+            packets.on_vanished(1);
+        }
+    }
+    EXPECT_TRUE(packets.bursty());
+    // Byte errors: a frame vanishes only when its delimiter is hit (merged into its neighbour, which
+    // arrives damaged), about once in a frame's length of errors.
+    ErrorRateMeter bytes;
+    std::bernoulli_distribution delimiter(1.0 / 180.0);
+    for (int i = 0; i < 4000; ++i) {
+        const bool hit = coin(rng);
+        bytes.on_frame(180, !hit);
+        if (hit && delimiter(rng)) {
+            bytes.on_vanished(1);
+        }
+    }
+    EXPECT_FALSE(bytes.bursty());
+    // A number that arrives after all (another path) takes its vanishing back.
+    ErrorRateMeter late;
+    for (int i = 0; i < 10; ++i) {
+        late.on_frame(180, i % 2 == 0);
+    }
+    for (int i = 0; i < 4; ++i) {
+        late.on_vanished(1);
+    }
+    EXPECT_TRUE(late.bursty());
+    late.on_vanished(-1);
+    late.on_vanished(-1);
+    EXPECT_FALSE(late.bursty());
+}
+
+TEST(GroundlinkFec, AGroupOfShardsIsNeverLongerOnTheWireThanThreeOfTheLongestPlainFrames) {
+    // Small shards with much parity are several times their frame on the wire, and a group is written at
+    // once: a radio buffer that takes a few of the longest frames must take it.
+    bool some_shards = false;
+    for (const double p : {0.005, 0.01, 0.02, 0.05, 0.08}) {
+        const auto plan = fec::plan_frames(p, 30, 16, 1024, true);
+        if (!plan.fec) {
+            continue;
+        }
+        some_shards = true;
+        const std::size_t n = fec::data_shards_for(plan.payload + 28, plan.shard_bytes);
+        const std::size_t k = fec::parity_for(n, plan.shard_survival);
+        EXPECT_LE((n + k) * (plan.shard_bytes + fec::kShardOverhead), 3U * (1024U + 30U)) << "rate " << p;
+    }
+    EXPECT_TRUE(some_shards);
+}
+
 TEST(GroundlinkFec, ThePlanPicksPlainFramesOnGoodLinksAndShardsOnBadOnes) {
     const std::size_t overhead = 15;
     const auto clean = fec::plan_frames(0.0, overhead, 16, 1024, true);

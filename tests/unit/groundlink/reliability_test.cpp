@@ -276,8 +276,30 @@ TEST(GroundlinkSafeSender, SegmentLostTwiceIsRepeatedOnALossyLink) {
     EXPECT_FALSE(tx.has_lost());
     ASSERT_EQ(tx.on_timeout(t0 + milliseconds(1000), milliseconds(500)), 1U);
     EXPECT_EQ(tx.take_lost(t0 + milliseconds(1000), true).seq, 0);  // third: twice in a row
+    // Not twice in the same frame, which would share its fate: the second copy is due once it is complete.
+    EXPECT_FALSE(tx.has_lost());
+    tx.frame_done();
     ASSERT_TRUE(tx.has_lost());
     EXPECT_EQ(tx.take_lost(t0 + milliseconds(1010), true).seq, 0);
+    tx.frame_done();
+    EXPECT_FALSE(tx.has_lost());  // the second copy is not repeated again
+}
+
+TEST(GroundlinkSafeSender, ARepeatAcknowledgedBeforeItsFrameIsNotSent) {
+    SafeSender tx(8, 1 << 20, 100000);
+    tx.enqueue(seq_bytes(10));
+    ASSERT_TRUE(tx.take_new(100, false, t0).has_value());
+    for (int i = 1; i <= 2; ++i) {
+        ASSERT_EQ(tx.on_timeout(t0 + milliseconds(500 * i), milliseconds(500)), 1U);
+        tx.take_lost(t0 + milliseconds(500 * i), true);
+        tx.frame_done();
+    }
+    EXPECT_TRUE(tx.has_lost());  // the third transmission's second copy is due
+    frame::AckChunk ack;
+    ack.next_expected = 1;
+    tx.on_ack(ack, t0 + milliseconds(1100));
+    EXPECT_FALSE(tx.has_lost());
+    tx.frame_done();
     EXPECT_FALSE(tx.has_lost());
 }
 
