@@ -2,7 +2,7 @@
 # ci-cross.sh [--prepare] [ARCH...]
 #
 # The package stage of CI, on a fresh Debian 12 amd64 machine (as root). ARCH: amd64, armhf, armel,
-# arm64 (default: amd64 armhf armel; arm64 is not in CI's default, see docs/operations.md "CI").
+# arm64 (default: all four).
 #
 # 1. Installs the tools it needs with apt-get, lets binfmt_misc run ARM programs through
 #    qemu-arm, and builds the sysroots.
@@ -35,7 +35,7 @@ for a in "$@"; do
     *) die "unknown argument '$a' (expected --prepare, amd64, armhf, armel, arm64)" ;;
   esac
 done
-[ ${#arches[@]} -gt 0 ] || arches=(amd64 armhf armel)
+[ ${#arches[@]} -gt 0 ] || arches=(amd64 armhf armel arm64)
 
 t0=$SECONDS
 step() { log "[$((SECONDS - t0)) s] $*"; }

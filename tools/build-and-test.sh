@@ -10,10 +10,10 @@
 #             tests/concurrency-tests.txt (the bus and dispatcher, the serial port's threads, the daemon's
 #             thread pool running all its services) and the binaries they start; each runs whole, and a race
 #             report fails it
-#   cross     packaging/ci-cross.sh for the architectures in AIRSEG_CROSS (default "amd64 armhf armel"): the
+#   cross     packaging/ci-cross.sh for the architectures in AIRSEG_CROSS (default "amd64 armhf armel arm64"): the
 #             amd64 packages are built and checked (lintian, contents, manual pages against --help) and
 #             installed, upgraded and removed in a throwaway chroot; each ARM package is cross-built with the
-#             whole test suite, which runs under qemu-arm (needs root)
+#             whole test suite, which runs under qemu-arm or qemu-aarch64 (needs root)
 #   native    GCC build as shipped (build/, the one tools/demo.sh runs) and the whole ctest suite
 # Default: "sanitize fuzz tsan cross". The shipped GCC build is tested by the cross stage on the two ARM
 # targets; "native" repeats that on amd64 and is the quickest check while developing.
@@ -57,7 +57,7 @@ prepare_pid=""
 if has_stage cross && { has_stage sanitize || has_stage fuzz; }; then
   mkdir -p build-logs
   # shellcheck disable=SC2086
-  packaging/ci-cross.sh --prepare ${AIRSEG_CROSS:-amd64 armhf armel} >build-logs/cross-prepare.log 2>&1 &
+  packaging/ci-cross.sh --prepare ${AIRSEG_CROSS:-amd64 armhf armel arm64} >build-logs/cross-prepare.log 2>&1 &
   prepare_pid=$!
 fi
 
@@ -144,7 +144,7 @@ if has_stage cross; then
   tests/integration/mavlink_interop/setup.sh "$modules_dir"
   # shellcheck disable=SC2086
   AIRSEG_INTEROP_MODULES="$(cd "$modules_dir" && pwd)/mavlink_interop/node_modules" \
-    packaging/ci-cross.sh ${AIRSEG_CROSS:-amd64 armhf armel}
+    packaging/ci-cross.sh ${AIRSEG_CROSS:-amd64 armhf armel arm64}
   elapsed "packages (amd64, and ARM with their tests under qemu-arm)" "$start"
 fi
 
