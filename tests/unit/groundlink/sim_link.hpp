@@ -23,6 +23,10 @@ struct Impairments {
     double duplicate = 0.0;     ///< a written frame arrives twice
     double reorder = 0.0;       ///< a written frame is held back by up to reorder_delay
     double garbage = 0.0;       ///< random bytes are inserted before a frame
+    /// The byte stream of each direction travels in air packets of air_packet_bytes; each is lost whole
+    /// with this probability (drawn only when set), taking with it the frames or shards it carries.
+    double air_packet_loss = 0.0;
+    std::size_t air_packet_bytes = 252;
     Duration reorder_delay = std::chrono::milliseconds(300);
     Duration latency = std::chrono::milliseconds(5);
 };
@@ -176,6 +180,16 @@ class SimLink {
             }
         }
         for (std::uint8_t b : bytes) {
+            if (imp.air_packet_loss > 0.0) {
+                AirStream& s = air_[from][p];
+                if (s.bytes % imp.air_packet_bytes == 0) {
+                    s.lost = uni() < imp.air_packet_loss;
+                }
+                ++s.bytes;
+                if (s.lost) {
+                    continue;
+                }
+            }
             if (imp.byte_loss > 0.0 && uni() < imp.byte_loss) {
                 continue;
             }
@@ -199,6 +213,11 @@ class SimLink {
     std::vector<TimePoint> air_free_;
     std::multimap<TimePoint, Flight> inflight_;
     std::array<std::array<std::uint64_t, 2>, 2> written_{};
+    struct AirStream {
+        std::uint64_t bytes = 0;
+        bool lost = false;
+    };
+    std::array<std::map<std::size_t, AirStream>, 2> air_;  // by direction, then path
     std::array<std::vector<std::vector<std::uint8_t>>, 2> recorded_;
     std::size_t largest_frame_ = 0;
     bool livelock_ = false;

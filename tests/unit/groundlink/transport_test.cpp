@@ -523,6 +523,38 @@ TEST(GroundlinkTransport, UnderByteLossFramesTravelAsShardsAndMessagesGetThrough
     EXPECT_LT(count_safe(plain.b(), 3), count_safe(link.b(), 3));
 }
 
+TEST(GroundlinkTransport, LostAirPacketsKeepFramesPlainNotShards) {
+    // A radio that loses whole air packets: frames vanish about as often as they arrive damaged. Parity
+    // sized for independent byte errors would not repair that, so the receiver reports the errors as
+    // bursty and the sender keeps plain frames. Byte errors alone make shards pay.
+    test::Impairments packets;
+    packets.air_packet_loss = 0.3;
+    SimLink link(base_config(1), base_config(2), one_path(packets), 31);
+    for (std::uint32_t i = 0; i < 40; ++i) {
+        link.a().core->send_safe(3, pattern(1000, i), link.now());
+    }
+    // Frames across a lost packet arrive damaged, so the first error rates may favour shards for a few
+    // seconds; the vanished ones soon say otherwise, and shards stay off.
+    link.run_for(20s);
+    const auto groups_early = link.a().core->stats().fec_frames_sent;
+    link.run_for(40s);
+    EXPECT_GT(link.b().core->stats().byte_error_rate, 0.0);
+    EXPECT_FALSE(link.a().core->stats().fec);
+    EXPECT_EQ(link.a().core->stats().fec_frames_sent, groups_early) << "shards again after the first 20 s";
+    // Without counting vanished frames this draw sends 27 groups, and 15 to 34 in most others.
+    EXPECT_LE(groups_early, 10U);
+    EXPECT_GE(count_safe(link.b(), 3), 10U);
+
+    test::Impairments bytes;
+    bytes.byte_loss = 0.01;
+    SimLink alone(base_config(1), base_config(2), one_path(bytes), 31);
+    for (std::uint32_t i = 0; i < 40; ++i) {
+        alone.a().core->send_safe(3, pattern(1000, i), alone.now());
+    }
+    alone.run_for(60s);
+    EXPECT_TRUE(alone.a().core->stats().fec);
+}
+
 TEST(GroundlinkTransport, AnEndThatHearsNoAcknowledgementsProbesInsteadOfFillingTheAir) {
     // b hears a but a hears nothing for a minute: a's window goes out once, then one probe per timeout. If
     // every outstanding segment timed out in turn, a would resend its window at the full link rate and, with
