@@ -30,6 +30,13 @@ std::size_t count_safe(const test::Endpoint& e, std::uint8_t prio) {
         [prio](const Delivered& d) { return d.cls == MessageClass::safe && d.priority == prio; }));
 }
 
+/// Offers `a` 40 KB of bulk: 40 messages of 1000 bytes on the lowest priority.
+void offer_bulk(SimLink& link) {
+    for (std::uint32_t i = 0; i < 40; ++i) {
+        link.a().core->send_safe(3, pattern(1000, i), link.now());
+    }
+}
+
 TEST(GroundlinkTransportConfig, ValidateNamesEachProblem) {
     EXPECT_TRUE(base_config(1).validate().empty());
     TransportConfig c = base_config(1);
@@ -495,9 +502,7 @@ TEST(GroundlinkTransport, UnderByteLossFramesTravelAsShardsAndMessagesGetThrough
     test::Impairments lossy;
     lossy.byte_loss = 0.02;
     SimLink link(base_config(1), base_config(2), one_path(lossy), 21);
-    for (std::uint32_t i = 0; i < 40; ++i) {
-        link.a().core->send_safe(3, pattern(1000, i), link.now());
-    }
+    offer_bulk(link);
     link.run_for(60s);
     const auto& a = link.a().core->stats();
     const auto& b = link.b().core->stats();
@@ -514,9 +519,7 @@ TEST(GroundlinkTransport, UnderByteLossFramesTravelAsShardsAndMessagesGetThrough
     auto plain_b = base_config(2);
     plain_b.fec = false;
     SimLink plain(plain_a, plain_b, one_path(lossy), 21);
-    for (std::uint32_t i = 0; i < 40; ++i) {
-        plain.a().core->send_safe(3, pattern(1000, i), plain.now());
-    }
+    offer_bulk(plain);
     plain.run_for(60s);
     EXPECT_FALSE(plain.a().core->stats().fec);
     EXPECT_EQ(plain.a().core->stats().fec_frames_sent, 0U);
@@ -530,9 +533,7 @@ TEST(GroundlinkTransport, LostAirPacketsKeepFramesPlainNotShards) {
     test::Impairments packets;
     packets.air_packet_loss = 0.3;
     SimLink link(base_config(1), base_config(2), one_path(packets), 31);
-    for (std::uint32_t i = 0; i < 40; ++i) {
-        link.a().core->send_safe(3, pattern(1000, i), link.now());
-    }
+    offer_bulk(link);
     // Frames across a lost packet arrive damaged, so the first error rates may favour shards for a few
     // seconds; the vanished ones soon say otherwise, and shards stay off.
     link.run_for(20s);
@@ -548,9 +549,7 @@ TEST(GroundlinkTransport, LostAirPacketsKeepFramesPlainNotShards) {
     test::Impairments bytes;
     bytes.byte_loss = 0.01;
     SimLink alone(base_config(1), base_config(2), one_path(bytes), 31);
-    for (std::uint32_t i = 0; i < 40; ++i) {
-        alone.a().core->send_safe(3, pattern(1000, i), alone.now());
-    }
+    offer_bulk(alone);
     alone.run_for(60s);
     EXPECT_TRUE(alone.a().core->stats().fec);
 }
