@@ -82,6 +82,10 @@ ShardAssembler::Group& ShardAssembler::slot_for(std::uint8_t id, std::size_t n, 
     return *slot;
 }
 
+ShardId shard_id(std::span<const std::uint8_t> plain) {
+    return ShardId{static_cast<std::uint8_t>(plain[0] & 0x3FU), plain[1]};
+}
+
 ShardAssembler::Result ShardAssembler::add(std::span<const std::uint8_t> plain, TimePoint now,
                                            std::vector<std::uint8_t>& frame) {
     if (!is_shard(plain) || plain.size() < kShardHeaderBytes + kShardCrcBytes + 1) {
@@ -92,8 +96,8 @@ ShardAssembler::Result ShardAssembler::add(std::span<const std::uint8_t> plain, 
     if (crc16_ccitt(body) != crc) {
         return Result::bad;
     }
-    const std::uint8_t id = body[0] & 0x3FU;
-    const std::size_t index = body[1];
+    const auto [id, index8] = shard_id(body);
+    const std::size_t index = index8;
     const std::size_t n = static_cast<std::size_t>(body[2]) + 1;
     const auto bytes = body.subspan(kShardHeaderBytes);
     if (index >= kMaxShards || n > kMaxShards) {

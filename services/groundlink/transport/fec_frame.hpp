@@ -28,6 +28,14 @@ inline constexpr std::size_t kMaxShardBytes = 240;  // one COBS block: no extra 
 /// A COBS-decoded frame that is a shard (its first two bits are 10).
 [[nodiscard]] bool is_shard(std::span<const std::uint8_t> plain);
 
+/// A shard's group and index, from its header (`plain` holds at least the header: a shard the assembler
+/// did not find bad).
+struct ShardId {
+    std::uint8_t group = 0;
+    std::uint8_t index = 0;
+};
+[[nodiscard]] ShardId shard_id(std::span<const std::uint8_t> plain);
+
 /// Data shards that carry a sealed frame of `frame_bytes` in shards of `shard_bytes`.
 [[nodiscard]] constexpr std::size_t data_shards_for(std::size_t frame_bytes, std::size_t shard_bytes) {
     return (frame_bytes + 1 + shard_bytes - 1) / shard_bytes;

@@ -152,7 +152,7 @@ class Transport::Impl {
         std::size_t last_frame = 0;  // bytes of the latest frame written
         // The last good shard heard (group, index) and the damaged frames heard since: a gap in a group's
         // indices beyond those is shards that never arrived (lost whole, with an air packet).
-        std::optional<std::pair<std::uint8_t, std::uint8_t>> last_shard;
+        std::optional<fec::ShardId> last_shard;
         std::size_t bad_since_shard = 0;
     };
     std::vector<Path> paths;

@@ -73,18 +73,17 @@ void Transport::Impl::on_shard(std::size_t path, std::span<const std::uint8_t> p
     }
     // Shards lost whole are as lost as damaged ones, and they are what tells lost air packets (runs of
     // missing shards) from byte errors to the meter.
-    const auto group = static_cast<std::uint8_t>(plain[0] & 0x3FU);
-    const std::uint8_t index = plain[1];
-    std::size_t gap = index;  // a group's first shard heard: those before it never arrived
-    if (ps.last_shard && ps.last_shard->first == group) {
-        gap = index > ps.last_shard->second ? index - ps.last_shard->second - 1U : 0U;
+    const auto id = fec::shard_id(plain);
+    std::size_t gap = id.index;  // a group's first shard heard: those before it never arrived
+    if (ps.last_shard && ps.last_shard->group == id.group) {
+        gap = id.index > ps.last_shard->index ? id.index - ps.last_shard->index - 1U : 0U;
     }
     const std::size_t unheard = gap - std::min(gap, ps.bad_since_shard);
     for (std::size_t i = 0; i < unheard; ++i) {
         meter.on_frame(wire_bytes, false);
     }
     meter.on_vanished(static_cast<double>(unheard));
-    ps.last_shard = std::pair{group, index};
+    ps.last_shard = id;
     ps.bad_since_shard = 0;
     meter.on_frame(wire_bytes, true);
     shards_heard_since_report = true;
