@@ -41,11 +41,15 @@ MissionItem WindowFeeder::Entry::item() const {
 }
 
 bool WindowFeeder::confirmed(const Entry& e) const {
-    if (!mission_ok_ || static_cast<std::size_t>(e.slot) + kWrapSlots > confirmed_.size())
+    return holds(e.slot, e.item());
+}
+
+bool WindowFeeder::holds(std::uint16_t slot, const MissionItem& item) const {
+    if (!mission_ok_ || static_cast<std::size_t>(slot) + kWrapSlots > confirmed_.size())
         return false;
-    const auto want = slot_items(e.slot, e.item());
+    const auto want = slot_items(slot, item);
     for (std::size_t i = 0; i < want.size(); ++i) {
-        if (confirmed_[e.slot + i] != want[i])
+        if (confirmed_[slot + i] != want[i])
             return false;
     }
     return true;
@@ -687,6 +691,44 @@ std::optional<FeederRequest> WindowFeeder::poll_request(TimePoint now) {
     }
     if (desired_mode() == Mode::Auto && mode_ != Mode::Auto && ready_for_auto()) {
         return issue(ResumeMission{}, now);
+    }
+    return next_stop_filler(now);
+}
+
+// Once the plan has ended, the ring slots after the Stop item still hold waypoints already driven. A board
+// that stores the Stop as a plain waypoint drives on to the next slot by itself until the HOLD it is sent
+// on arrival takes effect; with the Stop copied into the free slots, driving on keeps it where it is.
+// The slots the vehicle left last are copied into only once it holds: a reached report for one of them may
+// still be on its way (the feeder also moves on by MISSION_CURRENT), and found naming a Stop it would hold
+// the vehicle there, short of the end.
+std::optional<FeederRequest> WindowFeeder::next_stop_filler(TimePoint now) {
+    if (!stream_ended_ || queue_.empty() || !queue_.back().stop || need_set_current_)
+        return std::nullopt;
+    if (!std::all_of(queue_.begin(), queue_.end(), [&](const Entry& e) { return confirmed(e); }))
+        return std::nullopt;
+    const MissionItem stop = queue_.back().item();
+    const int ring = wrap_slot() - kFirstRingSlot + 1;
+    const int settled =
+        done_ && mode_ == Mode::Hold ? 0 : static_cast<int>(config_.lost_reached_tolerance) + 2;
+    auto free_slot = [&](std::uint16_t slot) {
+        const int behind_head = (queue_[0].slot - slot + ring) % ring;
+        return std::none_of(queue_.begin(), queue_.end(), [&](const Entry& e) { return e.slot == slot; }) &&
+               ap_target_ != slot && behind_head > settled;
+    };
+    // From the slot after the Stop round the ring: the slot the board reaches first is written first.
+    std::uint16_t slot = ring_next(queue_.back().slot);
+    for (std::uint16_t n = 0; n < wrap_slot(); ++n, slot = ring_next(slot)) {
+        if (!free_slot(slot) || holds(slot, stop))
+            continue;
+        WriteItems w;
+        w.first_slot = slot;
+        w.items = slot_items(slot, stop);
+        for (std::uint16_t next = slot + 1; next <= wrap_slot() && free_slot(next) && !holds(next, stop);
+             ++next) {
+            for (const auto& m : slot_items(next, stop))
+                w.items.push_back(m);
+        }
+        return issue(std::move(w), now);
     }
     return std::nullopt;
 }

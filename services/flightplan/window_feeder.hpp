@@ -129,6 +129,8 @@ class WindowFeeder {
     /// What a ring position holds on board for `item`: the item, or at W the whole wrap.
     std::vector<MissionItem> slot_items(std::uint16_t slot, const MissionItem& item) const;
     bool confirmed(const Entry& e) const;
+    /// The autopilot is known to hold `item` at ring position `slot`.
+    bool holds(std::uint16_t slot, const MissionItem& item) const;
     void start_fresh(std::uint16_t first_slot, TimePoint now);
     void restart(TimePoint now);
     void refill(TimePoint now);
@@ -148,6 +150,7 @@ class WindowFeeder {
     std::optional<Mode> desired_mode() const;
     bool ready_for_auto() const;
     std::optional<FeederRequest> next_write(std::size_t from, std::size_t to, TimePoint now);
+    std::optional<FeederRequest> next_stop_filler(TimePoint now);
     FeederRequest issue(decltype(FeederRequest::op) op, TimePoint now);
     void request_succeeded(const FeederRequest& request);
 

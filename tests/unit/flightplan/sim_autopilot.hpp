@@ -119,6 +119,8 @@ class SimAutopilot {
     bool in_auto() const { return auto_; }
     bool parked() const { return parked_; }
     const std::vector<LatLon>& visited() const { return visited_; }
+    /// The mission as stored, slot 0 (home) first.
+    const std::vector<MissionItem>& slots() const { return slots_; }
     int end_of_mission_holds() const { return end_of_mission_holds_; }
     int hold_requests() const { return hold_requests_; }
     int writes() const { return writes_; }

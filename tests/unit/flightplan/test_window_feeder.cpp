@@ -441,6 +441,42 @@ TEST(FlightplanFeeder, ShortPlanEndsOnStopItem) {
     EXPECT_EQ(h.feeder.progress().state, PlanState::Done);
 }
 
+TEST(FlightplanFeeder, AfterTheEndTheRingSlotsHoldTheStopSoDrivingOnGoesNowhere) {
+    // A board that stores the Stop as a plain waypoint drives on to the next slot until its HOLD lands;
+    // the slots after the end must not send it back to waypoints already driven.
+    FeederConfig c;
+    c.window = 10;  // ring positions 2..11; the wrap is slots 11..14 (11, a copy, the jump, a copy)
+    Harness h(c);
+    h.feeder.replace_plan(test::synthetic(23), h.now);
+    ASSERT_LT(h.run_until_done(200), 200);
+    for (int i = 0; i < 40; ++i)
+        h.step();
+    const LatLon end = SyntheticStream::position_of(41.0, 22);
+    const auto& slots = h.ap.slots();
+    ASSERT_EQ(slots.size(), 15u);
+    auto holds_stop = [&](std::size_t s) {
+        return slots[s].kind == MissionItem::Kind::Stop && slots[s].position == end;
+    };
+    // The 24th entry, the Stop, went to ring position 2 + 23 % 10 = 5.
+    EXPECT_TRUE(holds_stop(5));
+    for (std::size_t s : {6, 7, 8, 9, 10, 11, 12, 14})
+        EXPECT_TRUE(holds_stop(s)) << "slot " << s;
+    EXPECT_EQ(slots[13].kind, MissionItem::Kind::JumpTo);
+    // The slots left last keep their waypoints while the vehicle may still report reaching them.
+    for (std::size_t s : {2, 3, 4})
+        EXPECT_FALSE(holds_stop(s)) << "slot " << s;
+
+    // Held at the end, no report can still come: the whole ring gets the Stop.
+    h.ap.board_holds();
+    for (int i = 0; i < 40; ++i)
+        h.step();
+    for (std::size_t s : {2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 14})
+        EXPECT_TRUE(holds_stop(s)) << "slot " << s;
+    EXPECT_EQ(h.reached, iota(0, 23));
+    EXPECT_EQ(h.feeder.progress().state, PlanState::Done);
+    EXPECT_FALSE(h.feeder.poll_request(h.now).has_value()) << "nothing more to write once the ring is full";
+}
+
 TEST(FlightplanFeeder, ProgressReportsWindowAndResumePoint) {
     Harness h;
     EXPECT_EQ(h.feeder.progress().state, PlanState::None);
