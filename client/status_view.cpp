@@ -2,8 +2,7 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
-#include <cctype>
+#include "services/common/text.hpp"
 
 namespace airseg::client {
 namespace {
@@ -28,12 +27,6 @@ void flatten(const nlohmann::json& v, const std::string& prefix, std::string& ou
     out += fmt::format("  {:<28} {}\n", prefix, scalar(v));
 }
 
-std::string upper(std::string s) {
-    std::transform(s.begin(), s.end(), s.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
-    return s;
-}
-
 }  // namespace
 
 std::string render_status(const nlohmann::json& doc) {
@@ -43,7 +36,7 @@ std::string render_status(const nlohmann::json& doc) {
         out += "services:\n";
         for (const auto& [name, s] : doc["services"].items()) {
             const std::string error = s.value("error", "");
-            out += fmt::format("  {:<12} {:<9} since {}{}\n", name, upper(s.value("health", "?")),
+            out += fmt::format("  {:<12} {:<9} since {}{}\n", name, to_upper(s.value("health", "?")),
                                s.value("since", "?"), error.empty() ? "" : "  (" + error + ")");
         }
     }

@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <optional>
 
+#include "services/common/text.hpp"
+
 namespace airseg::client {
 
 namespace {
@@ -14,13 +16,6 @@ BuiltCommand usage(std::string why) {
     BuiltCommand b;
     b.usage_error = std::move(why);
     return b;
-}
-
-std::string upper(std::string s) {
-    for (auto& c : s) {
-        c = (c >= 'a' && c <= 'z') ? static_cast<char>(c - 'a' + 'A') : c;
-    }
-    return s;
 }
 
 std::optional<double> number(const std::string& text) {
@@ -54,7 +49,7 @@ BuiltCommand state_command(const std::vector<std::string>& a) {
         return usage("state needs one STATE: PARKING, DIRECTED, MANUAL_NAVIGATION or WAYPOINT_NAVIGATION");
     }
     BuiltCommand b;
-    b.request = {{"cmd", "state"}, {"state", upper(a[1])}};
+    b.request = {{"cmd", "state"}, {"state", to_upper(a[1])}};
     b.render = [](const nlohmann::json& r) {
         return "vehicle acknowledged: state " + r.value("state", std::string("?")) + "\n";
     };
@@ -65,7 +60,7 @@ BuiltCommand param_command(const std::vector<std::string>& a) {
     const std::string sub = a.size() >= 2 ? a[1] : "";
     BuiltCommand b;
     if (sub == "get" && a.size() == 3) {
-        b.request = {{"cmd", "param.get"}, {"name", upper(a[2])}};
+        b.request = {{"cmd", "param.get"}, {"name", to_upper(a[2])}};
         b.render = [](const nlohmann::json& r) {
             return fmt::format("{} = {}\n", r.value("name", "?"), r.value("value", nlohmann::json()).dump());
         };
@@ -74,7 +69,7 @@ BuiltCommand param_command(const std::vector<std::string>& a) {
         if (!v) {
             return usage("param set: '" + a[3] + "' is not a number");
         }
-        b.request = {{"cmd", "param.set"}, {"name", upper(a[2])}, {"value", *v}};
+        b.request = {{"cmd", "param.set"}, {"name", to_upper(a[2])}, {"value", *v}};
         b.render = [](const nlohmann::json& r) {
             return fmt::format("vehicle acknowledged: {} = {}\n", r.value("name", "?"),
                                r.value("value", nlohmann::json()).dump());

@@ -11,8 +11,6 @@ namespace airseg::flightplan {
 
 namespace {
 
-constexpr const char* kPrefix = "flightplan: ";
-
 struct PlanText {
     std::string text;
     std::string source;

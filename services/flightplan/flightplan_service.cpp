@@ -13,8 +13,6 @@ namespace airseg::flightplan {
 
 namespace {
 
-constexpr const char* kPrefix = "flightplan: ";
-
 autopilot::MissionItem to_autopilot(const MissionItem& m) {
     autopilot::MissionItem out;
     switch (m.kind) {

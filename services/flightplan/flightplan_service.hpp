@@ -50,6 +50,8 @@ class FlightplanService : public Service {
     void on_stop() override;
 
   private:
+    /// What every log line of this service starts with.
+    static constexpr const char* kPrefix = "flightplan: ";
     struct ActivePlan {
         std::shared_ptr<const Plan> plan;
         std::string text;

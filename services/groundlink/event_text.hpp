@@ -3,12 +3,11 @@
 // at the severity an operator should give it. Header-only: a few pure functions over bus messages.
 #include <fmt/format.h>
 
-#include <algorithm>
-#include <cctype>
 #include <string>
 #include <string_view>
 
 #include "services/autopilot/autopilot.hpp"
+#include "services/common/text.hpp"
 #include "services/groundlink/protocol/ground_protocol.hpp"
 
 namespace airseg::groundlink {
@@ -18,10 +17,7 @@ inline std::string state_words(autopilot::VehicleState s) {
     if (s == autopilot::VehicleState::ConfigureCheck) {
         return "STARTING";  // the connection sequence: parameters and streams set, not yet ready
     }
-    std::string name = autopilot::to_string(s);
-    std::transform(name.begin(), name.end(), name.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
-    return name;
+    return to_upper(autopilot::to_string(s));
 }
 
 /// "autopilot mode MANUAL -> HOLD" while the vehicle's state stays, "vehicle PARKING -> DIRECTED (autopilot
@@ -40,9 +36,7 @@ inline std::string mode_change_text(const autopilot::ModeChanged& m) {
 /// boot notices ArduPilot sends at CRITICAL or ALERT on every power-up (the sensor calibration, "Initialising
 /// APM..."): routine, so info; a calibration that failed stays an error.
 inline protocol::Event::Severity status_text_severity(int mav_severity, std::string_view text) {
-    std::string lower(text);
-    std::transform(lower.begin(), lower.end(), lower.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const std::string lower = to_lower(std::string(text));
     const auto has = [&lower](std::string_view word) { return lower.find(word) != std::string::npos; };
     const bool routine_boot =
         (has("beginning ins calibration") || has("calibrating") || has("calibration complete") ||

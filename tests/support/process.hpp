@@ -17,6 +17,11 @@ using namespace std::chrono_literals;
 bool wait_until(const std::function<bool()>& condition, std::chrono::milliseconds timeout = 10s,
                 std::chrono::milliseconds poll = 10ms);
 
+/// Wall-clock seconds since `t`, for the figures tests print.
+inline double seconds_since(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
 /// A unique temporary directory, removed with everything in it.
 class TempDir {
   public:

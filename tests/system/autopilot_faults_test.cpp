@@ -7,10 +7,6 @@
 namespace airseg::test::sys {
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
 /// A bench for plans: the board at `speedup`, 4 m/s, 1.5 m waypoint radius.
 BenchOptions plan_bench(int speedup, std::vector<std::string> sets = {}) {
     BenchOptions o;

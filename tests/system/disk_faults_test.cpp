@@ -13,10 +13,6 @@
 namespace airseg::test::sys {
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
 /// Writes `path` until the file system is full; returns the bytes written and the errno that stopped it.
 std::pair<std::size_t, int> fill(const std::string& path) {
     const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);

@@ -14,10 +14,6 @@
 namespace airseg::test::sys {
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
 TEST(SystemRadio, FrameLossSweepEveryCommandAnsweredOnce) {
     SystemBench bench;
     int serial = 0;

@@ -3,34 +3,18 @@
 #include <algorithm>
 #include <cmath>
 
+#include "services/autopilot/mavlink/enums.hpp"
+
 namespace airseg::apmsim {
 
 namespace mv = mavlink;
 
 namespace {
 
-constexpr std::uint8_t kOurSystem = 1;
-// MAV_MISSION_RESULT values (MAVLink 1.0 common.xml).
-constexpr std::uint8_t kAccepted = 0;
-constexpr std::uint8_t kError = 1;
-constexpr std::uint8_t kUnsupportedFrame = 2;
-constexpr std::uint8_t kUnsupported = 3;
-constexpr std::uint8_t kInvalidSequence = 13;
-// MAV_FRAME values the 2.x firmware accepts. Its MAV_FRAME_LOCAL_NED case is inside "#ifdef
-// MAV_FRAME_LOCAL_NED", and the MAVLink 1.0 headers define frames as enum values, not macros, so that case
-// is not compiled.
-constexpr std::uint8_t kFrameGlobal = 0;
-constexpr std::uint8_t kFrameMission = 2;
-constexpr std::uint8_t kFrameGlobalRelativeAlt = 3;
+// The 2.x firmware's system id; it answers only mission messages addressed to it (no broadcast 0).
+constexpr std::uint8_t kRover2System = 1;
 // The 2.x severities (GCS_MAVLink.h: SEVERITY_LOW = 1).
 constexpr std::uint8_t kSeverityLow = 1;
-// MAV_CMD values stored by the 2.x firmware besides those in mission_store.hpp.
-constexpr std::uint16_t kCmdDoSetHome = 179;
-constexpr std::uint16_t kCmdDoSetParameter = 180;
-constexpr std::uint16_t kCmdDoSetRelay = 181;
-constexpr std::uint16_t kCmdDoRepeatRelay = 182;
-constexpr std::uint16_t kCmdDoSetServo = 183;
-constexpr std::uint16_t kCmdDoRepeatServo = 184;
 
 // C's float to integer conversion truncates; out-of-range and non-finite values are undefined there, so the
 // simulator saturates them.
@@ -46,8 +30,8 @@ std::uint8_t to_p1(float v) {
     return static_cast<std::uint8_t>(static_cast<std::uint32_t>(to_i32(v)) & 0xFFU);
 }
 
-bool for_us(std::uint8_t target_system) {
-    return target_system == kOurSystem;
+bool for_rover2(std::uint8_t target_system) {
+    return target_system == kRover2System;
 }
 
 }  // namespace
@@ -55,7 +39,7 @@ bool for_us(std::uint8_t target_system) {
 StoredItem rover2_blank() {
     StoredItem s;
     s.command = 0;  // CMD_BLANK
-    s.frame = kFrameGlobal;
+    s.frame = mavlink::kFrameGlobal;
     s.autocontinue = 1;
     return s;
 }
@@ -66,17 +50,21 @@ Rover2Stored rover2_store(const mv::MissionItem& m) {
     s = rover2_blank();
     s.command = m.command;
     switch (m.frame) {
-        case kFrameMission:
-        case kFrameGlobal:
-        case kFrameGlobalRelativeAlt:
+        // The frames the 2.x firmware accepts. Its MAV_FRAME_LOCAL_NED case is inside "#ifdef
+        // MAV_FRAME_LOCAL_NED", and the MAVLink 1.0 headers define frames as enum values, not macros, so that
+        // case is not compiled.
+        case mavlink::kFrameMission:
+        case mavlink::kFrameGlobal:
+        case mavlink::kFrameGlobalRelativeAlt:
             // GCS_Mavlink.pde: tell_command.lat = 1.0e7f * packet.x (single precision, truncated).
             s.lat_e7 = to_i32(1.0e7F * m.x);
             s.lon_e7 = to_i32(1.0e7F * m.y);
             s.alt = static_cast<float>(to_i32(m.z * 1.0e2F));  // centimetres
-            s.frame = m.frame == kFrameGlobalRelativeAlt ? kFrameGlobalRelativeAlt : kFrameGlobal;
+            s.frame = m.frame == mavlink::kFrameGlobalRelativeAlt ? mavlink::kFrameGlobalRelativeAlt
+                                                                  : mavlink::kFrameGlobal;
             break;
         default:
-            r.result = kUnsupportedFrame;
+            r.result = mavlink::kMissionUnsupportedFrame;
             return r;
     }
     switch (m.command) {
@@ -84,7 +72,7 @@ Rover2Stored rover2_store(const mv::MissionItem& m) {
         case kCmdNavReturnToLaunch:
             break;
         case kCmdNavTakeoff:
-        case kCmdDoSetHome:
+        case mavlink::kCmdDoSetHome:
             s.param1 = to_p1(m.param1);
             break;
         case kCmdConditionChangeAlt:
@@ -96,26 +84,26 @@ Rover2Stored rover2_store(const mv::MissionItem& m) {
             s.lat_e7 = to_i32(m.param2);  // repeats
             s.param1 = to_p1(m.param1);   // target item
             break;
-        case kCmdDoRepeatServo:
+        case mavlink::kCmdDoRepeatServo:
             s.lon_e7 = to_i32(m.param4);
             [[fallthrough]];
-        case kCmdDoRepeatRelay:
+        case mavlink::kCmdDoRepeatRelay:
         case kCmdDoChangeSpeed:
             s.lat_e7 = to_i32(m.param3);
             s.alt = static_cast<float>(to_i32(m.param2));
             s.param1 = to_p1(m.param1);
             break;
-        case kCmdDoSetParameter:
-        case kCmdDoSetRelay:
-        case kCmdDoSetServo:
+        case mavlink::kCmdDoSetParameter:
+        case mavlink::kCmdDoSetRelay:
+        case mavlink::kCmdDoSetServo:
             s.alt = static_cast<float>(to_i32(m.param2));
             s.param1 = to_p1(m.param1);
             break;
         default:
-            r.result = kUnsupported;
+            r.result = mavlink::kMissionUnsupported;
             return r;
     }
-    r.result = kAccepted;
+    r.result = mavlink::kMissionAccepted;
     return r;
 }
 
@@ -127,14 +115,14 @@ mv::MissionItem rover2_download(const StoredItem& s, std::int32_t home_alt_cm) {
     const bool place = s.command < kCmdNavLast || s.command == kCmdConditionChangeAlt;
     if (place) {
         // get_cmd_with_index() adds the home altitude to a relative one before the download scales it.
-        const double alt_cm = s.alt + (s.frame == kFrameGlobalRelativeAlt ? home_alt_cm : 0);
+        const double alt_cm = s.alt + (s.frame == mavlink::kFrameGlobalRelativeAlt ? home_alt_cm : 0);
         m.x = static_cast<float>(s.lat_e7 / 1.0e7);
         m.y = static_cast<float>(s.lon_e7 / 1.0e7);
         m.z = static_cast<float>(alt_cm / 1.0e2);
     }
     switch (s.command) {
         case kCmdNavTakeoff:
-        case kCmdDoSetHome:
+        case mavlink::kCmdDoSetHome:
             m.param1 = s.param1;
             break;
         case kCmdConditionChangeAlt:
@@ -149,18 +137,18 @@ mv::MissionItem rover2_download(const StoredItem& s, std::int32_t home_alt_cm) {
             m.param2 = static_cast<float>(s.lat_e7);
             m.param1 = s.param1;
             break;
-        case kCmdDoRepeatServo:
+        case mavlink::kCmdDoRepeatServo:
             m.param4 = static_cast<float>(s.lon_e7);
             [[fallthrough]];
-        case kCmdDoRepeatRelay:
+        case mavlink::kCmdDoRepeatRelay:
         case kCmdDoChangeSpeed:
             m.param3 = static_cast<float>(s.lat_e7);
             m.param2 = s.alt;
             m.param1 = s.param1;
             break;
-        case kCmdDoSetParameter:
-        case kCmdDoSetRelay:
-        case kCmdDoSetServo:
+        case mavlink::kCmdDoSetParameter:
+        case mavlink::kCmdDoSetRelay:
+        case mavlink::kCmdDoSetServo:
             m.param2 = s.alt;
             m.param1 = s.param1;
             break;
@@ -173,7 +161,7 @@ mv::MissionItem rover2_download(const StoredItem& s, std::int32_t home_alt_cm) {
 bool LegacyMissionServer::handle(const mv::Frame& f, TimePoint now) {
     switch (f.msgid) {
         case mv::MissionRequestList::kId: {
-            if (!for_us(mv::decode_payload<mv::MissionRequestList>(f.payload_view()).target_system)) {
+            if (!for_rover2(mv::decode_payload<mv::MissionRequestList>(f.payload_view()).target_system)) {
                 return true;
             }
             mv::MissionCount c;
@@ -191,7 +179,7 @@ bool LegacyMissionServer::handle(const mv::Frame& f, TimePoint now) {
         }
         case mv::MissionRequest::kId: {
             const auto r = mv::decode_payload<mv::MissionRequest>(f.payload_view());
-            if (!for_us(r.target_system)) {
+            if (!for_rover2(r.target_system)) {
                 return true;
             }
             const StoredItem s = r.seq < store_.count() ? store_.at(r.seq) : rover2_blank();
@@ -207,17 +195,17 @@ bool LegacyMissionServer::handle(const mv::Frame& f, TimePoint now) {
         case mv::MissionAck::kId:
             return true;  // not used by the board
         case mv::MissionClearAll::kId: {
-            if (!for_us(mv::decode_payload<mv::MissionClearAll>(f.payload_view()).target_system)) {
+            if (!for_rover2(mv::decode_payload<mv::MissionClearAll>(f.payload_view()).target_system)) {
                 return true;
             }
             store_.truncate(1);  // CMD_TOTAL = 0
-            ack(f, kAccepted);
+            ack(f, mavlink::kMissionAccepted);
             hooks_.changed();
             return true;
         }
         case mv::MissionSetCurrent::kId: {
             const auto m = mv::decode_payload<mv::MissionSetCurrent>(f.payload_view());
-            if (!for_us(m.target_system)) {
+            if (!for_rover2(m.target_system)) {
                 return true;
             }
             hooks_.change_command(m.seq);
@@ -228,7 +216,7 @@ bool LegacyMissionServer::handle(const mv::Frame& f, TimePoint now) {
         }
         case mv::MissionCount::kId: {
             const auto m = mv::decode_payload<mv::MissionCount>(f.payload_view());
-            if (!for_us(m.target_system)) {
+            if (!for_rover2(m.target_system)) {
                 return true;
             }
             if (m.count == 0) {
@@ -237,7 +225,7 @@ bool LegacyMissionServer::handle(const mv::Frame& f, TimePoint now) {
                 receiving_ = false;
                 store_.truncate(1);
                 ++stats_.uploads_completed;
-                ack(f, kAccepted);
+                ack(f, mavlink::kMissionAccepted);
                 hooks_.changed();
                 return true;
             }
@@ -253,7 +241,7 @@ bool LegacyMissionServer::handle(const mv::Frame& f, TimePoint now) {
         }
         case mv::MissionWritePartialList::kId: {
             const auto m = mv::decode_payload<mv::MissionWritePartialList>(f.payload_view());
-            if (!for_us(m.target_system)) {
+            if (!for_rover2(m.target_system)) {
                 return true;
             }
             const auto total = static_cast<std::int32_t>(store_.count()) - 1;
@@ -271,7 +259,7 @@ bool LegacyMissionServer::handle(const mv::Frame& f, TimePoint now) {
         }
         case mv::MissionItem::kId: {
             const auto m = mv::decode_payload<mv::MissionItem>(f.payload_view());
-            if (for_us(m.target_system)) {
+            if (for_rover2(m.target_system)) {
                 on_item(f, m, now);
             }
             return true;
@@ -283,26 +271,26 @@ bool LegacyMissionServer::handle(const mv::Frame& f, TimePoint now) {
 
 void LegacyMissionServer::on_item(const mv::Frame& f, const mv::MissionItem& m, TimePoint now) {
     const Rover2Stored stored = rover2_store(m);
-    if (stored.result != kAccepted) {
+    if (stored.result != mavlink::kMissionAccepted) {
         ack(f, stored.result);  // the transfer goes on: the same item is asked for again
         return;
     }
     if (m.current == 2) {
         hooks_.guided_goto(stored.item);
-        ack(f, kAccepted);
+        ack(f, mavlink::kMissionAccepted);
         return;
     }
     if (!receiving_) {
-        ack(f, kError);
+        ack(f, mavlink::kMissionError);
         return;
     }
     if (m.seq != request_i_) {
-        ack(f, kInvalidSequence);
+        ack(f, mavlink::kMissionInvalidSequence);
         return;
     }
     StoredItem item = stored.item;
     if (m.seq == 0) {
-        item.frame = kFrameGlobal;  // set_cmd_with_index() keeps home's altitude absolute
+        item.frame = mavlink::kFrameGlobal;  // set_cmd_with_index() keeps home's altitude absolute
     }
     store_.write(m.seq, item);
     ++stats_.items_received;
@@ -311,7 +299,7 @@ void LegacyMissionServer::on_item(const mv::Frame& f, const mv::MissionItem& m, 
     if (request_i_ > request_last_) {
         receiving_ = false;
         ++stats_.uploads_completed;
-        ack(f, kAccepted);
+        ack(f, mavlink::kMissionAccepted);
         text("flight plan received");
         hooks_.changed();
         return;

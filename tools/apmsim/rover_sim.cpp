@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "services/autopilot/mavlink/enums.hpp"
 #include "services/autopilot/mavlink/messages.hpp"
 
 namespace airseg::apmsim {
@@ -10,8 +11,6 @@ namespace mv = mavlink;
 
 namespace {
 
-constexpr std::uint8_t kSeverityInfo = 6;
-constexpr std::uint8_t kSeverityCritical = 2;
 constexpr double kIdleAmps = 1.5;
 
 StoredItem home_item(const RoverSimConfig& c) {
@@ -188,8 +187,8 @@ void RoverSim::enter_phase(BootPhase phase, TimePoint now) {
                 r2_text(2, "Beginning INS calibration; do not move vehicle");
                 break;
             }
-            text(kSeverityInfo, "Initialising APM...");
-            text(kSeverityCritical, "Beginning INS calibration; do not move vehicle");
+            text(mavlink::kSeverityInfo, "Initialising APM...");
+            text(mavlink::kSeverityCritical, "Beginning INS calibration; do not move vehicle");
             break;
         case BootPhase::Ready: {
             phase_until_ = kNever;
@@ -205,7 +204,7 @@ void RoverSim::enter_phase(BootPhase phase, TimePoint now) {
                 r2_text(1, "\n\n Ready to drive.");
                 r2_text(1, "init home");  // init_home(), once the GPS has a fix
             } else {
-                text(kSeverityInfo, "Ready to drive.");
+                text(mavlink::kSeverityInfo, "Ready to drive.");
             }
             next_heartbeat_ = now;
             break;

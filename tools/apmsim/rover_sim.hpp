@@ -48,6 +48,11 @@
 
 namespace airseg::apmsim {
 
+/// Where a stored navigation item points.
+inline GeoPoint point_of(const StoredItem& item) {
+    return GeoPoint{item.lat_e7 / 1e7, item.lon_e7 / 1e7};
+}
+
 enum class ReachedStyle : std::uint8_t {
     MessageAndText,  // MISSION_ITEM_REACHED and the STATUSTEXT
     TextOnly,        // the STATUSTEXT alone, as APM:Rover 2.x firmware does

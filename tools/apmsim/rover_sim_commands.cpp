@@ -3,37 +3,13 @@
 #include <cmath>
 #include <string>
 
+#include "services/autopilot/mavlink/enums.hpp"
 #include "services/autopilot/mavlink/messages.hpp"
 #include "tools/apmsim/rover_sim.hpp"
 
 namespace airseg::apmsim {
 
 namespace mv = mavlink;
-
-namespace {
-
-// MAV_CMD values served.
-constexpr std::uint16_t kCmdReturnToLaunch = 20;
-constexpr std::uint16_t kCmdDoSetMode = 176;
-constexpr std::uint16_t kCmdDoSetMissionCurrent = 224;
-constexpr std::uint16_t kCmdPreflightRebootShutdown = 246;
-constexpr std::uint16_t kCmdMissionStart = 300;
-constexpr std::uint16_t kCmdComponentArmDisarm = 400;
-constexpr std::uint16_t kCmdGetHomePosition = 410;
-constexpr std::uint16_t kCmdSetMessageInterval = 511;
-constexpr std::uint16_t kCmdRequestMessage = 512;
-constexpr std::uint16_t kCmdRequestAutopilotCapabilities = 520;
-
-// MAV_RESULT values.
-constexpr std::uint8_t kAccepted = 0;
-constexpr std::uint8_t kTemporarilyRejected = 1;
-constexpr std::uint8_t kDenied = 2;
-constexpr std::uint8_t kUnsupported = 3;
-constexpr std::uint8_t kFailed = 4;
-
-constexpr std::uint8_t kModeFlagCustomModeEnabled = 1;
-
-}  // namespace
 
 void RoverSim::on_param(const mv::Frame& f) {
     if (f.msgid == mv::ParamRequestList::kId) {
@@ -147,12 +123,13 @@ void RoverSim::on_set_mode(const mv::Frame& f, TimePoint now) {
     if (!addressed(m.target_system)) {
         return;
     }
-    std::uint8_t result = kFailed;
+    std::uint8_t result = mavlink::kResultFailed;
     const auto mode = mode_from_number(m.custom_mode);
     if (phase_ != BootPhase::Ready) {
-        result = kTemporarilyRejected;
-    } else if ((m.base_mode & kModeFlagCustomModeEnabled) != 0 && mode && *mode != RoverMode::Initialising) {
-        result = set_mode(*mode, "command", now) ? kAccepted : kFailed;
+        result = mavlink::kResultTemporarilyRejected;
+    } else if ((m.base_mode & mavlink::kModeFlagCustomModeEnabled) != 0 && mode &&
+               *mode != RoverMode::Initialising) {
+        result = set_mode(*mode, "command", now) ? mavlink::kResultAccepted : mavlink::kResultFailed;
     }
     mv::CommandAck ack;  // later firmware acknowledges SET_MODE with the message id as the command
     ack.command = mv::SetMode::kId;
@@ -171,19 +148,19 @@ void RoverSim::on_command_long(const mv::Frame& f, TimePoint now) {
     if (!addressed(c.target_system)) {
         return;
     }
-    std::uint8_t result = kUnsupported;
+    std::uint8_t result = mavlink::kResultUnsupported;
     bool reboot_after_ack = false;
     const bool ready = phase_ == BootPhase::Ready;
     switch (c.command) {
-        case kCmdDoSetMode: {
+        case mavlink::kCmdDoSetMode: {
             const auto mode = mode_from_number(static_cast<std::uint32_t>(c.param2));
             if (!ready) {
-                result = kTemporarilyRejected;
-            } else if ((static_cast<int>(c.param1) & kModeFlagCustomModeEnabled) == 0 || !mode ||
+                result = mavlink::kResultTemporarilyRejected;
+            } else if ((static_cast<int>(c.param1) & mavlink::kModeFlagCustomModeEnabled) == 0 || !mode ||
                        *mode == RoverMode::Initialising) {
-                result = kFailed;
+                result = mavlink::kResultFailed;
             } else {
-                result = set_mode(*mode, "command", now) ? kAccepted : kFailed;
+                result = set_mode(*mode, "command", now) ? mavlink::kResultAccepted : mavlink::kResultFailed;
             }
             break;
         }
@@ -191,60 +168,61 @@ void RoverSim::on_command_long(const mv::Frame& f, TimePoint now) {
             // Rover's handle of MAV_CMD_DO_CHANGE_SPEED: param2 is the new speed (m/s), param1 (speed type)
             // and param3 (throttle) are not used; a negative speed fails (Mode::set_desired_speed()).
             if (!config_.firmware.change_speed_command) {
-                result = kUnsupported;
+                result = mavlink::kResultUnsupported;
             } else if (!(c.param2 >= 0)) {
-                result = kFailed;
+                result = mavlink::kResultFailed;
             } else {
                 speed_override_ = c.param2;
                 note_speed("command", now);
-                result = kAccepted;
+                result = mavlink::kResultAccepted;
             }
             break;
-        case kCmdMissionStart:
-            result = !ready                                      ? kTemporarilyRejected
-                     : set_mode(RoverMode::Auto, "command", now) ? kAccepted
-                                                                 : kFailed;
+        case mavlink::kCmdMissionStart:
+            result = !ready                                      ? mavlink::kResultTemporarilyRejected
+                     : set_mode(RoverMode::Auto, "command", now) ? mavlink::kResultAccepted
+                                                                 : mavlink::kResultFailed;
             break;
-        case kCmdReturnToLaunch:
-            result = !ready                                     ? kTemporarilyRejected
-                     : set_mode(RoverMode::Rtl, "command", now) ? kAccepted
-                                                                : kFailed;
+        case kCmdNavReturnToLaunch:
+            result = !ready                                     ? mavlink::kResultTemporarilyRejected
+                     : set_mode(RoverMode::Rtl, "command", now) ? mavlink::kResultAccepted
+                                                                : mavlink::kResultFailed;
             break;
-        case kCmdComponentArmDisarm:
+        case mavlink::kCmdComponentArmDisarm:
             if (!ready) {
-                result = kTemporarilyRejected;
+                result = mavlink::kResultTemporarilyRejected;
             } else {
                 armed_ = c.param1 >= 0.5F;
-                result = kAccepted;
+                result = mavlink::kResultAccepted;
             }
             break;
-        case kCmdDoSetMissionCurrent: {
+        case mavlink::kCmdDoSetMissionCurrent: {
             const auto seq = static_cast<std::uint16_t>(std::clamp(c.param1, 0.0F, 65535.0F));
-            result = seq < store_.count() && set_current(seq, now) ? kAccepted : kDenied;
-            if (result == kAccepted) {
+            result = seq < store_.count() && set_current(seq, now) ? mavlink::kResultAccepted
+                                                                   : mavlink::kResultDenied;
+            if (result == mavlink::kResultAccepted) {
                 send_mission_current();
             }
             break;
         }
-        case kCmdPreflightRebootShutdown:
+        case mavlink::kCmdPreflightRebootShutdown:
             if (std::lround(c.param1) == 1) {
-                result = kAccepted;
+                result = mavlink::kResultAccepted;
                 reboot_after_ack = true;
             } else {
-                result = kUnsupported;
+                result = mavlink::kResultUnsupported;
             }
             break;
-        case kCmdGetHomePosition:
+        case mavlink::kCmdGetHomePosition:
             send_home_position();
-            result = kAccepted;
+            result = mavlink::kResultAccepted;
             break;
-        case kCmdRequestAutopilotCapabilities:
+        case mavlink::kCmdRequestAutopilotCapabilities:
             send_autopilot_version();
-            result = kAccepted;
+            result = mavlink::kResultAccepted;
             break;
-        case kCmdRequestMessage: {
+        case mavlink::kCmdRequestMessage: {
             const auto id = static_cast<std::uint32_t>(std::max(0.0F, c.param1));
-            result = kAccepted;
+            result = mavlink::kResultAccepted;
             if (id == mv::HomePosition::kId) {
                 send_home_position();
             } else if (id == mv::AutopilotVersion::kId) {
@@ -257,11 +235,11 @@ void RoverSim::on_command_long(const mv::Frame& f, TimePoint now) {
                                  id == mv::RcChannelsRaw::kId || id == mv::ServoOutputRaw::kId)) {
                 send_stream_message(id, now);
             } else {
-                result = kDenied;
+                result = mavlink::kResultDenied;
             }
             break;
         }
-        case kCmdSetMessageInterval: {
+        case mavlink::kCmdSetMessageInterval: {
             const auto id = static_cast<std::uint32_t>(std::max(0.0F, c.param1));
             const float us = c.param2;
             if (us < -0.5F) {
@@ -274,7 +252,7 @@ void RoverSim::on_command_long(const mv::Frame& f, TimePoint now) {
                     milliseconds(20));  // the same 50 Hz ceiling as the stream groups
                 streams_.set_message_interval(id, interval, now);
             }
-            result = kAccepted;
+            result = mavlink::kResultAccepted;
             break;
         }
         default:

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "services/autopilot/mavlink/enums.hpp"
 #include "services/autopilot/mavlink/messages.hpp"
 #include "tools/apmsim/rover_sim.hpp"
 
@@ -11,12 +12,6 @@ namespace airseg::apmsim {
 namespace mv = mavlink;
 
 namespace {
-
-constexpr std::uint8_t kSeverityInfo = 6;
-
-GeoPoint point_of(const StoredItem& item) {
-    return GeoPoint{item.lat_e7 / 1e7, item.lon_e7 / 1e7};
-}
 
 bool is_manual(RoverMode m) {
     return m == RoverMode::Manual || m == RoverMode::Learning || m == RoverMode::Steering ||
@@ -50,7 +45,7 @@ bool RoverSim::set_mode(RoverMode mode, const std::string& cause, TimePoint now)
         return r2_set_mode(mode, cause, now);
     }
     if (mode == RoverMode::Auto && store_.count() <= 1) {
-        text(kSeverityInfo, "No Mission. Can't set AUTO.");
+        text(mavlink::kSeverityInfo, "No Mission. Can't set AUTO.");
         return false;
     }
     const RoverMode from = mode_;
@@ -131,7 +126,7 @@ void RoverSim::load_item(std::uint16_t seq, TimePoint now) {
         mission_complete_ = true;
         mission_running_ = false;
         target_.reset();
-        text(kSeverityInfo, "Mission Complete");
+        text(mavlink::kSeverityInfo, "Mission Complete");
         set_mode(RoverMode::Hold, "mission end", now);
         return;
     }
@@ -192,12 +187,12 @@ void RoverSim::physics_step(TimePoint at) {
 
 void RoverSim::on_target_reached(double distance, bool passed, TimePoint now) {
     if (mode_ == RoverMode::Rtl || mode_ == RoverMode::SmartRtl) {
-        text(kSeverityInfo, "Reached Destination");
+        text(mavlink::kSeverityInfo, "Reached Destination");
         set_mode(RoverMode::Hold, "rtl end", now);
         return;
     }
     if (mode_ == RoverMode::Guided) {
-        text(kSeverityInfo, "Reached Destination");
+        text(mavlink::kSeverityInfo, "Reached Destination");
         guided_target_.reset();
         target_.reset();
         return;
@@ -206,7 +201,7 @@ void RoverSim::on_target_reached(double distance, bool passed, TimePoint now) {
     char line[50];
     std::snprintf(line, sizeof line, "%s waypoint #%u dist %um", passed ? "Passed" : "Reached",
                   static_cast<unsigned>(seq), static_cast<unsigned>(std::lround(distance)));
-    text(kSeverityInfo, line);
+    text(mavlink::kSeverityInfo, line);
     if (config_.reached_style == ReachedStyle::MessageAndText) {
         mv::MissionItemReached r;
         r.seq = seq;

@@ -8,6 +8,7 @@
 #include <cstdarg>
 #include <cstdio>
 
+#include "services/autopilot/mavlink/enums.hpp"
 #include "services/autopilot/mavlink/messages.hpp"
 #include "tools/apmsim/rover_sim.hpp"
 
@@ -26,12 +27,6 @@ constexpr std::uint8_t kHigh = 3;
 // The scheduler runs navigate() and update_commands() every 5 ticks of the 50 Hz loop.
 constexpr Duration kTick = milliseconds(100);
 
-// MAV_CMD values handled here besides those of mission_store.hpp.
-constexpr std::uint16_t kCmdDoSetMode = 176;
-constexpr std::uint16_t kCmdDoSetServo = 183;
-constexpr std::uint16_t kCmdPreflightCalibration = 241;
-constexpr std::uint16_t kCmdPreflightRebootShutdown = 246;
-constexpr std::uint16_t kCmdMissionStart = 300;
 // MAV_MODE values DO_SET_MODE's param1 is matched against.
 constexpr std::uint16_t kMavModeManualDisarmed = 64;
 constexpr std::uint16_t kMavModeManualArmed = 192;
@@ -39,22 +34,6 @@ constexpr std::uint16_t kMavModeAutoDisarmed = 92;
 constexpr std::uint16_t kMavModeAutoArmed = 220;
 constexpr std::uint16_t kMavModeStabilizeDisarmed = 80;
 constexpr std::uint16_t kMavModeStabilizeArmed = 208;
-// MAV_RESULT
-constexpr std::uint8_t kAccepted = 0;
-constexpr std::uint8_t kUnsupported = 3;
-// Heartbeat
-constexpr std::uint8_t kMavTypeGroundRover = 10;
-constexpr std::uint8_t kMavAutopilotArdupilotmega = 3;
-constexpr std::uint8_t kFlagCustomModeEnabled = 1;
-constexpr std::uint8_t kFlagGuidedEnabled = 8;
-constexpr std::uint8_t kFlagManualInputEnabled = 64;
-constexpr std::uint8_t kFlagSafetyArmed = 128;
-constexpr std::uint8_t kStateCalibrating = 2;
-constexpr std::uint8_t kStateActive = 4;
-
-GeoPoint point_of(const StoredItem& item) {
-    return GeoPoint{item.lat_e7 / 1e7, item.lon_e7 / 1e7};
-}
 
 std::string format(const char* fmt, ...) {
     char buf[64];
@@ -120,24 +99,24 @@ StoredItem RoverSim::r2_cmd(int index) const {
 // send_heartbeat() of GCS_Mavlink.pde: armed whenever not initialising, HOLD reports system status 0.
 void RoverSim::r2_send_heartbeat() {
     mv::Heartbeat hb;
-    hb.type = kMavTypeGroundRover;
-    hb.autopilot = kMavAutopilotArdupilotmega;
+    hb.type = mavlink::kMavTypeGroundRover;
+    hb.autopilot = mavlink::kMavAutopilotArdupilotmega;
     hb.custom_mode = static_cast<std::uint32_t>(mode_);
-    hb.system_status = kStateActive;
+    hb.system_status = mavlink::kMavStateActive;
     std::uint8_t base = 0;
     switch (mode_) {
         case RoverMode::Manual:
         case RoverMode::Learning:
         case RoverMode::Steering:
-            base = kFlagManualInputEnabled;
+            base = mavlink::kModeFlagManualInputEnabled;
             break;
         case RoverMode::Auto:
         case RoverMode::Rtl:
         case RoverMode::Guided:
-            base = kFlagGuidedEnabled;
+            base = mavlink::kModeFlagGuidedEnabled;
             break;
         case RoverMode::Initialising:
-            hb.system_status = kStateCalibrating;
+            hb.system_status = mavlink::kMavStateCalibrating;
             break;
         case RoverMode::Hold:
             hb.system_status = 0;
@@ -146,9 +125,9 @@ void RoverSim::r2_send_heartbeat() {
             break;
     }
     if (mode_ != RoverMode::Initialising) {
-        base |= kFlagSafetyArmed;  // "we are armed if we are not initialising"
+        base |= mavlink::kModeFlagSafetyArmed;  // "we are armed if we are not initialising"
     }
-    hb.base_mode = base | kFlagCustomModeEnabled;
+    hb.base_mode = base | mavlink::kModeFlagCustomModeEnabled;
     heartbeat_sent_this_boot_ = true;
     ++counters_.heartbeats_sent;
     out_.send(hb);
@@ -553,7 +532,7 @@ bool RoverSim::r2_verify_rtl() {
 // HOLD, LEARNING, STEERING, AUTO and RTL only.
 void RoverSim::r2_on_set_mode(const mv::Frame& f, TimePoint now) {
     const auto m = mv::decode_payload<mv::SetMode>(f.payload_view());
-    if ((m.base_mode & kFlagCustomModeEnabled) == 0) {
+    if ((m.base_mode & mavlink::kModeFlagCustomModeEnabled) == 0) {
         return;  // "we ignore base_mode as there is no sane way to map from that bitmap"
     }
     const auto mode = mode_from_number(m.custom_mode);
@@ -581,46 +560,46 @@ void RoverSim::r2_on_command_long(const mv::Frame& f, TimePoint now) {
         return;
     }
     r2_text(kLow, "command received: ");
-    std::uint8_t result = kUnsupported;
+    std::uint8_t result = mavlink::kResultUnsupported;
     switch (c.command) {
         case kCmdNavReturnToLaunch:
             r2_set_mode(RoverMode::Rtl, "command", now);
-            result = kAccepted;
+            result = mavlink::kResultAccepted;
             break;
-        case kCmdMissionStart:
+        case mavlink::kCmdMissionStart:
             r2_set_mode(RoverMode::Auto, "command", now);  // with no mission: AUTO, then HOLD
-            result = kAccepted;
+            result = mavlink::kResultAccepted;
             break;
-        case kCmdPreflightCalibration:
-            result = kAccepted;  // the INS and radio trims are not simulated
+        case mavlink::kCmdPreflightCalibration:
+            result = mavlink::kResultAccepted;  // the INS and radio trims are not simulated
             break;
-        case kCmdDoSetMode:
+        case mavlink::kCmdDoSetMode:
             // param1 is a MAV_MODE (base mode), not a custom mode.
             switch (static_cast<std::uint16_t>(c.param1)) {
                 case kMavModeManualArmed:
                 case kMavModeManualDisarmed:
                     r2_set_mode(RoverMode::Manual, "command", now);
-                    result = kAccepted;
+                    result = mavlink::kResultAccepted;
                     break;
                 case kMavModeAutoArmed:
                 case kMavModeAutoDisarmed:
                     r2_set_mode(RoverMode::Auto, "command", now);
-                    result = kAccepted;
+                    result = mavlink::kResultAccepted;
                     break;
                 case kMavModeStabilizeDisarmed:
                 case kMavModeStabilizeArmed:
                     r2_set_mode(RoverMode::Learning, "command", now);
-                    result = kAccepted;
+                    result = mavlink::kResultAccepted;
                     break;
                 default:
-                    result = kUnsupported;
+                    result = mavlink::kResultUnsupported;
                     break;
             }
             break;
-        case kCmdDoSetServo:
-            result = kAccepted;
+        case mavlink::kCmdDoSetServo:
+            result = mavlink::kResultAccepted;
             break;
-        case kCmdPreflightRebootShutdown:
+        case mavlink::kCmdPreflightRebootShutdown:
             if (c.param1 == 1) {
                 reboot(now);  // reboot_apm() does not return: no COMMAND_ACK
                 return;

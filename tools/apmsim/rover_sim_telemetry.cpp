@@ -3,6 +3,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "services/autopilot/mavlink/enums.hpp"
 #include "services/autopilot/mavlink/messages.hpp"
 #include "tools/apmsim/rover_sim.hpp"
 
@@ -12,20 +13,6 @@ namespace mv = mavlink;
 
 namespace {
 
-constexpr std::uint8_t kMavTypeGroundRover = 10;
-constexpr std::uint8_t kMavAutopilotArdupilotmega = 3;
-// MAV_MODE_FLAG bits.
-constexpr std::uint8_t kFlagCustomModeEnabled = 1;
-constexpr std::uint8_t kFlagAutoEnabled = 4;
-constexpr std::uint8_t kFlagGuidedEnabled = 8;
-constexpr std::uint8_t kFlagStabilizeEnabled = 16;
-constexpr std::uint8_t kFlagManualInputEnabled = 64;
-constexpr std::uint8_t kFlagSafetyArmed = 128;
-// MAV_STATE values.
-constexpr std::uint8_t kStateBoot = 1;
-constexpr std::uint8_t kStateCalibrating = 2;
-constexpr std::uint8_t kStateStandby = 3;
-constexpr std::uint8_t kStateActive = 4;
 // Sensors an APM 2.5 reports (gyro, accel, mag, baro, GPS, motor outputs, RC receiver).
 constexpr std::uint32_t kSensors = 0x1 | 0x2 | 0x4 | 0x8 | 0x20 | 0x8000 | 0x10000;
 
@@ -49,24 +36,25 @@ void RoverSim::send_heartbeat(TimePoint now) {
         return;
     }
     mv::Heartbeat hb;
-    hb.type = kMavTypeGroundRover;
-    hb.autopilot = kMavAutopilotArdupilotmega;
+    hb.type = mavlink::kMavTypeGroundRover;
+    hb.autopilot = mavlink::kMavAutopilotArdupilotmega;
     hb.custom_mode = static_cast<std::uint32_t>(mode_);
-    hb.base_mode = kFlagCustomModeEnabled;
+    hb.base_mode = mavlink::kModeFlagCustomModeEnabled;
     switch (mode_) {
         case RoverMode::Manual:
         case RoverMode::Learning:
         case RoverMode::Acro:
-            hb.base_mode |= kFlagManualInputEnabled;
+            hb.base_mode |= mavlink::kModeFlagManualInputEnabled;
             break;
         case RoverMode::Steering:
-            hb.base_mode |= kFlagManualInputEnabled | kFlagStabilizeEnabled;
+            hb.base_mode |= mavlink::kModeFlagManualInputEnabled | mavlink::kModeFlagStabilizeEnabled;
             break;
         case RoverMode::Auto:
         case RoverMode::Rtl:
         case RoverMode::SmartRtl:
         case RoverMode::Guided:
-            hb.base_mode |= kFlagAutoEnabled | kFlagGuidedEnabled | kFlagStabilizeEnabled;
+            hb.base_mode |= mavlink::kModeFlagAutoEnabled | mavlink::kModeFlagGuidedEnabled |
+                            mavlink::kModeFlagStabilizeEnabled;
             break;
         case RoverMode::Hold:
         case RoverMode::Loiter:
@@ -74,12 +62,12 @@ void RoverSim::send_heartbeat(TimePoint now) {
             break;
     }
     if (armed_) {
-        hb.base_mode |= kFlagSafetyArmed;
+        hb.base_mode |= mavlink::kModeFlagSafetyArmed;
     }
     if (phase_ == BootPhase::Calibrating) {
-        hb.system_status = heartbeat_sent_this_boot_ ? kStateCalibrating : kStateBoot;
+        hb.system_status = heartbeat_sent_this_boot_ ? mavlink::kMavStateCalibrating : mavlink::kMavStateBoot;
     } else {
-        hb.system_status = armed_ ? kStateActive : kStateStandby;
+        hb.system_status = armed_ ? mavlink::kMavStateActive : mavlink::kMavStateStandby;
     }
     heartbeat_sent_this_boot_ = true;
     ++counters_.heartbeats_sent;

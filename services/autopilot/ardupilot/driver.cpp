@@ -5,15 +5,13 @@
 
 #include "services/autopilot/ardupilot/mission_codec.hpp"
 #include "services/autopilot/ardupilot/rover_modes.hpp"
+#include "services/autopilot/mavlink/enums.hpp"
 
 namespace airseg::autopilot::ardupilot {
 
 namespace mav = airseg::mavlink;
 
 namespace {
-constexpr std::uint16_t kCmdDoSetMode = 176;
-constexpr std::uint16_t kCmdSetMessageInterval = 511;
-constexpr std::uint8_t kModeFlagCustomModeEnabled = 1;
 
 double seconds_between(TimePoint a, TimePoint b) {
     return std::chrono::duration<double>(b - a).count();
@@ -314,7 +312,7 @@ void Driver::request_streams() {
         mav::CommandLong m;
         m.target_system = config_.target_sysid;
         m.target_component = config_.target_compid;
-        m.command = kCmdSetMessageInterval;
+        m.command = mavlink::kCmdSetMessageInterval;
         m.param1 = static_cast<float>(r.msgid);
         m.param2 = r.hz > 0 ? static_cast<float>(1e6 / r.hz) : -1.0f;  // -1 disables the message
         out_.send(m);
@@ -670,15 +668,15 @@ void Driver::send_mode(std::uint32_t mode) {
     if (config_.board == Board::Apm2) {
         mav::SetMode m;  // ArduRover 2.x does not know MAV_CMD_DO_SET_MODE
         m.target_system = config_.target_sysid;
-        m.base_mode = kModeFlagCustomModeEnabled;
+        m.base_mode = mavlink::kModeFlagCustomModeEnabled;
         m.custom_mode = mode;
         out_.send(m);
     } else {
         mav::CommandLong m;
         m.target_system = config_.target_sysid;
         m.target_component = config_.target_compid;
-        m.command = kCmdDoSetMode;
-        m.param1 = kModeFlagCustomModeEnabled;
+        m.command = mavlink::kCmdDoSetMode;
+        m.param1 = mavlink::kModeFlagCustomModeEnabled;
         m.param2 = static_cast<float>(mode);
         out_.send(m);
     }

@@ -7,18 +7,13 @@
 #include "services/autopilot/ardupilot/driver.hpp"
 #include "services/autopilot/ardupilot/rover_modes.hpp"
 #include "services/autopilot/mavlink/encoder.hpp"
+#include "services/autopilot/mavlink/enums.hpp"
 
 namespace airseg::autopilot::ardupilot {
 
 namespace mav = airseg::mavlink;
 
 namespace {
-constexpr std::uint8_t kMavStateUninit = 0;
-constexpr std::uint8_t kMavStateBoot = 1;
-constexpr std::uint8_t kMavStateCalibrating = 2;
-constexpr std::uint8_t kMavStatePoweroff = 7;
-constexpr std::uint16_t kCmdDoSetMode = 176;
-constexpr std::uint16_t kCmdDoChangeSpeed = 178;
 constexpr Duration kGapWindow = seconds(10);   // boot banners this long after a heartbeat gap mean a reboot
 constexpr Duration kSameReached = seconds(3);  // the item-reached message and the text for the same slot
 constexpr Duration kClockSlack = seconds(2);   // latency jitter allowed when comparing time_boot_ms
@@ -154,10 +149,10 @@ void Driver::on_heartbeat(const mav::Heartbeat& hb, TimePoint now) {
     system_status_ = hb.system_status;
     // APM:Rover 2.x reports MAV_STATE_UNINIT in HOLD (send_heartbeat() of its GCS_Mavlink.pde): in a running
     // mode UNINIT is that quirk, not a board starting up.
-    const bool uninit_booting =
-        hb.system_status == kMavStateUninit && hb.custom_mode != static_cast<std::uint32_t>(RoverMode::Hold);
-    const bool booting = uninit_booting || hb.system_status == kMavStateBoot ||
-                         hb.system_status == kMavStateCalibrating ||
+    const bool uninit_booting = hb.system_status == mavlink::kMavStateUninit &&
+                                hb.custom_mode != static_cast<std::uint32_t>(RoverMode::Hold);
+    const bool booting = uninit_booting || hb.system_status == mavlink::kMavStateBoot ||
+                         hb.system_status == mavlink::kMavStateCalibrating ||
                          hb.custom_mode == static_cast<std::uint32_t>(RoverMode::Initialising);
     if (!link_up_) {
         link_up_ = true;
@@ -177,7 +172,7 @@ void Driver::on_heartbeat(const mav::Heartbeat& hb, TimePoint now) {
     } else if (mode_changed) {
         override_active_ = false;  // the RC pilot or the autopilot took over
     }
-    if (phase_ == Phase::WaitBoot && !booting && hb.system_status != kMavStatePoweroff) {
+    if (phase_ == Phase::WaitBoot && !booting && hb.system_status != mavlink::kMavStatePoweroff) {
         enter(Phase::Params, now);
     }
     update_state(now, false);
@@ -294,11 +289,11 @@ void Driver::on_time_boot(std::uint32_t time_boot_ms, TimePoint now) {
 }
 
 void Driver::on_command_ack(const mav::CommandAck& ack, TimePoint now) {
-    if (ack.command == kCmdDoChangeSpeed) {
+    if (ack.command == mavlink::kCmdDoChangeSpeed) {
         on_speed_ack(ack.result, now);
         return;
     }
-    if (ack.command != kCmdDoSetMode || !mode_request_) {
+    if (ack.command != mavlink::kCmdDoSetMode || !mode_request_) {
         return;
     }
     if (ack.result == 0 || ack.result == 5) {

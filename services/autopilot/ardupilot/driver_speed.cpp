@@ -10,16 +10,15 @@
 
 #include "services/autopilot/ardupilot/driver.hpp"
 
+#include "services/autopilot/mavlink/enums.hpp"
+
 namespace airseg::autopilot::ardupilot {
 
 namespace mav = airseg::mavlink;
 
 namespace {
-constexpr std::uint16_t kCmdDoChangeSpeed = 178;
 constexpr float kSpeedTypeGround = 1.0F;
 constexpr float kThrottleUnchanged = -1.0F;
-constexpr std::uint8_t kResultAccepted = 0;
-constexpr std::uint8_t kResultInProgress = 5;
 constexpr double kSameSpeed = 0.005;  // m/s: below this two speeds are the same
 constexpr const char* kCruiseSpeed = "CRUISE_SPEED";
 
@@ -76,7 +75,7 @@ void Driver::send_speed(double value, unsigned attempt, TimePoint now) {
     mav::CommandLong m;
     m.target_system = config_.target_sysid;
     m.target_component = config_.target_compid;
-    m.command = kCmdDoChangeSpeed;
+    m.command = mavlink::kCmdDoChangeSpeed;
     m.confirmation = static_cast<std::uint8_t>(std::min(attempt, 255u));
     m.param1 = kSpeedTypeGround;
     m.param2 = static_cast<float>(value);
@@ -89,11 +88,11 @@ void Driver::on_speed_ack(std::uint8_t result, TimePoint now) {
     if (!speed_request_ || speed_request_->param_op != 0) {
         return;
     }
-    if (result == kResultInProgress) {
+    if (result == mavlink::kResultInProgress) {
         return;
     }
     const double v = speed_request_->value;
-    if (result == kResultAccepted) {
+    if (result == mavlink::kResultAccepted) {
         speed_request_.reset();
         speed_set_ = v;
         ++speed_changes_;

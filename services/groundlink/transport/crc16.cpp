@@ -5,7 +5,7 @@
 namespace airseg::groundlink {
 namespace {
 
-constexpr std::array<std::uint16_t, 256> make_table() {
+constexpr std::array<std::uint16_t, 256> make_crc16_table() {
     std::array<std::uint16_t, 256> table{};
     for (unsigned i = 0; i < 256; ++i) {
         auto c = static_cast<std::uint16_t>(i << 8);
@@ -17,14 +17,14 @@ constexpr std::array<std::uint16_t, 256> make_table() {
     return table;
 }
 
-constexpr std::array<std::uint16_t, 256> kTable = make_table();
+constexpr std::array<std::uint16_t, 256> kCrc16Table = make_crc16_table();
 
 }  // namespace
 
 std::uint16_t crc16_ccitt(std::span<const std::uint8_t> data) {
     std::uint16_t crc = 0xFFFF;
     for (std::uint8_t b : data) {
-        crc = static_cast<std::uint16_t>((crc << 8) ^ kTable[((crc >> 8) ^ b) & 0xFFU]);
+        crc = static_cast<std::uint16_t>((crc << 8) ^ kCrc16Table[((crc >> 8) ^ b) & 0xFFU]);
     }
     return crc;
 }

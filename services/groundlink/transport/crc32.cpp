@@ -5,7 +5,7 @@
 namespace airseg::groundlink {
 namespace {
 
-constexpr std::array<std::uint32_t, 256> make_table() {
+constexpr std::array<std::uint32_t, 256> make_crc32_table() {
     std::array<std::uint32_t, 256> table{};
     for (std::uint32_t i = 0; i < 256; ++i) {
         std::uint32_t c = i;
@@ -17,13 +17,13 @@ constexpr std::array<std::uint32_t, 256> make_table() {
     return table;
 }
 
-constexpr std::array<std::uint32_t, 256> kTable = make_table();
+constexpr std::array<std::uint32_t, 256> kCrc32Table = make_crc32_table();
 
 }  // namespace
 
 void Crc32::update(std::span<const std::uint8_t> data) {
     for (std::uint8_t b : data) {
-        state_ = kTable[(state_ ^ b) & 0xFFU] ^ (state_ >> 8);
+        state_ = kCrc32Table[(state_ ^ b) & 0xFFU] ^ (state_ >> 8);
     }
 }
 

@@ -47,10 +47,6 @@ bool exists(const std::string& path) {
     return ::stat(path.c_str(), &st) == 0;
 }
 
-double seconds_since(std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
 using SimControl = ControlClient;
 
 struct Answer {
@@ -263,8 +259,10 @@ TEST_P(FlightplanE2e, LongScanRunsToTheEndWithEveryWaypointReachedOnceInOrderAnd
     EXPECT_EQ(plan["waypoints_reached"].get<std::size_t>(), expected.size()) << plan.dump();
     EXPECT_EQ(plan["starvation_holds"], 0) << plan.dump();
 
-    // The board's own record: every plan waypoint reached exactly once, in plan order (then the Stop item
-    // at the last position, where the vehicle stays).
+    // The board's own record: every plan waypoint reached exactly once, in plan order, then only the Stop
+    // at the last position, where the vehicle stays. A board that takes the Stop for a plain waypoint
+    // (rover2) may reach the copies of it in the slots after it before its HOLD lands: same place, so
+    // what is checked after the end is the place, not the count.
     const auto reached = board_log(first);
     ASSERT_GE(reached.size(), expected.size());
     for (std::size_t i = 0; i < expected.size(); ++i) {
@@ -274,7 +272,6 @@ TEST_P(FlightplanE2e, LongScanRunsToTheEndWithEveryWaypointReachedOnceInOrderAnd
     for (std::size_t i = expected.size(); i < reached.size(); ++i) {
         EXPECT_PRED2(same_place, reached[i].at, expected.back()) << "after the end, only the final stop";
     }
-    EXPECT_LE(reached.size(), expected.size() + 1);
     // Zero HOLDs: the window never ran dry.
     const double end = reached[expected.size() - 1].t;
     EXPECT_TRUE(holds_between(t0, end).empty()) << holds_between(t0, end).dump();

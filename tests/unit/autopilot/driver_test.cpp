@@ -16,7 +16,7 @@ using testing::LinkModel;
 using testing::Party;
 namespace mav = airseg::mavlink;
 
-const TimePoint kStart = TimePoint{} + std::chrono::hours(2);
+const TimePoint kDriverTestStart = TimePoint{} + std::chrono::hours(2);
 
 AutopilotConfig apm2_config() {
     auto c = AutopilotConfig::defaults_for(Board::Apm2);
@@ -27,8 +27,8 @@ AutopilotConfig apm2_config() {
 struct Rig {
     Rig(AutopilotConfig config, FakeRover::Options opts, LinkModel link = {}, std::uint32_t seed = 1)
         : driver(std::move(config)),
-          rover(opts, kStart),
-          harness(ground(), vehicle(), link, link, seed, kStart) {}
+          rover(opts, kDriverTestStart),
+          harness(ground(), vehicle(), link, link, seed, kDriverTestStart) {}
 
     Party ground() {
         Party p;
@@ -442,7 +442,7 @@ TEST(Driver, UnresponsiveAutopilotGetsAtMostNResetPulses) {
     config.unresponsive_timeout = seconds(5);
     config.max_reset_pulses = 2;
     Rig rig(config, apm2_rover());
-    rig.rover.stall(kStart + std::chrono::hours(1));
+    rig.rover.stall(kDriverTestStart + std::chrono::hours(1));
     rig.driver.on_port_open(rig.now());
     rig.harness.run_until(
         [&] {
@@ -464,7 +464,7 @@ TEST(Driver, ResetPulseRecoversAStuckAutopilot) {
     config.reset_on_open = false;
     config.unresponsive_timeout = seconds(5);
     Rig rig(config, apm2_rover());
-    rig.rover.stall(kStart + std::chrono::hours(1));
+    rig.rover.stall(kDriverTestStart + std::chrono::hours(1));
     rig.driver.on_port_open(rig.now());
     const bool ready = rig.harness.run_until(
         [&] {
@@ -488,9 +488,9 @@ TEST(Driver, BaudProbingMovesToTheNextRateUntilAFrameArrives) {
     config.bauds = {57600, 115200};
     config.baud_probe = seconds(2);
     Rig rig(config, apm2_rover());
-    rig.rover.stall(kStart + seconds(3));  // nothing readable at first
+    rig.rover.stall(kDriverTestStart + seconds(3));  // nothing readable at first
     rig.open_with_reset();
-    rig.rover.stall(kStart + seconds(3));
+    rig.rover.stall(kDriverTestStart + seconds(3));
     ASSERT_TRUE(rig.run_until_event<Ready>(1, seconds(40)));
     ASSERT_FALSE(rig.actions.empty());
     ASSERT_TRUE(std::holds_alternative<SwitchBaud>(rig.actions[0]));
@@ -607,7 +607,7 @@ TEST(Driver, OurHeartbeatGoesToTheAutopilotAtOneHertzWithTheConfiguredType) {
     for (std::size_t i = before + 1; i < sent.size(); ++i) {
         EXPECT_LE(sent[i] - sent[i - 1], milliseconds(1050)) << "gap before heartbeat " << i;
     }
-    EXPECT_GT(sent.front(), kStart - seconds(1));
+    EXPECT_GT(sent.front(), kDriverTestStart - seconds(1));
     (void)from;
 }
 

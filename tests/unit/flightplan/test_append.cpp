@@ -8,6 +8,7 @@
 #include "services/flightplan/expander.hpp"
 #include "services/flightplan/plan_loader.hpp"
 #include "services/flightplan/plan_merge.hpp"
+#include "tests/unit/flightplan/plan_text.hpp"
 #include "tests/unit/flightplan/sim_autopilot.hpp"
 
 namespace airseg::flightplan {
@@ -22,11 +23,7 @@ std::string line_plan(const std::string& name, double lat, int count, const std:
     return o.str();
 }
 
-std::shared_ptr<const Plan> load(const std::string& text) {
-    auto r = load_plan_text(text, "test.yaml");
-    EXPECT_TRUE(r.ok()) << to_string(r.errors);
-    return r.plan;
-}
+using test::load;
 
 std::vector<LatLon> expand(const std::shared_ptr<const Plan>& plan) {
     std::vector<LatLon> out;

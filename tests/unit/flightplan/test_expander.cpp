@@ -7,15 +7,12 @@
 
 #include "services/flightplan/expander.hpp"
 #include "services/flightplan/plan_loader.hpp"
+#include "tests/unit/flightplan/plan_text.hpp"
 
 namespace airseg::flightplan {
 namespace {
 
-std::shared_ptr<const Plan> load(const std::string& text) {
-    auto r = load_plan_text(text, "test.yaml");
-    EXPECT_TRUE(r.ok()) << to_string(r.errors);
-    return r.plan;
-}
+using test::load;
 
 std::vector<Waypoint> expand_all(std::shared_ptr<const Plan> plan, std::size_t limit = 10'000'000) {
     Expander e(std::move(plan));
