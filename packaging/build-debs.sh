@@ -1,5 +1,5 @@
 #!/bin/bash
-# build-debs.sh [--no-check] [--no-debug-info] [--clean] [ARCH...]
+# build-debs.sh [--no-check] [--no-debug-info] [--clean] [--upgrade-build] [ARCH...]
 #
 # Builds the airseg .debs (airsegd, airseg-client, airseg-sim, and the transitional airseg) for each
 # ARCH (default: every one, amd64 armhf armel arm64) on Debian 12 from Debian packages only, and writes
@@ -21,18 +21,24 @@
 # AIRSEG_EXTRA_CMAKE_ARGS: more cmake options (CI: -DAIRSEG_TEST_HANG_INJECTION=ON, so that the
 # stuck-service test runs on ARM too; packages to ship leave the test-only hook out).
 # AIRSEG_TEST_JOBS: test cases run at once (default: AIRSEG_JOBS, the build's parallel level).
+# --upgrade-build: build the same source again, as version V+upgradetest1 (a changelog entry on top) with one
+# comment line more in the shipped airseg.yaml, into dist/upgrade-test/, for packaging/test-install.sh's
+# upgrade. Run it after a plain build of that ARCH with the same options: the build directory is reused, so
+# only the packaging runs again.
 set -euo pipefail
 . "$(dirname "$0")/lib.sh"
 
 check=1
 clean=0
 debug_info=1
+upgrade_build=0
 arches=()
 for a in "$@"; do
   case "$a" in
     --no-check) check=0 ;;
     --no-debug-info) debug_info=0 ;;
     --clean) clean=1 ;;
+    --upgrade-build) upgrade_build=1 ;;
     -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
     -*) die "unknown option $a" ;;
     *) arch_triplet "$a" >/dev/null; arches+=("$a") ;;
@@ -66,8 +72,9 @@ stage_source() {
 }
 
 build_one() {
-  local arch=$1 work="$AIRSEG_ROOT/build-pkg-$1" src opts sysroot=""
+  local arch=$1 work="$AIRSEG_ROOT/build-pkg-$1" src opts sysroot="" pkg_version=$version
   src="$work/airseg-$version"
+  [ "$upgrade_build" = 0 ] || pkg_version="$version+upgradetest1"
   local -a dpkg_args=(-b -us -uc --no-sign)
   # debian/ is fresh on every run, so skipping the pre-clean only keeps the cmake build directory.
   [ "$clean" = 1 ] || dpkg_args+=(--no-pre-clean)
@@ -93,8 +100,15 @@ build_one() {
     env+=(CC="$(arch_triplet "$arch")-gcc" CXX="$(arch_triplet "$arch")-g++")
   fi
 
-  log "building airseg $version for $arch in $work"
+  log "building airseg $pkg_version for $arch in $work"
   stage_source "$src"
+  if [ "$upgrade_build" = 1 ]; then
+    local entry
+    entry=$(printf 'airseg (%s) bookworm; urgency=medium\n\n  * The same source rebuilt, for the upgrade test.\n\n -- %s  %s\n' \
+      "$pkg_version" "$(dpkg-parsechangelog -l "$src/debian/changelog" -S Maintainer)" "$(date -R)")
+    printf '%s\n\n%s\n' "$entry" "$(cat "$src/debian/changelog")" >"$src/debian/changelog"
+    echo "# shipped by $pkg_version" >>"$src/config/airseg.yaml"
+  fi
   # CMake reads the compiler flags only when it creates a build directory: one kept from a build
   # with other options (tests, debug information) is started afresh.
   local obj="$src/obj-$(arch_triplet "$arch")" key="check=$check debug_info=$debug_info${AIRSEG_EXTRA_CMAKE_ARGS:+ $AIRSEG_EXTRA_CMAKE_ARGS}"
@@ -117,6 +131,12 @@ build_one() {
     grep -E '^[0-9]+% tests passed|^Total Test time' "$work/build.log" | sed "s/^/$arch: /" || true
   fi
   # The packages to install in dist/, debug symbols (for crash analysis on the vehicle) apart in dist/debug/.
+  if [ "$upgrade_build" = 1 ]; then
+    rm -rf "$AIRSEG_ROOT/dist/upgrade-test" && mkdir -p "$AIRSEG_ROOT/dist/upgrade-test"
+    cp "$work"/*_"$pkg_version"_"$arch".deb "$work"/*_"$pkg_version"_all.deb "$AIRSEG_ROOT/dist/upgrade-test/"
+    log "$arch: version $pkg_version in dist/upgrade-test/"
+    return
+  fi
   mkdir -p "$AIRSEG_ROOT/dist/debug"
   local -a debs=()
   local deb
@@ -132,6 +152,7 @@ build_one() {
   "$AIRSEG_ROOT/packaging/check-deb.sh" "$arch" "${debs[@]}"
 }
 
+[ "$upgrade_build" = 0 ] || [ ${#arches[@]} = 1 ] || die "--upgrade-build builds one architecture"
 for arch in "${arches[@]}"; do
   build_one "$arch"
 done

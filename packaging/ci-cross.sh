@@ -14,8 +14,9 @@
 # 3. Checks each .deb (packaging/check-deb.sh: lintian, Architecture, shlibs Depends, ELF format
 #    and loader).
 # 4. amd64 is built first, without its tests (the whole suite runs natively in CI's sanitize stage) and
-#    without debug information, checked the same way (with the manual pages against --help), and then
-#    installed, upgraded and removed in a throwaway chroot (packaging/test-install.sh) in the background
+#    without debug information, checked the same way (with the manual pages against --help), rebuilt from
+#    the same build directory as the next version (build-debs.sh --upgrade-build), and then installed,
+#    upgraded to that rebuild and removed in a throwaway chroot (packaging/test-install.sh) in the background
 #    while the ARM packages build: that test mostly downloads. AIRSEG_CI_SKIP_INSTALL_TEST=1 skips it.
 # With --prepare, only step 1: CI runs it in the background while it compiles the sanitizer build, so
 # the downloads overlap the compiling.
@@ -83,12 +84,16 @@ for arch in "${arches[@]}"; do
     "$AIRSEG_ROOT/packaging/build-debs.sh" --no-check --no-debug-info amd64
     summary+=("amd64: $((SECONDS - start)) s wall, $(($(cpu_seconds) - cpu0)) CPU-s; packages checked")
     if [ "${AIRSEG_CI_SKIP_INSTALL_TEST:-0}" != 1 ]; then
+      step "the amd64 packages rebuilt as the next version, for the upgrade"
+      "$AIRSEG_ROOT/packaging/build-debs.sh" --no-check --no-debug-info --upgrade-build amd64
+      summary+=("amd64 rebuilt as the next version: $((SECONDS - start)) s wall since the amd64 build began")
       step "install / upgrade / remove test of the amd64 packages, in the background"
       # Its own copy: the ARM builds write dist/ meanwhile.
-      rm -rf "$AIRSEG_ROOT/build-logs/install-debs" && mkdir -p "$AIRSEG_ROOT/build-logs/install-debs"
+      rm -rf "$AIRSEG_ROOT/build-logs/install-debs" && mkdir -p "$AIRSEG_ROOT/build-logs/install-debs/next"
       cp "$AIRSEG_ROOT"/dist/*_amd64.deb "$AIRSEG_ROOT"/dist/*_all.deb "$AIRSEG_ROOT/build-logs/install-debs/"
+      cp "$AIRSEG_ROOT"/dist/upgrade-test/*.deb "$AIRSEG_ROOT/build-logs/install-debs/next/"
       "$AIRSEG_ROOT/packaging/test-install.sh" "$AIRSEG_ROOT/build-logs/install-debs" \
-        >"$AIRSEG_ROOT/build-logs/test-install.log" 2>&1 &
+        "$AIRSEG_ROOT/build-logs/install-debs/next" >"$AIRSEG_ROOT/build-logs/test-install.log" 2>&1 &
       install_pid=$!
     fi
     continue

@@ -1,11 +1,13 @@
 #!/bin/bash
-# test-install.sh [DIST_DIR]
+# test-install.sh [DIST_DIR [NEXT_DIR]]
 #
 # Installs, upgrades and removes the amd64 packages in a throwaway Debian 12 chroot (mmdebstrap, discarded
 # afterwards); the host is not touched. DIST_DIR (default dist/) holds the airsegd, airseg-client,
-# airseg-sim and airseg .debs of one version V. The upgrade goes to V+upgradetest1: the same packages
-# repacked with that version and one more comment line in the shipped /etc/airseg/airseg.yaml, so that
-# dpkg runs the real upgrade paths of the maintainer scripts and a changed conffile.
+# airseg-sim and airseg .debs of one version V. The upgrade goes to NEXT_DIR's packages: the same source
+# rebuilt as V+upgradetest1 with one more comment line in the shipped /etc/airseg/airseg.yaml
+# (`build-debs.sh --upgrade-build amd64` writes them to dist/upgrade-test/; CI does this), so that dpkg runs
+# the real upgrade paths of the maintainer scripts and a changed conffile. Without NEXT_DIR, DIST_DIR's
+# packages are repacked as that version instead (quicker by hand; the packaged files are then the same).
 #
 # systemd does not run in a chroot, so the chroot pretends it does (/run/systemd/system) and
 # deb-systemd-invoke is diverted to a log: the checks read which unit actions the maintainer scripts ask
@@ -22,6 +24,7 @@ set -euo pipefail
 . "$(dirname "$0")/lib.sh"
 
 dist=${1:-$AIRSEG_ROOT/dist}
+next_dir=${2:-}
 [ "$(id -u)" -eq 0 ] || die "needs root (mmdebstrap chroot)"
 ensure_packages mmdebstrap dpkg-dev
 mirror=${AIRSEG_MIRROR:-http://deb.debian.org/debian}
@@ -38,10 +41,18 @@ deb=$(ls "$dist"/airseg_*_all.deb 2>/dev/null | sort -V | tail -n1)
 [ -n "$deb" ] || die "no airseg_*_all.deb in $dist"
 cp "$deb" "$work/v1/airseg.deb"
 
-# The upgrade: each package repacked as version V+upgradetest1 (dependencies between them follow).
 version=$(dpkg-deb --field "$work/v1/airsegd.deb" Version)
 next="$version+upgradetest1"
+if [ -n "$next_dir" ]; then
+  for pkg in airsegd airseg-client airseg-sim airseg; do
+    deb=$(ls "$next_dir/${pkg}_${next}"_*.deb 2>/dev/null | head -n1)
+    [ -n "$deb" ] || die "no ${pkg}_${next}_*.deb in $next_dir (packaging/build-debs.sh --upgrade-build amd64)"
+    cp "$deb" "$work/v2/$pkg.deb"
+  done
+fi
+# Without NEXT_DIR: each package repacked as version V+upgradetest1 (dependencies between them follow).
 for f in "$work"/v1/*.deb; do
+  [ -z "$next_dir" ] || break
   tree="$work/tree-$(basename "$f" .deb)"
   dpkg-deb -R "$f" "$tree"
   sed -i -e "s/^Version: .*/Version: $next/" -e "s/(= $version)/(= $next)/g" -e "s/(>= $version)/(>= $next)/g" \
@@ -145,7 +156,8 @@ check "dpkg -P removes the enablement link" test ! -e /etc/systemd/system/multi-
 exit $fail
 CHECKS
 
-log "installing $version, upgrading to $next and removing, in a throwaway chroot (preinstalled: $deps)"
+log "installing $version, upgrading to $next ($([ -n "$next_dir" ] && echo rebuilt || echo repacked)) and removing," \
+    "in a throwaway chroot (preinstalled: $deps)"
 mmdebstrap --quiet --variant=apt --include="systemd,man-db,$deps" \
   --aptopt='Acquire::Retries "3"' \
   --customize-hook="copy-in \"$work/v1\" \"$work/v2\" \"$work/checks.sh\" /tmp" \
