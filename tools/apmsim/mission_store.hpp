@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "services/autopilot/mavlink/enums.hpp"
+
 namespace airseg::apmsim {
 
 /// MAV_CMD values the simulator acts on; every other command is stored and skipped when reached.
@@ -20,8 +22,7 @@ inline constexpr std::uint16_t kCmdConditionChangeAlt = 113;
 inline constexpr std::uint16_t kCmdConditionDistance = 114;
 inline constexpr std::uint16_t kCmdConditionLast = 159;  // MAV_CMD_CONDITION_LAST
 inline constexpr std::uint16_t kCmdDoJump = 177;         // param1: target item, param2: repeats (-1: forever)
-inline constexpr std::uint16_t kCmdDoChangeSpeed =
-    178;  // param1: speed type, param2: m/s, param3: throttle %
+using mavlink::kCmdDoChangeSpeed;  // param1: speed type, param2: m/s, param3: throttle %
 
 struct StoredItem {
     std::uint16_t command = kCmdNavWaypoint;
