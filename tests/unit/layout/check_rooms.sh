@@ -20,6 +20,6 @@ check() {
 }
 check "termios/ioctl serial headers" '#include <(termios\.h|asm/termbits\.h|sys/ioctl\.h|pty\.h)>' '^hal/'
 check "libgpiod" '#include <gpiod\.h>' '^hal/'
-check "sd-daemon / sd_notify" '(#include <systemd/sd-daemon\.h>|sd_notify\()' '^daemon/'
+check "systemd notify protocol" '(#include <systemd/sd-daemon\.h>|sd_notify\(|NOTIFY_SOCKET)' '^daemon/'
 check "MAVLink outside the autopilot layer" '#include "services/autopilot/mavlink/' '^(services/autopilot/|tools/(mavdump|apmsim)/)'
 exit $fail

@@ -1,0 +1,147 @@
+#!/usr/bin/env bash
+# bench/footprint/footprint.sh [--build DIR] [--idle S] [--busy S] [--plan FILE] [--emulator armhf|armel]
+#
+# airsegd's memory and CPU on the bench wiring of tools/demo.sh, without the live view: airseg-linksim (a
+# 57600-baud radio pair, 2 % frame loss), airseg-apmsim, airsegd on config/airseg.yaml, and a ground peer
+# (airsegctl log over the radio, so the ground session is up and the 2 Hz vehicle telemetry flows).
+# It measures in two phases:
+#   idle  (--idle S, default 60): the link up, no plan; CPU seconds per minute.
+#   busy  (--busy S, default 30): a plan running (--plan, default config/plans/rover-survey.yaml); CPU per
+#         minute, then VmRSS, VmHWM, private memory (smaps_rollup Private_*), the heap's size ([heap] mapping)
+#         and the program's own mapped code.
+# --emulator ARCH runs airsegd from an ARM cross build (--build, e.g. build-pkg-cross-armhf) under
+# qemu-ARCH-static with QEMU_LD_PREFIX=sysroots/ARCH, the simulators from the native build (AIRSEG_BUILD_DIR,
+# default build). Under qemu-user the host process also holds qemu's own memory and translated code, so the
+# figures are those of the guest's address space: the host mappings inside the range qemu reserves for it
+# (guest_base is fixed with QEMU_GUEST_BASE to find it). CPU under emulation is not meaningful and is not
+# printed.
+# Everything runs in a temporary directory; nothing needs root. The run takes about idle+busy+10 s.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+native=${AIRSEG_BUILD_DIR:-build}
+build=""
+idle_s=60
+busy_s=30
+plan=config/plans/rover-survey.yaml
+emulator=""
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --build) build=${2:?--build needs DIR}; shift 2 ;;
+    --idle) idle_s=${2:?--idle needs seconds}; shift 2 ;;
+    --busy) busy_s=${2:?--busy needs seconds}; shift 2 ;;
+    --plan) plan=${2:?--plan needs FILE}; shift 2 ;;
+    --emulator) emulator=${2:?--emulator needs armhf or armel}; shift 2 ;;
+    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
+    *) echo "footprint: unknown argument '$1'; see $0 --help" >&2; exit 2 ;;
+  esac
+done
+build=${build:-$native}
+daemon="$build/daemon/airsegd"
+for program in "$daemon" "$native/tools/linksim/airseg-linksim" "$native/tools/apmsim/airseg-apmsim" \
+    "$native/client/airsegctl"; do
+  [ -x "$program" ] || { echo "footprint: $program is not built" >&2; exit 2; }
+done
+guest_base=0x40000000
+launch=()
+if [ -n "$emulator" ]; then
+  case "$emulator" in
+    armhf|armel) ;;
+    *) echo "footprint: --emulator takes armhf or armel, not '$emulator'" >&2; exit 2 ;;
+  esac
+  sysroot=${AIRSEG_SYSROOTS:-sysroots}/$emulator
+  [ -d "$sysroot" ] || { echo "footprint: no sysroot at $sysroot (packaging/ensure-sysroot.sh $emulator $sysroot)" >&2; exit 2; }
+  command -v qemu-arm-static >/dev/null || { echo "footprint: qemu-arm-static is not installed" >&2; exit 2; }
+  launch=(env QEMU_LD_PREFIX="$sysroot" QEMU_GUEST_BASE=$guest_base qemu-arm-static)
+fi
+
+run_dir=$(mktemp -d /tmp/airseg-footprint.XXXXXX)
+pids=()
+cleanup() {
+  for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+  [ -n "${AIRSEG_FOOTPRINT_KEEP:-}" ] || rm -rf "$run_dir"
+}
+trap cleanup EXIT INT TERM HUP
+
+wait_for() {  # wait_for PATH: until a pty link appears (at most 10 s)
+  for _ in $(seq 100); do [ -e "$1" ] && return 0; sleep 0.1; done
+  echo "footprint: $1 did not appear" >&2; return 1
+}
+
+"$native/tools/linksim/airseg-linksim" --a "$run_dir/radio-air" --b "$run_dir/radio-ground" --baud 57600 \
+  --frame-loss 0.02 --seed 1 > "$run_dir/linksim.log" 2>&1 &
+pids+=($!)
+wait_for "$run_dir/radio-air"
+"$native/tools/apmsim/airseg-apmsim" --link "$run_dir/apm" > "$run_dir/apmsim.log" 2>&1 &
+pids+=($!)
+wait_for "$run_dir/apm"
+"${launch[@]}" "$daemon" --config config/airseg.yaml \
+  --set "status.socket=$run_dir/status.sock" --set "state_dir=$run_dir/state" \
+  --set "autopilot.port=$run_dir/apm" --set "groundlink.ports=[$run_dir/radio-air]" \
+  > "$run_dir/airsegd.log" 2>&1 &
+daemon_pid=$!
+pids+=($daemon_pid)
+"$native/client/airsegctl" --link "$run_dir/radio-ground" --baud 57600 log --duration $(((idle_s + busy_s + 60) * 1000)) \
+  > "$run_dir/ground.log" 2>&1 &
+pids+=($!)
+
+ctl=("$native/client/airsegctl" --socket "$run_dir/status.sock" --timeout 20000)
+# Ready: the autopilot connected and the ground session up, as the status document says.
+for _ in $(seq 60); do
+  if status=$("${ctl[@]}" --json status 2>/dev/null) &&
+      python3 -c 'import json,sys; s=json.load(sys.stdin); sys.exit(0 if s["autopilot"].get("ready") and s["groundlink"].get("link")=="up" else 1)' <<<"$status" 2>/dev/null; then
+    break
+  fi
+  sleep 0.1
+done
+"${ctl[@]}" --json status > "$run_dir/status.json" 2>/dev/null || { echo "footprint: airsegd did not answer" >&2; cat "$run_dir/airsegd.log" >&2; exit 1; }
+
+# CPU time in ns over all of airsegd's threads (schedstat: finer than the 10 ms ticks of /proc/PID/stat).
+cpu_ns() { cat /proc/"$daemon_pid"/task/*/schedstat | awk '{ sum += $1 } END { printf "%.0f", sum }'; }
+cpu_per_minute() {  # cpu_per_minute SECONDS: airsegd's CPU seconds per minute over that wall time
+  local before after
+  before=$(cpu_ns)
+  sleep "$1"
+  after=$(cpu_ns)
+  awk -v d=$((after - before)) -v s="$1" 'BEGIN { printf "%.3f", d / 1e9 * 60 / s }'
+}
+
+kib_of() { awk -v k="$1:" '$1 == k { print $2 }' "/proc/$daemon_pid/status"; }
+# Sums a smaps field over the mappings inside [lo, hi) (all mappings when hi is 0).
+smaps_sum() {
+  awk -v field="$1:" -v lo="$2" -v hi="$3" '
+    function hex(s,   i, c, v) { v = 0; s = tolower(s)
+      for (i = 1; i <= length(s); i++) { c = index("0123456789abcdef", substr(s, i, 1)) - 1; v = v * 16 + c }
+      return v }
+    /^[0-9a-f]+-[0-9a-f]+ / { split($1, r, "-"); start = hex(r[1]); inside = (hi == 0) || (start >= lo && start < hi)
+      name = $6; next }
+    $1 == field && inside { sum += $2 }
+    END { print sum + 0 }' "/proc/$daemon_pid/smaps"
+}
+own_code_kib() {  # the daemon binary's own mapped text
+  awk -v bin="$(readlink -f "$daemon")" '
+    /^[0-9a-f]+-[0-9a-f]+ / { mine = ($6 == bin) && ($2 ~ /x/); next }
+    $1 == "Rss:" && mine { sum += $2 }
+    END { print sum + 0 }' "/proc/$daemon_pid/smaps"
+}
+heap_kib() { awk '/\[heap\]/ { h = 1; next } /^[0-9a-f]+-[0-9a-f]+ / { h = 0 } h && $1 == "Size:" { print $2 }' \
+  "/proc/$daemon_pid/smaps"; }
+
+echo "footprint: airsegd $(readlink -f "$daemon")${emulator:+ under qemu-arm-static ($emulator)}"
+if [ -z "$emulator" ]; then
+  echo "idle (link up, no plan, 2 Hz telemetry), ${idle_s} s: CPU $(cpu_per_minute "$idle_s") s per minute"
+else
+  sleep "$idle_s"
+fi
+"${ctl[@]}" plan load "$plan" > "$run_dir/plan.log" 2>&1 || { echo "footprint: plan load failed:" >&2; cat "$run_dir/plan.log" >&2; exit 1; }
+if [ -z "$emulator" ]; then
+  echo "busy (plan $plan running), ${busy_s} s: CPU $(cpu_per_minute "$busy_s") s per minute"
+  echo "VmRSS $(kib_of VmRSS) KiB, VmHWM $(kib_of VmHWM) KiB, private $(( $(smaps_sum Private_Clean 0 0) + $(smaps_sum Private_Dirty 0 0) )) KiB, heap $(heap_kib) KiB, own code $(own_code_kib) KiB"
+else
+  sleep "$busy_s"
+  lo=$((guest_base)); hi=$((guest_base + 0x100000000))
+  rss=$(smaps_sum Rss "$lo" "$hi")
+  private=$(( $(smaps_sum Private_Clean "$lo" "$hi") + $(smaps_sum Private_Dirty "$lo" "$hi") ))
+  echo "guest address space (the ARM program's own memory): RSS $rss KiB, private $private KiB, own code $(own_code_kib) KiB"
+  echo "host process (qemu included): VmRSS $(kib_of VmRSS) KiB"
+fi
