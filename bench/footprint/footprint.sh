@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # bench/footprint/footprint.sh [--build DIR] [--idle S] [--busy S] [--plan FILE] [--emulator armhf|armel]
+#                              [--set KEY=VALUE]...   (passed to airsegd, e.g. --set threads=1)
 #
 # airsegd's memory and CPU on the bench wiring of tools/demo.sh, without the live view: airseg-linksim (a
 # 57600-baud radio pair, 2 % frame loss), airseg-apmsim, airsegd on config/airseg.yaml, and a ground peer
@@ -24,6 +25,7 @@ idle_s=60
 busy_s=30
 plan=config/plans/rover-survey.yaml
 emulator=""
+extra=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) build=${2:?--build needs DIR}; shift 2 ;;
@@ -31,7 +33,8 @@ while [ $# -gt 0 ]; do
     --busy) busy_s=${2:?--busy needs seconds}; shift 2 ;;
     --plan) plan=${2:?--plan needs FILE}; shift 2 ;;
     --emulator) emulator=${2:?--emulator needs armhf or armel}; shift 2 ;;
-    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
+    --set) extra+=(--set "${2:?--set needs KEY=VALUE}"); shift 2 ;;
+    -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
     *) echo "footprint: unknown argument '$1'; see $0 --help" >&2; exit 2 ;;
   esac
 done
@@ -42,7 +45,9 @@ for program in "$daemon" "$native/tools/linksim/airseg-linksim" "$native/tools/a
   [ -x "$program" ] || { echo "footprint: $program is not built" >&2; exit 2; }
 done
 guest_base=0x40000000
-launch=()
+# AIRSEG_FOOTPRINT_WRAP: a command put before airsegd, e.g. "valgrind --tool=callgrind" to see where its
+# time goes (the figures printed are then those of the wrapped process).
+read -r -a launch <<<"${AIRSEG_FOOTPRINT_WRAP:-}"
 if [ -n "$emulator" ]; then
   case "$emulator" in
     armhf|armel) ;;
@@ -77,7 +82,7 @@ pids+=($!)
 wait_for "$run_dir/apm"
 "${launch[@]}" "$daemon" --config config/airseg.yaml \
   --set "status.socket=$run_dir/status.sock" --set "state_dir=$run_dir/state" \
-  --set "autopilot.port=$run_dir/apm" --set "groundlink.ports=[$run_dir/radio-air]" \
+  --set "autopilot.port=$run_dir/apm" --set "groundlink.ports=[$run_dir/radio-air]" "${extra[@]}" \
   > "$run_dir/airsegd.log" 2>&1 &
 daemon_pid=$!
 pids+=($daemon_pid)
