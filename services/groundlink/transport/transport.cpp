@@ -183,15 +183,11 @@ void Transport::Impl::refresh(TimePoint now) {
     }
     stats.tx_safe.queue_depth = safe_depth;
     stats.tx_fast.queue_depth = fast_depth;
-    const auto safe_waiting = static_cast<std::uint64_t>(
-        std::count_if(deliveries.begin(), deliveries.end(),
-                      [](const Delivered& d) { return d.cls == MessageClass::safe; }));
-    stats.rx_safe.queue_depth = safe_waiting;
-    stats.rx_fast.queue_depth = deliveries.size() - safe_waiting;
     for (std::size_t p = 0; p < paths.size(); ++p) {
         stats.path[p].alive = paths[p].alive;
         stats.path[p].peer_hears = peer_mask_fresh() && ((peer_mask >> p) & 1U) != 0;
     }
+    refreshed_at = now_;
 }
 
 // ---- public forwarding

@@ -206,6 +206,8 @@ class Transport::Impl {
     std::deque<Delivered> deliveries;
     std::deque<TransportEvent> events;
     std::array<TimePoint, static_cast<std::size_t>(Timer::count)> timers{};
+    // When refresh() last ran: the timers describe the state as of then, until any input changes it.
+    TimePoint refreshed_at{};
 };
 
 }  // namespace airseg::groundlink

@@ -259,6 +259,7 @@ void Transport::Impl::on_safe(const frame::SafeChunk& c, TimePoint now) {
         ++stats.rx_safe.messages;
         stats.rx_safe.bytes += m->size();
         deliveries.push_back(Delivered{MessageClass::safe, c.channel, 0, std::move(*m)});
+        ++stats.rx_safe.queue_depth;
     }
 }
 
@@ -288,6 +289,7 @@ void Transport::Impl::on_fast(const frame::FastChunk& c, TimePoint now) {
     ++stats.rx_fast.messages;
     stats.rx_fast.bytes += whole->size();
     deliveries.push_back(Delivered{MessageClass::fast, c.priority, c.topic, std::move(*whole)});
+    ++stats.rx_fast.queue_depth;
 }
 
 void Transport::Impl::on_ack(const frame::AckChunk& a, TimePoint now) {

@@ -203,6 +203,12 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::poll_transmit(std::siz
     if (path >= paths.size() || now_ < paths[path].next_free) {
         return std::nullopt;
     }
+    // The transmit deadline refresh() computed at this very time still holds (every input refreshes): no
+    // path has anything to send before it, so no frame needs building. The driver polls after every serial
+    // read, most of which complete no frame.
+    if (refreshed_at == now_ && now_ < timers[static_cast<std::size_t>(Timer::transmit)]) {
+        return std::nullopt;
+    }
     auto out = build_hello(path, now_);
     if (!out && confirmed) {
         out = build_data(path, now_);
