@@ -163,14 +163,17 @@ void Transport::Impl::refresh(TimePoint now) {
     }
     timers[static_cast<std::size_t>(Timer::liveness)] = live;
 
-    // Snapshots for stats().
+    update_plan();
+    refreshed_at = now_;
+}
+
+void Transport::Impl::snapshot_stats() {
     stats.session = established;
     stats.link_up = link;
     stats.srtt_ms = std::chrono::duration<double, std::milli>(rtt.srtt()).count();
     stats.rttvar_ms = std::chrono::duration<double, std::milli>(rtt.rttvar()).count();
     stats.rto_ms = std::chrono::duration<double, std::milli>(rtt.rto()).count();
     stats.rtt_samples = rtt.samples();
-    update_plan();
     stats.frame_payload = payload_cap();
     stats.byte_error_rate = meter.byte_error_rate().value_or(-1.0);
     stats.peer_byte_error_rate = peer_error.value_or(-1.0);
@@ -187,7 +190,6 @@ void Transport::Impl::refresh(TimePoint now) {
         stats.path[p].alive = paths[p].alive;
         stats.path[p].peer_hears = peer_mask_fresh() && ((peer_mask >> p) & 1U) != 0;
     }
-    refreshed_at = now_;
 }
 
 // ---- public forwarding
@@ -235,6 +237,7 @@ void Transport::handle_timeout(TimePoint now) {
     impl_->handle_timeout(now);
 }
 const LinkStats& Transport::stats() const {
+    impl_->snapshot_stats();
     return impl_->stats;
 }
 bool Transport::link_up() const {
