@@ -24,6 +24,12 @@ inline void put_u32(std::vector<std::uint8_t>& out, std::uint32_t v) {
         out.push_back(static_cast<std::uint8_t>((v >> (8 * i)) & 0xFFU));
     }
 }
+/// Writes `v` little-endian at `p` (8 bytes).
+inline void store_u64(std::uint8_t* p, std::uint64_t v) {
+    for (int i = 0; i < 8; ++i) {
+        p[i] = static_cast<std::uint8_t>((v >> (8 * i)) & 0xFFU);
+    }
+}
 inline void put_u64(std::vector<std::uint8_t>& out, std::uint64_t v) {
     for (int i = 0; i < 8; ++i) {
         out.push_back(static_cast<std::uint8_t>((v >> (8 * i)) & 0xFFU));

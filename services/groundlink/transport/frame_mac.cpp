@@ -3,7 +3,6 @@
 #include <sodium.h>
 
 #include <stdexcept>
-#include <vector>
 
 #include "services/groundlink/transport/byte_io.hpp"
 
@@ -20,11 +19,10 @@ FrameMac::~FrameMac() {
 }
 
 MacTag FrameMac::tag(const MacContext& ctx, std::span<const std::uint8_t> frame) const {
-    std::vector<std::uint8_t> prefix;
-    prefix.reserve(24);
-    wire::put_u64(prefix, ctx.sender_nonce);
-    wire::put_u64(prefix, ctx.receiver_nonce);
-    wire::put_u64(prefix, ctx.frame_number);
+    std::array<std::uint8_t, 24> prefix{};
+    wire::store_u64(prefix.data(), ctx.sender_nonce);
+    wire::store_u64(prefix.data() + 8, ctx.receiver_nonce);
+    wire::store_u64(prefix.data() + 16, ctx.frame_number);
 
     crypto_generichash_state st;
     std::array<std::uint8_t, crypto_generichash_BYTES_MIN> full{};

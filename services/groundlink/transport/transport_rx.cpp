@@ -19,7 +19,7 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
     Path& ps = paths[path];
     stats.bytes_received += bytes.size();
     stats.path[path].bytes_received += bytes.size();
-    {
+    if (cfg.path_mode == PathMode::split && cfg.split_borrow) {  // only borrowing reads it (an exp() a read)
         ps.rx_rate = decayed_rate(ps.rx_rate, ps.rx_rate_time, now_) + static_cast<double>(bytes.size());
         ps.rx_rate_time = now_;
     }

@@ -178,16 +178,19 @@ TimePoint Transport::Impl::content_due(std::size_t path) const {
         return std::min(t, ps.next_hello);
     }
     if (carries_data(path)) {
-        const AirGate gate = air_gate(path);
+        // The air gate (a decaying rate: an exp()) is judged only when there is data it could hold back.
         if (borrowed(path)) {
             // A borrowed path carries bulk only: urgent traffic keeps to this end's own pair.
             if (level_ready(senders.size() - 1, true)) {
-                t = std::min(t, gate == AirGate::open ? now_ : ps.air_debt);
+                t = std::min(t, air_gate(path) == AirGate::open ? now_ : ps.air_debt);
             }
-        } else if (!ps.mirror.empty() || (gate == AirGate::open && data_ready(true)) ||
-                   (gate == AirGate::urgent_only && data_ready(false))) {
+        } else if (!ps.mirror.empty()) {
             return std::min(t, now_);
         } else if (data_ready(true)) {
+            const AirGate gate = air_gate(path);
+            if (gate == AirGate::open || (gate == AirGate::urgent_only && data_ready(false))) {
+                return std::min(t, now_);
+            }
             t = std::min(t, ps.air_debt);
         }
         t = std::min(t, ack_due());
