@@ -137,6 +137,17 @@ void Transport::Impl::update_link_state() {
 }
 
 void Transport::Impl::refresh(TimePoint now) {
+    refresh_transmit(now);
+    TimePoint rto = kNever;
+    for (std::size_t l = 0; l < senders.size(); ++l) {
+        rto = std::min(rto, senders[l].next_timeout(rtt.rto(backoff[l])));
+    }
+    timers[static_cast<std::size_t>(Timer::retransmit)] = rto;
+    timers[static_cast<std::size_t>(Timer::reassembly)] = reassembly.next_deadline();
+    update_plan();
+}
+
+void Transport::Impl::refresh_transmit(TimePoint now) {
     now_ = std::max(now_, now);
     TimePoint tx = kNever;
     for (std::size_t p = 0; p < paths.size(); ++p) {
@@ -146,12 +157,6 @@ void Transport::Impl::refresh(TimePoint now) {
         }
     }
     timers[static_cast<std::size_t>(Timer::transmit)] = tx;
-    TimePoint rto = kNever;
-    for (std::size_t l = 0; l < senders.size(); ++l) {
-        rto = std::min(rto, senders[l].next_timeout(rtt.rto(backoff[l])));
-    }
-    timers[static_cast<std::size_t>(Timer::retransmit)] = rto;
-    timers[static_cast<std::size_t>(Timer::reassembly)] = reassembly.next_deadline();
     TimePoint live = kNever;
     for (const Path& ps : paths) {
         if (ps.alive) {
@@ -162,8 +167,6 @@ void Transport::Impl::refresh(TimePoint now) {
         live = std::min(live, peer_mask_time + cfg.link_down_after);  // path selection changes then
     }
     timers[static_cast<std::size_t>(Timer::liveness)] = live;
-
-    update_plan();
     refreshed_at = now_;
 }
 

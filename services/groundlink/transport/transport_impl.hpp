@@ -50,6 +50,9 @@ class Transport::Impl {
     void push_event(TransportEvent::Kind kind, std::size_t path = 0, std::uint64_t count = 0);
     void update_link_state();
     void refresh(TimePoint now);
+    /// The part of refresh() that time and the air budget move: enough after an input that completed no
+    /// frame (the Safe windows, the reassembly and the error rate are as they were).
+    void refresh_transmit(TimePoint now);
     /// The fields of stats() that mirror state (link, timing, sizes, queues), as of the latest input: taken
     /// when stats() is asked for rather than after every input.
     void snapshot_stats();

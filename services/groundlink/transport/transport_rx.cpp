@@ -38,9 +38,11 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
             ps.air_debt = std::max(ps.air_debt, now_) + 2 * cfg.air_turnaround;
         }
     };
+    bool framed = false;  // a frame (or a damaged one) ended in these bytes
     ps.deframer.feed(
         bytes,
         [&](std::vector<std::uint8_t>&& plain) {
+            framed = true;
             const std::size_t wire = ps.deframer.last_encoded_bytes();
             if (fec::is_shard(plain)) {
                 // Shards come in bursts of one frame: one change of sender per group, not per shard.
@@ -51,12 +53,18 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
             on_plain_frame(path, plain, wire, now_);
         },
         [&] {
+            framed = true;
             turnaround();
             ++stats.framing_errors;
             ++ps.bad_since_shard;
             ++damaged_since_numbered;
             meter.on_frame(ps.deframer.last_encoded_bytes(), false);
         });
+    if (!framed) {
+        // Most serial reads are part of a frame: they move only the clock and the air budget.
+        refresh_transmit(now_);
+        return;
+    }
     update_link_state();
     refresh(now_);
 }
