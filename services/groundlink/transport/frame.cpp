@@ -84,8 +84,12 @@ std::size_t encoded_size(const Chunk& c) {
 
 std::vector<std::uint8_t> encode_data(std::uint8_t header_flags, std::uint32_t frame_number24,
                                       std::span<const Chunk> chunks) {
+    std::size_t size = kDataHeaderBytes + kMacTagBytes + kCrcBytes;  // room for seal_plain() too
+    for (const auto& c : chunks) {
+        size += encoded_size(c);
+    }
     std::vector<std::uint8_t> out;
-    out.reserve(64);
+    out.reserve(size);
     out.push_back(
         static_cast<std::uint8_t>((static_cast<std::uint8_t>(Kind::data) << 6) | (header_flags & 0x07U)));
     wire::put_u24(out, frame_number24 & kFrameNumberMask);

@@ -209,6 +209,12 @@ class Transport::Impl {
     fec::ShardAssembler shards;
     std::vector<std::uint8_t> rebuilt;  // a frame rebuilt from shards
 
+    // build_data's scratch: the chunks of the frame being filled, the bytes they point into, the channels it
+    // acknowledges.
+    std::vector<frame::Chunk> tx_chunks;
+    std::vector<std::vector<std::uint8_t>> tx_storage;
+    std::vector<std::size_t> tx_acked;
+
     std::deque<Delivered> deliveries;
     std::deque<TransportEvent> events;
     std::array<TimePoint, static_cast<std::size_t>(Timer::count)> timers{};

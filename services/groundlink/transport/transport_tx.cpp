@@ -1,6 +1,8 @@
 // Frames out: path selection, pacing, handshake frames and the scheduler that fills data frames.
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <span>
 
 #include "services/groundlink/transport/transport_impl.hpp"
 
@@ -287,17 +289,18 @@ bool Transport::Impl::add_data_chunk(std::vector<frame::Chunk>& chunks,
     const bool retx_ok = retx_credit > 0.0 || !any_fast;
 
     // Level order: a lower level that has earned its minimum share goes first, then strict priority.
-    std::vector<std::size_t> order;
+    std::array<std::size_t, 2 * kMaxPriorities> order{};
+    std::size_t order_size = 0;
     for (std::size_t l = 1; l < levels; ++l) {
         if (share_credit[l] > 0.0 && level_ready(l, retx_ok)) {
-            order.push_back(l);
+            order[order_size++] = l;
         }
     }
     for (std::size_t l = 0; l < levels; ++l) {
-        order.push_back(l);
+        order[order_size++] = l;
     }
 
-    for (const std::size_t l : order) {
+    for (const std::size_t l : std::span(order).first(order_size)) {
         if (!level_ready(l, retx_ok)) {
             continue;
         }
@@ -381,13 +384,17 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
         return to_wire(std::move(plain), mac, ctx);
     }
 
-    std::vector<frame::Chunk> chunks;
-    std::vector<std::vector<std::uint8_t>> storage;
-    storage.reserve(kMaxDataChunks);  // chunk spans point into it: no reallocation while filling
+    // Scratch kept from frame to frame (filling one allocates no vectors). Chunk spans point into the
+    // storage's buffers, which stay where they are when the storage grows.
+    auto& chunks = tx_chunks;
+    auto& storage = tx_storage;
+    auto& acked_channels = tx_acked;
+    chunks.clear();
+    storage.clear();
+    acked_channels.clear();
     std::size_t room = payload_cap();
     const bool ack_is_due = ack_due() <= now;
 
-    std::vector<std::size_t> acked_channels;
     for (std::size_t l = 0; l < acks.size(); ++l) {
         if (acks[l].needed) {
             chunks.emplace_back(receivers[l].make_ack(static_cast<std::uint8_t>(l)));
