@@ -8,14 +8,21 @@
 
 namespace airseg::groundlink {
 
+struct FrameMac::KeyedState {
+    crypto_generichash_state state;
+};
+
 FrameMac::FrameMac(const std::array<std::uint8_t, kKeyBytes>& key) : key_(key) {
     if (sodium_init() < 0) {
         throw std::runtime_error("groundlink: libsodium failed to initialise");
     }
+    keyed_ = std::make_unique<KeyedState>();
+    crypto_generichash_init(&keyed_->state, key_.data(), key_.size(), crypto_generichash_BYTES_MIN);
 }
 
 FrameMac::~FrameMac() {
     sodium_memzero(key_.data(), key_.size());
+    sodium_memzero(&keyed_->state, sizeof(keyed_->state));
 }
 
 MacTag FrameMac::tag(const MacContext& ctx, std::span<const std::uint8_t> frame) const {
@@ -24,9 +31,8 @@ MacTag FrameMac::tag(const MacContext& ctx, std::span<const std::uint8_t> frame)
     wire::store_u64(prefix.data() + 8, ctx.receiver_nonce);
     wire::store_u64(prefix.data() + 16, ctx.frame_number);
 
-    crypto_generichash_state st;
+    crypto_generichash_state st = keyed_->state;
     std::array<std::uint8_t, crypto_generichash_BYTES_MIN> full{};
-    crypto_generichash_init(&st, key_.data(), key_.size(), full.size());
     crypto_generichash_update(&st, prefix.data(), prefix.size());
     crypto_generichash_update(&st, frame.data(), frame.size());
     crypto_generichash_final(&st, full.data(), full.size());

@@ -144,6 +144,7 @@ void Transport::Impl::refresh(TimePoint now) {
     }
     timers[static_cast<std::size_t>(Timer::retransmit)] = rto;
     timers[static_cast<std::size_t>(Timer::reassembly)] = reassembly.next_deadline();
+    earliest = *std::min_element(timers.begin(), timers.end());
     update_plan();
 }
 
@@ -167,6 +168,7 @@ void Transport::Impl::refresh_transmit(TimePoint now) {
         live = std::min(live, peer_mask_time + cfg.link_down_after);  // path selection changes then
     }
     timers[static_cast<std::size_t>(Timer::liveness)] = live;
+    earliest = *std::min_element(timers.begin(), timers.end());
     refreshed_at = now_;
 }
 
@@ -234,7 +236,7 @@ std::optional<std::vector<std::uint8_t>> Transport::poll_transmit(std::size_t pa
     return impl_->poll_transmit(path, now);
 }
 TimePoint Transport::poll_timeout() const {
-    return *std::min_element(impl_->timers.begin(), impl_->timers.end());
+    return impl_->earliest;
 }
 void Transport::handle_timeout(TimePoint now) {
     impl_->handle_timeout(now);

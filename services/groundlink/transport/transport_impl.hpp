@@ -220,6 +220,7 @@ class Transport::Impl {
     std::array<TimePoint, static_cast<std::size_t>(Timer::count)> timers{};
     // When refresh() last ran: the timers describe the state as of then, until any input changes it.
     TimePoint refreshed_at{};
+    TimePoint earliest = kNever;  // the earliest of the timers: poll_timeout()
 };
 
 }  // namespace airseg::groundlink
