@@ -88,7 +88,15 @@ class Transport::Impl {
     [[nodiscard]] bool borrowed(std::size_t path) const;
     [[nodiscard]] Duration reorder_slack() const;
     /// Any Safe or Fast traffic ready; `bulk`: include the lowest priority.
-    [[nodiscard]] bool data_ready(bool bulk) const;
+    [[nodiscard]] bool data_ready(bool bulk) const {
+        const std::size_t levels = bulk ? senders.size() : senders.size() - 1;
+        for (std::size_t l = 0; l < levels; ++l) {
+            if (level_ready(l, true)) {
+                return true;
+            }
+        }
+        return false;
+    }
     /// Half-duplex air gate of a path: open; only urgent (non-bulk) traffic, for an end using less than half
     /// the air; closed until the shared budget is paid.
     enum class AirGate : std::uint8_t { open, urgent_only, closed };
@@ -96,7 +104,14 @@ class Transport::Impl {
     [[nodiscard]] TimePoint ack_due() const;
     [[nodiscard]] TimePoint content_due(std::size_t path) const;
     [[nodiscard]] std::size_t payload_cap() const;
-    [[nodiscard]] bool level_ready(std::size_t level, bool retx_ok) const;
+    // Inline: every deadline computation asks them for each level.
+    [[nodiscard]] bool level_ready(std::size_t level, bool retx_ok) const {
+        if ((bulk_blocked && level + 1 == senders.size()) || (bulk_only && level + 1 < senders.size())) {
+            return false;
+        }
+        return !fast[level].empty() || (retx_ok && senders[level].has_lost()) ||
+               senders[level].can_send_new();
+    }
     std::optional<std::vector<std::uint8_t>> build_hello(std::size_t path, TimePoint now);
     std::optional<std::vector<std::uint8_t>> build_data(std::size_t path, TimePoint now);
     bool add_data_chunk(std::vector<frame::Chunk>& chunks, std::vector<std::vector<std::uint8_t>>& storage,

@@ -126,23 +126,6 @@ std::size_t Transport::Impl::payload_cap() const {
     return std::max(cap, cfg.min_frame_payload);
 }
 
-bool Transport::Impl::level_ready(std::size_t level, bool retx_ok) const {
-    if ((bulk_blocked && level + 1 == senders.size()) || (bulk_only && level + 1 < senders.size())) {
-        return false;
-    }
-    return !fast[level].empty() || (retx_ok && senders[level].has_lost()) || senders[level].can_send_new();
-}
-
-bool Transport::Impl::data_ready(bool bulk) const {
-    const std::size_t levels = bulk ? senders.size() : senders.size() - 1;
-    for (std::size_t l = 0; l < levels; ++l) {
-        if (level_ready(l, true)) {
-            return true;
-        }
-    }
-    return false;
-}
-
 Transport::Impl::AirGate Transport::Impl::air_gate(std::size_t path) const {
     const Path& ps = paths[path];
     if (!cfg.half_duplex || now_ >= ps.air_debt) {
