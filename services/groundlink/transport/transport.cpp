@@ -99,14 +99,23 @@ SendResult Transport::Impl::send_fast(std::uint8_t priority, std::uint16_t topic
 
 void Transport::Impl::handle_timeout(TimePoint now) {
     now_ = std::max(now_, now);
-    for (std::size_t l = 0; l < senders.size(); ++l) {
-        const std::size_t lost = senders[l].on_timeout(now_, rtt.rto(backoff[l]));
-        if (lost > 0) {
-            backoff[l] = std::min(backoff[l] + 1, kMaxBackoff);
-            lost_window += static_cast<double>(lost);
+    // The timers are exact as of the latest input: a Safe window or the reassembly is looked through only
+    // when its own deadline has come (most wake-ups are for pacing).
+    bool expired = false;
+    if (now_ >= timers[static_cast<std::size_t>(Timer::retransmit)]) {
+        for (std::size_t l = 0; l < senders.size(); ++l) {
+            const std::size_t lost = senders[l].on_timeout(now_, rtt.rto(backoff[l]));
+            if (lost > 0) {
+                backoff[l] = std::min(backoff[l] + 1, kMaxBackoff);
+                lost_window += static_cast<double>(lost);
+                expired = true;
+            }
         }
     }
-    stats.rx_fast.drops += reassembly.expire(now_);
+    if (now_ >= timers[static_cast<std::size_t>(Timer::reassembly)]) {
+        stats.rx_fast.drops += reassembly.expire(now_);
+        expired = true;
+    }
     for (std::size_t p = 0; p < paths.size(); ++p) {
         Path& ps = paths[p];
         if (ps.alive && ps.last_heard + cfg.link_down_after <= now_) {
@@ -116,7 +125,11 @@ void Transport::Impl::handle_timeout(TimePoint now) {
         }
     }
     update_link_state();
-    refresh(now_);
+    if (expired) {
+        refresh(now_);
+    } else {
+        refresh_transmit(now_);
+    }
 }
 
 void Transport::Impl::push_event(TransportEvent::Kind kind, std::size_t path, std::uint64_t count) {
@@ -145,7 +158,6 @@ void Transport::Impl::refresh(TimePoint now) {
     timers[static_cast<std::size_t>(Timer::retransmit)] = rto;
     timers[static_cast<std::size_t>(Timer::reassembly)] = reassembly.next_deadline();
     earliest = *std::min_element(timers.begin(), timers.end());
-    update_plan();
 }
 
 void Transport::Impl::refresh_transmit(TimePoint now) {

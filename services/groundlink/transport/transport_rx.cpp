@@ -67,6 +67,7 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
     }
     update_link_state();
     refresh(now_);
+    update_plan();  // the error rate is measured only on frames heard
 }
 
 void Transport::Impl::on_shard(std::size_t path, std::span<const std::uint8_t> plain, std::size_t wire_bytes,
