@@ -24,6 +24,18 @@ inline void put_u32(std::vector<std::uint8_t>& out, std::uint32_t v) {
         out.push_back(static_cast<std::uint8_t>((v >> (8 * i)) & 0xFFU));
     }
 }
+/// Writes `v` little-endian at `p` (8 bytes).
+inline void store_u64(std::uint8_t* p, std::uint64_t v) {
+    // Spelt out: compilers merge these into one store on a little-endian host.
+    p[0] = static_cast<std::uint8_t>(v);
+    p[1] = static_cast<std::uint8_t>(v >> 8);
+    p[2] = static_cast<std::uint8_t>(v >> 16);
+    p[3] = static_cast<std::uint8_t>(v >> 24);
+    p[4] = static_cast<std::uint8_t>(v >> 32);
+    p[5] = static_cast<std::uint8_t>(v >> 40);
+    p[6] = static_cast<std::uint8_t>(v >> 48);
+    p[7] = static_cast<std::uint8_t>(v >> 56);
+}
 inline void put_u64(std::vector<std::uint8_t>& out, std::uint64_t v) {
     for (int i = 0; i < 8; ++i) {
         out.push_back(static_cast<std::uint8_t>((v >> (8 * i)) & 0xFFU));

@@ -1,35 +1,42 @@
 #include "services/groundlink/transport/cobs.hpp"
 
+#include <algorithm>
+#include <cstring>
+
 namespace airseg::groundlink {
 
+// Whole runs at a time (memchr finds the next zero, memcpy moves the run): frames are mostly long runs.
 void cobs_encode(std::span<const std::uint8_t> data, std::vector<std::uint8_t>& out) {
-    std::size_t code_pos = out.size();
-    out.push_back(0);  // placeholder for the first code byte
-    std::uint8_t code = 1;
-    for (std::uint8_t b : data) {
-        if (b == 0) {
-            out[code_pos] = code;
-            code_pos = out.size();
-            out.push_back(0);
-            code = 1;
+    const std::size_t base = out.size();
+    out.resize(base + cobs_max_encoded(data.size()));
+    std::uint8_t* dst = out.data() + base;
+    const std::uint8_t* src = data.data();
+    const std::uint8_t* const end = src + data.size();
+    while (true) {
+        const auto limit = std::min<std::size_t>(static_cast<std::size_t>(end - src), 0xFE);
+        const auto* zero = limit > 0 ? static_cast<const std::uint8_t*>(std::memchr(src, 0, limit)) : nullptr;
+        const std::size_t run = zero != nullptr ? static_cast<std::size_t>(zero - src) : limit;
+        *dst++ = static_cast<std::uint8_t>(run + 1);
+        if (run > 0) {
+            std::memcpy(dst, src, run);
+        }
+        dst += run;
+        src += run;
+        if (zero != nullptr) {
+            ++src;  // the zero ends this block; another follows, if only an empty one
             continue;
         }
-        out.push_back(b);
-        ++code;
-        if (code == 0xFF) {
-            out[code_pos] = code;
-            code_pos = out.size();
-            out.push_back(0);
-            code = 1;
+        if (run < 0xFE) {
+            break;  // the data ended inside this block
         }
     }
-    out[code_pos] = code;
-    out.push_back(0);
+    *dst++ = 0;
+    out.resize(static_cast<std::size_t>(dst - out.data()));
 }
 
 std::optional<std::vector<std::uint8_t>> cobs_decode(std::span<const std::uint8_t> encoded) {
-    std::vector<std::uint8_t> out;
-    out.reserve(encoded.size());
+    std::vector<std::uint8_t> out(encoded.size());  // decoding never grows the data
+    std::uint8_t* dst = out.data();
     std::size_t i = 0;
     while (i < encoded.size()) {
         const std::uint8_t code = encoded[i];
@@ -41,17 +48,19 @@ std::optional<std::vector<std::uint8_t>> cobs_decode(std::span<const std::uint8_
         if (run > encoded.size() - i) {
             return std::nullopt;
         }
-        for (std::size_t k = 0; k < run; ++k) {
-            if (encoded[i + k] == 0) {
+        if (run > 0) {
+            if (std::memchr(encoded.data() + i, 0, run) != nullptr) {
                 return std::nullopt;
             }
-            out.push_back(encoded[i + k]);
+            std::memcpy(dst, encoded.data() + i, run);
+            dst += run;
         }
         i += run;
         if (code != 0xFF && i < encoded.size()) {
-            out.push_back(0);
+            *dst++ = 0;
         }
     }
+    out.resize(static_cast<std::size_t>(dst - out.data()));
     return out;
 }
 

@@ -2,8 +2,10 @@
 // Consistent Overhead Byte Stuffing: a frame never contains 0x00, so 0x00 delimits frames and the receiver
 // resynchronizes at the next delimiter after lost, inserted or corrupted bytes. Overhead: at most one byte
 // per 254 (0.4 %), plus the delimiter.
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <optional>
 #include <span>
 #include <vector>
@@ -29,15 +31,21 @@ class CobsDeframer {
     /// invalid or oversize one.
     template <typename OnFrame, typename OnError>
     void feed(std::span<const std::uint8_t> bytes, OnFrame&& on_frame, OnError&& on_error) {
-        for (std::uint8_t b : bytes) {
-            if (b != 0) {
-                if (buf_.size() < max_encoded_) {
-                    buf_.push_back(b);
-                } else {
-                    overflow_ = true;
-                }
-                continue;
+        const std::uint8_t* p = bytes.data();
+        const std::uint8_t* const end = p + bytes.size();
+        while (p < end) {
+            // Up to the next delimiter in one piece: a read of a long frame has none.
+            const auto* zero =
+                static_cast<const std::uint8_t*>(std::memchr(p, 0, static_cast<std::size_t>(end - p)));
+            const std::uint8_t* stop = zero != nullptr ? zero : end;
+            const auto n = static_cast<std::size_t>(stop - p);
+            const std::size_t room = max_encoded_ > buf_.size() ? max_encoded_ - buf_.size() : 0;
+            buf_.insert(buf_.end(), p, p + std::min(n, room));
+            overflow_ = overflow_ || n > room;
+            if (zero == nullptr) {
+                return;
             }
+            p = zero + 1;
             last_encoded_ = buf_.size() + 1;
             if (overflow_) {
                 on_error();

@@ -12,6 +12,7 @@ void ErrorRateMeter::on_frame(std::size_t wire_bytes, bool good) {
     }
     const std::size_t c = std::min<std::size_t>(std::bit_width(wire_bytes) - 1, kClasses - 1);
     stale_ = true;
+    bursty_stale_ = true;
     (good ? classes_[c].good : classes_[c].bad) += 1.0;
     if (last_bad_) {
         after_bad_ += 1.0;
@@ -37,6 +38,7 @@ void ErrorRateMeter::on_frame(std::size_t wire_bytes, bool good) {
 
 void ErrorRateMeter::on_vanished(double frames) {
     vanished_ = std::max(0.0, vanished_ + frames);
+    bursty_stale_ = true;
 }
 
 std::optional<double> ErrorRateMeter::byte_error_rate() const {
@@ -90,6 +92,14 @@ std::optional<double> ErrorRateMeter::estimate() const {
 namespace airseg::groundlink {
 
 bool ErrorRateMeter::bursty() const {
+    if (bursty_stale_) {
+        bursty_ = judge_bursty();
+        bursty_stale_ = false;
+    }
+    return bursty_;
+}
+
+bool ErrorRateMeter::judge_bursty() const {
     double bad = 0.0;
     for (const auto& k : classes_) {
         bad += k.bad;

@@ -55,7 +55,10 @@ class ErrorRateMeter {
     // (boards without an FPU pay for every exp()).
     mutable bool stale_ = true;
     mutable std::optional<double> estimate_;
+    mutable bool bursty_stale_ = true;
+    mutable bool bursty_ = false;
     [[nodiscard]] std::optional<double> estimate() const;
+    [[nodiscard]] bool judge_bursty() const;
 };
 
 }  // namespace airseg::groundlink

@@ -1,5 +1,7 @@
 #include "services/groundlink/transport/frame.hpp"
 
+#include <array>
+
 #include "services/groundlink/transport/byte_io.hpp"
 #include "services/groundlink/transport/cobs.hpp"
 #include "services/groundlink/transport/crc32.hpp"
@@ -49,6 +51,14 @@ void encode_chunk(const Chunk& c, bool last, std::vector<std::uint8_t>& out) {
     }
 }
 
+// What an unkeyed frame's CRC covers before the frame: both session nonces.
+std::array<std::uint8_t, 16> nonce_prefix(const MacContext& ctx) {
+    std::array<std::uint8_t, 16> prefix{};
+    wire::store_u64(prefix.data(), ctx.sender_nonce);
+    wire::store_u64(prefix.data() + 8, ctx.receiver_nonce);
+    return prefix;
+}
+
 bool read_data(wire::Reader& r, bool to_end, std::span<const std::uint8_t>& data) {
     std::uint16_t len = 0;
     if (to_end) {
@@ -74,8 +84,12 @@ std::size_t encoded_size(const Chunk& c) {
 
 std::vector<std::uint8_t> encode_data(std::uint8_t header_flags, std::uint32_t frame_number24,
                                       std::span<const Chunk> chunks) {
+    std::size_t size = kDataHeaderBytes + kMacTagBytes + kCrcBytes;  // room for seal_plain() too
+    for (const auto& c : chunks) {
+        size += encoded_size(c);
+    }
     std::vector<std::uint8_t> out;
-    out.reserve(64);
+    out.reserve(size);
     out.push_back(
         static_cast<std::uint8_t>((static_cast<std::uint8_t>(Kind::data) << 6) | (header_flags & 0x07U)));
     wire::put_u24(out, frame_number24 & kFrameNumberMask);
@@ -113,10 +127,7 @@ std::vector<std::uint8_t> seal_plain(std::vector<std::uint8_t> frame, const Fram
         const MacTag tag = mac->tag(ctx, frame);
         frame.insert(frame.end(), tag.begin(), tag.end());
     } else {
-        std::vector<std::uint8_t> prefix;
-        wire::put_u64(prefix, ctx.sender_nonce);
-        wire::put_u64(prefix, ctx.receiver_nonce);
-        crc.update(prefix);
+        crc.update(nonce_prefix(ctx));
     }
     crc.update(frame);
     wire::put_u32(frame, crc.value());
@@ -131,10 +142,7 @@ std::optional<std::span<const std::uint8_t>> check_crc(std::span<const std::uint
     const auto body = plain.first(plain.size() - kCrcBytes);
     Crc32 crc;
     if (!keyed) {
-        std::vector<std::uint8_t> prefix;
-        wire::put_u64(prefix, ctx.sender_nonce);
-        wire::put_u64(prefix, ctx.receiver_nonce);
-        crc.update(prefix);
+        crc.update(nonce_prefix(ctx));
     }
     crc.update(body);
     std::uint32_t got = 0;

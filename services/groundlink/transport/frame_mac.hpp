@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 
 #include "services/groundlink/transport/transport.hpp"
@@ -36,6 +37,10 @@ class FrameMac {
 
   private:
     std::array<std::uint8_t, kKeyBytes> key_;
+    // The hash state right after keying (the key block padded and buffered, nothing compressed yet): every
+    // tag starts from a copy of it instead of keying again.
+    struct KeyedState;
+    std::unique_ptr<KeyedState> keyed_;
 };
 
 }  // namespace airseg::groundlink

@@ -17,10 +17,6 @@ SendResult SafeSender::enqueue(std::span<const std::uint8_t> msg) {
     return SendResult::accepted;
 }
 
-bool SafeSender::can_send_new() const {
-    return !queue_.empty() && next_ - una_ < window_;
-}
-
 std::size_t SafeSender::lost_size() const {
     for (const auto& s : inflight_) {
         if (s.lost) {

@@ -31,7 +31,7 @@ class SafeSender {
     };
 
     [[nodiscard]] bool has_lost() const { return lost_count_ > 0; }
-    [[nodiscard]] bool can_send_new() const;
+    [[nodiscard]] bool can_send_new() const { return !queue_.empty() && next_ - una_ < window_; }
     /// Size of the data of the lowest lost segment (it is resent as it was cut).
     [[nodiscard]] std::size_t lost_size() const;
     /// Resends the lowest lost segment; with `repeat_twice_lost`, a segment already lost twice is sent in two

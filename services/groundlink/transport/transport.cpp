@@ -99,14 +99,23 @@ SendResult Transport::Impl::send_fast(std::uint8_t priority, std::uint16_t topic
 
 void Transport::Impl::handle_timeout(TimePoint now) {
     now_ = std::max(now_, now);
-    for (std::size_t l = 0; l < senders.size(); ++l) {
-        const std::size_t lost = senders[l].on_timeout(now_, rtt.rto(backoff[l]));
-        if (lost > 0) {
-            backoff[l] = std::min(backoff[l] + 1, kMaxBackoff);
-            lost_window += static_cast<double>(lost);
+    // The timers are exact as of the latest input: a Safe window or the reassembly is looked through only
+    // when its own deadline has come (most wake-ups are for pacing).
+    bool expired = false;
+    if (now_ >= timers[static_cast<std::size_t>(Timer::retransmit)]) {
+        for (std::size_t l = 0; l < senders.size(); ++l) {
+            const std::size_t lost = senders[l].on_timeout(now_, rtt.rto(backoff[l]));
+            if (lost > 0) {
+                backoff[l] = std::min(backoff[l] + 1, kMaxBackoff);
+                lost_window += static_cast<double>(lost);
+                expired = true;
+            }
         }
     }
-    stats.rx_fast.drops += reassembly.expire(now_);
+    if (now_ >= timers[static_cast<std::size_t>(Timer::reassembly)]) {
+        stats.rx_fast.drops += reassembly.expire(now_);
+        expired = true;
+    }
     for (std::size_t p = 0; p < paths.size(); ++p) {
         Path& ps = paths[p];
         if (ps.alive && ps.last_heard + cfg.link_down_after <= now_) {
@@ -116,7 +125,11 @@ void Transport::Impl::handle_timeout(TimePoint now) {
         }
     }
     update_link_state();
-    refresh(now_);
+    if (expired) {
+        refresh(now_);
+    } else {
+        refresh_transmit(now_);
+    }
 }
 
 void Transport::Impl::push_event(TransportEvent::Kind kind, std::size_t path, std::uint64_t count) {
@@ -137,6 +150,17 @@ void Transport::Impl::update_link_state() {
 }
 
 void Transport::Impl::refresh(TimePoint now) {
+    refresh_transmit(now);
+    TimePoint rto = kNever;
+    for (std::size_t l = 0; l < senders.size(); ++l) {
+        rto = std::min(rto, senders[l].next_timeout(rtt.rto(backoff[l])));
+    }
+    timers[static_cast<std::size_t>(Timer::retransmit)] = rto;
+    timers[static_cast<std::size_t>(Timer::reassembly)] = reassembly.next_deadline();
+    earliest = *std::min_element(timers.begin(), timers.end());
+}
+
+void Transport::Impl::refresh_transmit(TimePoint now) {
     now_ = std::max(now_, now);
     TimePoint tx = kNever;
     for (std::size_t p = 0; p < paths.size(); ++p) {
@@ -146,12 +170,6 @@ void Transport::Impl::refresh(TimePoint now) {
         }
     }
     timers[static_cast<std::size_t>(Timer::transmit)] = tx;
-    TimePoint rto = kNever;
-    for (std::size_t l = 0; l < senders.size(); ++l) {
-        rto = std::min(rto, senders[l].next_timeout(rtt.rto(backoff[l])));
-    }
-    timers[static_cast<std::size_t>(Timer::retransmit)] = rto;
-    timers[static_cast<std::size_t>(Timer::reassembly)] = reassembly.next_deadline();
     TimePoint live = kNever;
     for (const Path& ps : paths) {
         if (ps.alive) {
@@ -162,15 +180,17 @@ void Transport::Impl::refresh(TimePoint now) {
         live = std::min(live, peer_mask_time + cfg.link_down_after);  // path selection changes then
     }
     timers[static_cast<std::size_t>(Timer::liveness)] = live;
+    earliest = *std::min_element(timers.begin(), timers.end());
+    refreshed_at = now_;
+}
 
-    // Snapshots for stats().
+void Transport::Impl::snapshot_stats() {
     stats.session = established;
     stats.link_up = link;
     stats.srtt_ms = std::chrono::duration<double, std::milli>(rtt.srtt()).count();
     stats.rttvar_ms = std::chrono::duration<double, std::milli>(rtt.rttvar()).count();
     stats.rto_ms = std::chrono::duration<double, std::milli>(rtt.rto()).count();
     stats.rtt_samples = rtt.samples();
-    update_plan();
     stats.frame_payload = payload_cap();
     stats.byte_error_rate = meter.byte_error_rate().value_or(-1.0);
     stats.peer_byte_error_rate = peer_error.value_or(-1.0);
@@ -183,11 +203,6 @@ void Transport::Impl::refresh(TimePoint now) {
     }
     stats.tx_safe.queue_depth = safe_depth;
     stats.tx_fast.queue_depth = fast_depth;
-    const auto safe_waiting = static_cast<std::uint64_t>(
-        std::count_if(deliveries.begin(), deliveries.end(),
-                      [](const Delivered& d) { return d.cls == MessageClass::safe; }));
-    stats.rx_safe.queue_depth = safe_waiting;
-    stats.rx_fast.queue_depth = deliveries.size() - safe_waiting;
     for (std::size_t p = 0; p < paths.size(); ++p) {
         stats.path[p].alive = paths[p].alive;
         stats.path[p].peer_hears = peer_mask_fresh() && ((peer_mask >> p) & 1U) != 0;
@@ -233,12 +248,13 @@ std::optional<std::vector<std::uint8_t>> Transport::poll_transmit(std::size_t pa
     return impl_->poll_transmit(path, now);
 }
 TimePoint Transport::poll_timeout() const {
-    return *std::min_element(impl_->timers.begin(), impl_->timers.end());
+    return impl_->earliest;
 }
 void Transport::handle_timeout(TimePoint now) {
     impl_->handle_timeout(now);
 }
 const LinkStats& Transport::stats() const {
+    impl_->snapshot_stats();
     return impl_->stats;
 }
 bool Transport::link_up() const {

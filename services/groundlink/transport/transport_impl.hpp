@@ -50,6 +50,12 @@ class Transport::Impl {
     void push_event(TransportEvent::Kind kind, std::size_t path = 0, std::uint64_t count = 0);
     void update_link_state();
     void refresh(TimePoint now);
+    /// The part of refresh() that time and the air budget move: enough after an input that completed no
+    /// frame (the Safe windows, the reassembly and the error rate are as they were).
+    void refresh_transmit(TimePoint now);
+    /// The fields of stats() that mirror state (link, timing, sizes, queues), as of the latest input: taken
+    /// when stats() is asked for rather than after every input.
+    void snapshot_stats();
 
     // transport_rx.cpp
     void handle_bytes(std::size_t path, std::span<const std::uint8_t> bytes, TimePoint now);
@@ -82,7 +88,15 @@ class Transport::Impl {
     [[nodiscard]] bool borrowed(std::size_t path) const;
     [[nodiscard]] Duration reorder_slack() const;
     /// Any Safe or Fast traffic ready; `bulk`: include the lowest priority.
-    [[nodiscard]] bool data_ready(bool bulk) const;
+    [[nodiscard]] bool data_ready(bool bulk) const {
+        const std::size_t levels = bulk ? senders.size() : senders.size() - 1;
+        for (std::size_t l = 0; l < levels; ++l) {
+            if (level_ready(l, true)) {
+                return true;
+            }
+        }
+        return false;
+    }
     /// Half-duplex air gate of a path: open; only urgent (non-bulk) traffic, for an end using less than half
     /// the air; closed until the shared budget is paid.
     enum class AirGate : std::uint8_t { open, urgent_only, closed };
@@ -90,7 +104,14 @@ class Transport::Impl {
     [[nodiscard]] TimePoint ack_due() const;
     [[nodiscard]] TimePoint content_due(std::size_t path) const;
     [[nodiscard]] std::size_t payload_cap() const;
-    [[nodiscard]] bool level_ready(std::size_t level, bool retx_ok) const;
+    // Inline: every deadline computation asks them for each level.
+    [[nodiscard]] bool level_ready(std::size_t level, bool retx_ok) const {
+        if ((bulk_blocked && level + 1 == senders.size()) || (bulk_only && level + 1 < senders.size())) {
+            return false;
+        }
+        return !fast[level].empty() || (retx_ok && senders[level].has_lost()) ||
+               senders[level].can_send_new();
+    }
     std::optional<std::vector<std::uint8_t>> build_hello(std::size_t path, TimePoint now);
     std::optional<std::vector<std::uint8_t>> build_data(std::size_t path, TimePoint now);
     bool add_data_chunk(std::vector<frame::Chunk>& chunks, std::vector<std::vector<std::uint8_t>>& storage,
@@ -203,9 +224,18 @@ class Transport::Impl {
     fec::ShardAssembler shards;
     std::vector<std::uint8_t> rebuilt;  // a frame rebuilt from shards
 
+    // build_data's scratch: the chunks of the frame being filled, the bytes they point into, the channels it
+    // acknowledges.
+    std::vector<frame::Chunk> tx_chunks;
+    std::vector<std::vector<std::uint8_t>> tx_storage;
+    std::vector<std::size_t> tx_acked;
+
     std::deque<Delivered> deliveries;
     std::deque<TransportEvent> events;
     std::array<TimePoint, static_cast<std::size_t>(Timer::count)> timers{};
+    // When refresh() last ran: the timers describe the state as of then, until any input changes it.
+    TimePoint refreshed_at{};
+    TimePoint earliest = kNever;  // the earliest of the timers: poll_timeout()
 };
 
 }  // namespace airseg::groundlink

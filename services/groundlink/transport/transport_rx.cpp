@@ -19,7 +19,7 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
     Path& ps = paths[path];
     stats.bytes_received += bytes.size();
     stats.path[path].bytes_received += bytes.size();
-    {
+    if (cfg.path_mode == PathMode::split && cfg.split_borrow) {  // only borrowing reads it (an exp() a read)
         ps.rx_rate = decayed_rate(ps.rx_rate, ps.rx_rate_time, now_) + static_cast<double>(bytes.size());
         ps.rx_rate_time = now_;
     }
@@ -38,9 +38,11 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
             ps.air_debt = std::max(ps.air_debt, now_) + 2 * cfg.air_turnaround;
         }
     };
+    bool framed = false;  // a frame (or a damaged one) ended in these bytes
     ps.deframer.feed(
         bytes,
         [&](std::vector<std::uint8_t>&& plain) {
+            framed = true;
             const std::size_t wire = ps.deframer.last_encoded_bytes();
             if (fec::is_shard(plain)) {
                 // Shards come in bursts of one frame: one change of sender per group, not per shard.
@@ -51,14 +53,21 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
             on_plain_frame(path, plain, wire, now_);
         },
         [&] {
+            framed = true;
             turnaround();
             ++stats.framing_errors;
             ++ps.bad_since_shard;
             ++damaged_since_numbered;
             meter.on_frame(ps.deframer.last_encoded_bytes(), false);
         });
+    if (!framed) {
+        // Most serial reads are part of a frame: they move only the clock and the air budget.
+        refresh_transmit(now_);
+        return;
+    }
     update_link_state();
     refresh(now_);
+    update_plan();  // the error rate is measured only on frames heard
 }
 
 void Transport::Impl::on_shard(std::size_t path, std::span<const std::uint8_t> plain, std::size_t wire_bytes,
@@ -259,6 +268,7 @@ void Transport::Impl::on_safe(const frame::SafeChunk& c, TimePoint now) {
         ++stats.rx_safe.messages;
         stats.rx_safe.bytes += m->size();
         deliveries.push_back(Delivered{MessageClass::safe, c.channel, 0, std::move(*m)});
+        ++stats.rx_safe.queue_depth;
     }
 }
 
@@ -288,6 +298,7 @@ void Transport::Impl::on_fast(const frame::FastChunk& c, TimePoint now) {
     ++stats.rx_fast.messages;
     stats.rx_fast.bytes += whole->size();
     deliveries.push_back(Delivered{MessageClass::fast, c.priority, c.topic, std::move(*whole)});
+    ++stats.rx_fast.queue_depth;
 }
 
 void Transport::Impl::on_ack(const frame::AckChunk& a, TimePoint now) {

@@ -1,6 +1,8 @@
 // Frames out: path selection, pacing, handshake frames and the scheduler that fills data frames.
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <span>
 
 #include "services/groundlink/transport/transport_impl.hpp"
 
@@ -124,23 +126,6 @@ std::size_t Transport::Impl::payload_cap() const {
     return std::max(cap, cfg.min_frame_payload);
 }
 
-bool Transport::Impl::level_ready(std::size_t level, bool retx_ok) const {
-    if ((bulk_blocked && level + 1 == senders.size()) || (bulk_only && level + 1 < senders.size())) {
-        return false;
-    }
-    return !fast[level].empty() || (retx_ok && senders[level].has_lost()) || senders[level].can_send_new();
-}
-
-bool Transport::Impl::data_ready(bool bulk) const {
-    const std::size_t levels = bulk ? senders.size() : senders.size() - 1;
-    for (std::size_t l = 0; l < levels; ++l) {
-        if (level_ready(l, true)) {
-            return true;
-        }
-    }
-    return false;
-}
-
 Transport::Impl::AirGate Transport::Impl::air_gate(std::size_t path) const {
     const Path& ps = paths[path];
     if (!cfg.half_duplex || now_ >= ps.air_debt) {
@@ -178,16 +163,19 @@ TimePoint Transport::Impl::content_due(std::size_t path) const {
         return std::min(t, ps.next_hello);
     }
     if (carries_data(path)) {
-        const AirGate gate = air_gate(path);
+        // The air gate (a decaying rate: an exp()) is judged only when there is data it could hold back.
         if (borrowed(path)) {
             // A borrowed path carries bulk only: urgent traffic keeps to this end's own pair.
             if (level_ready(senders.size() - 1, true)) {
-                t = std::min(t, gate == AirGate::open ? now_ : ps.air_debt);
+                t = std::min(t, air_gate(path) == AirGate::open ? now_ : ps.air_debt);
             }
-        } else if (!ps.mirror.empty() || (gate == AirGate::open && data_ready(true)) ||
-                   (gate == AirGate::urgent_only && data_ready(false))) {
+        } else if (!ps.mirror.empty()) {
             return std::min(t, now_);
         } else if (data_ready(true)) {
+            const AirGate gate = air_gate(path);
+            if (gate == AirGate::open || (gate == AirGate::urgent_only && data_ready(false))) {
+                return std::min(t, now_);
+            }
             t = std::min(t, ps.air_debt);
         }
         t = std::min(t, ack_due());
@@ -201,6 +189,12 @@ TimePoint Transport::Impl::content_due(std::size_t path) const {
 std::optional<std::vector<std::uint8_t>> Transport::Impl::poll_transmit(std::size_t path, TimePoint now) {
     now_ = std::max(now_, now);
     if (path >= paths.size() || now_ < paths[path].next_free) {
+        return std::nullopt;
+    }
+    // The transmit deadline refresh() computed at this very time still holds (every input refreshes): no
+    // path has anything to send before it, so no frame needs building. The driver polls after every serial
+    // read, most of which complete no frame.
+    if (refreshed_at == now_ && now_ < timers[static_cast<std::size_t>(Timer::transmit)]) {
         return std::nullopt;
     }
     auto out = build_hello(path, now_);
@@ -278,17 +272,18 @@ bool Transport::Impl::add_data_chunk(std::vector<frame::Chunk>& chunks,
     const bool retx_ok = retx_credit > 0.0 || !any_fast;
 
     // Level order: a lower level that has earned its minimum share goes first, then strict priority.
-    std::vector<std::size_t> order;
+    std::array<std::size_t, 2 * kMaxPriorities> order{};
+    std::size_t order_size = 0;
     for (std::size_t l = 1; l < levels; ++l) {
         if (share_credit[l] > 0.0 && level_ready(l, retx_ok)) {
-            order.push_back(l);
+            order[order_size++] = l;
         }
     }
     for (std::size_t l = 0; l < levels; ++l) {
-        order.push_back(l);
+        order[order_size++] = l;
     }
 
-    for (const std::size_t l : order) {
+    for (const std::size_t l : std::span(order).first(order_size)) {
         if (!level_ready(l, retx_ok)) {
             continue;
         }
@@ -372,13 +367,17 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
         return to_wire(std::move(plain), mac, ctx);
     }
 
-    std::vector<frame::Chunk> chunks;
-    std::vector<std::vector<std::uint8_t>> storage;
-    storage.reserve(kMaxDataChunks);  // chunk spans point into it: no reallocation while filling
+    // Scratch kept from frame to frame (filling one allocates no vectors). Chunk spans point into the
+    // storage's buffers, which stay where they are when the storage grows.
+    auto& chunks = tx_chunks;
+    auto& storage = tx_storage;
+    auto& acked_channels = tx_acked;
+    chunks.clear();
+    storage.clear();
+    acked_channels.clear();
     std::size_t room = payload_cap();
     const bool ack_is_due = ack_due() <= now;
 
-    std::vector<std::size_t> acked_channels;
     for (std::size_t l = 0; l < acks.size(); ++l) {
         if (acks[l].needed) {
             chunks.emplace_back(receivers[l].make_ack(static_cast<std::uint8_t>(l)));

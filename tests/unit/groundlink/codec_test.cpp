@@ -28,6 +28,72 @@ TEST(GroundlinkCrc32, KnownVectors) {
     EXPECT_EQ(split.value(), 0xCBF43926U);
 }
 
+// The table-driven CRC reads eight bytes a step: every length and alignment must match the bitwise
+// definition.
+TEST(GroundlinkCrc32, MatchesTheBitwiseDefinitionAtEveryLengthAndSplit) {
+    std::mt19937 rng(3);
+    std::vector<std::uint8_t> data(300);
+    for (auto& b : data) {
+        b = static_cast<std::uint8_t>(rng());
+    }
+    auto bitwise = [](std::span<const std::uint8_t> d) {
+        std::uint32_t c = 0xFFFFFFFFU;
+        for (std::uint8_t b : d) {
+            c ^= b;
+            for (int k = 0; k < 8; ++k) {
+                c = (c & 1U) != 0 ? 0xEDB88320U ^ (c >> 1) : c >> 1;
+            }
+        }
+        return ~c;
+    };
+    for (std::size_t n = 0; n <= data.size(); n += (n < 40 ? 1 : 37)) {
+        const std::span<const std::uint8_t> d(data.data(), n);
+        ASSERT_EQ(crc32(d), bitwise(d)) << n;
+        Crc32 split;
+        split.update(d.first(n / 3));
+        split.update(d.subspan(n / 3));
+        ASSERT_EQ(split.value(), bitwise(d)) << n;
+    }
+}
+
+// The run-at-a-time encoder against the byte-at-a-time definition, around zeros and 254-byte runs.
+TEST(GroundlinkCobs, EncodingMatchesTheByteAtATimeDefinition) {
+    auto reference = [](std::span<const std::uint8_t> data) {
+        std::vector<std::uint8_t> out{0};
+        std::size_t code_pos = 0;
+        std::uint8_t code = 1;
+        for (std::uint8_t b : data) {
+            if (b != 0) {
+                out.push_back(b);
+                ++code;
+            }
+            if (b == 0 || code == 0xFF) {
+                out[code_pos] = code;
+                code_pos = out.size();
+                out.push_back(0);
+                code = 1;
+            }
+        }
+        out[code_pos] = code;
+        out.push_back(0);
+        return out;
+    };
+    std::mt19937 rng(11);
+    for (int trial = 0; trial < 200; ++trial) {
+        std::vector<std::uint8_t> in(rng() % 700);
+        const unsigned zero_every = 1 + rng() % 400;
+        for (auto& b : in) {
+            b = static_cast<std::uint8_t>(rng() % zero_every == 0 ? 0 : 1 + rng() % 255);
+        }
+        std::vector<std::uint8_t> out{0xAB};  // appends after what is there
+        cobs_encode(in, out);
+        ASSERT_EQ(std::vector<std::uint8_t>(out.begin() + 1, out.end()), reference(in)) << trial;
+        const auto back = cobs_decode(std::span(out).subspan(1, out.size() - 2));
+        ASSERT_TRUE(back.has_value());
+        ASSERT_EQ(*back, in);
+    }
+}
+
 TEST(GroundlinkCobs, KnownVectors) {
     auto enc = [](std::vector<std::uint8_t> in) {
         std::vector<std::uint8_t> out;
