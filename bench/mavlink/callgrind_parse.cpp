@@ -183,7 +183,8 @@ int main(int argc, char** argv) {
     const bench::TelemetryStream stream = bench::make_telemetry_stream(60.0);
     const std::span<const std::uint8_t> bytes(stream.bytes);
     if (mode == "write-stream" && argc == 3) {
-        return write_file(argv[2], std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()))
+        return write_file(argv[2],
+                          std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()))
                    ? 0
                    : 1;
     }
