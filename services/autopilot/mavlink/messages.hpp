@@ -150,12 +150,18 @@ constexpr std::size_t encode_payload(const M& m, std::span<std::uint8_t, kMaxPay
 template <Message M>
 constexpr M decode_payload(std::span<const std::uint8_t> payload) {
     constexpr auto& layout = MessageTraits<M>::layout;
-    std::array<std::uint8_t, kMaxPayload> full{};
-    std::copy_n(payload.begin(), std::min<std::size_t>(payload.size(), layout.length), full.begin());
-    M m{};
+    // Members are read straight from the payload; only a short one (what the parser delivers never is) is
+    // first copied into a zeroed buffer of the message's length, not of the largest payload.
+    if (payload.size() < layout.length) {
+        std::array<std::uint8_t, layout.length> full{};
+        std::copy(payload.begin(), payload.end(), full.begin());
+        return decode_payload<M>(full);
+    }
+    const std::uint8_t* in = payload.data();
+    M m;
     std::size_t i = 0;
     MessageTraits<M>::visit(
-        m, [&](auto& member) { detail::get_member(full.data() + layout.offset_by_decl[i++], member); });
+        m, [&](auto& member) { detail::get_member(in + layout.offset_by_decl[i++], member); });
     return m;
 }
 

@@ -80,6 +80,27 @@ const LinkStats* Parser::link(std::uint8_t sysid, std::uint8_t compid) const {
 }
 
 void Parser::push(std::span<const std::uint8_t> bytes, Sink sink) {
+    // The common case of a small read (a UART gives a few bytes at a time): bytes that do not complete the
+    // head and hold no start byte. Then there is nothing to judge, exactly as push_and_judge() would find
+    // after looking: they are only kept.
+    if (len_ + bytes.size() < append_limit_) {
+        // Copied as checked: bytes past len_ are free, and push_and_judge() would copy the same ones there.
+        std::uint8_t* out = buf_.data() + len_;
+        std::size_t i = 0;
+        for (; i < bytes.size() && !is_magic(bytes[i]); ++i) {
+            out[i] = bytes[i];
+        }
+        if (i == bytes.size()) {
+            len_ += i;
+            scanned_ = len_;
+            return;
+        }
+    }
+    push_and_judge(bytes, sink);
+    append_limit_ = append_limit();
+}
+
+void Parser::push_and_judge(std::span<const std::uint8_t> bytes, Sink sink) {
     std::size_t pos = 0;
     while (true) {
         if (len_ == 0 && signature_left_ == 0) {
@@ -94,6 +115,7 @@ void Parser::push(std::span<const std::uint8_t> bytes, Sink sink) {
             }
             buf_[0] = bytes[pos++];
             len_ = 1;
+            scanned_ = 1;  // the start byte itself is no inner start
         }
         if (head() != Head::Noise) {
             const std::size_t need = required_length();
@@ -126,6 +148,19 @@ void Parser::finish(Sink sink) {
         }
         step(sink, true);
     }
+    append_limit_ = 0;
+}
+
+// Below how many bytes in the buffer push() may only append: while the head is a candidate whose header, or
+// with a known id whose checksum, is incomplete and no start byte inside it is pending. 0 when not.
+std::size_t Parser::append_limit() const {
+    if (len_ == 0 || signature_left_ != 0 || inner_count_ != 0 || scanned_ != len_) {
+        return 0;
+    }
+    if (head_cached_) {
+        return head_cache_ == Head::Known ? head_checked_length_ : 0;
+    }
+    return is_magic(buf_[0]) ? header_length(buf_[0]) : 0;
 }
 
 Parser::Head Parser::head() const {
@@ -144,9 +179,11 @@ Parser::Head Parser::head() const {
         return Head::Incomplete;  // looked at again as bytes arrive
     } else {
         const Header h = read_header(buf_.data());
-        head_cache_ = find_message(h.msgid) != nullptr ? Head::Known
-                      : h.unknown_flags()              ? Head::Unacceptable
-                                                       : Head::Unknown;
+        head_info_ = find_message(h.msgid);
+        head_checked_length_ = h.checked_length();
+        head_cache_ = head_info_ != nullptr ? Head::Known
+                      : h.unknown_flags()   ? Head::Unacceptable
+                                            : Head::Unknown;
     }
     head_cached_ = true;  // until the front of the buffer is dropped
     return head_cache_;
@@ -184,7 +221,7 @@ std::size_t Parser::required_length() const {
         case Head::Unacceptable:
             return header_length(buf_[0]);
         case Head::Known:
-            return read_header(buf_.data()).checked_length();
+            return head_checked_length_;
         case Head::Unknown: {
             const std::size_t length = unverifiable_length(kind);
             if (len_ <= length || !is_magic(buf_[length])) {
@@ -233,39 +270,60 @@ std::size_t Parser::pending_end(std::size_t first, std::size_t end, std::size_t 
 // verified frame that starts after it is complete first, nothing inside it can be verified before that
 // frame, which it does not overlap: the head stands.
 //
-// Each inner frame is checked once: checked_len_ is the end up to which frames were checked and found
-// wanting.
+// Each inner start byte is looked at once as it arrives (note_inner_starts) and then kept only while it
+// can still begin a verified frame: its header incomplete, or its id known, its length plausible and its
+// checksum not yet complete in time. Its checksum is computed once, when it is.
+void Parser::note_inner_starts(std::size_t first) {
+    scanned_ = std::max(scanned_, first);
+    for (; scanned_ < len_; ++scanned_) {
+        if (is_magic(buf_[scanned_])) {
+            inner_at_[inner_count_] = static_cast<std::uint16_t>(scanned_);
+            inner_end_[inner_count_] = 0;
+            ++inner_count_;
+        }
+    }
+}
+
 bool Parser::resync_inside_candidate(Sink sink, std::size_t need) {
     const Head kind = head();
     const std::size_t unverifiable = unverifiable_length(kind);
     // Inner frames must be complete at or before this.
     const std::size_t limit = std::min(len_, unverifiable > 0 ? need : need - 1);
-    if (limit <= checked_len_) {
-        return false;
-    }
+    note_inner_starts(kind == Head::Signature ? 0 : 1);
     bool found = false;
     std::size_t found_at = 0;
     std::size_t found_end = limit + 1;
-    for (std::size_t k = kind == Head::Signature ? 0 : 1; k < limit; ++k) {
-        if (!is_magic(buf_[k]) || len_ - k < header_length(buf_[k])) {
-            continue;
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < inner_count_; ++i) {
+        const std::size_t k = inner_at_[i];
+        std::size_t end = inner_end_[i];
+        if (end == 0) {
+            if (len_ - k >= header_length(buf_[k])) {
+                const Header h = read_header(buf_.data() + k);
+                const MessageInfo* info = find_message(h.msgid);
+                if (info == nullptr || !plausible_inner(h, *info)) {
+                    continue;  // can never be verified: dropped
+                }
+                end = k + h.checked_length();
+            }
         }
-        const Header h = read_header(buf_.data() + k);
-        const std::size_t end = k + h.checked_length();
-        // Skipped: not complete in time, not before one already found (ties go to the earlier start), or
-        // checked before.
-        if (end >= found_end || end <= checked_len_) {
-            continue;
-        }
-        const MessageInfo* info = find_message(h.msgid);
-        if (info != nullptr && plausible_inner(h, *info) && checksum_matches(buf_.data() + k, h, *info)) {
+        // Checked now if complete in time and before one already found (ties go to the earlier start);
+        // one that fails its checksum is dropped.
+        if (end != 0 && end < found_end) {
+            const Header h = read_header(buf_.data() + k);
+            if (!checksum_matches(buf_.data() + k, h, *find_message(h.msgid))) {
+                continue;
+            }
             found = true;
             found_at = k;
             found_end = end;
         }
+        inner_at_[kept] = static_cast<std::uint16_t>(k);
+        inner_end_[kept] = static_cast<std::uint16_t>(end);
+        ++kept;
     }
+    inner_count_ = kept;
     if (!found) {
-        checked_len_ = limit;
         return false;
     }
     if (kind == Head::Signature) {
@@ -347,7 +405,7 @@ void Parser::judge(Sink sink, Head kind) {
     }
     const Header h = read_header(buf_.data());
     if (kind == Head::Known) {
-        const MessageInfo* info = find_message(h.msgid);
+        const MessageInfo* info = head_info_;
         if (checksum_matches(buf_.data(), h, *info)) {
             accept(sink, h.checked_length(), info);
             return;
@@ -390,8 +448,12 @@ void Parser::deliver(Sink sink, std::size_t frame_length, const MessageInfo* inf
     frame_.payload_length = info != nullptr ? std::max(h.payload_length, info->length) : h.payload_length;
     frame_.is_signed = h.is_signed();
     frame_.checksum_verified = info != nullptr;
+    // The payload stays zero beyond wire_length: only what the previous frames wrote there is cleared.
     std::memcpy(frame_.payload.data(), buf_.data() + h.header_length, h.payload_length);
-    std::fill(frame_.payload.begin() + h.payload_length, frame_.payload.end(), std::uint8_t{0});
+    if (payload_dirty_ > h.payload_length) {
+        std::memset(frame_.payload.data() + h.payload_length, 0, payload_dirty_ - h.payload_length);
+    }
+    payload_dirty_ = h.payload_length;
     if (info != nullptr) {
         ++stats_.frames_ok;
     } else {
@@ -459,7 +521,8 @@ void Parser::discard(std::size_t n) {
 void Parser::drop_front(std::size_t n) {
     std::memmove(buf_.data(), buf_.data() + n, len_ - n);
     len_ -= n;
-    checked_len_ = 0;
+    inner_count_ = 0;
+    scanned_ = 0;
     head_cached_ = false;
 }
 

@@ -116,6 +116,10 @@ class Parser {
     std::size_t unverifiable_length(Head kind) const;
     std::size_t required_length() const;
     std::size_t pending_end(std::size_t first, std::size_t end, std::size_t at_least) const;
+    // Out of line, so that a push that only appends costs little more than its bytes.
+    [[gnu::noinline]] void push_and_judge(std::span<const std::uint8_t> bytes, Sink sink);
+    std::size_t append_limit() const;
+    void note_inner_starts(std::size_t first);
     bool resync_inside_candidate(Sink sink, std::size_t need);
     void account_failed_starts(std::size_t k);
     void step(Sink sink, bool at_end);
@@ -132,15 +136,25 @@ class Parser {
     // its last byte.
     std::array<std::uint8_t, 2 * kMaxFrameLength> buf_{};
     std::size_t len_ = 0;
-    std::size_t checked_len_ = 0;  // inner frames ending up to here were checked (resync_inside_candidate)
+    // The start bytes inside the head that may still begin a verified frame (resync_inside_candidate), in
+    // buffer order, each with the end of its checksum once its header is in (0 before). Kept as bytes
+    // arrive, so that a push looks only at its own bytes, not again at the whole candidate.
+    std::array<std::uint16_t, 2 * kMaxFrameLength> inner_at_{};
+    std::array<std::uint16_t, 2 * kMaxFrameLength> inner_end_{};
+    std::size_t inner_count_ = 0;
+    std::size_t scanned_ = 0;       // bytes of the buffer looked at for start bytes
+    std::size_t append_limit_ = 0;  // append_limit() after the last push
     // How many of the first bytes of the buffer (and of those still to come) are presumed the signature of
     // the frame just delivered.
     std::size_t signature_left_ = 0;
     mutable Head head_cache_ = Head::Noise;  // head(), once the candidate's header is complete
     mutable bool head_cached_ = false;
+    mutable const MessageInfo* head_info_ = nullptr;  // a Known head's message
+    mutable std::size_t head_checked_length_ = 0;     // a Known head's length up to its checksum
     std::size_t damaged_left_ = 0;
     DamageKind damage_kind_ = DamageKind::BadChecksum;
     Frame frame_{};
+    std::size_t payload_dirty_ = 0;  // bytes of frame_.payload that may not be zero
     ParserStats stats_{};
     std::array<LinkStats, kMaxLinks> links_{};
     std::array<std::uint64_t, kMaxLinks> link_last_heard_{};

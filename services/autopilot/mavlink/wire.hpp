@@ -1,9 +1,11 @@
 #pragma once
 // Explicit little-endian encoding of MAVLink scalars, byte by byte, so the result does not depend on the
-// host's byte order or alignment rules (ARM, big-endian hosts).
+// host's byte order or alignment rules (ARM, big-endian hosts); on a little-endian host at run time that
+// is a plain (unaligned) copy.
 #include <bit>
 #include <concepts>
 #include <cstdint>
+#include <cstring>
 #include <type_traits>
 
 namespace airseg::mavlink::wire {
@@ -21,6 +23,10 @@ using UnsignedOf =
 template <Scalar T>
 constexpr void put(std::uint8_t* out, T value) {
     using U = UnsignedOf<T>;
+    if (!std::is_constant_evaluated() && std::endian::native == std::endian::little) {
+        std::memcpy(out, &value, sizeof(T));
+        return;
+    }
     const U bits = std::bit_cast<U>(value);
     for (std::size_t i = 0; i < sizeof(T); ++i) {
         out[i] = static_cast<std::uint8_t>(bits >> (8 * i));
@@ -31,6 +37,12 @@ constexpr void put(std::uint8_t* out, T value) {
 template <Scalar T>
 constexpr T get(const std::uint8_t* in) {
     using U = UnsignedOf<T>;
+    if (!std::is_constant_evaluated() && std::endian::native == std::endian::little) {
+        // One load: the byte loop below is not always merged into one by the compiler (64-bit members).
+        T value;
+        std::memcpy(&value, in, sizeof(T));
+        return value;
+    }
     U bits = 0;
     for (std::size_t i = 0; i < sizeof(T); ++i) {
         bits = static_cast<U>(bits | (static_cast<U>(in[i]) << (8 * i)));
