@@ -49,7 +49,7 @@ class App::Impl {
     Impl(CliOptions options, Config config)
         : options_(std::move(options)),
           config_(std::move(config)),
-          strand_(asio::make_strand(io_)),
+          strand_(asio::make_strand(control_io_)),
           signals_(strand_, SIGTERM, SIGINT, SIGHUP),
           watchdog_timer_(strand_),
           context_{io_, bus_, health_, commands_, progress_interval()} {}
@@ -71,6 +71,11 @@ class App::Impl {
 
         // Keeps run() going while services wait on nothing but signals; shutdown() ends it with io_.stop().
         auto work = asio::require(io_.get_executor(), asio::execution::outstanding_work.tracked);
+        auto control_work =
+            asio::require(control_io_.get_executor(), asio::execution::outstanding_work.tracked);
+        // Signals, the watchdog and the notifier run on a thread of their own, apart from the services: a
+        // stuck service cannot silence them, however few threads the services have.
+        std::thread control([this] { control_io_.run(); });
         const unsigned threads = config_.threads > 0 ? static_cast<unsigned>(config_.threads)
                                                      : std::max(1u, std::thread::hardware_concurrency());
         std::vector<std::thread> pool;
@@ -81,6 +86,8 @@ class App::Impl {
         for (auto& t : pool) {
             t.join();
         }
+        control_io_.stop();
+        control.join();
         spdlog::info("airsegd: stopped");
         return 0;
     }
@@ -280,7 +287,8 @@ class App::Impl {
 
     CliOptions options_;
     Config config_;
-    asio::io_context io_;
+    asio::io_context io_;          // the services
+    asio::io_context control_io_;  // strand_: signals, the watchdog, systemd, the status LED
     Strand strand_;
     asio::signal_set signals_;
     asio::steady_timer watchdog_timer_;

@@ -24,7 +24,8 @@ class AutopilotStatusSection {
 
   private:
     Bus& bus_;
-    nlohmann::json last_;  // only changes are published: the status service keeps the newest anyway
+    std::optional<autopilot::AutopilotStatus>
+        last_;  // only changes are published: the status service keeps the newest
     Subscription subscription_;
 };
 

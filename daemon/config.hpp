@@ -77,7 +77,7 @@ struct FlightplanConfig {
 };
 
 struct Config {
-    int threads = 0;                            // threads: 0 = one per core
+    int threads = 1;                            // threads: 0 = one per core
     std::string log_level = "info";             // log_level
     std::string state_dir = "/var/lib/airseg";  // state_dir
     StatusConfig status;

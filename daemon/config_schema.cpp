@@ -317,7 +317,7 @@ std::vector<KeySpec> build_schema() {
     // General
     s.push_back(integer(
         "threads", [](Config& c) -> int& { return c.threads; }, 0, 64,
-        "worker threads running the event loop; 0 = one per CPU core"));
+        "threads running the services; 0 = one per CPU core"));
     s.push_back(choice(
         "log_level", [](Config& c) -> std::string& { return c.log_level; },
         {"trace", "debug", "info", "warn", "error", "critical", "off"}, "least severe log level written",

@@ -205,6 +205,7 @@ struct AutopilotStatus {
     std::uint64_t tlog_write_errors = 0;    // autopilot.tlog.write_errors
     std::uint64_t tlog_dropped_frames = 0;  // autopilot.tlog.dropped_frames: lost to write errors
     std::string tlog_error;                 // autopilot.tlog.error: the last write error, "" when none yet
+    bool operator==(const AutopilotStatus&) const = default;
 };
 
 }  // namespace airseg::autopilot

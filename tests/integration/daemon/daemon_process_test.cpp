@@ -12,7 +12,7 @@ namespace airseg::test {
 namespace {
 
 class DaemonProcess : public ::testing::Test {
-  protected:
+  public:
     DaemonProcess() : notify(dir.file("notify.sock")) {}
 
     std::vector<std::string> daemon_args(const std::string& config = source_path("config/airseg.yaml")) {
@@ -82,19 +82,20 @@ TEST_F(DaemonProcess, ReadyPingsAnswersAndStopsCleanlyWithoutAnyDevice) {
     EXPECT_FALSE(std::filesystem::exists(socket())) << "the status socket is removed on exit";
 }
 
-TEST_F(DaemonProcess, AStuckServiceStopsTheWatchdogPings) {
-#ifndef AIRSEG_TEST_HANG_INJECTION
-    GTEST_SKIP()
-        << "airsegd is built without AIRSEG_TEST_HANG_INJECTION (a package build): no service can be made "
-           "to hang";
-#endif
+// groundlink's strand blocks; the pings stop within one watchdog period and airsegd says what stalled. With
+// one service thread (the default) every service waits behind the stuck one, so all are named; with two,
+// only the stuck one. Either way signals still work: the watchdog and signals have a thread of their own.
+void check_a_stuck_service_stops_the_pings(DaemonProcess& t, int threads, const std::string& named) {
     // WatchdogSec=1s; groundlink's strand blocks 1.5 s after the start (the delay counts from before
     // READY=1).
     constexpr auto kPeriod = 1000ms;
     constexpr auto kHangDelay = 1500ms;
-    auto e = env("1000000");
+    auto e = t.env("1000000");
     e["AIRSEG_TEST_HANG"] = "groundlink:1500";
-    Subprocess daemon(daemon_args(), e, dir.path());
+    auto args = t.daemon_args();
+    args.insert(args.end(), {"--set", "threads=" + std::to_string(threads)});
+    Subprocess daemon(args, e, t.dir.path());
+    auto& notify = t.notify;
     const auto ready = notify.wait_for("READY=1", 10s);
     ASSERT_TRUE(ready) << daemon.err();
     const auto ready_at = *ready;
@@ -126,13 +127,31 @@ TEST_F(DaemonProcess, AStuckServiceStopsTheWatchdogPings) {
         << " ms after the hang (watchdog period " << kPeriod.count() << " ms)\n";
     EXPECT_TRUE(daemon.running());
     EXPECT_TRUE(wait_until([&] {
-        return daemon.err().find("no progress from groundlink") != std::string::npos;
+        return daemon.err().find("no progress from " + named) != std::string::npos;
     })) << daemon.err();
 
     daemon.signal(SIGTERM);
     auto code = daemon.wait_exit(5s);
     ASSERT_TRUE(code);
     EXPECT_EQ(*code, 0);
+}
+
+TEST_F(DaemonProcess, AStuckServiceStopsTheWatchdogPings) {
+#ifndef AIRSEG_TEST_HANG_INJECTION
+    GTEST_SKIP()
+        << "airsegd is built without AIRSEG_TEST_HANG_INJECTION (a package build): no service can be made "
+           "to hang";
+#endif
+    check_a_stuck_service_stops_the_pings(*this, 2, "groundlink\n");
+}
+
+TEST_F(DaemonProcess, AStuckServiceStopsTheWatchdogPingsWithOneServiceThread) {
+#ifndef AIRSEG_TEST_HANG_INJECTION
+    GTEST_SKIP()
+        << "airsegd is built without AIRSEG_TEST_HANG_INJECTION (a package build): no service can be made "
+           "to hang";
+#endif
+    check_a_stuck_service_stops_the_pings(*this, 1, "autopilot, flightplan, groundlink, status\n");
 }
 
 TEST_F(DaemonProcess, AnInvalidConfigExits78AndStartsNothing) {
@@ -175,7 +194,7 @@ TEST_F(DaemonProcess, SighupAppliesRuntimeKeysAndKeepsTheRunningConfigOnErrors) 
     })) << daemon.err();
 
     std::string broken = changed;
-    broken.replace(broken.find("threads: 0"), 10, "threads: lots");
+    broken.replace(broken.find("threads: 1"), 10, "threads: lots");
     write_file(config, broken);
     daemon.signal(SIGHUP);
     EXPECT_TRUE(wait_until([&] {
