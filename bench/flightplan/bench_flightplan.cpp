@@ -115,7 +115,7 @@ void BM_SeekInMillionWaypointScan(benchmark::State& state) {
     auto plan = million_plan();
     Expander e(plan);
     std::mt19937_64 rng(1);
-    const std::uint64_t total = plan->nodes[plan->main_list].count.value();
+    const std::uint64_t total = plan->count(plan->main_list).value();
     for (auto _ : state) {
         const std::uint64_t target = rng() % total;
         benchmark::DoNotOptimize(e.seek(target));
@@ -167,7 +167,7 @@ void BM_LoadExplicitList(benchmark::State& state, bool from_file) {
             std::abort();
         peak = g_peak.load() - base;
         kept = g_live.load() - base;
-        elements = r.plan->nodes[r.plan->main_list].children.size();
+        elements = r.plan->children(r.plan->main_list).size();
         benchmark::DoNotOptimize(r.plan);
     }
     if (from_file)

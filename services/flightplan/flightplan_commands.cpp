@@ -185,13 +185,13 @@ void FlightplanService::cmd_show(CommandDispatcher::Reply reply) {
     if (active_) {
         const Plan& plan = *active_->plan;
         auto& elements = j["elements"] = Json::array();
-        for (auto id : plan.nodes[plan.main_list].children) {
+        for (auto id : plan.children(plan.main_list)) {
             const Node& n = plan.nodes[id];
-            elements.push_back({{"path", n.path},
+            elements.push_back({{"path", plan.element_path(id)},
                                 {"kind", to_string(n.kind)},
-                                {"name", n.name},
+                                {"name", plan.element_name(id)},
                                 {"line", n.mark.line},
-                                {"waypoints", optional_json(n.count)}});
+                                {"waypoints", optional_json(plan.count(id))}});
         }
     }
     reply(CommandResult::ok(std::move(j)));

@@ -67,15 +67,71 @@ std::optional<VehicleProfile> VehicleProfile::defaults_for(std::string_view type
 
 std::uint32_t Plan::find(std::string_view wanted) const {
     for (std::uint32_t i = 0; i < nodes.size(); ++i) {
-        if (!nodes[i].name.empty() && nodes[i].name == wanted)
+        if (nodes[i].extra != kNoNode && !wanted.empty() && extras[nodes[i].extra].name == wanted)
             return i;
     }
     return kNoNode;
 }
 
-const std::string& Plan::element_path(std::uint32_t id) const {
-    static const std::string kNone;
-    return id < nodes.size() ? nodes[id].path : kNone;
+const NodeExtra& Plan::extra(std::uint32_t id) const {
+    static const NodeExtra kNone;
+    return id < nodes.size() && nodes[id].extra != kNoNode ? extras[nodes[id].extra] : kNone;
+}
+
+NodeExtra& Plan::extra_for(std::uint32_t id) {
+    Node& n = nodes.at(id);
+    if (n.extra == kNoNode) {
+        n.extra = static_cast<std::uint32_t>(extras.size());
+        extras.emplace_back();
+    }
+    return extras[n.extra];
+}
+
+std::optional<std::uint64_t> Plan::count(std::uint32_t id) const {
+    const Node& n = nodes[id];
+    switch (n.kind) {
+        case NodeKind::Waypoint:
+        case NodeKind::Hold:
+            return 1;
+        case NodeKind::Speed:
+            return 0;
+        case NodeKind::Scan: {
+            const auto& scan = extra(id).scan;
+            return scan ? scan->total_count() : 0;
+        }
+        case NodeKind::Orbit: {
+            const auto& orbit = extra(id).orbit;
+            return orbit ? orbit->count() : 0;
+        }
+        case NodeKind::Goto:
+            return std::nullopt;
+        case NodeKind::ElementList:
+        case NodeKind::Repeat:
+        case NodeKind::Block:
+            return extra(id).count;
+    }
+    return std::nullopt;
+}
+
+std::string Plan::element_path(std::uint32_t id) const {
+    // Paths are rebuilt from the parent chain rather than stored: a long list would otherwise keep a string
+    // per element. Shapes: plan.elements[i], <container>.<kind>.elements[i], plan.blocks[i].elements[j].
+    if (id >= nodes.size())
+        return {};
+    if (id == main_list)
+        return "plan.elements";
+    if (id == blocks_list)
+        return "plan.blocks";
+    const Node& n = nodes[id];
+    if (n.parent == kNoNode)
+        return {};
+    const std::string index = "[" + std::to_string(n.index_in_parent) + "]";
+    const Node& p = nodes[n.parent];
+    if (p.kind == NodeKind::ElementList)
+        return element_path(n.parent) + index;
+    if (p.kind == NodeKind::Block && p.parent == blocks_list && blocks_list != kNoNode)
+        return element_path(n.parent) + ".elements" + index;
+    return element_path(n.parent) + "." + to_string(p.kind) + ".elements" + index;
 }
 
 }  // namespace airseg::flightplan
