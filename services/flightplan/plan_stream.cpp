@@ -1,5 +1,7 @@
 #include "services/flightplan/plan_stream.hpp"
 
+#include <utility>
+
 namespace airseg::flightplan {
 
 // One level per list being streamed (level 0 is the document). A level's builder holds the trees of that
@@ -64,8 +66,8 @@ void PlanEventReader::before_node(const YNode* key, bool is_key) {
                 pending_ = Pending::PlanBlocks;
             } else if (name == "blocks") {
                 o.blocks = true;  // before the elements: read whole, checked after them
-            } else if (name == "elements") {
-                pending_ = Pending::PlanElements;
+            } else if (name == "elements" && !std::exchange(o.elements, true)) {
+                pending_ = Pending::PlanElements;  // the first one: lookups find the first of duplicate keys
             }
             break;
         case Role::Item:
@@ -78,7 +80,7 @@ void PlanEventReader::before_node(const YNode* key, bool is_key) {
         case Role::BlockItem:
             if (o.streamed)
                 throw NotStreamable{};
-            if (name == "elements")
+            if (name == "elements" && !std::exchange(o.elements, true))
                 pending_ = Pending::Elements;
             break;
     }

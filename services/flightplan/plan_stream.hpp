@@ -51,6 +51,7 @@ class PlanEventReader final : public YAML::EventHandler {
         Role role = Role::Plain;
         std::size_t keys = 0;
         bool streamed = false;  // its "elements" list (Root: the plan) was streamed
+        bool elements = false;  // an "elements" key was seen
         bool blocks = false;    // PlanBody: a "blocks" key was seen
         bool blocks_streamed = false;
     };
