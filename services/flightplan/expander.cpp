@@ -81,7 +81,7 @@ void Expander::place_at(std::uint32_t target) {
     for (auto [ancestor, on_path] : chain) {
         if (ancestor == plan_->blocks_list)
             continue;  // a detached block ends the plan when it ends
-        const std::uint32_t next = nodes[on_path].index_in_parent + (on_path == target ? 0 : 1);
+        const std::uint32_t next = plan_->index_in_parent(on_path) + (on_path == target ? 0 : 1);
         stack_.push_back({ancestor, next, 0});
     }
     if (nodes[target].parent == plan_->blocks_list)

@@ -1,5 +1,6 @@
 #include "services/flightplan/plan.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace airseg::flightplan {
@@ -66,25 +67,55 @@ std::optional<VehicleProfile> VehicleProfile::defaults_for(std::string_view type
 }
 
 std::uint32_t Plan::find(std::string_view wanted) const {
-    for (std::uint32_t i = 0; i < nodes.size(); ++i) {
-        if (nodes[i].extra != kNoNode && !wanted.empty() && extras[nodes[i].extra].name == wanted)
-            return i;
+    if (wanted.empty())
+        return kNoNode;
+    for (const auto& x : extras) {
+        if (x.name == wanted)
+            return x.node;
     }
     return kNoNode;
 }
 
+namespace {
+template <typename Extras>
+auto extra_at(Extras& extras, std::uint32_t id) {
+    return std::lower_bound(extras.begin(), extras.end(), id,
+                            [](const NodeExtra& x, std::uint32_t wanted) { return x.node < wanted; });
+}
+NodeExtra extra_of(std::uint32_t id) {
+    NodeExtra x;
+    x.node = id;
+    return x;
+}
+}  // namespace
+
 const NodeExtra& Plan::extra(std::uint32_t id) const {
     static const NodeExtra kNone;
-    return id < nodes.size() && nodes[id].extra != kNoNode ? extras[nodes[id].extra] : kNone;
+    if (id >= nodes.size() || !nodes[id].has_extra)
+        return kNone;
+    if (!extras.empty() && extras.back().node == id)
+        return extras.back();
+    auto it = extra_at(extras, id);
+    return it != extras.end() && it->node == id ? *it : kNone;
 }
 
 NodeExtra& Plan::extra_for(std::uint32_t id) {
     Node& n = nodes.at(id);
-    if (n.extra == kNoNode) {
-        n.extra = static_cast<std::uint32_t>(extras.size());
-        extras.emplace_back();
+    if (extras.empty() || extras.back().node < id) {
+        n.has_extra = true;
+        return extras.emplace_back(extra_of(id));
     }
-    return extras[n.extra];
+    auto it = extra_at(extras, id);
+    if (it != extras.end() && it->node == id)
+        return *it;
+    n.has_extra = true;
+    return *extras.insert(it, extra_of(id));
+}
+
+std::uint32_t Plan::index_in_parent(std::uint32_t id) const {
+    const auto& siblings = children(nodes[id].parent);
+    return static_cast<std::uint32_t>(std::lower_bound(siblings.begin(), siblings.end(), id) -
+                                      siblings.begin());
 }
 
 std::optional<std::uint64_t> Plan::count(std::uint32_t id) const {
@@ -125,7 +156,7 @@ std::string Plan::element_path(std::uint32_t id) const {
     const Node& n = nodes[id];
     if (n.parent == kNoNode)
         return {};
-    const std::string index = "[" + std::to_string(n.index_in_parent) + "]";
+    const std::string index = "[" + std::to_string(index_in_parent(id)) + "]";
     const Node& p = nodes[n.parent];
     if (p.kind == NodeKind::ElementList)
         return element_path(n.parent) + index;

@@ -48,8 +48,9 @@ struct OrbitPattern {
 };
 
 /// What few elements have: kept out of line so that a plan written as a long explicit list of waypoints costs
-/// little more than its positions (a Node is 48 bytes; most waypoints have no NodeExtra).
+/// little more than its positions (a Node is 40 bytes; most waypoints have no NodeExtra).
 struct NodeExtra {
+    std::uint32_t node = kNoNode;          // the element it belongs to (Plan::extras is sorted by it)
     std::vector<std::uint32_t> children;   // ElementList, Repeat, Block
     std::string name;                      // optional for every element; goto/reaction target
     std::optional<double> speed;           // Waypoint/Scan/Orbit: leg speed; Speed: the new speed
@@ -70,9 +71,8 @@ struct Node {
     // Waypoint / Hold / Orbit (a hold without a position holds where the previous waypoint ends).
     bool has_position = false;
     bool has_alt = false;
+    bool has_extra = false;  // a NodeExtra exists for it
     std::uint32_t parent = kNoNode;
-    std::uint32_t index_in_parent = 0;
-    std::uint32_t extra = kNoNode;  // index in Plan::extras, kNoNode when the element needs none
     SourceMark mark;
     LatLon geo;  // the local position is derived (Plan::local) rather than stored
     double alt_value = 0.0;
@@ -131,7 +131,7 @@ struct Plan {
 
     // Deques: no reallocation peak while a long list loads, and references stay valid as elements are added.
     std::deque<Node> nodes;
-    std::deque<NodeExtra> extras;
+    std::deque<NodeExtra> extras;         // sorted by NodeExtra::node
     std::uint32_t main_list = kNoNode;    // the plan's elements
     std::uint32_t blocks_list = kNoNode;  // detached named blocks, reached only by goto or a reaction
 
@@ -142,9 +142,12 @@ struct Plan {
 
     /// The out-of-line members of element `id` (an empty NodeExtra when it has none).
     const NodeExtra& extra(std::uint32_t id) const;
-    /// The same, created on first use (loader and tests that build plans by hand).
+    /// The same, created on first use (loader and tests that build plans by hand). Creating one for an id
+    /// below the last one created moves later extras (the loader creates them in id order).
     NodeExtra& extra_for(std::uint32_t id);
     const std::vector<std::uint32_t>& children(std::uint32_t id) const { return extra(id).children; }
+    /// Position of element `id` in its parent's children (children are in id order).
+    std::uint32_t index_in_parent(std::uint32_t id) const;
     const std::string& element_name(std::uint32_t id) const { return extra(id).name; }
     /// Waypoints one execution of element `id` produces; empty when unbounded or when the subtree contains a
     /// goto.

@@ -167,11 +167,11 @@ std::uint32_t PlanParser::add_node(NodeKind kind, std::uint32_t parent, SourceMa
     node.kind = kind;
     node.parent = parent;
     node.mark = mark;
-    if (parent != kNoNode) {
-        auto& siblings = plan_.extra_for(parent).children;
-        node.index_in_parent = static_cast<std::uint32_t>(siblings.size());
-        siblings.push_back(id);
-    }
+    if (parent != kNoNode)
+        plan_.extra_for(parent).children.push_back(id);
+    // Scans and orbits get their patterns at the end; their extras are made now, in id order.
+    if (kind == NodeKind::Scan || kind == NodeKind::Orbit)
+        plan_.extra_for(id);
     return id;
 }
 
