@@ -22,6 +22,7 @@
 
 #include "services/flightplan/expander.hpp"
 #include "services/flightplan/plan_loader.hpp"
+#include "services/flightplan/plan_merge.hpp"
 #include "services/flightplan/window_feeder.hpp"
 
 namespace {
@@ -180,6 +181,27 @@ void BM_LoadExplicitList(benchmark::State& state, bool from_file) {
 }
 BENCHMARK_CAPTURE(BM_LoadExplicitList, text, false)->Arg(4'000)->Arg(40'000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_LoadExplicitList, file, true)->Arg(4'000)->Arg(40'000)->Unit(benchmark::kMillisecond);
+
+// plan.append on a long explicit list: the merge still works on whole yaml-cpp trees of both texts (then the
+// merged text is loaded as above); its heap peak is shown so that it is not mistaken for the loader's.
+void BM_AppendToExplicitList(benchmark::State& state) {
+    const std::string running = explicit_list_plan(static_cast<int>(state.range(0)));
+    const std::string appended = explicit_list_plan(10);
+    std::int64_t peak = 0;
+    for (auto _ : state) {
+        const auto base = g_live.load();
+        g_peak.store(base);
+        auto merged = append_plan_text(running, appended);
+        if (!merged.text)
+            std::abort();
+        peak = g_peak.load() - base;
+        benchmark::DoNotOptimize(merged.text);
+    }
+    state.counters["file_bytes"] = static_cast<double>(running.size());
+    state.counters["peak_heap_bytes"] = static_cast<double>(peak);
+    state.counters["peak_over_file"] = static_cast<double>(peak) / static_cast<double>(running.size());
+}
+BENCHMARK(BM_AppendToExplicitList)->Arg(40'000)->Unit(benchmark::kMillisecond);
 
 // The feeder's own work per reached waypoint: reached report, refill, one partial write, result.
 void BM_FeederPerReachedWaypoint(benchmark::State& state) {

@@ -116,7 +116,9 @@ bool Expander::activate_next_leaf(std::uint64_t* skip_budget) {
         }
         Frame& f = stack_.back();
         const Node& container = nodes[f.node];
-        const NodeExtra& box = plan_->extra(f.node);
+        if (f.box == nullptr)
+            f.box = &plan_->extra(f.node);
+        const NodeExtra& box = *f.box;
         if (f.next_child >= box.children.size()) {
             if (fold_repeats_ && container.kind == NodeKind::Repeat && f.iteration >= 1 &&
                 body_count(f.node)) {
@@ -181,9 +183,10 @@ bool Expander::activate_next_leaf(std::uint64_t* skip_budget) {
 void Expander::activate_leaf(std::uint32_t node, std::uint64_t offset) {
     const Node& n = plan_->nodes[node];
     leaf_ = node;
+    leaf_extra_ = &plan_->extra(node);
     leaf_count_ = plan_->count(node).value_or(0);
     leaf_offset_ = offset;
-    const auto& scan = plan_->extra(node).scan;
+    const auto& scan = leaf_extra_->scan;
     if (n.kind == NodeKind::Scan && scan) {
         scan_line_ = 0;
         scan_line_start_ = 0;
@@ -197,7 +200,7 @@ void Expander::activate_leaf(std::uint32_t node, std::uint64_t offset) {
 
 Waypoint Expander::make_waypoint() {
     const Node& n = plan_->nodes[leaf_];
-    const NodeExtra& x = plan_->extra(leaf_);
+    const NodeExtra& x = *leaf_extra_;
     Waypoint w;
     w.index = position_;
     w.element = leaf_;

@@ -50,6 +50,7 @@ class Expander final : public WaypointStream {
         std::uint32_t node;
         std::uint32_t next_child;
         std::uint64_t iteration;
+        const NodeExtra* box = nullptr;  // the container's children and repeat count, looked up once
     };
 
     void reset_to_origin();
@@ -71,6 +72,7 @@ class Expander final : public WaypointStream {
     std::uint64_t position_ = 0;
 
     std::uint32_t leaf_ = kNoNode;
+    const NodeExtra* leaf_extra_ = nullptr;  // looked up once per leaf, not per waypoint
     std::uint64_t leaf_offset_ = 0;
     std::uint64_t leaf_count_ = 0;
     std::uint64_t scan_line_ = 0;
