@@ -1,5 +1,6 @@
 // Flight plan benchmarks: expansion rate and memory of a 1,000,000-waypoint scan, seek cost, plan load
-// (with no-fly validation) and the rolling-window feeder's cost per reached waypoint.
+// (with no-fly validation), the memory of loading a plan written as an explicit list of waypoints, and the
+// rolling-window feeder's cost per reached waypoint.
 //
 // Memory is measured with a counting allocator (this binary replaces global operator new/delete): the
 // "peak_heap_bytes" counter is the largest heap growth while the stream is expanded, i.e. what the
@@ -9,13 +10,19 @@
 #include <malloc.h>
 #include <sys/resource.h>
 
+#include <unistd.h>
 #include <atomic>
+#include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <new>
 #include <random>
+#include <string>
 
 #include "services/flightplan/expander.hpp"
 #include "services/flightplan/plan_loader.hpp"
+#include "services/flightplan/plan_merge.hpp"
 #include "services/flightplan/window_feeder.hpp"
 
 namespace {
@@ -109,7 +116,7 @@ void BM_SeekInMillionWaypointScan(benchmark::State& state) {
     auto plan = million_plan();
     Expander e(plan);
     std::mt19937_64 rng(1);
-    const std::uint64_t total = plan->nodes[plan->main_list].count.value();
+    const std::uint64_t total = plan->count(plan->main_list).value();
     for (auto _ : state) {
         const std::uint64_t target = rng() % total;
         benchmark::DoNotOptimize(e.seek(target));
@@ -125,6 +132,76 @@ void BM_LoadAndValidateMillionWaypointPlan(benchmark::State& state) {
     }
 }
 BENCHMARK(BM_LoadAndValidateMillionWaypointPlan)->Unit(benchmark::kMillisecond);
+
+// A plan written as an explicit list: `count` waypoints, one per line, about 50 bytes each.
+std::string explicit_list_plan(int count) {
+    std::string text = "plan:\n  name: explicit\n  vehicle: {type: rover}\n  elements:\n";
+    char line[96];
+    for (int i = 0; i < count; ++i) {
+        std::snprintf(line, sizeof line, "    - waypoint: {lat: %.7f, lon: %.7f}\n", 41.0 + (i / 200) * 5e-5,
+                      2.0 + (i % 200) * 5e-5);
+        text += line;
+    }
+    return text;
+}
+
+// Heap kept per element after the load, and the heap peak while loading relative to the file's size. Two
+// ways in: load_plan_file (reads the file itself; its peak includes whatever it buffers of the text) and
+// load_plan_text (the daemon's way: the text is already in memory, held by the caller, and not counted).
+void BM_LoadExplicitList(benchmark::State& state, bool from_file) {
+    const int count = static_cast<int>(state.range(0));
+    const std::string text = explicit_list_plan(count);
+    const auto file = std::filesystem::temp_directory_path() /
+                      ("airseg-bench-explicit-" + std::to_string(::getpid()) + ".yaml");
+    if (from_file)
+        std::ofstream(file, std::ios::binary) << text;
+    LoadOptions options;
+    options.max_elements = 1'000'000;
+    std::int64_t kept = 0, peak = 0;
+    std::size_t elements = 0;
+    for (auto _ : state) {
+        const auto base = g_live.load();
+        g_peak.store(base);
+        auto r = from_file ? load_plan_file(file.string(), options)
+                           : load_plan_text(text, "explicit.yaml", options);
+        if (!r.ok())
+            std::abort();
+        peak = g_peak.load() - base;
+        kept = g_live.load() - base;
+        elements = r.plan->children(r.plan->main_list).size();
+        benchmark::DoNotOptimize(r.plan);
+    }
+    if (from_file)
+        std::filesystem::remove(file);
+    state.counters["elements"] = static_cast<double>(elements);
+    state.counters["file_bytes"] = static_cast<double>(text.size());
+    state.counters["kept_bytes_per_element"] = static_cast<double>(kept) / static_cast<double>(elements);
+    state.counters["peak_heap_bytes"] = static_cast<double>(peak);
+    state.counters["peak_over_file"] = static_cast<double>(peak) / static_cast<double>(text.size());
+}
+BENCHMARK_CAPTURE(BM_LoadExplicitList, text, false)->Arg(4'000)->Arg(40'000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_LoadExplicitList, file, true)->Arg(4'000)->Arg(40'000)->Unit(benchmark::kMillisecond);
+
+// plan.append on a long explicit list: the merge still works on whole yaml-cpp trees of both texts (then the
+// merged text is loaded as above); its heap peak is shown so that it is not mistaken for the loader's.
+void BM_AppendToExplicitList(benchmark::State& state) {
+    const std::string running = explicit_list_plan(static_cast<int>(state.range(0)));
+    const std::string appended = explicit_list_plan(10);
+    std::int64_t peak = 0;
+    for (auto _ : state) {
+        const auto base = g_live.load();
+        g_peak.store(base);
+        auto merged = append_plan_text(running, appended);
+        if (!merged.text)
+            std::abort();
+        peak = g_peak.load() - base;
+        benchmark::DoNotOptimize(merged.text);
+    }
+    state.counters["file_bytes"] = static_cast<double>(running.size());
+    state.counters["peak_heap_bytes"] = static_cast<double>(peak);
+    state.counters["peak_over_file"] = static_cast<double>(peak) / static_cast<double>(running.size());
+}
+BENCHMARK(BM_AppendToExplicitList)->Arg(40'000)->Unit(benchmark::kMillisecond);
 
 // The feeder's own work per reached waypoint: reached report, refill, one partial write, result.
 void BM_FeederPerReachedWaypoint(benchmark::State& state) {

@@ -18,28 +18,31 @@ const char* to_string(WaypointAction action) {
 }
 
 Expander::Expander(std::shared_ptr<const Plan> plan, bool enforce_no_fly, bool fold_repeats)
-    : plan_(std::move(plan)),
-      enforce_no_fly_(enforce_no_fly),
-      fold_repeats_(fold_repeats),
-      body_count_(plan_->nodes.size()) {
+    : plan_(std::move(plan)), enforce_no_fly_(enforce_no_fly), fold_repeats_(fold_repeats) {
     for (const auto& zone : plan_->no_fly)
         zone_boxes_.push_back(Box::around(zone.local, zone.buffer));
     for (std::uint32_t i = 0; i < plan_->nodes.size(); ++i) {
-        const Node& n = plan_->nodes[i];
-        if (n.kind != NodeKind::Repeat)
+        if (plan_->nodes[i].kind != NodeKind::Repeat)
             continue;
         std::optional<std::uint64_t> sum = 0;
-        for (auto c : n.children) {
-            const auto& cc = plan_->nodes[c].count;
+        for (auto c : plan_->children(i)) {
+            const auto cc = plan_->count(c);
             if (!cc) {
                 sum.reset();
                 break;
             }
             *sum += *cc;
         }
-        body_count_[i] = sum;
+        body_count_.emplace_back(i, sum);
     }
     reset_to_origin();
+}
+
+const std::optional<std::uint64_t>& Expander::body_count(std::uint32_t repeat) const {
+    static const std::optional<std::uint64_t> kNone;
+    auto it = std::lower_bound(body_count_.begin(), body_count_.end(), repeat,
+                               [](const auto& entry, std::uint32_t id) { return entry.first < id; });
+    return it != body_count_.end() && it->first == repeat ? it->second : kNone;
 }
 
 void Expander::reset_to_origin() {
@@ -78,7 +81,7 @@ void Expander::place_at(std::uint32_t target) {
     for (auto [ancestor, on_path] : chain) {
         if (ancestor == plan_->blocks_list)
             continue;  // a detached block ends the plan when it ends
-        const std::uint32_t next = nodes[on_path].index_in_parent + (on_path == target ? 0 : 1);
+        const std::uint32_t next = plan_->index_in_parent(on_path) + (on_path == target ? 0 : 1);
         stack_.push_back({ancestor, next, 0});
     }
     if (nodes[target].parent == plan_->blocks_list)
@@ -92,10 +95,10 @@ bool Expander::activate_next_leaf(std::uint64_t* skip_budget) {
     // Seeking: skip whole iterations of a goto-free repeat, keeping the last one to walk so that speed
     // elements inside it still take effect.
     auto fast_forward = [&](Frame& f) {
-        const auto& per = body_count_[f.node];
+        const auto& per = body_count(f.node);
         if (skip_budget == nullptr || !per || *per == 0)
             return;
-        const auto& total = nodes[f.node].repeat_count;
+        const auto& total = plan_->extra(f.node).repeat_count;
         const std::uint64_t left = total ? *total - f.iteration : std::numeric_limits<std::uint64_t>::max();
         const std::uint64_t k = std::min(*skip_budget / *per, left);
         if (k < 2)
@@ -113,20 +116,23 @@ bool Expander::activate_next_leaf(std::uint64_t* skip_budget) {
         }
         Frame& f = stack_.back();
         const Node& container = nodes[f.node];
-        if (f.next_child >= container.children.size()) {
+        if (f.box == nullptr)
+            f.box = &plan_->extra(f.node);
+        const NodeExtra& box = *f.box;
+        if (f.next_child >= box.children.size()) {
             if (fold_repeats_ && container.kind == NodeKind::Repeat && f.iteration >= 1 &&
-                body_count_[f.node]) {
+                body_count(f.node)) {
                 // Iterations are identical: after two, every leg of the repeat has been seen once.
-                if (!container.repeat_count) {
+                if (!box.repeat_count) {
                     stack_.clear();
                     return false;
                 }
-                position_ += (*container.repeat_count - f.iteration - 1) * *body_count_[f.node];
+                position_ += (*box.repeat_count - f.iteration - 1) * *body_count(f.node);
                 stack_.pop_back();
                 continue;
             }
             if (container.kind == NodeKind::Repeat &&
-                (!container.repeat_count || f.iteration + 1 < *container.repeat_count)) {
+                (!box.repeat_count || f.iteration + 1 < *box.repeat_count)) {
                 ++f.iteration;
                 f.next_child = 0;
                 fast_forward(f);
@@ -135,11 +141,11 @@ bool Expander::activate_next_leaf(std::uint64_t* skip_budget) {
             }
             continue;
         }
-        const std::uint32_t id = container.children[f.next_child++];
+        const std::uint32_t id = box.children[f.next_child++];
         const Node& n = nodes[id];
         switch (n.kind) {
             case NodeKind::Speed:
-                speed_ = n.speed.value_or(speed_);
+                speed_ = plan_->extra(id).speed.value_or(speed_);
                 speed_changed_ = true;
                 break;
             case NodeKind::Repeat:
@@ -149,7 +155,7 @@ bool Expander::activate_next_leaf(std::uint64_t* skip_budget) {
                     fast_forward(stack_.back());
                 break;
             case NodeKind::Goto:
-                place_at(n.goto_target);
+                place_at(plan_->extra(id).goto_target);
                 break;
             case NodeKind::ElementList:
                 break;
@@ -157,7 +163,7 @@ bool Expander::activate_next_leaf(std::uint64_t* skip_budget) {
             case NodeKind::Hold:
             case NodeKind::Scan:
             case NodeKind::Orbit: {
-                const std::uint64_t count = n.count.value_or(0);
+                const std::uint64_t count = plan_->count(id).value_or(0);
                 if (count == 0)
                     break;
                 if (skip_budget != nullptr && *skip_budget >= count) {
@@ -177,52 +183,55 @@ bool Expander::activate_next_leaf(std::uint64_t* skip_budget) {
 void Expander::activate_leaf(std::uint32_t node, std::uint64_t offset) {
     const Node& n = plan_->nodes[node];
     leaf_ = node;
-    leaf_count_ = n.count.value_or(0);
+    leaf_extra_ = &plan_->extra(node);
+    leaf_count_ = plan_->count(node).value_or(0);
     leaf_offset_ = offset;
-    if (n.kind == NodeKind::Scan && n.scan) {
+    const auto& scan = leaf_extra_->scan;
+    if (n.kind == NodeKind::Scan && scan) {
         scan_line_ = 0;
         scan_line_start_ = 0;
-        line_ = n.scan->line(0);
-        while (offset - scan_line_start_ >= line_.count && scan_line_ + 1 < n.scan->line_count()) {
+        line_ = scan->line(0);
+        while (offset - scan_line_start_ >= line_.count && scan_line_ + 1 < scan->line_count()) {
             scan_line_start_ += line_.count;
-            line_ = n.scan->line(++scan_line_);
+            line_ = scan->line(++scan_line_);
         }
     }
 }
 
 Waypoint Expander::make_waypoint() {
     const Node& n = plan_->nodes[leaf_];
+    const NodeExtra& x = *leaf_extra_;
     Waypoint w;
     w.index = position_;
     w.element = leaf_;
     w.origin = origin_;
-    w.alt = n.alt;
-    w.speed = n.speed.value_or(speed_);
+    w.alt = n.alt();
+    w.speed = x.speed.value_or(speed_);
     w.speed_changed = speed_changed_;
-    w.arrival_radius = n.arrival_radius.value_or(plan_->vehicle.arrival_radius);
+    w.arrival_radius = x.arrival_radius.value_or(plan_->vehicle.arrival_radius);
     w.first_of_element = leaf_offset_ == 0;
     w.last_of_element = leaf_offset_ + 1 == leaf_count_;
     switch (n.kind) {
         case NodeKind::Hold:
-            w.action = n.hold_seconds ? WaypointAction::HoldFor : WaypointAction::HoldUntilReleased;
-            w.hold_seconds = n.hold_seconds.value_or(0.0);
+            w.action = x.hold_seconds ? WaypointAction::HoldFor : WaypointAction::HoldUntilReleased;
+            w.hold_seconds = x.hold_seconds.value_or(0.0);
             w.has_position = n.has_position;
             w.position = n.geo;
-            w.local = n.pos;
+            w.local = n.has_position ? plan_->local(leaf_) : Enu{};
             return w;
         case NodeKind::Waypoint:
             w.position = n.geo;
-            w.local = n.pos;
+            w.local = plan_->local(leaf_);
             return w;
         case NodeKind::Orbit:
-            w.local = n.orbit->point(leaf_offset_);
+            w.local = x.orbit->point(leaf_offset_);
             break;
         case NodeKind::Scan:
             while (leaf_offset_ - scan_line_start_ >= line_.count) {
                 scan_line_start_ += line_.count;
-                line_ = n.scan->line(++scan_line_);
+                line_ = x.scan->line(++scan_line_);
             }
-            w.local = n.scan->point(scan_line_, line_, leaf_offset_ - scan_line_start_);
+            w.local = x.scan->point(scan_line_, line_, leaf_offset_ - scan_line_start_);
             break;
         default:
             break;

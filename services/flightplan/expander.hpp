@@ -50,6 +50,7 @@ class Expander final : public WaypointStream {
         std::uint32_t node;
         std::uint32_t next_child;
         std::uint64_t iteration;
+        const NodeExtra* box = nullptr;  // the container's children and repeat count, looked up once
     };
 
     void reset_to_origin();
@@ -58,18 +59,20 @@ class Expander final : public WaypointStream {
     bool activate_next_leaf(std::uint64_t* skip_budget);
     void activate_leaf(std::uint32_t node, std::uint64_t offset);
     Waypoint make_waypoint();
+    const std::optional<std::uint64_t>& body_count(std::uint32_t repeat) const;
 
     std::shared_ptr<const Plan> plan_;
     bool enforce_no_fly_;
     bool fold_repeats_;
-    std::vector<std::optional<std::uint64_t>> body_count_;
-    std::vector<Box>
-        zone_boxes_;  // per no-fly zone, buffer included  // per repeat: waypoints of one iteration
+    std::vector<std::pair<std::uint32_t, std::optional<std::uint64_t>>>
+        body_count_;               // per repeat, by id: waypoints of one iteration
+    std::vector<Box> zone_boxes_;  // per no-fly zone, buffer included
     std::vector<Frame> stack_;
     StreamOrigin origin_;
     std::uint64_t position_ = 0;
 
     std::uint32_t leaf_ = kNoNode;
+    const NodeExtra* leaf_extra_ = nullptr;  // looked up once per leaf, not per waypoint
     std::uint64_t leaf_offset_ = 0;
     std::uint64_t leaf_count_ = 0;
     std::uint64_t scan_line_ = 0;

@@ -1,6 +1,7 @@
 // The flight plan commands of FlightplanService (see docs/flight-plan.md, "Commands").
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
@@ -51,9 +52,26 @@ PlanText plan_text_of(const Json& req) {
         out.error = out.source + ": cannot open the file";
         return out;
     }
-    out.text.assign(kMaxPlanTextBytes + 1, '\0');
-    in.read(out.text.data(), static_cast<std::streamsize>(out.text.size()));
-    out.text.resize(static_cast<std::size_t>(in.gcount()));
+    // Sized to the file: the text is kept with the running plan (persistence, plan.append), and a buffer of
+    // the largest allowed plan would stay allocated, and resident, with it.
+    in.seekg(0, std::ios::end);
+    const std::streamoff size = in.tellg();
+    in.clear();
+    in.seekg(0, std::ios::beg);
+    std::size_t want = size >= 0 ? static_cast<std::size_t>(std::min<std::uint64_t>(
+                                       static_cast<std::uint64_t>(size), kMaxPlanTextBytes + 1))
+                                 : std::size_t{64} << 10;
+    // Not seekable (a pipe): read in growing steps, never more than one byte past the largest plan.
+    while (true) {
+        const std::size_t have = out.text.size();
+        out.text.resize(have + want);
+        in.read(out.text.data() + have, static_cast<std::streamsize>(want));
+        out.text.resize(have + static_cast<std::size_t>(in.gcount()));
+        if (!in || out.text.size() > kMaxPlanTextBytes || in.peek() == std::char_traits<char>::eof())
+            break;
+        want = std::min(out.text.size(), kMaxPlanTextBytes + 1 - out.text.size());
+    }
+    out.text.shrink_to_fit();
     if (out.text.size() > kMaxPlanTextBytes)
         out.error = out.source + ": plan larger than " + std::to_string(kMaxPlanTextBytes) + " bytes";
     return out;
@@ -185,13 +203,13 @@ void FlightplanService::cmd_show(CommandDispatcher::Reply reply) {
     if (active_) {
         const Plan& plan = *active_->plan;
         auto& elements = j["elements"] = Json::array();
-        for (auto id : plan.nodes[plan.main_list].children) {
+        for (auto id : plan.children(plan.main_list)) {
             const Node& n = plan.nodes[id];
-            elements.push_back({{"path", n.path},
+            elements.push_back({{"path", plan.element_path(id)},
                                 {"kind", to_string(n.kind)},
-                                {"name", n.name},
+                                {"name", plan.element_name(id)},
                                 {"line", n.mark.line},
-                                {"waypoints", optional_json(n.count)}});
+                                {"waypoints", optional_json(plan.count(id))}});
         }
     }
     reply(CommandResult::ok(std::move(j)));

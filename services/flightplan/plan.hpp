@@ -1,8 +1,10 @@
 #pragma once
 // The flight plan model: what the YAML loader produces and the expander walks. Elements form a tree of
-// nodes stored in one vector (parents before children); containers (the plan's element list, repeat,
-// block) hold child ids. Positions are kept both geographic and in the plan's local frame.
+// nodes stored in one deque (parents before children); containers (the plan's element list, repeat,
+// block) hold child ids. Positions are kept geographic; the local frame position is derived on demand, as is
+// an element's path.
 #include <cstdint>
+#include <deque>
 #include <limits>
 #include <optional>
 #include <string>
@@ -45,20 +47,12 @@ struct OrbitPattern {
     Enu point(std::uint64_t k) const;
 };
 
-struct Node {
-    NodeKind kind = NodeKind::ElementList;
-    std::uint32_t parent = kNoNode;
-    std::uint32_t index_in_parent = 0;
-    std::vector<std::uint32_t> children;  // ElementList, Repeat, Block
-    std::string name;                     // optional for every element; goto/reaction target
-    std::string path;                     // "plan.elements[2].repeat.elements[0]"
-    SourceMark mark;
-
-    // Waypoint / Hold (a hold without a position holds where the previous waypoint ends).
-    bool has_position = false;
-    LatLon geo;
-    Enu pos;
-    std::optional<double> alt;
+/// What few elements have: kept out of line so that a plan written as a long explicit list of waypoints costs
+/// little more than its positions (a Node is 40 bytes; most waypoints have no NodeExtra).
+struct NodeExtra {
+    std::uint32_t node = kNoNode;          // the element it belongs to (Plan::extras is sorted by it)
+    std::vector<std::uint32_t> children;   // ElementList, Repeat, Block
+    std::string name;                      // optional for every element; goto/reaction target
     std::optional<double> speed;           // Waypoint/Scan/Orbit: leg speed; Speed: the new speed
     std::optional<double> arrival_radius;  // overrides the vehicle profile
     std::optional<double> hold_seconds;    // Hold: empty = until released
@@ -67,11 +61,26 @@ struct Node {
     std::optional<std::uint64_t> repeat_count;  // Repeat: empty = forever
     std::string goto_target_name;
     std::uint32_t goto_target = kNoNode;
-
-    // Derived: waypoints one execution of the node produces; empty when unbounded or when the subtree
-    // contains a goto (its count then depends on where the goto lands).
+    /// Containers: waypoints one execution produces; empty when unbounded or when the subtree contains a
+    /// goto (its count then depends on where the goto lands). Leaves derive theirs (Plan::count).
     std::optional<std::uint64_t> count;
 };
+
+struct Node {
+    NodeKind kind = NodeKind::ElementList;
+    // Waypoint / Hold / Orbit (a hold without a position holds where the previous waypoint ends).
+    bool has_position = false;
+    bool has_alt = false;
+    bool has_extra = false;  // a NodeExtra exists for it
+    std::uint32_t parent = kNoNode;
+    SourceMark mark;
+    LatLon geo;  // the local position is derived (Plan::local) rather than stored
+    double alt_value = 0.0;
+
+    std::optional<double> alt() const { return has_alt ? std::optional<double>(alt_value) : std::nullopt; }
+};
+// A long explicit list costs about this per element (plus 4 bytes in its parent's children).
+static_assert(sizeof(Node) <= 40);
 
 struct VehicleProfile {
     std::string type = "rover";
@@ -122,13 +131,31 @@ struct Plan {
     std::vector<Enu> geofence_local;
     Reactions reactions;
 
-    std::vector<Node> nodes;
+    // Deques: no reallocation peak while a long list loads, and references stay valid as elements are added.
+    std::deque<Node> nodes;
+    std::deque<NodeExtra> extras;         // sorted by NodeExtra::node
     std::uint32_t main_list = kNoNode;    // the plan's elements
     std::uint32_t blocks_list = kNoNode;  // detached named blocks, reached only by goto or a reaction
 
     /// The element with this name, or kNoNode.
     std::uint32_t find(std::string_view name) const;
-    const std::string& element_path(std::uint32_t id) const;
+    /// "plan.elements[2].repeat.elements[0]", computed from the tree (empty for an unknown id).
+    std::string element_path(std::uint32_t id) const;
+
+    /// The out-of-line members of element `id` (an empty NodeExtra when it has none).
+    const NodeExtra& extra(std::uint32_t id) const;
+    /// The same, created on first use (loader and tests that build plans by hand). Creating one for an id
+    /// below the last one created moves later extras (the loader creates them in id order).
+    NodeExtra& extra_for(std::uint32_t id);
+    const std::vector<std::uint32_t>& children(std::uint32_t id) const { return extra(id).children; }
+    /// Position of element `id` in its parent's children (children are in id order).
+    std::uint32_t index_in_parent(std::uint32_t id) const;
+    const std::string& element_name(std::uint32_t id) const { return extra(id).name; }
+    /// Waypoints one execution of element `id` produces; empty when unbounded or when the subtree contains a
+    /// goto.
+    std::optional<std::uint64_t> count(std::uint32_t id) const;
+    /// The element's position in the plan's local frame.
+    Enu local(std::uint32_t id) const { return frame.to_local(nodes[id].geo); }
 };
 
 }  // namespace airseg::flightplan

@@ -21,7 +21,7 @@ void check_legs(const Plan& plan, std::uint64_t limit, std::vector<Diagnostic>& 
     std::vector<std::uint32_t> entries;
     entries.push_back(kNoNode);
     if (plan.blocks_list != kNoNode) {
-        for (auto b : plan.nodes[plan.blocks_list].children)
+        for (auto b : plan.children(plan.blocks_list))
             entries.push_back(b);
     }
     std::vector<Box> boxes;
@@ -48,18 +48,19 @@ void check_legs(const Plan& plan, std::uint64_t limit, std::vector<Diagnostic>& 
                 if (!bad || !reported.emplace(w->element, z).second)
                     continue;
                 const Node& node = plan.nodes[w->element];
-                errors.push_back({plan.source_file, node.mark.line, node.mark.col, node.path,
-                                  "the leg to waypoint " + std::to_string(w->index) +
-                                      " crosses no-fly zone '" + zone.name + "' (buffer " +
-                                      std::to_string(zone.buffer) + " m)"});
+                errors.push_back(
+                    {plan.source_file, node.mark.line, node.mark.col, plan.element_path(w->element),
+                     "the leg to waypoint " + std::to_string(w->index) + " crosses no-fly zone '" +
+                         zone.name + "' (buffer " + std::to_string(zone.buffer) + " m)"});
                 if (errors.size() >= kMaxLegErrors)
                     return;
             }
             last = w->local;
         }
         if (auto e = stream.error()) {
-            const Node& node = plan.nodes[entry == kNoNode ? plan.main_list : entry];
-            errors.push_back({plan.source_file, node.mark.line, node.mark.col, node.path, *e});
+            const std::uint32_t at = entry == kNoNode ? plan.main_list : entry;
+            const Node& node = plan.nodes[at];
+            errors.push_back({plan.source_file, node.mark.line, node.mark.col, plan.element_path(at), *e});
         }
     }
 }

@@ -40,8 +40,9 @@ TEST(FlightplanExpander, ScanLinesAreSpacedAlternateAndCoverThePolygon) {
     auto plan = load(kScanPlan);
     ASSERT_TRUE(plan);
     const auto wps = expand_all(plan);
-    const Node& scan = plan->nodes[plan->nodes[plan->main_list].children[0]];
-    ASSERT_EQ(wps.size(), scan.count);
+    const std::uint32_t scan_id = plan->children(plan->main_list)[0];
+    const NodeExtra& scan = plan->extra(scan_id);
+    ASSERT_EQ(wps.size(), plan->count(scan_id));
     ASSERT_EQ(wps.size() % 2, 0u);
     // Lines run east-west: both ends of a line share the northing; consecutive lines are 8 m apart and
     // alternate direction.
@@ -92,7 +93,8 @@ TEST(FlightplanExpander, ConcavePolygonIsCoveredAndStepAddsPoints) {
 )");
     ASSERT_TRUE(plan);
     const auto wps = expand_all(plan);
-    const Node& scan = plan->nodes[plan->nodes[plan->main_list].children[0]];
+    const std::uint32_t scan_id = plan->children(plan->main_list)[0];
+    const NodeExtra& scan = plan->extra(scan_id);
     const auto& poly = scan.scan->polygon();
     // Along a line (lines run north: same easting) waypoints are at most `step` apart.
     std::size_t along_line = 0;
@@ -152,7 +154,7 @@ TEST(FlightplanExpander, RepeatSpeedHoldAndOrbitSemantics) {
     auto plan = load(kMixedPlan);
     ASSERT_TRUE(plan);
     const auto wps = expand_all(plan);
-    const auto& root = plan->nodes[plan->main_list];
+    const auto& root = plan->extra(plan->main_list);
     EXPECT_EQ(wps.size(), *root.count);
     // Speed: the autopilot's own at first (the plan states no cruise_speed: 0), 3 after the speed element,
     // 1.5 after the inner one, and a per-waypoint 4.
@@ -163,7 +165,7 @@ TEST(FlightplanExpander, RepeatSpeedHoldAndOrbitSemantics) {
     EXPECT_DOUBLE_EQ(wps[2].speed, 1.5);
     EXPECT_TRUE(wps[2].speed_changed);
     EXPECT_FALSE(wps[3].speed_changed);
-    const Node& orbit = plan->nodes[plan->nodes[root.children[2]].children[2]];
+    const NodeExtra& orbit = plan->extra(plan->children(root.children[2])[2]);
     const std::uint64_t orbit_n = orbit.orbit->count();
     EXPECT_EQ(orbit_n, orbit.orbit->points_per_turn + 1);
     for (std::uint64_t k = 0; k < orbit_n; ++k) {
@@ -230,7 +232,7 @@ TEST(FlightplanExpander, JumpIntoDetachedBlockThenGotoBackIntoLoop) {
     while (auto n = e.next())
         rest.push_back(*n);
     EXPECT_EQ(rest.size(), 3u * 5u + 1u);
-    EXPECT_EQ(plan->nodes[rest[0].element].name, "r");
+    EXPECT_EQ(plan->element_name(rest[0].element), "r");
     // Restore reproduces the stream after the jump.
     Expander again(plan);
     ASSERT_TRUE(again.restore(origin, 8));
@@ -276,7 +278,7 @@ TEST(FlightplanExpander, StopsOnALegIntoANoFlyZoneAddedAfterValidation) {
         ++produced;
     ASSERT_TRUE(e.error().has_value());
     EXPECT_NE(e.error()->find("late-zone"), std::string::npos);
-    EXPECT_LT(produced, plan->nodes[plan->nodes[plan->main_list].children[0]].count.value());
+    EXPECT_LT(produced, plan->count(plan->children(plan->main_list)[0]).value());
     EXPECT_FALSE(e.next().has_value());
 }
 
@@ -289,7 +291,7 @@ TEST(FlightplanExpander, MillionWaypointScanStreamsInSmallMemory) {
     - scan: {rectangle: {sw: [41.0, 2.0], ne: [41.009, 2.012]}, spacing: 4, step: 4, heading: 0}
 )");
     ASSERT_TRUE(plan);
-    const Node& scan = plan->nodes[plan->nodes[plan->main_list].children[0]];
+    const std::uint32_t scan_id = plan->children(plan->main_list)[0];
     Expander e(plan);
     std::uint64_t n = 0;
     Enu last{};
@@ -300,7 +302,7 @@ TEST(FlightplanExpander, MillionWaypointScanStreamsInSmallMemory) {
         last = w->local;
         ++n;
     }
-    EXPECT_EQ(n, scan.count.value());
+    EXPECT_EQ(n, plan->count(scan_id).value());
     EXPECT_GT(n, 60'000u);
     EXPECT_LE(max_gap, 4.0 + 1e-6);
     EXPECT_EQ(sizeof(Expander) < 512, true);

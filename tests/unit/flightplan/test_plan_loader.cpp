@@ -42,16 +42,16 @@ TEST(FlightplanLoader, ExampleSurveyHasTheExpectedShape) {
     EXPECT_DOUBLE_EQ(p.no_fly[0].buffer, 5.0);
     ASSERT_TRUE(p.reactions.link_loss.has_value());
     EXPECT_EQ(p.reactions.link_loss->action, ReactionAction::GotoBlock);
-    EXPECT_EQ(p.nodes[p.reactions.link_loss->target_node].path, "plan.blocks[0]");
+    EXPECT_EQ(p.element_path(p.reactions.link_loss->target_node), "plan.blocks[0]");
     EXPECT_DOUBLE_EQ(p.reactions.link_loss_seconds, 30.0);
     const auto field = p.find("field");
     ASSERT_NE(field, kNoNode);
-    EXPECT_EQ(p.nodes[field].path, "plan.elements[3]");
+    EXPECT_EQ(p.element_path(field), "plan.elements[3]");
     EXPECT_EQ(p.nodes[field].mark.line, 23);
-    ASSERT_TRUE(p.nodes[field].scan.has_value());
+    ASSERT_TRUE(p.extra(field).scan.has_value());
     const auto patrol = p.find("patrol");
     ASSERT_NE(patrol, kNoNode);
-    EXPECT_EQ(p.nodes[patrol].count, 6u);
+    EXPECT_EQ(p.count(patrol), 6u);
 }
 
 TEST(FlightplanLoader, ReportsEveryErrorAtOnceWithLocation) {
@@ -75,7 +75,8 @@ TEST(FlightplanLoader, ReportsEveryErrorAtOnceWithLocation) {
         "geofence, reactions, elements, blocks)",
         "broken.yaml:5:23: plan.elements[0].waypoint.lat: must be between -90 and 90 (got 95)",
         "broken.yaml:8:18: plan.elements[1].scan.spacing: must be > 0 (got 0)",
-        "broken.yaml:9:39: plan.elements[2].waypoint.sped: unknown field (did you mean 'speed'?) (expected one of: name, lat, lon, "
+        "broken.yaml:9:39: plan.elements[2].waypoint.sped: unknown field (did you mean 'speed'?) (expected "
+        "one of: name, lat, lon, "
         "alt, "
         "speed, radius)",
         "broken.yaml:11:13: plan.elements[4].hold: needs exactly one of: seconds, until_released: true",
