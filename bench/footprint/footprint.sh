@@ -123,16 +123,16 @@ smaps_sum() {
     $1 == field && inside { sum += $2 }
     END { print sum + 0 }' "/proc/$daemon_pid/smaps"
 }
-own_code_kib() {  # the daemon binary's own mapped text
-  awk -v bin="$(readlink -f "$daemon")" '
-    /^[0-9a-f]+-[0-9a-f]+ / { mine = ($6 == bin) && ($2 ~ /x/); next }
+own_code_kib() {  # the daemon binary's own mapped text (under qemu-user its guest pages are not executable)
+  awk -v bin="$(readlink -f "$daemon")" -v perms="${emulator:+.}" '
+    /^[0-9a-f]+-[0-9a-f]+ / { mine = ($6 == bin) && ($2 ~ (perms == "" ? "x" : perms)); next }
     $1 == "Rss:" && mine { sum += $2 }
     END { print sum + 0 }' "/proc/$daemon_pid/smaps"
 }
 heap_kib() { awk '/\[heap\]/ { h = 1; next } /^[0-9a-f]+-[0-9a-f]+ / { h = 0 } h && $1 == "Size:" { print $2 }' \
   "/proc/$daemon_pid/smaps"; }
 
-echo "footprint: airsegd $(readlink -f "$daemon")${emulator:+ under qemu-arm-static ($emulator)}"
+echo "footprint: airsegd (pid $daemon_pid) $(readlink -f "$daemon")${emulator:+ under qemu-arm-static ($emulator)}"
 if [ -z "$emulator" ]; then
   echo "idle (link up, no plan, 2 Hz telemetry), ${idle_s} s: CPU $(cpu_per_minute "$idle_s") s per minute"
 else

@@ -1,7 +1,9 @@
 // airsegd as systemd runs it: a real NOTIFY_SOCKET, signals, the status socket and airsegctl.
 #include <gtest/gtest.h>
+
 #include <signal.h>
 #include <sys/stat.h>
+#include <regex>
 
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -83,8 +85,10 @@ TEST_F(DaemonProcess, ReadyPingsAnswersAndStopsCleanlyWithoutAnyDevice) {
 }
 
 // groundlink's strand blocks; the pings stop within one watchdog period and airsegd says what stalled. With
-// one service thread (the default) every service waits behind the stuck one, so all are named; with two,
-// only the stuck one. Either way signals still work: the watchdog and signals have a thread of their own.
+// one service thread (the default) every service waits behind the stuck one, so the stuck one is named among
+// those whose last tick is older than half a period; with two, it is named alone. Either way signals still
+// work: the watchdog and signals have a thread of their own. `named`: the complaint's list of services, or a
+// regex matching it.
 void check_a_stuck_service_stops_the_pings(DaemonProcess& t, int threads, const std::string& named) {
     // WatchdogSec=1s; groundlink's strand blocks 1.5 s after the start (the delay counts from before
     // READY=1).
@@ -127,7 +131,7 @@ void check_a_stuck_service_stops_the_pings(DaemonProcess& t, int threads, const 
         << " ms after the hang (watchdog period " << kPeriod.count() << " ms)\n";
     EXPECT_TRUE(daemon.running());
     EXPECT_TRUE(wait_until([&] {
-        return daemon.err().find("no progress from " + named) != std::string::npos;
+        return std::regex_search(daemon.err(), std::regex("no progress from " + named + "\n"));
     })) << daemon.err();
 
     daemon.signal(SIGTERM);
@@ -142,7 +146,7 @@ TEST_F(DaemonProcess, AStuckServiceStopsTheWatchdogPings) {
         << "airsegd is built without AIRSEG_TEST_HANG_INJECTION (a package build): no service can be made "
            "to hang";
 #endif
-    check_a_stuck_service_stops_the_pings(*this, 2, "groundlink\n");
+    check_a_stuck_service_stops_the_pings(*this, 2, "groundlink");
 }
 
 TEST_F(DaemonProcess, AStuckServiceStopsTheWatchdogPingsWithOneServiceThread) {
@@ -151,7 +155,7 @@ TEST_F(DaemonProcess, AStuckServiceStopsTheWatchdogPingsWithOneServiceThread) {
         << "airsegd is built without AIRSEG_TEST_HANG_INJECTION (a package build): no service can be made "
            "to hang";
 #endif
-    check_a_stuck_service_stops_the_pings(*this, 1, "autopilot, flightplan, groundlink, status\n");
+    check_a_stuck_service_stops_the_pings(*this, 1, "([a-z]+, )*groundlink(, [a-z]+)*");
 }
 
 TEST_F(DaemonProcess, AnInvalidConfigExits78AndStartsNothing) {
