@@ -50,6 +50,7 @@ class App::Impl {
         : options_(std::move(options)),
           config_(std::move(config)),
           strand_(asio::make_strand(control_io_)),
+          adapters_strand_(asio::make_strand(io_)),
           signals_(strand_, SIGTERM, SIGINT, SIGHUP),
           watchdog_timer_(strand_),
           context_{io_, bus_, health_, commands_, progress_interval()} {}
@@ -117,7 +118,7 @@ class App::Impl {
         auto ap = autopilot_setup(config_);  // already validated by the loader
         if (ap.status_led) {
             if (auto r = gpio_.request(*ap.status_led); r.ok()) {
-                status_led_ = std::make_unique<StatusLedDriver>(bus_, strand_, r.line);
+                status_led_ = std::make_unique<StatusLedDriver>(bus_, adapters_strand_, r.line);
             } else {
                 spdlog::warn("status_led: {}; no status LED", r.message);
             }
@@ -152,7 +153,7 @@ class App::Impl {
                 asio::post(strand_, [this, remaining] {
                     if (--*remaining == 0) {
                         // The status service now listens: sections published from here on are kept.
-                        autopilot_section_ = std::make_unique<AutopilotStatusSection>(bus_, strand_);
+                        autopilot_section_ = std::make_unique<AutopilotStatusSection>(bus_, adapters_strand_);
                         spdlog::info("airsegd {}: all {} services started", AIRSEG_VERSION, services_.size());
                         notifier_.ready();
                     }
@@ -186,8 +187,10 @@ class App::Impl {
         boost::system::error_code ignored;
         signals_.cancel(ignored);
         line_sub_.reset();
-        autopilot_section_.reset();
-        status_led_.reset();
+        asio::post(adapters_strand_, [this] {
+            autopilot_section_.reset();
+            status_led_.reset();
+        });
         auto remaining = std::make_shared<std::size_t>(services_.size());
         for (auto& s : services_) {
             s->stop([this, remaining] {
@@ -288,8 +291,11 @@ class App::Impl {
     CliOptions options_;
     Config config_;
     asio::io_context io_;          // the services
-    asio::io_context control_io_;  // strand_: signals, the watchdog, systemd, the status LED
+    asio::io_context control_io_;  // strand_: signals, the watchdog, systemd
     Strand strand_;
+    // The autopilot's status section and the status LED follow the autopilot's status, published five times
+    // a second: on the services' thread, they wake no other thread for it.
+    Strand adapters_strand_;
     asio::signal_set signals_;
     asio::steady_timer watchdog_timer_;
     SystemdNotifier notifier_;

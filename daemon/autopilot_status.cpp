@@ -66,7 +66,7 @@ AutopilotStatusSection::AutopilotStatusSection(Bus& bus, Strand strand) : bus_(b
                 return;
             }
             last_ = s;
-            bus_.publish(status::StatusSection{"autopilot", autopilot_status_json(s)});
+            bus_.publish(status::StatusSection{"autopilot", autopilot_status_json(s), {}});
         });
 }
 

@@ -2,7 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "services/status/status_messages.hpp"
+#include "services/groundlink/link_state.hpp"
 
 namespace airseg::daemon {
 
@@ -13,12 +13,9 @@ StatusLedDriver::StatusLedDriver(Bus& bus, Strand strand, std::shared_ptr<hal::G
             led_.autopilot(s, SteadyClock::now());
             show();
         });
-    // The ground link's state is its status section ("link": "up" | "down").
-    groundlink_sub_ = bus.subscribe<status::StatusSection>(strand, [this](const status::StatusSection& s) {
-        if (s.name == "groundlink" && s.value.is_object()) {
-            led_.ground_link(s.value.value("link", std::string()) == "up", SteadyClock::now());
-            show();
-        }
+    groundlink_sub_ = bus.subscribe<groundlink::LinkState>(strand, [this](const groundlink::LinkState& s) {
+        led_.ground_link(s.up, SteadyClock::now());
+        show();
     });
     asio::dispatch(strand, [this] { show(); });
 }

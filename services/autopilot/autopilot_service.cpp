@@ -43,7 +43,6 @@ AutopilotService::AutopilotService(ServiceContext& ctx, AutopilotServiceConfig c
                                    }}),
       tlog_(config_.tlog),
       timer_(strand()),
-      status_timer_(strand()),
       prefix_("autopilot[" + config_.port.serial.path + "]: ") {
     if (config_.tlog.enabled) {
         driver_.set_frame_tap([this](bool, std::span<const std::uint8_t> frame) {
@@ -79,14 +78,12 @@ void AutopilotService::on_start() {
     keeper_.start();
     publish_status();
     update_health();
-    schedule_status();
 }
 
 void AutopilotService::on_stop() {
     running_ = false;
     subscriptions_.clear();
     timer_.cancel();
-    status_timer_.cancel();
     keeper_.stop();
     tlog_.flush();
 }
@@ -161,6 +158,9 @@ void AutopilotService::pump() {
     if (changed) {
         publish_status();
         update_health();
+    } else {
+        // Every pump follows an input or a deadline of the driver, which may have moved the telemetry on.
+        publish_status_soon(SteadyClock::now());
     }
     arm_timer();
 }
@@ -207,16 +207,23 @@ void AutopilotService::arm_timer() {
     timer_.async_wait([this](const boost::system::error_code& ec) { on_timer(ec); });
 }
 
-void AutopilotService::schedule_status() {
-    status_timer_.expires_after(config_.status_period);
-    status_timer_.async_wait([this](const boost::system::error_code& ec) {
-        if (ec || !running_) {
-            return;
-        }
+// Published from the wake-up that brought the change, so the status costs no wake-up of its own. Inputs
+// closer together than status_spacing are published once: a change not yet published goes with the next
+// input, or at the latest with the next tick (a second), when the autopilot falls silent.
+void AutopilotService::publish_status_soon(TimePoint now) {
+    if (now - status_published_at_ >= config_.status_spacing) {
+        status_published_at_ = now;
+        publish_status();
+    }
+}
+
+// What changes without an event (the port keeper's retries and errors, the .tlog's counters) is refreshed
+// once a second, with every service's tick.
+void AutopilotService::on_tick(TimePoint) {
+    if (running_) {
         publish_status();
         update_health();
-        schedule_status();
-    });
+    }
 }
 
 void AutopilotService::on_timer(const boost::system::error_code& ec) {

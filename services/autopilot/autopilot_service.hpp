@@ -28,7 +28,9 @@ struct AutopilotServiceConfig {
     TlogConfig tlog;
     std::optional<hal::GpioLineRequest> reset_line;  // autopilot.reset.line
     Duration reset_pulse_width = milliseconds(200);  // autopilot.reset.pulse_width
-    Duration status_period = milliseconds(200);      // how often status and telemetry are published
+    // Status and telemetry are published after each input from the autopilot, at most this often, and at
+    // every progress tick (so a change waits at most for the next input or the next tick).
+    Duration status_spacing = milliseconds(50);
 };
 
 class AutopilotService : public Service {
@@ -50,7 +52,8 @@ class AutopilotService : public Service {
     void arm_timer();
     void on_timer(const boost::system::error_code& ec);
     void publish_status();
-    void schedule_status();
+    void publish_status_soon(TimePoint now);
+    void on_tick(TimePoint now) override;
     void publish(Event e);
     void pulse_reset(unsigned attempt);
     void switch_baud(unsigned baud);
@@ -64,7 +67,7 @@ class AutopilotService : public Service {
     TlogWriter tlog_;
     asio::steady_timer timer_;
     TimePoint timer_at_ = kNever;
-    asio::steady_timer status_timer_;
+    TimePoint status_published_at_{};
     std::map<std::uint32_t, std::uint32_t> requester_ids_;  // driver id -> requester id
     std::vector<Subscription> subscriptions_;
     bool running_ = false;

@@ -63,8 +63,10 @@ void Service::do_tick() {
     if (!running_) {
         return;
     }
-    ctx_.health.progress(name_, SteadyClock::now());
-    tick_timer_.expires_after(ctx_.progress_interval);
+    const TimePoint now = SteadyClock::now();
+    ctx_.health.progress(name_, now);
+    on_tick(now);
+    tick_timer_.expires_at(next_on_grid(now, ctx_.progress_interval));
     tick_timer_.async_wait([this](boost::system::error_code ec) {
         if (!ec) {
             do_tick();

@@ -13,6 +13,7 @@
 #include "services/common/bus.hpp"
 #include "services/common/command_dispatcher.hpp"
 #include "services/common/health.hpp"
+#include "services/common/time.hpp"
 
 namespace airseg {
 
@@ -45,6 +46,9 @@ class Service {
   protected:
     virtual void on_start() = 0;
     virtual void on_stop() = 0;
+    /// Called on the strand at each progress tick (every ServiceContext::progress_interval, all services on
+    /// the same instants): for slow housekeeping that needs no wake-up of its own.
+    virtual void on_tick(TimePoint /*now*/) {}
 
     /// Health changes are logged once per change and shown in the status document.
     void set_health(Health health, std::string error = {});

@@ -7,6 +7,7 @@
 #include "services/flightplan/home_stream.hpp"
 #include "services/flightplan/plan_progress.hpp"
 #include "services/flightplan/resume.hpp"
+#include "services/groundlink/link_state.hpp"
 #include "services/status/status_messages.hpp"
 
 namespace airseg::flightplan {
@@ -99,15 +100,13 @@ void FlightplanService::on_start() {
     subscriptions_.push_back(bus.subscribe<autopilot::RequestDone>(
         strand(), [this](const autopilot::RequestDone& d) { on_request_done(d); }));
     subscriptions_.push_back(
-        bus.subscribe<status::StatusSection>(strand(), [this](const status::StatusSection& s) {
-            if (s.name != "groundlink" || !s.value.is_object() || !reactions_)
-                return;
-            const bool up = s.value.value("link", std::string()) == "up";
+        bus.subscribe<groundlink::LinkState>(strand(), [this](const groundlink::LinkState& s) {
             // Link loss means losing a link that was there: a vehicle started without a ground station
             // does not react to its absence.
-            groundlink_seen_up_ = groundlink_seen_up_ || up;
-            if (groundlink_seen_up_) {
-                reactions_->on_link(up, SteadyClock::now());
+            groundlink_seen_up_ = groundlink_seen_up_ || s.up;
+            groundlink_up_ = s.up;
+            if (groundlink_seen_up_ && reactions_) {
+                reactions_->on_link(s.up, SteadyClock::now());
                 pump();
             }
         }));
@@ -148,6 +147,7 @@ void FlightplanService::start_plan(ActivePlan plan, bool append, TimePoint now) 
     }
     plan.stream = raw;
     reactions_ = std::make_unique<ReactionMonitor>(ReactionSettings::from_plan(*plan.plan));
+    tell_reactions_the_link(now);
     active_ = std::move(plan);
     returning_home_ = false;
     problem_.clear();
@@ -181,10 +181,17 @@ void FlightplanService::resume_stored_plan(TimePoint now) {
         feeder_.pause();
     feeder_.restore_plan(PlanFeed{std::move(r.stream), r.plan->name}, r.progress.waypoints_reached, now);
     reactions_ = std::make_unique<ReactionMonitor>(ReactionSettings::from_plan(*plan.plan));
+    tell_reactions_the_link(now);
     spdlog::info("{}resuming plan '{}' ({}) at waypoint {}, {} reached{}", kPrefix, r.plan->name, plan.source,
                  r.progress.next_index, r.progress.waypoints_reached,
                  r.progress.state == PlanState::Paused ? ", paused" : "");
     active_ = std::move(plan);
+}
+
+// The link's state comes as a change (LinkState): a new plan's reactions start from the one last heard.
+void FlightplanService::tell_reactions_the_link(TimePoint now) {
+    if (groundlink_seen_up_ && reactions_)
+        reactions_->on_link(groundlink_up_, now);
 }
 
 void FlightplanService::save_progress() {
@@ -512,7 +519,8 @@ void FlightplanService::arm_timer() {
 }
 
 void FlightplanService::schedule_status() {
-    status_timer_.expires_after(config_.status_period);
+    // On the grid the services' progress ticks use: one wake-up for both (time.hpp).
+    status_timer_.expires_at(next_on_grid(SteadyClock::now(), config_.status_period));
     status_timer_.async_wait([this](const boost::system::error_code& ec) {
         if (ec || !running_)
             return;
@@ -547,7 +555,7 @@ void FlightplanService::publish_status(bool force) {
     if (!force && j == last_status_)
         return;
     last_status_ = j;
-    ctx_.bus.publish(status::StatusSection{"plan", std::move(j)});
+    ctx_.bus.publish(status::StatusSection{"plan", std::move(j), {}});
 }
 
 }  // namespace airseg::flightplan

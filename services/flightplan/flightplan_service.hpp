@@ -109,6 +109,9 @@ class FlightplanService : public Service {
     std::optional<std::pair<unsigned, unsigned>> ready_counts_;
     std::optional<autopilot::Position> autopilot_home_;
     bool groundlink_seen_up_ = false;
+    bool groundlink_up_ = false;
+    void tell_reactions_the_link(
+        TimePoint now);  // the link's state as last published (LinkState, sent on changes only)
     struct InFlight {
         std::uint32_t feeder_id = 0;
         TimePoint sent{};

@@ -20,22 +20,23 @@ double rounded(double v) {
 
 }  // namespace
 
-nlohmann::json GroundlinkService::rates_json() const {
+nlohmann::json GroundlinkService::rates_json(const RatesSnapshot& rates) {
+    const auto& scheduler = rates.scheduler;
     nlohmann::json requested, effective;
     for (auto k : kAllTelemetryKinds) {
-        requested[to_string(k)] = rounded(scheduler_.requested_hz(k));
-        effective[to_string(k)] = rounded(scheduler_.effective_hz(k));
+        requested[to_string(k)] = rounded(scheduler.requested_hz(k));
+        effective[to_string(k)] = rounded(scheduler.effective_hz(k));
     }
-    return {
-        {"requested_hz", requested},
-        {"effective_hz", effective},
-        {"factor", scheduler_.factor()},
-        {"weak_link", scheduler_.weak()},
-        {"budget_bytes_per_s", std::round(scheduler_.budget_bytes_per_s())},
-        {"lowerings", scheduler_.lowerings()},
-        {"restorations", scheduler_.restorations()},
-        {"samples_sent", samples_sent_},
-        {"delivery_loss", delivery_.loss() ? nlohmann::json(rounded(*delivery_.loss())) : nlohmann::json()}};
+    return {{"requested_hz", requested},
+            {"effective_hz", effective},
+            {"factor", scheduler.factor()},
+            {"weak_link", scheduler.weak()},
+            {"budget_bytes_per_s", std::round(scheduler.budget_bytes_per_s())},
+            {"lowerings", scheduler.lowerings()},
+            {"restorations", scheduler.restorations()},
+            {"samples_sent", rates.samples_sent},
+            {"delivery_loss",
+             rates.delivery_loss ? nlohmann::json(rounded(*rates.delivery_loss)) : nlohmann::json()}};
 }
 
 void GroundlinkService::register_commands() {

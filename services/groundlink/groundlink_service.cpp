@@ -1,5 +1,9 @@
 #include "services/groundlink/groundlink_service.hpp"
 
+#include <array>
+
+#include "services/groundlink/link_state.hpp"
+
 #include <spdlog/spdlog.h>
 
 #include <random>
@@ -295,7 +299,8 @@ void GroundlinkService::do_stats() {
     }
     update_health();
     publish_status();
-    stats_timer_.expires_after(config_.stats_interval);
+    // On the grid the services' progress ticks use: one wake-up for both (time.hpp).
+    stats_timer_.expires_at(next_on_grid(now, config_.stats_interval));
     stats_timer_.async_wait([this](boost::system::error_code ec) {
         if (!ec) {
             do_stats();
@@ -399,60 +404,82 @@ void GroundlinkService::update_health() {
 }
 
 void GroundlinkService::publish_status() {
-    nlohmann::json g;
-    g["mode"] = config_.mode;
+    const bool up = driver_ && driver_->link_up();
+    if (!link_state_published_ || *link_state_published_ != up) {
+        link_state_published_ = up;
+        ctx_.bus.publish_latest(LinkState{up});
+    }
     if (!driver_) {
+        nlohmann::json g;
+        g["mode"] = config_.mode;
         g["link"] = "down";
         g["error"] = fatal_;
-        ctx_.bus.publish(status::StatusSection{"groundlink", std::move(g)});
+        ctx_.bus.publish(status::StatusSection{"groundlink", std::move(g), {}});
         return;
     }
-    const auto& s = driver_->stats();
-    g["link"] = driver_->link_up() ? "up" : "down";
-    g["authenticated"] = s.authenticated;
-    g["rtt_ms"] = std::round(s.srtt_ms);
-    g["loss"] = std::round(s.frame_loss * 1000) / 1000;
-    g["goodput_bps"] = std::round(goodput_bps_);
-    g["frame_payload"] = s.frame_payload;
-    auto rate = [](double r) {
-        return r < 0 ? nlohmann::json(nullptr) : nlohmann::json(std::round(r * 1e6) / 1e6);
-    };
-    g["byte_error_rate"] = rate(s.byte_error_rate);
-    g["peer_byte_error_rate"] = rate(s.peer_byte_error_rate);
-    g["fec"] = {{"active", s.fec},
-                {"shard_bytes", s.fec_shard_bytes},
-                {"frames_sent", s.fec_frames_sent},
-                {"frames_decoded", s.fec_frames_decoded},
-                {"frames_repaired", s.fec_frames_repaired},
-                {"shard_errors", s.fec_shard_errors}};
-    g["frames_sent"] = s.frames_sent;
-    g["frames_received"] = s.frames_received;
-    g["crc_errors"] = s.crc_errors;
-    g["framing_errors"] = s.framing_errors;
-    g["mac_failures"] = s.mac_failures;
-    g["replays"] = s.replays;
-    g["oversized"] = s.oversized;
-    g["peer_restarts"] = s.peer_restarts;
-    g["commands"] = commands_;
-    g["commands_refused"] = commands_refused_;
-    g["role"] = !s.authenticated ? "control (unauthenticated)" : to_string(ground_role());
-    g["joystick_inputs"] = joystick_inputs_;
-    g["joystick_refused"] = joystick_refused_;
-    g["events_sent"] = events_sent_;
-    g["events_dropped"] = events_dropped_;
-    g["bad_messages"] = bad_messages_;
-    g["telemetry"] = rates_json();
-    g["tx"] = {{"safe", class_json(s.tx_safe)}, {"fast", class_json(s.tx_fast)}};
-    g["rx"] = {{"safe", class_json(s.rx_safe)}, {"fast", class_json(s.rx_fast)}};
-    auto& paths = g["paths"] = nlohmann::json::array();
+    // Published every second and read when somebody asks for the status document: a snapshot of plain
+    // values now, the JSON (about 100,000 instructions) only then.
+    const auto& stats = driver_->stats();
+    std::vector<std::string> ports;
     for (std::size_t i = 0; i < driver_->core().config().paths; ++i) {
-        const auto& p = s.path[i];
-        paths.push_back({{"port", config_.mode == "udp" ? "udp" : config_.ports[i]},
-                         {"alive", p.alive},
-                         {"frames_sent", p.frames_sent},
-                         {"frames_received", p.frames_received}});
+        ports.push_back(config_.mode == "udp" ? "udp" : config_.ports[i]);
     }
-    ctx_.bus.publish(status::StatusSection{"groundlink", std::move(g)});
+    status::StatusSection section{"groundlink", {}, {}};
+    section.render =
+        [mode = config_.mode, up, s = stats, goodput = goodput_bps_, ports = std::move(ports),
+         counters = std::array{commands_, commands_refused_, joystick_inputs_, joystick_refused_,
+                               events_sent_, events_dropped_, bad_messages_},
+         role = std::string(!stats.authenticated ? "control (unauthenticated)" : to_string(ground_role())),
+         rates = rates_snapshot()] {
+            nlohmann::json g;
+            g["mode"] = mode;
+            g["link"] = up ? "up" : "down";
+            g["authenticated"] = s.authenticated;
+            g["rtt_ms"] = std::round(s.srtt_ms);
+            g["loss"] = std::round(s.frame_loss * 1000) / 1000;
+            g["goodput_bps"] = std::round(goodput);
+            g["frame_payload"] = s.frame_payload;
+            auto rate = [](double r) {
+                return r < 0 ? nlohmann::json(nullptr) : nlohmann::json(std::round(r * 1e6) / 1e6);
+            };
+            g["byte_error_rate"] = rate(s.byte_error_rate);
+            g["peer_byte_error_rate"] = rate(s.peer_byte_error_rate);
+            g["fec"] = {{"active", s.fec},
+                        {"shard_bytes", s.fec_shard_bytes},
+                        {"frames_sent", s.fec_frames_sent},
+                        {"frames_decoded", s.fec_frames_decoded},
+                        {"frames_repaired", s.fec_frames_repaired},
+                        {"shard_errors", s.fec_shard_errors}};
+            g["frames_sent"] = s.frames_sent;
+            g["frames_received"] = s.frames_received;
+            g["crc_errors"] = s.crc_errors;
+            g["framing_errors"] = s.framing_errors;
+            g["mac_failures"] = s.mac_failures;
+            g["replays"] = s.replays;
+            g["oversized"] = s.oversized;
+            g["peer_restarts"] = s.peer_restarts;
+            g["commands"] = counters[0];
+            g["commands_refused"] = counters[1];
+            g["role"] = role;
+            g["joystick_inputs"] = counters[2];
+            g["joystick_refused"] = counters[3];
+            g["events_sent"] = counters[4];
+            g["events_dropped"] = counters[5];
+            g["bad_messages"] = counters[6];
+            g["telemetry"] = rates_json(rates);
+            g["tx"] = {{"safe", class_json(s.tx_safe)}, {"fast", class_json(s.tx_fast)}};
+            g["rx"] = {{"safe", class_json(s.rx_safe)}, {"fast", class_json(s.rx_fast)}};
+            auto& paths = g["paths"] = nlohmann::json::array();
+            for (std::size_t i = 0; i < ports.size(); ++i) {
+                const auto& p = s.path[i];
+                paths.push_back({{"port", ports[i]},
+                                 {"alive", p.alive},
+                                 {"frames_sent", p.frames_sent},
+                                 {"frames_received", p.frames_received}});
+            }
+            return g;
+        };
+    ctx_.bus.publish(std::move(section));
 }
 
 }  // namespace airseg::groundlink

@@ -63,7 +63,15 @@ class GroundlinkService : public Service {
     void send_link_stats(TimePoint now);
     void update_health();
     void publish_status();
-    nlohmann::json rates_json() const;
+    /// What the telemetry rates report is made of, copied so it can be rendered later on another strand.
+    struct RatesSnapshot {
+        TelemetryScheduler scheduler;
+        std::uint64_t samples_sent = 0;
+        std::optional<double> delivery_loss;
+    };
+    RatesSnapshot rates_snapshot() const { return {scheduler_, samples_sent_, delivery_.loss()}; }
+    static nlohmann::json rates_json(const RatesSnapshot& rates);
+    nlohmann::json rates_json() const { return rates_json(rates_snapshot()); }
 
     GroundlinkServiceConfig config_;
     std::unique_ptr<LinkDriver> driver_;
@@ -94,6 +102,7 @@ class GroundlinkService : public Service {
     double goodput_bps_ = 0;
     std::uint64_t commands_ = 0;
     std::uint64_t bad_messages_ = 0;
+    std::optional<bool> link_state_published_;
 };
 
 /// The transport configuration for a service configuration: paths and mode from `mode` and `ports`, the link

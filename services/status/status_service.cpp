@@ -16,12 +16,21 @@ StatusService::StatusService(ServiceContext& ctx, StatusServiceConfig config)
 
 nlohmann::json StatusService::document() const {
     const double uptime = std::chrono::duration<double>(SteadyClock::now() - started_at_).count();
+    for (auto& [name, render] : unrendered_) {
+        sections_[name] = render();
+    }
+    unrendered_.clear();
     return build_document(ctx_.health.snapshot(), sections_, uptime);
 }
 
 void StatusService::on_start() {
     sections_sub_ = ctx_.bus.subscribe<StatusSection>(strand(), [this](const StatusSection& s) {
-        sections_[s.name] = s.value;
+        if (s.render) {
+            unrendered_[s.name] = s.render;
+        } else {
+            unrendered_.erase(s.name);
+            sections_[s.name] = s.value;
+        }
         publish_summary();
     });
     ctx_.commands.add("status", strand(), Role::Monitor, [this](const Json&, CommandDispatcher::Reply reply) {
@@ -57,7 +66,8 @@ void StatusService::do_open_socket() {
 
 void StatusService::do_refresh() {
     publish_summary();
-    refresh_timer_.expires_after(config_.refresh_interval);
+    // On the grid the services' progress ticks use: one wake-up for both (time.hpp).
+    refresh_timer_.expires_at(next_on_grid(SteadyClock::now(), config_.refresh_interval));
     refresh_timer_.async_wait([this](boost::system::error_code ec) {
         if (!ec) {
             do_refresh();

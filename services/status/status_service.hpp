@@ -39,7 +39,9 @@ class StatusService : public Service {
     LocalCommandServer server_;
     asio::steady_timer refresh_timer_;
     asio::steady_timer socket_timer_;
-    std::map<std::string, nlohmann::json> sections_;
+    // Rendered when the document is read (document() is const to its callers, the cache is not).
+    mutable std::map<std::string, nlohmann::json> sections_;
+    mutable std::map<std::string, std::function<nlohmann::json()>> unrendered_;
     Subscription sections_sub_;
     std::string last_summary_;
     TimePoint started_at_;

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "hal/gpio_fake.hpp"
-#include "services/status/status_messages.hpp"
+#include "services/groundlink/link_state.hpp"
 #include "tests/unit/hal/run_until.hpp"
 
 namespace airseg::daemon {
@@ -33,7 +33,7 @@ TEST(StatusLedDriver, BlinksWhileBootingAndStaysMostlyOnWhenReadyWithAGroundLink
         ready.link_up = true;
         ready.ready = true;
         bus.publish_latest(ready);
-        bus.publish(status::StatusSection{"groundlink", {{"link", "up"}}});
+        bus.publish_latest(groundlink::LinkState{true});
         // LinkUp starts with 1.9 s on: the line goes on and stays on.
         const auto before = gpio.history("STATUS_LED").size();
         ASSERT_TRUE(run_until(io, [&] {
