@@ -184,7 +184,8 @@ void Driver::handle_timeout(TimePoint now) {
         hb.autopilot = 8;      // MAV_AUTOPILOT_INVALID
         hb.system_status = 4;  // MAV_STATE_ACTIVE
         out_.send(hb);
-        next_gcs_heartbeat_ = now + seconds(1);
+        // On the whole-second grid the daemon's other periodic work uses: one wake-up for all (time.hpp).
+        next_gcs_heartbeat_ = next_on_grid(now, seconds(1));
     }
     if (now >= phase_deadline_) {
         phase_deadline_ = kNever;
