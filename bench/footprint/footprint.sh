@@ -8,8 +8,8 @@
 # It measures in two phases:
 #   idle  (--idle S, default 60): the link up, no plan; CPU seconds per minute.
 #   busy  (--busy S, default 30): a plan running (--plan, default config/plans/rover-survey.yaml); CPU per
-#         minute, then VmRSS, VmHWM, private memory (smaps_rollup Private_*), the heap's size ([heap] mapping)
-#         and the program's own mapped code.
+#         minute, then VmRSS, VmHWM (the peak), private memory (smaps Private_*), the heap's size ([heap]
+#         mapping: malloc's high-water mark unless it trimmed the top) and the program's own mapped code.
 # --emulator ARCH runs airsegd from an ARM cross build (--build, e.g. build-pkg-cross-armhf) under
 # qemu-ARCH-static with QEMU_LD_PREFIX=sysroots/ARCH, the simulators from the native build (AIRSEG_BUILD_DIR,
 # default build). Under qemu-user the host process also holds qemu's own memory and translated code, so the
@@ -34,7 +34,7 @@ while [ $# -gt 0 ]; do
     --plan) plan=${2:?--plan needs FILE}; shift 2 ;;
     --emulator) emulator=${2:?--emulator needs armhf or armel}; shift 2 ;;
     --set) extra+=(--set "${2:?--set needs KEY=VALUE}"); shift 2 ;;
-    -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
     *) echo "footprint: unknown argument '$1'; see $0 --help" >&2; exit 2 ;;
   esac
 done
@@ -141,7 +141,7 @@ fi
 "${ctl[@]}" plan load "$plan" > "$run_dir/plan.log" 2>&1 || { echo "footprint: plan load failed:" >&2; cat "$run_dir/plan.log" >&2; exit 1; }
 if [ -z "$emulator" ]; then
   echo "busy (plan $plan running), ${busy_s} s: CPU $(cpu_per_minute "$busy_s") s per minute"
-  echo "VmRSS $(kib_of VmRSS) KiB, VmHWM $(kib_of VmHWM) KiB, private $(( $(smaps_sum Private_Clean 0 0) + $(smaps_sum Private_Dirty 0 0) )) KiB, heap $(heap_kib) KiB, own code $(own_code_kib) KiB"
+  echo "VmRSS $(kib_of VmRSS) KiB, VmHWM $(kib_of VmHWM) KiB, private $(( $(smaps_sum Private_Clean 0 0) + $(smaps_sum Private_Dirty 0 0) )) KiB, heap (brk; its high-water mark unless trimmed) $(heap_kib) KiB, own code $(own_code_kib) KiB"
 else
   sleep "$busy_s"
   lo=$((guest_base)); hi=$((guest_base + 0x100000000))
