@@ -5,16 +5,12 @@
 #include <filesystem>
 
 #include "services/flightplan/plan_loader.hpp"
+#include "tests/unit/flightplan/plan_text.hpp"
 
 namespace airseg::flightplan {
 namespace {
 
-std::vector<std::string> messages(const LoadResult& r) {
-    std::vector<std::string> out;
-    for (const auto& d : r.errors)
-        out.push_back(d.to_string());
-    return out;
-}
+using test::messages;
 
 TEST(FlightplanLoader, ExamplePlansLoad) {
     int loaded = 0;

@@ -9,16 +9,12 @@
 #include <fstream>
 
 #include "services/flightplan/plan_loader.hpp"
+#include "tests/unit/flightplan/plan_text.hpp"
 
 namespace airseg::flightplan {
 namespace {
 
-std::vector<std::string> messages(const LoadResult& r) {
-    std::vector<std::string> out;
-    for (const auto& d : r.errors)
-        out.push_back(d.to_string());
-    return out;
-}
+using test::messages;
 
 TEST(FlightplanStreaming, FieldsAfterTheElementsStillApplyToThem) {
     // The vehicle comes last, yet its min_spacing bounds the scan above it.

@@ -20,16 +20,16 @@ namespace {
 
 using test::Bytes;
 
-struct Outcome {
+struct SplitOutcome {
     std::vector<Frame> frames;
     ParserStats stats;
 };
 
 // Reads of the sizes `next_size()` returns, then finish().
 template <class NextSize>
-Outcome run(const Bytes& bytes, NextSize next_size) {
+SplitOutcome run_split(const Bytes& bytes, NextSize next_size) {
     Parser parser;
-    Outcome out;
+    SplitOutcome out;
     auto sink = [&](const Frame& f) { out.frames.push_back(f); };
     for (std::size_t i = 0; i < bytes.size();) {
         const std::size_t n = std::min(next_size(), bytes.size() - i);
@@ -41,17 +41,17 @@ Outcome run(const Bytes& bytes, NextSize next_size) {
     return out;
 }
 
-bool same_frame(const Frame& a, const Frame& b) {
+bool same_split_frame(const Frame& a, const Frame& b) {
     return a.version == b.version && a.incompat_flags == b.incompat_flags &&
            a.compat_flags == b.compat_flags && a.seq == b.seq && a.sysid == b.sysid && a.compid == b.compid &&
            a.msgid == b.msgid && a.wire_length == b.wire_length && a.payload_length == b.payload_length &&
            a.is_signed == b.is_signed && a.checksum_verified == b.checksum_verified && a.payload == b.payload;
 }
 
-void expect_same(const Outcome& whole, const Outcome& split, const char* how) {
+void expect_same(const SplitOutcome& whole, const SplitOutcome& split, const char* how) {
     ASSERT_EQ(whole.frames.size(), split.frames.size()) << how;
     for (std::size_t i = 0; i < whole.frames.size(); ++i) {
-        ASSERT_TRUE(same_frame(whole.frames[i], split.frames[i])) << how << ", frame " << i;
+        ASSERT_TRUE(same_split_frame(whole.frames[i], split.frames[i])) << how << ", frame " << i;
     }
     EXPECT_EQ(whole.stats.frames_ok, split.stats.frames_ok) << how;
     EXPECT_EQ(whole.stats.garbage_bytes, split.stats.garbage_bytes) << how;
@@ -64,19 +64,21 @@ void expect_same(const Outcome& whole, const Outcome& split, const char* how) {
 }
 
 void check_splits(const Bytes& bytes) {
-    const Outcome whole = run(bytes, [&] { return bytes.size() + 1; });
+    const SplitOutcome whole = run_split(bytes, [&] { return bytes.size() + 1; });
     for (const std::size_t size : {1u, 2u, 3u, 5u, 16u, 17u, 64u, 97u}) {
-        expect_same(whole, run(bytes, [&] { return size; }), ("reads of " + std::to_string(size)).c_str());
+        expect_same(whole, run_split(bytes, [&] { return size; }),
+                    ("reads of " + std::to_string(size)).c_str());
     }
     std::mt19937 rng(7);
-    expect_same(whole, run(bytes, [&] { return std::size_t{rng() % 40}; }), "random reads, empty ones too");
+    expect_same(whole, run_split(bytes, [&] { return std::size_t{rng() % 40}; }),
+                "random reads, empty ones too");
 }
 
 TEST(MavlinkParserSplit, NoisyArdupilotStreamGivesTheSameFramesAndCountersHoweverRead) {
     test::LineNoise noise;
     noise.byte_error_rate = 2e-3;  // a damaged frame every few dozen: resynchronisation all the time
     const auto s = test::make_ardupilot_stream(400'000, 11, noise);
-    const ParserStats whole = run(s.received, [&] { return s.received.size(); }).stats;
+    const ParserStats whole = run_split(s.received, [&] { return s.received.size(); }).stats;
     ASSERT_GT(whole.bad_checksum, 0u);  // the stream does make the parser resynchronise
     ASSERT_GT(whole.truncated, 0u);
     ASSERT_GT(whole.unknown_msgid, 0u);
