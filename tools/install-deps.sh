@@ -5,7 +5,7 @@ packages=(
   cmake ninja-build g++ pkg-config ccache
   libboost-dev libboost-program-options-dev libyaml-cpp-dev libspdlog-dev libfmt-dev
   libgpiod-dev libsodium-dev nlohmann-json3-dev zlib1g-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libgtest-dev libgmock-dev libbenchmark-dev valgrind
   clang libclang-rt-14-dev
 )
 sudo=""
