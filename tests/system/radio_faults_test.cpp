@@ -366,6 +366,14 @@ TEST(SystemRadio, AFloodOfCommandsIsAnsweredOrCleanlyRefusedNeverDuplicated) {
             ++local_refused;
         }
     }
+    // The three stations wrote into one pty faster than the radio carries: their bytes wait in the emulator's
+    // host backlog (up to 64 KiB, about 11 s at 57600 baud) after they exit, and a command among them may
+    // still reach the vehicle. Count once the vehicle has heard nothing from the ground for its link timeout.
+    const auto exited = bench.status();
+    const auto quiet_from = std::chrono::steady_clock::now();
+    ASSERT_TRUE(wait_until([&] { return section(bench.status(), "groundlink").value("link", "") == "down"; },
+                           std::chrono::seconds(60)))
+        << "the ground link goes down once the stations are gone";
     const auto end = bench.status();
     const auto received = counter(end, "/groundlink/commands") - counter(mid, "/groundlink/commands");
     std::cout << "[ figures ] flood: 20 sequential radio commands in " << rapid_s
@@ -373,7 +381,10 @@ TEST(SystemRadio, AFloodOfCommandsIsAnsweredOrCleanlyRefusedNeverDuplicated) {
               << "concurrent radio clients: " << radio_answered << " answered, " << radio_failed
               << " failed cleanly, daemon received " << received
               << "; 40 concurrent local: " << local_answered << " answered, " << local_refused
-              << " refused; peer_restarts " << counter(end, "/groundlink/peer_restarts") << "\n";
+              << " refused; peer_restarts " << counter(end, "/groundlink/peer_restarts") << "; link down "
+              << seconds_since(quiet_from) << " s after the stations exited, "
+              << counter(end, "/groundlink/commands") - counter(exited, "/groundlink/commands")
+              << " command(s) arrived meanwhile\n";
     EXPECT_GE(received, static_cast<std::uint64_t>(radio_answered));
     EXPECT_LE(received, 3u) << "no command executed twice";
     // Several programs reading one serial line steal each other's bytes: that they fail (cleanly) is
