@@ -209,6 +209,13 @@ void GroundlinkService::on_command(const protocol::Command& command) {
     ++commands_;
     const std::uint32_t id = command.request_id;
     const Role role = ground_role();
+    // The journal keeps what the ground asked of the vehicle; a plan upload is cut to its first characters.
+    constexpr std::size_t kShown = 160;
+    auto shown = command.request.dump(-1, ' ', true, nlohmann::json::error_handler_t::replace);
+    if (shown.size() > kShown) {
+        shown = shown.substr(0, kShown) + fmt::format("… ({} bytes)", shown.size());
+    }
+    spdlog::info("groundlink: request {} from the ground ({}): {}", id, to_string(role), shown);
     ctx_.commands.dispatch(command.request, role, [this, id](CommandResult result) {
         asio::dispatch(strand(), [this, id, result = std::move(result)]() mutable {
             if (result.status == CommandStatus::Forbidden) {

@@ -59,6 +59,18 @@ inline std::string rate_text(double v) {
     return o.str();
 }
 
+/// How many times airsegd's log shows the radio request `rates vehicle=V` arriving (it logs each request it
+/// executes, before answering it).
+inline int times_requested(SystemBench& bench, double v) {
+    const std::string log = bench.daemon_err();
+    const std::string needle = "{\"cmd\":\"rates.set\",\"rates\":{\"vehicle\":" + Json(v).dump() + "}}";
+    int n = 0;
+    for (auto at = log.find(needle); at != std::string::npos; at = log.find(needle, at + needle.size())) {
+        ++n;
+    }
+    return n;
+}
+
 /// One uniquely identifiable command over the radio; counts it into `tally`.
 inline void send_unique(SystemBench& bench, int serial, CommandTally& tally, long timeout_ms = 60'000) {
     const double v = unique_rate(serial);
