@@ -103,12 +103,19 @@ done
 
 # CPU time in ns over all of airsegd's threads (schedstat: finer than the 10 ms ticks of /proc/PID/stat).
 cpu_ns() { cat /proc/"$daemon_pid"/task/*/schedstat | awk '{ sum += $1 } END { printf "%.0f", sum }'; }
-cpu_per_minute() {  # cpu_per_minute SECONDS: airsegd's CPU seconds per minute over that wall time
-  local before after
+# Times airsegd's threads went to sleep (voluntary context switches): each is one wake-up later. On an idle
+# daemon the wake-ups, not the instructions run in them, are most of the CPU time, and unlike the CPU time
+# their count does not depend on the machine or on what else it runs.
+sleeps() { cat /proc/"$daemon_pid"/task/*/status | awk '$1 == "voluntary_ctxt_switches:" { sum += $2 } END { print sum + 0 }'; }
+cpu_per_minute() {  # cpu_per_minute SECONDS: airsegd's CPU seconds per minute, and wake-ups per second
+  local before after slept_before slept_after
   before=$(cpu_ns)
+  slept_before=$(sleeps)
   sleep "$1"
   after=$(cpu_ns)
-  awk -v d=$((after - before)) -v s="$1" 'BEGIN { printf "%.3f", d / 1e9 * 60 / s }'
+  slept_after=$(sleeps)
+  awk -v d=$((after - before)) -v w=$((slept_after - slept_before)) -v s="$1" \
+    'BEGIN { printf "%.3f s per minute, %.1f wake-ups per second", d / 1e9 * 60 / s, w / s }'
 }
 
 kib_of() { awk -v k="$1:" '$1 == k { print $2 }' "/proc/$daemon_pid/status"; }
@@ -134,13 +141,13 @@ heap_kib() { awk '/\[heap\]/ { h = 1; next } /^[0-9a-f]+-[0-9a-f]+ / { h = 0 } h
 
 echo "footprint: airsegd (pid $daemon_pid) $(readlink -f "$daemon")${emulator:+ under qemu-arm-static ($emulator)}"
 if [ -z "$emulator" ]; then
-  echo "idle (link up, no plan, 2 Hz telemetry), ${idle_s} s: CPU $(cpu_per_minute "$idle_s") s per minute"
+  echo "idle (link up, no plan, 2 Hz telemetry), ${idle_s} s: CPU $(cpu_per_minute "$idle_s")"
 else
   sleep "$idle_s"
 fi
 "${ctl[@]}" plan load "$plan" > "$run_dir/plan.log" 2>&1 || { echo "footprint: plan load failed:" >&2; cat "$run_dir/plan.log" >&2; exit 1; }
 if [ -z "$emulator" ]; then
-  echo "busy (plan $plan running), ${busy_s} s: CPU $(cpu_per_minute "$busy_s") s per minute"
+  echo "busy (plan $plan running), ${busy_s} s: CPU $(cpu_per_minute "$busy_s")"
   echo "VmRSS $(kib_of VmRSS) KiB, VmHWM $(kib_of VmHWM) KiB, private $(( $(smaps_sum Private_Clean 0 0) + $(smaps_sum Private_Dirty 0 0) )) KiB, heap (brk; its high-water mark unless trimmed) $(heap_kib) KiB, own code $(own_code_kib) KiB"
 else
   sleep "$busy_s"
