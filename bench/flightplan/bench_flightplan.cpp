@@ -1,6 +1,6 @@
 // Flight plan benchmarks: expansion rate and memory of a 1,000,000-waypoint scan, seek cost, plan load
-// (with no-fly validation), the memory of loading a plan written as an explicit list of waypoints, and the
-// rolling-window feeder's cost per reached waypoint.
+// (with no-fly validation), the memory of loading a plan written as an explicit list of waypoints and of
+// appending to one (plan.append's merge), and the rolling-window feeder's cost per reached waypoint.
 //
 // Memory is measured with a counting allocator (this binary replaces global operator new/delete): the
 // "peak_heap_bytes" counter is the largest heap growth while the stream is expanded, i.e. what the
@@ -182,12 +182,14 @@ void BM_LoadExplicitList(benchmark::State& state, bool from_file) {
 BENCHMARK_CAPTURE(BM_LoadExplicitList, text, false)->Arg(4'000)->Arg(40'000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_LoadExplicitList, file, true)->Arg(4'000)->Arg(40'000)->Unit(benchmark::kMillisecond);
 
-// plan.append on a long explicit list: the merge still works on whole yaml-cpp trees of both texts (then the
-// merged text is loaded as above); its heap peak is shown so that it is not mistaken for the loader's.
+// plan.append: `running` explicit-list elements, then `appended` more. The merge streams the running text
+// (parser events to an emitter) and copies the appended items in, so its peak is about the merged text plus
+// the parser's; peak_over_texts relates it to both texts, peak_over_file to the running one as before.
 void BM_AppendToExplicitList(benchmark::State& state) {
     const std::string running = explicit_list_plan(static_cast<int>(state.range(0)));
-    const std::string appended = explicit_list_plan(10);
+    const std::string appended = explicit_list_plan(static_cast<int>(state.range(1)));
     std::int64_t peak = 0;
+    bool whole_tree = false;
     for (auto _ : state) {
         const auto base = g_live.load();
         g_peak.store(base);
@@ -195,13 +197,21 @@ void BM_AppendToExplicitList(benchmark::State& state) {
         if (!merged.text)
             std::abort();
         peak = g_peak.load() - base;
+        whole_tree = merged.whole_tree;
         benchmark::DoNotOptimize(merged.text);
     }
+    const auto texts = static_cast<double>(running.size() + appended.size());
     state.counters["file_bytes"] = static_cast<double>(running.size());
     state.counters["peak_heap_bytes"] = static_cast<double>(peak);
     state.counters["peak_over_file"] = static_cast<double>(peak) / static_cast<double>(running.size());
+    state.counters["peak_over_texts"] = static_cast<double>(peak) / texts;
+    state.counters["whole_tree"] = whole_tree ? 1.0 : 0.0;
 }
-BENCHMARK(BM_AppendToExplicitList)->Arg(40'000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_AppendToExplicitList)
+    ->Args({40'000, 10})
+    ->Args({10, 40'000})
+    ->Args({20'000, 20'000})
+    ->Unit(benchmark::kMillisecond);
 
 // The feeder's own work per reached waypoint: reached report, refill, one partial write, result.
 void BM_FeederPerReachedWaypoint(benchmark::State& state) {
