@@ -10,27 +10,11 @@
 
 #include "services/flightplan/plan_parser.hpp"
 #include "services/flightplan/plan_stream.hpp"
+#include "services/flightplan/text_stream.hpp"
 
 namespace airseg::flightplan {
 
 namespace {
-
-// Reads the caller's text where it lies (YAML::Load would copy it into a string, then a stringstream).
-class TextBuffer : public std::streambuf {
-  public:
-    explicit TextBuffer(std::string_view text) {
-        char* p = const_cast<char*>(text.data());  // get area only: never written
-        setg(p, p, p + text.size());
-    }
-};
-
-class TextStream : public std::istream {
-  public:
-    explicit TextStream(std::string_view text) : std::istream(nullptr), buffer_(text) { rdbuf(&buffer_); }
-
-  private:
-    TextBuffer buffer_;
-};
 
 LoadResult one_error(const std::string& source, int line, int col, std::string message) {
     LoadResult r;

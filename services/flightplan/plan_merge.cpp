@@ -16,10 +16,12 @@
 #include <string_view>
 #include <vector>
 
+#include "services/flightplan/text_stream.hpp"
+
 namespace airseg::flightplan {
 
 // A named namespace inside the anonymous one: this file is compiled in a unity batch with others that
-// have helpers of the same names (TextStream).
+// have helpers of the same names.
 namespace {
 namespace merge {
 
@@ -36,7 +38,7 @@ struct NeedsWholeTree {};
 struct ListCopied {};
 
 // ------------------------------------------------------------------------------------------------------
-// The merge as it was: both documents as yaml-cpp trees. Still used for the layouts that need it.
+// The merge as it was: both documents as yaml-cpp trees (append_plan_text_as_trees).
 
 void append_list(YAML::Node into, const YAML::Node& from) {
     if (!from.IsSequence())
@@ -45,7 +47,11 @@ void append_list(YAML::Node into, const YAML::Node& from) {
         into.push_back(YAML::Clone(item));
 }
 
-MergedPlan merge_whole_trees(std::string_view running, std::string_view appended) {
+}  // namespace merge
+}  // namespace
+
+MergedPlan append_plan_text_as_trees(std::string_view running, std::string_view appended) {
+    using namespace merge;
     MergedPlan out;
     out.whole_tree = true;
     try {
@@ -79,25 +85,11 @@ MergedPlan merge_whole_trees(std::string_view running, std::string_view appended
     return out;
 }
 
+namespace {
+namespace merge {
+
 // ------------------------------------------------------------------------------------------------------
 // Input and output.
-
-// Reads the caller's text where it lies (YAML::Load would copy it into a string, then a stringstream).
-class TextBuffer : public std::streambuf {
-  public:
-    explicit TextBuffer(std::string_view text) {
-        char* p = const_cast<char*>(text.data());  // get area only: never written
-        setg(p, p, p + text.size());
-    }
-};
-
-class TextStream : public std::istream {
-  public:
-    explicit TextStream(std::string_view text) : std::istream(nullptr), buffer_(text) { rdbuf(&buffer_); }
-
-  private:
-    TextBuffer buffer_;
-};
 
 /// The merged text, written straight into the string that is returned. It is reserved once; what does not
 /// fit is only counted and the merge runs again at the exact size, because growing the string while the
@@ -855,7 +847,7 @@ MergedPlan append_plan_text(std::string_view running, std::string_view appended)
         // alias, or an alias used as a key of the document or of the plan, in either text; an appended item
         // referring to a node that encloses its own list. An alias from the appended items to any other
         // node outside them (home, geofence, another list's item, a list given as an alias) streams.
-        return merge_whole_trees(running, appended);
+        return append_plan_text_as_trees(running, appended);
     } catch (const YAML::Exception& e) {
         out.text.reset();
         out.error = std::string("cannot merge the plans: ") + e.what();

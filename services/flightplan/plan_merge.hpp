@@ -28,5 +28,8 @@ struct MergedPlan {
 
 /// Both texts must already load on their own (the appended one is checked first, for its own file:line).
 MergedPlan append_plan_text(std::string_view running, std::string_view appended);
+/// The same merge with both plans loaded as whole yaml-cpp documents: what append_plan_text falls back to
+/// for the layouts above, and the reference its tests compare it with. About 70 times the text in memory.
+MergedPlan append_plan_text_as_trees(std::string_view running, std::string_view appended);
 
 }  // namespace airseg::flightplan

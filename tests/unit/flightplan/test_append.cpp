@@ -107,41 +107,11 @@ TEST(FlightplanAppend, FeederContinuesMidRouteAndAfterTheEndWithoutStopping) {
     EXPECT_EQ(h.feeder.progress().starvation_holds, 0u);
 }
 
-// The merge as it was before it streamed, kept here as the reference: both plans loaded as whole yaml-cpp
-// trees, the appended lists' items cloned onto the running plan's.
+// The merge as it was before it streamed (the library keeps it for the layouts that need it) is the
+// reference: both plans loaded as whole yaml-cpp trees, the appended lists' items cloned onto the running
+// plan's.
 MergedPlan whole_tree_merge(std::string_view running, std::string_view appended) {
-    MergedPlan out;
-    try {
-        YAML::Node base = YAML::Load(std::string(running));
-        const YAML::Node extra = YAML::Load(std::string(appended));
-        YAML::Node plan = base["plan"];
-        const YAML::Node more = extra["plan"];
-        if (!plan.IsMap() || !more.IsMap()) {
-            out.error = "both plans need a 'plan' mapping";
-            return out;
-        }
-        for (const char* key : {"elements", "blocks", "no_fly"}) {
-            if (!more[key].IsDefined() || more[key].IsNull())
-                continue;
-            if (!plan[key].IsDefined() || plan[key].IsNull())
-                plan[key] = YAML::Node(YAML::NodeType::Sequence);
-            YAML::Node list = plan[key];
-            if (more[key].IsSequence()) {
-                for (const auto& item : more[key])
-                    list.push_back(YAML::Clone(item));
-            }
-        }
-        YAML::Emitter emitter;
-        emitter << base;
-        if (!emitter.good()) {
-            out.error = "cannot write the merged plan: " + emitter.GetLastError();
-            return out;
-        }
-        out.text = std::string(emitter.c_str()) + "\n";
-    } catch (const YAML::Exception& e) {
-        out.error = std::string("cannot merge the plans: ") + e.what();
-    }
-    return out;
+    return append_plan_text_as_trees(running, appended);
 }
 
 /// Everything a loaded plan means, as text: its fields, every element, the waypoints of the main stream and
