@@ -20,6 +20,21 @@ class DeadlineTimerTest : public ::testing::Test {
     auto record(std::vector<TimePoint>& into) {
         return [&into] { into.push_back(SteadyClock::now()); };
     }
+
+    // Arms `first_in` from now, then `second_in`: only the second fires, at its deadline.
+    void expect_second_arm_wins(Duration first_in, Duration second_in) {
+        DeadlineTimer timer(strand);
+        const TimePoint start = SteadyClock::now();
+        timer.arm(start + first_in, record(fired_a));
+        timer.arm(start + second_in, record(fired_b));
+        io.run();
+        EXPECT_TRUE(fired_a.empty());
+        ASSERT_EQ(fired_b.size(), 1u);
+        EXPECT_GE(fired_b[0], start + second_in);
+        if (second_in < first_in) {
+            EXPECT_LT(fired_b[0], start + first_in);
+        }
+    }
 };
 
 TEST_F(DeadlineTimerTest, FiresAtTheDeadlineAndDisarms) {
@@ -92,28 +107,11 @@ TEST_F(DeadlineTimerTest, CancelStops) {
 }
 
 TEST_F(DeadlineTimerTest, EarlierArmReplacesLater) {
-    DeadlineTimer timer(strand);
-    const TimePoint later = SteadyClock::now() + milliseconds(200);
-    const TimePoint earlier = SteadyClock::now() + milliseconds(20);
-    timer.arm(later, record(fired_a));
-    timer.arm(earlier, record(fired_b));
-    io.run();
-    EXPECT_TRUE(fired_a.empty());
-    ASSERT_EQ(fired_b.size(), 1u);
-    EXPECT_GE(fired_b[0], earlier);
-    EXPECT_LT(fired_b[0], later);
+    expect_second_arm_wins(milliseconds(200), milliseconds(20));
 }
 
 TEST_F(DeadlineTimerTest, LaterArmReplacesEarlier) {
-    DeadlineTimer timer(strand);
-    const TimePoint earlier = SteadyClock::now() + milliseconds(10);
-    const TimePoint later = SteadyClock::now() + milliseconds(40);
-    timer.arm(earlier, record(fired_a));
-    timer.arm(later, record(fired_b));
-    io.run();
-    EXPECT_TRUE(fired_a.empty());
-    ASSERT_EQ(fired_b.size(), 1u);
-    EXPECT_GE(fired_b[0], later);
+    expect_second_arm_wins(milliseconds(10), milliseconds(40));
 }
 
 // Two deadlines already past complete in one pass of the reactor, earliest first: the first handler runs
