@@ -194,17 +194,7 @@ void AutopilotService::publish(Event e) {
 
 // One timer for the driver's deadlines and the .tlog's flush deadline.
 void AutopilotService::arm_timer() {
-    const TimePoint next = std::min(driver_.poll_timeout(), tlog_.poll_timeout());
-    if (next == timer_at_) {
-        return;
-    }
-    timer_at_ = next;
-    if (next == kNever) {
-        timer_.cancel();
-        return;
-    }
-    timer_.expires_at(next);
-    timer_.async_wait([this](const boost::system::error_code& ec) { on_timer(ec); });
+    timer_.arm(std::min(driver_.poll_timeout(), tlog_.poll_timeout()), [this] { on_timer(); });
 }
 
 // Published from the wake-up that brought the change, so the status costs no wake-up of its own. Inputs
@@ -226,11 +216,10 @@ void AutopilotService::on_tick(TimePoint) {
     }
 }
 
-void AutopilotService::on_timer(const boost::system::error_code& ec) {
-    if (ec == asio::error::operation_aborted || !running_) {
+void AutopilotService::on_timer() {
+    if (!running_) {
         return;
     }
-    timer_at_ = kNever;
     const TimePoint now = SteadyClock::now();
     driver_.handle_timeout(now);
     tlog_.handle_timeout(now);

@@ -17,6 +17,7 @@
 #include "services/autopilot/autopilot.hpp"
 #include "services/autopilot/autopilot_config.hpp"
 #include "services/autopilot/tlog_writer.hpp"
+#include "services/common/deadline_timer.hpp"
 #include "services/common/port_keeper.hpp"
 #include "services/common/service.hpp"
 
@@ -50,7 +51,7 @@ class AutopilotService : public Service {
     void on_request(const AutopilotRequest& r);
     void pump();
     void arm_timer();
-    void on_timer(const boost::system::error_code& ec);
+    void on_timer();
     void publish_status();
     void publish_status_soon(TimePoint now);
     void on_tick(TimePoint now) override;
@@ -65,8 +66,7 @@ class AutopilotService : public Service {
     ardupilot::Driver driver_;
     PortKeeper keeper_;
     TlogWriter tlog_;
-    asio::steady_timer timer_;
-    TimePoint timer_at_ = kNever;
+    DeadlineTimer timer_;
     TimePoint status_published_at_{};
     std::map<std::uint32_t, std::uint32_t> requester_ids_;  // driver id -> requester id
     std::vector<Subscription> subscriptions_;

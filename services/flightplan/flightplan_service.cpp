@@ -502,19 +502,9 @@ void FlightplanService::arm_timer() {
         next = std::min(next, reactions_->poll_timeout());
     for (const auto& w : waiters_)
         next = std::min(next, w.deadline);
-    if (next == timer_at_)
-        return;
-    timer_at_ = next;
-    if (next == kNever) {
-        timer_.cancel();
-        return;
-    }
-    timer_.expires_at(next);
-    timer_.async_wait([this](const boost::system::error_code& ec) {
-        if (ec == asio::error::operation_aborted || !running_)
-            return;
-        timer_at_ = kNever;
-        pump();
+    timer_.arm(next, [this] {
+        if (running_)
+            pump();
     });
 }
 

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "services/autopilot/autopilot.hpp"
+#include "services/common/deadline_timer.hpp"
 #include "services/common/service.hpp"
 #include "services/flightplan/expander.hpp"
 #include "services/flightplan/persistence.hpp"
@@ -127,8 +128,7 @@ class FlightplanService : public Service {
     std::string last_reaction_;  // plan.reaction
     Json last_status_;
 
-    asio::steady_timer timer_;
-    TimePoint timer_at_ = kNever;
+    DeadlineTimer timer_;
     asio::steady_timer status_timer_;
     std::vector<Subscription> subscriptions_;
     bool running_ = false;

@@ -333,22 +333,7 @@ void GroundlinkService::feed_scheduler(TimePoint now) {
 }
 
 void GroundlinkService::arm_telemetry() {
-    const TimePoint next = scheduler_.poll_timeout();
-    if (next == telemetry_armed_for_) {
-        return;
-    }
-    telemetry_armed_for_ = next;
-    if (next == kNever) {
-        telemetry_timer_.cancel();
-        return;
-    }
-    telemetry_timer_.expires_at(next);
-    telemetry_timer_.async_wait([this](boost::system::error_code ec) {
-        if (!ec) {
-            telemetry_armed_for_ = kNever;
-            on_telemetry_timer();
-        }
-    });
+    telemetry_timer_.arm(scheduler_.poll_timeout(), [this] { on_telemetry_timer(); });
 }
 
 void GroundlinkService::on_telemetry_timer() {

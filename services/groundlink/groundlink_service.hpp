@@ -7,6 +7,7 @@
 
 #include "hal/udp_socket.hpp"
 #include "services/autopilot/autopilot.hpp"
+#include "services/common/deadline_timer.hpp"
 #include "services/common/port_keeper.hpp"
 #include "services/common/service.hpp"
 #include "services/groundlink/delivery_meter.hpp"
@@ -79,8 +80,7 @@ class GroundlinkService : public Service {
     std::optional<std::array<std::uint8_t, kKeyBytes>> control_key_;
     TelemetryScheduler scheduler_;
     DeliveryMeter delivery_;
-    asio::steady_timer telemetry_timer_;
-    TimePoint telemetry_armed_for_ = kNever;
+    DeadlineTimer telemetry_timer_;
     std::optional<autopilot::Telemetry> vehicle_;
     PlanProgressSample plan_;
     std::vector<Subscription> subscriptions_;

@@ -90,21 +90,10 @@ void LinkDriver::arm_timer() {
     if (stopped_) {
         return;
     }
-    const TimePoint deadline = core_.poll_timeout();
-    if (deadline == armed_for_) {
-        return;
-    }
-    armed_for_ = deadline;
-    if (deadline == kNever) {
-        timer_.cancel();
-        return;
-    }
-    timer_.expires_at(deadline);
-    timer_.async_wait([this, deadline](boost::system::error_code ec) {
-        if (ec || stopped_ || deadline != armed_for_) {
+    timer_.arm(core_.poll_timeout(), [this] {
+        if (stopped_) {
             return;
         }
-        armed_for_ = kNever;
         core_.handle_timeout(SteadyClock::now());
         pump();
     });

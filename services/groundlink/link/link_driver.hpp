@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "services/common/asio.hpp"
+#include "services/common/deadline_timer.hpp"
 #include "services/groundlink/transport/transport.hpp"
 
 namespace airseg::groundlink {
@@ -46,8 +47,7 @@ class LinkDriver {
 
     Transport core_;
     Handlers handlers_;
-    asio::steady_timer timer_;
-    TimePoint armed_for_ = kNever;
+    DeadlineTimer timer_;
     std::array<Writer, kMaxPaths> writers_;
     bool pumping_ = false;
     bool pump_again_ = false;

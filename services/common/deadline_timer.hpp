@@ -1,0 +1,74 @@
+#pragma once
+// One asio steady_timer following the poll_timeout() of sans-IO cores (time.hpp). Cores are asked for their
+// next deadline after every input, and it mostly comes back unchanged: re-arming the timer for the same
+// instant would cost a timer-queue update (and often a timerfd syscall) per input for nothing, so an
+// unchanged deadline keeps the wait already running. kNever means no wake-up at all.
+#include <cstdint>
+#include <memory>
+#include <utility>
+
+#include "services/common/asio.hpp"
+#include "services/common/time.hpp"
+
+namespace airseg {
+
+class DeadlineTimer {
+  public:
+    /// Handlers run on `executor` (the owner's strand).
+    explicit DeadlineTimer(asio::any_io_executor executor) : timer_(std::move(executor)) {}
+    DeadlineTimer(const DeadlineTimer&) = delete;
+    DeadlineTimer& operator=(const DeadlineTimer&) = delete;
+    // The state goes with the owner: a completion already queued when it is destroyed finds nothing to call.
+    ~DeadlineTimer() = default;
+
+    /// Calls `on_due()` once `deadline` has passed; a deadline already past is due on the next run of the
+    /// executor. The deadline armed now is the only one that fires: any earlier or later one is dropped.
+    /// The deadline already armed keeps its wait and its handler (`on_due` is dropped); kNever cancels.
+    /// The deadline is disarmed before `on_due` runs, so `on_due` may arm the next one.
+    template <class Handler>
+    void arm(TimePoint deadline, Handler&& on_due) {
+        if (deadline == state_->armed) {
+            return;
+        }
+        if (deadline == kNever) {
+            cancel();
+            return;
+        }
+        state_->armed = deadline;
+        const std::uint64_t generation = ++state_->generation;
+        timer_.expires_at(deadline);
+        timer_.async_wait(
+            [state = std::weak_ptr<State>(state_), generation,
+             on_due = std::forward<Handler>(on_due)](const boost::system::error_code& ec) mutable {
+                // A completion queued before a re-arm, a cancel or the owner's destruction cannot be taken
+                // back by asio; the generation tells it apart from the wait armed now.
+                const auto s = state.lock();
+                if (ec || !s || s->generation != generation) {
+                    return;
+                }
+                s->armed = kNever;
+                on_due();
+            });
+    }
+
+    /// No wake-up until the next arm(); a completion already queued is dropped.
+    void cancel() {
+        state_->armed = kNever;
+        ++state_->generation;
+        timer_.cancel();
+    }
+
+    /// The deadline the timer waits for, kNever when none.
+    TimePoint armed() const { return state_->armed; }
+
+  private:
+    struct State {
+        TimePoint armed = kNever;
+        std::uint64_t generation = 0;
+    };
+
+    asio::steady_timer timer_;
+    std::shared_ptr<State> state_ = std::make_shared<State>();
+};
+
+}  // namespace airseg
