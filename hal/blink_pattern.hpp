@@ -1,6 +1,7 @@
 #pragma once
 // Status LED patterns as pure functions of time (no timer, no GPIO): what level the LED shows at time t
-// after the pattern started, and when it next changes. LedBlinker drives a GpioLine from these.
+// after the pattern started, and when it next changes. The daemon's status LED driver (through
+// autopilot::StatusLed) drives a GpioLine from these.
 #include <iosfwd>
 #include <span>
 

@@ -153,6 +153,10 @@ MissionClient::MissionClient(Outbox& outbox, std::uint8_t target_sysid, std::uin
       target_sysid_(target_sysid),
       target_compid_(target_compid),
       config_(config),
+      // A floor of 100 ms on the variance term keeps a perfectly steady link from getting a razor-thin
+      // timeout.
+      rtt_(config.initial_timeout, config.min_timeout, config.max_timeout, Duration::zero(), Duration::zero(),
+           milliseconds(100)),
       use_int_(config.use_int) {}
 
 void MissionClient::forget_board() {
@@ -246,12 +250,7 @@ void MissionClient::cancel_all(const std::string& why) {
 // --- sending -----------------------------------------------------------------------------------------------
 
 Duration MissionClient::base_timeout() const {
-    Duration t = config_.initial_timeout;
-    if (srtt_) {
-        // A floor on the variance term keeps a perfectly steady link from getting a razor-thin timeout.
-        t = *srtt_ + std::max<Duration>(4 * rttvar_, milliseconds(100));
-    }
-    return std::clamp(t, config_.min_timeout, config_.max_timeout);
+    return rtt_.rto();
 }
 
 void MissionClient::start_front(TimePoint now) {
@@ -367,7 +366,7 @@ void MissionClient::transmit(WorkItem& w, TimePoint now, bool retry) {
     }
     if (retry) {
         ++stats_.retransmissions;
-        if (!srtt_) {
+        if (rtt_.samples() == 0) {
             backoff_ = std::min(backoff_ * 2, 16u);
         }
     }
@@ -383,22 +382,14 @@ void MissionClient::transmit(WorkItem& w, TimePoint now, bool retry) {
 // ArduPilot abandons an upload after 8 s without an item, and at a few percent of bytes lost most item
 // frames are damaged, so an item needs several attempts inside those 8 s.
 Duration MissionClient::current_timeout(const WorkItem&) const {
-    const unsigned factor = srtt_ ? 1u : backoff_;
+    const unsigned factor = rtt_.samples() != 0 ? 1u : backoff_;
     return std::min<Duration>(base_timeout() * factor, config_.max_timeout);
 }
 
 // The vehicle answered something sent with the current step: take an RTT sample and refresh the budget.
 void MissionClient::progress(WorkItem& w, TimePoint now) {
     if (!w.retransmitted && w.sent_at != TimePoint{}) {
-        const Duration r = now - w.sent_at;
-        if (!srtt_) {
-            srtt_ = r;
-            rttvar_ = r / 2;
-        } else {
-            const Duration err = *srtt_ > r ? *srtt_ - r : r - *srtt_;
-            rttvar_ = (3 * rttvar_ + err) / 4;
-            srtt_ = (7 * *srtt_ + r) / 8;
-        }
+        rtt_.sample(now - w.sent_at);
         backoff_ = 1;
     }
     w.attempt = 0;

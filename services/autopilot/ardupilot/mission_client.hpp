@@ -42,6 +42,7 @@
 #include "services/autopilot/autopilot_config.hpp"
 #include "services/autopilot/mavlink/frame.hpp"
 #include "services/autopilot/mavlink/messages.hpp"
+#include "services/common/rtt_estimator.hpp"
 #include "services/common/time.hpp"
 
 namespace airseg::autopilot::ardupilot {
@@ -114,7 +115,9 @@ class MissionClient {
     /// The timeout from the RTT estimate alone.
     Duration base_timeout() const;
 
-    std::optional<Duration> smoothed_rtt() const { return srtt_; }
+    std::optional<Duration> smoothed_rtt() const {
+        return rtt_.samples() != 0 ? std::optional<Duration>(rtt_.srtt()) : std::nullopt;
+    }
     const MissionClientStats& stats() const { return stats_; }
 
   private:
@@ -174,8 +177,7 @@ class MissionClient {
     std::deque<WorkItem> work_;
     std::deque<MissionCompletion> done_;
     std::uint32_t next_id_ = 1;
-    std::optional<Duration> srtt_;
-    Duration rttvar_{};
+    RttEstimator rtt_;
     unsigned backoff_ = 1;
     bool use_int_ = true;      // the item form this board is answered with
     bool int_proven_ = false;  // the board went on after an item sent as MISSION_ITEM_INT

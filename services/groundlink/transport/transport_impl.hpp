@@ -8,6 +8,7 @@
 #include <optional>
 #include <vector>
 
+#include "services/common/rtt_estimator.hpp"
 #include "services/groundlink/transport/cobs.hpp"
 #include "services/groundlink/transport/erasure_code.hpp"
 #include "services/groundlink/transport/error_rate_meter.hpp"
@@ -18,7 +19,6 @@
 #include "services/groundlink/transport/frame.hpp"
 #include "services/groundlink/transport/frame_mac.hpp"
 #include "services/groundlink/transport/replay_window.hpp"
-#include "services/groundlink/transport/rtt_estimator.hpp"
 #include "services/groundlink/transport/safe_receiver.hpp"
 #include "services/groundlink/transport/safe_sender.hpp"
 #include "services/groundlink/transport/transport.hpp"

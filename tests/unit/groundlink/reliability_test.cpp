@@ -2,9 +2,9 @@
 // RTT/RTO.
 #include <gtest/gtest.h>
 
+#include "services/common/rtt_estimator.hpp"
 #include "services/groundlink/transport/fast_queue.hpp"
 #include "services/groundlink/transport/fast_reassembly.hpp"
-#include "services/groundlink/transport/rtt_estimator.hpp"
 #include "services/groundlink/transport/safe_receiver.hpp"
 #include "services/groundlink/transport/safe_sender.hpp"
 

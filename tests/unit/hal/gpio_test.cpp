@@ -6,7 +6,6 @@
 #include "hal/gpio_fake.hpp"
 #include "hal/gpio_libgpiod.hpp"
 #include "hal/gpio_pulse.hpp"
-#include "hal/led_blinker.hpp"
 #include "tests/unit/hal/run_until.hpp"
 
 namespace airseg::hal {
@@ -120,46 +119,6 @@ TEST(HalGpioPulseTest, HoldsTheLineActiveForTheWidthThenReleasesIt) {
     EXPECT_TRUE(h[1].value);
     EXPECT_FALSE(h[2].value);
     EXPECT_GE(h[2].at - h[1].at, milliseconds(20));
-}
-
-TEST(HalLedBlinkerTest, DrivesThePatternOnTheLineAndTurnsOffWhenDestroyed) {
-    boost::asio::io_context io;
-    SteadyClock clock;
-    FakeGpio gpio(clock);
-    gpio.add_line("gpiochip0", 17, "STATUS_LED");
-    auto r = gpio.request(by_name("STATUS_LED"));
-    ASSERT_TRUE(r.ok());
-    {
-        LedBlinker led(io.get_executor(), r.line);
-        led.set_pattern(LedPattern::Booting);
-        EXPECT_EQ(led.pattern(), LedPattern::Booting);
-        // initial off (request), on at 0, off at 100 ms, on at 200 ms
-        ASSERT_TRUE(run_until(io, [&] { return gpio.history("STATUS_LED").size() >= 4; }));
-        const auto h = gpio.history("STATUS_LED");
-        EXPECT_TRUE(h[1].value);
-        EXPECT_FALSE(h[2].value);
-        EXPECT_TRUE(h[3].value);
-        // The pattern's timing itself is checked in simulated time (blink_pattern tests); on a loaded machine
-        // or under emulation real timers only promise the order of the changes, and that they keep coming.
-        EXPECT_LE(h[1].at, h[2].at);
-        EXPECT_LE(h[2].at, h[3].at);
-    }
-    EXPECT_FALSE(gpio.value("STATUS_LED"));
-    test::run_until_idle(io);
-    EXPECT_FALSE(gpio.value("STATUS_LED")) << "no timer may fire after destruction";
-}
-
-TEST(HalLedBlinkerTest, ConstantPatternNeedsNoTimer) {
-    boost::asio::io_context io;
-    ManualClock clock;
-    FakeGpio gpio(clock);
-    gpio.add_line("gpiochip0", 17);
-    auto r = gpio.request(output_at("gpiochip0", 17));
-    ASSERT_TRUE(r.ok());
-    LedBlinker led(io.get_executor(), r.line);
-    led.set_pattern(LedPattern::Off);
-    test::run_until_idle(io);  // returns at once: nothing is scheduled
-    EXPECT_FALSE(gpio.value("gpiochip0:17"));
 }
 
 // ---- libgpiod backend: error paths run everywhere; line I/O needs a chip -------------------------------

@@ -13,32 +13,21 @@
 
 #include <chrono>
 #include <cstring>
-#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
-#include <thread>
 #include <vector>
+
+#include "tests/support/process.hpp"
 
 extern char** environ;
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-constexpr auto kGenerous = std::chrono::seconds(10);
 
 const std::string kBinary = std::string(AIRSEG_BINARY_DIR) + "/tools/linksim/airseg-linksim";
 
-// Polls `done` until it holds or `timeout` passes: a wait on a condition, never a fixed delay.
-bool wait_until(const std::function<bool()>& done, Clock::duration timeout = kGenerous) {
-    const auto deadline = Clock::now() + timeout;
-    while (!done()) {
-        if (Clock::now() >= deadline) {
-            return false;
-        }
-        std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    }
-    return true;
-}
+using airseg::test::wait_until;
 
 bool exists(const std::string& path) {
     struct stat st {};

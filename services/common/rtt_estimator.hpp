@@ -1,19 +1,27 @@
 #pragma once
 // Round-trip time and retransmission timeout after RFC 6298 (SRTT, RTTVAR, RTO = SRTT + 4·RTTVAR), plus the
-// receiver's acknowledgement delay and one frame time, clamped to [rto_min, rto_max].
+// receiver's acknowledgement delay and one frame time, clamped to [rto_min, rto_max]. Shared by the ground
+// link's transport and the autopilot's mission client, each with its own bounds.
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 
 #include "services/common/time.hpp"
 
-namespace airseg::groundlink {
+namespace airseg {
 
 class RttEstimator {
   public:
     /// `frame_time`: air time of the largest frame; a lost acknowledgement is repaired by the next one, about
-    /// a frame later, so the timeout leaves room for it.
-    RttEstimator(Duration initial, Duration min, Duration max, Duration ack_delay, Duration frame_time = {})
-        : initial_(initial), min_(min), max_(max), ack_delay_(ack_delay + frame_time) {}
+    /// a frame later, so the timeout leaves room for it. `variance_floor`: the least the 4·RTTVAR term adds,
+    /// so that a perfectly steady link does not get a razor-thin timeout.
+    RttEstimator(Duration initial, Duration min, Duration max, Duration ack_delay, Duration frame_time = {},
+                 Duration variance_floor = milliseconds(10))
+        : initial_(initial),
+          min_(min),
+          max_(max),
+          ack_delay_(ack_delay + frame_time),
+          variance_floor_(variance_floor) {}
 
     void sample(Duration rtt) {
         if (rtt < Duration::zero()) {
@@ -34,7 +42,7 @@ class RttEstimator {
         if (samples_ == 0) {
             return std::clamp(initial_, min_, max_);
         }
-        const Duration var = std::max<Duration>(rttvar_ * 4, std::chrono::milliseconds(10));
+        const Duration var = std::max<Duration>(rttvar_ * 4, variance_floor_);
         return std::clamp(srtt_ + var + ack_delay_, min_, max_);
     }
     /// The timeout after `backoff` consecutive expiries: doubled each time, capped at rto_max.
@@ -51,10 +59,10 @@ class RttEstimator {
     [[nodiscard]] std::uint64_t samples() const { return samples_; }
 
   private:
-    Duration initial_, min_, max_, ack_delay_;
+    Duration initial_, min_, max_, ack_delay_, variance_floor_;
     Duration srtt_{};
     Duration rttvar_{};
     std::uint64_t samples_ = 0;
 };
 
-}  // namespace airseg::groundlink
+}  // namespace airseg
