@@ -378,16 +378,16 @@ class FactsReader final : public YAML::EventHandler {
         for (std::size_t k = 0; k < kLists.size(); ++k) {
             ListFacts& list = facts_.lists[k];
             list.needs.assign(anchors_.size(), false);
-            std::vector<anchor_t> todo = std::move(seeds_[k]);
-            while (!todo.empty()) {
-                const anchor_t a = todo.back();
-                todo.pop_back();
+            std::vector<anchor_t> unvisited = std::move(seeds_[k]);
+            while (!unvisited.empty()) {
+                const anchor_t a = unvisited.back();
+                unvisited.pop_back();
                 if (list.needs[a - 1])
                     continue;
                 list.needs[a - 1] = true;
                 list.any_needs = true;
                 const auto& refs = anchors_[a - 1].outer_refs;
-                todo.insert(todo.end(), refs.begin(), refs.end());
+                unvisited.insert(unvisited.end(), refs.begin(), refs.end());
             }
         }
         return std::move(facts_);
