@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include "services/autopilot/ardupilot/rover_modes.hpp"
+
 namespace airseg::client {
 
 namespace proto = groundlink::protocol;
@@ -27,6 +29,13 @@ const char* plan_state_name(std::uint8_t s) {
     }
 }
 
+// The wire carries the autopilot's mode number; its name comes from the autopilot's own table, and a number
+// without one (or the "no mode" code) shows as "?".
+const char* mode_name(std::uint8_t code) {
+    const char* name = autopilot::ardupilot::rover_mode_known_name(code);
+    return name != nullptr ? name : "?";
+}
+
 const char* severity_name(proto::Event::Severity s) {
     switch (s) {
         case proto::Event::Severity::warning:
@@ -46,7 +55,7 @@ double seconds(std::chrono::steady_clock::duration d) {
 
 nlohmann::json telemetry_json(const proto::Telemetry& t) {
     nlohmann::json j{{"state", proto::vehicle_state_name(t.vehicle_state)},
-                     {"mode", proto::mode_name(t.mode)},
+                     {"mode", mode_name(t.mode)},
                      {"lat", t.lat_deg},
                      {"lon", t.lon_deg},
                      {"alt_m", t.alt_m},
@@ -104,7 +113,7 @@ std::string WatchState::render(Clock::time_point now) const {
     } else {
         const auto& t = *latest_;
         out += fmt::format("state       {:<20} mode {}\n", proto::vehicle_state_name(t.vehicle_state),
-                           proto::mode_name(t.mode));
+                           mode_name(t.mode));
         if (t.gps_fix >= 2) {
             out += fmt::format("position    {:.7f} {:.7f}  alt {:.1f} m\n", t.lat_deg, t.lon_deg, t.alt_m);
         } else {

@@ -47,6 +47,9 @@ struct Telemetry {
     std::optional<int> battery_remaining;   // percent
     std::optional<double> battery_current;  // amperes
     std::string mode;                       // the autopilot's own mode name ("AUTO", "HOLD", ...)
+    // The same mode as the autopilot's own number (ArduPilot: the heartbeat's custom_mode), for whoever
+    // forwards it without knowing the autopilot's names (the ground protocol). Empty exactly when `mode` is.
+    std::optional<std::uint32_t> custom_mode;
     VehicleState state = VehicleState::Unknown;
     std::uint16_t mission_current = 0;
     std::optional<Position> home;

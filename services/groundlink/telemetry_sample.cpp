@@ -34,7 +34,9 @@ protocol::Telemetry make_sample(const autopilot::Telemetry& t, const PlanProgres
     s.gps_fix = static_cast<std::uint8_t>(t.gps_fix);
     s.satellites = static_cast<std::uint8_t>(std::min(t.satellites, 15u));
     s.vehicle_state = static_cast<std::uint8_t>(t.state);
-    s.mode = protocol::mode_code(t.mode);
+    s.mode = t.custom_mode && *t.custom_mode < protocol::kModeUnknown
+                 ? static_cast<std::uint8_t>(*t.custom_mode)
+                 : protocol::kModeUnknown;
     s.plan_state = plan.plan_state;
     s.plan_element = plan.element;
     s.next_waypoint = plan.next_waypoint;

@@ -13,8 +13,9 @@ struct PlanProgressSample {
     std::uint32_t next_waypoint = 0;
 };
 
-/// Angles in radians become whole degrees; the mode name becomes its wire code (protocol::mode_code); a
-/// missing position leaves latitude and longitude 0 (the GPS fix says whether they mean anything).
+/// Angles in radians become whole degrees; the mode travels as the autopilot's number (protocol::kModeUnknown
+/// when absent or too large for the byte); a missing position leaves latitude and longitude 0 (the GPS fix
+/// says whether they mean anything).
 protocol::Telemetry make_sample(const autopilot::Telemetry& t, const PlanProgressSample& plan = {});
 
 }  // namespace airseg::groundlink

@@ -720,6 +720,7 @@ void Driver::update_state(TimePoint now, bool requested) {
     }
     telemetry_.state = state_;
     telemetry_.mode = mode_name_;
+    telemetry_.custom_mode = mode_;
     if (state_ != VehicleState::ManualNavigation) {
         rc_.set_enabled(false, now);
     }

@@ -2,7 +2,7 @@
 
 namespace airseg::autopilot::ardupilot {
 
-std::string rover_mode_name(std::uint32_t m) {
+const char* rover_mode_known_name(std::uint32_t m) {
     switch (static_cast<RoverMode>(m)) {
         case RoverMode::Manual:
             return "MANUAL";
@@ -29,7 +29,12 @@ std::string rover_mode_name(std::uint32_t m) {
         case RoverMode::Initialising:
             return "INITIALISING";
     }
-    return "MODE(" + std::to_string(m) + ")";
+    return nullptr;
+}
+
+std::string rover_mode_name(std::uint32_t m) {
+    const char* name = rover_mode_known_name(m);
+    return name != nullptr ? std::string(name) : "MODE(" + std::to_string(m) + ")";
 }
 
 VehicleState state_for(std::uint32_t custom_mode, bool booting, bool override_active, bool failsafe_latched) {

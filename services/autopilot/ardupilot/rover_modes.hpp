@@ -28,6 +28,9 @@ enum class RoverMode : std::uint32_t {
 /// "MANUAL", "HOLD", ...; "MODE(n)" for a number Rover does not define.
 std::string rover_mode_name(std::uint32_t custom_mode);
 
+/// "MANUAL", "HOLD", ...; nullptr for a number Rover does not define (the caller chooses how to show it).
+const char* rover_mode_known_name(std::uint32_t custom_mode);
+
 /// What a heartbeat says about the neutral state. `booting`: the autopilot reports BOOT/CALIBRATING or
 /// is not yet READY in this system's eyes; `override_active`: the ground joystick drives (MANUAL +
 /// RC override); `failsafe_latched`: the operator's failsafe MANUAL holds until an explicit reset.

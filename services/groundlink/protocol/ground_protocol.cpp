@@ -364,56 +364,10 @@ constexpr std::array<const char*, 7> kVehicleStates{"UNKNOWN",  "CONFIGURE_CHECK
                                                     "DIRECTED", "MANUAL_NAVIGATION", "WAYPOINT_NAVIGATION",
                                                     "MANUAL"};
 
-struct ModeEntry {
-    std::uint8_t code;
-    const char* name;
-};
-constexpr std::array<ModeEntry, 12> kRoverModes{{{0, "MANUAL"},
-                                                 {1, "ACRO"},
-                                                 {3, "STEERING"},
-                                                 {4, "HOLD"},
-                                                 {5, "LOITER"},
-                                                 {6, "FOLLOW"},
-                                                 {7, "SIMPLE"},
-                                                 {10, "AUTO"},
-                                                 {11, "RTL"},
-                                                 {12, "SMART_RTL"},
-                                                 {15, "GUIDED"},
-                                                 {16, "INITIALISING"}}};
-
 }  // namespace
 
 const char* vehicle_state_name(std::uint8_t code) {
     return code < kVehicleStates.size() ? kVehicleStates[code] : "?";
-}
-
-std::uint8_t mode_code(std::string_view name) {
-    for (const auto& m : kRoverModes) {
-        if (name == m.name) {
-            return m.code;
-        }
-    }
-    // A mode the table does not name arrives as "MODE(n)".
-    if (name.starts_with("MODE(") && name.ends_with(")") && name.size() > 6 && name.size() <= 9) {
-        unsigned v = 0;
-        for (char c : name.substr(5, name.size() - 6)) {
-            if (c < '0' || c > '9') {
-                return kModeUnknown;
-            }
-            v = v * 10 + static_cast<unsigned>(c - '0');
-        }
-        return v < kModeUnknown ? static_cast<std::uint8_t>(v) : kModeUnknown;
-    }
-    return kModeUnknown;
-}
-
-const char* mode_name(std::uint8_t code) {
-    for (const auto& m : kRoverModes) {
-        if (code == m.code) {
-            return m.name;
-        }
-    }
-    return "?";
 }
 
 }  // namespace airseg::groundlink::protocol

@@ -128,10 +128,9 @@ DecodeResult decode(std::span<const std::uint8_t> bytes);
 /// autopilot::VehicleState) and their names.
 const char* vehicle_state_name(std::uint8_t code);
 
-/// Wire codes of the telemetry's mode byte: ArduPilot Rover's mode numbers; kModeUnknown when the name is not
-/// one of them.
+/// The telemetry's mode byte is the autopilot's own mode number (autopilot::Telemetry::custom_mode), carried
+/// without interpretation; kModeUnknown when there is none or it does not fit below it. The names belong to
+/// the autopilot's table (services/autopilot/ardupilot/rover_modes.hpp), not to the protocol.
 inline constexpr std::uint8_t kModeUnknown = 255;
-std::uint8_t mode_code(std::string_view name);
-const char* mode_name(std::uint8_t code);  // "?" for codes without a name
 
 }  // namespace airseg::groundlink::protocol

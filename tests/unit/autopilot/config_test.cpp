@@ -66,6 +66,8 @@ TEST(RoverModes, StatesFromHeartbeats) {
     EXPECT_EQ(state_for(m(RoverMode::Rtl), false, false, false), VehicleState::Unknown);
     EXPECT_EQ(ardupilot::rover_mode_name(10), "AUTO");
     EXPECT_EQ(ardupilot::rover_mode_name(99), "MODE(99)");
+    EXPECT_STREQ(ardupilot::rover_mode_known_name(4), "HOLD");
+    EXPECT_EQ(ardupilot::rover_mode_known_name(99), nullptr);
 }
 
 TEST(RoverModes, TransitionTable) {

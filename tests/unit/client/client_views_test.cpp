@@ -83,6 +83,12 @@ TEST(WatchState, ShowsTheLatestSampleTheLinkAndRecentEvents) {
     const auto j = w.to_json(now);
     EXPECT_EQ(j["vehicle"]["state"], "MANUAL_NAVIGATION");
     EXPECT_EQ(j["vehicle"]["mode"], "MANUAL");
+    for (const std::uint8_t unnamed : {std::uint8_t{9}, proto::kModeUnknown}) {
+        t.mode = unnamed;
+        w.take(t, now);
+        EXPECT_EQ(w.to_json(now)["vehicle"]["mode"], "?");
+        EXPECT_NE(w.render(now).find("mode ?\n"), std::string::npos) << w.render(now);
+    }
     EXPECT_EQ(j["events"].size(), 8u);
 }
 

@@ -24,6 +24,23 @@ TransportConfig keyed(std::uint64_t nonce) {
     return c;
 }
 
+TEST(TelemetrySample, TheModeTravelsAsTheAutopilotsNumber) {
+    autopilot::Telemetry t;
+    EXPECT_EQ(make_sample(t).mode, protocol::kModeUnknown) << "no mode yet";
+    t.mode = "AUTO";
+    t.custom_mode = 10;
+    EXPECT_EQ(make_sample(t).mode, 10);
+    t.mode = "MODE(9)";
+    t.custom_mode = 9;
+    EXPECT_EQ(make_sample(t).mode, 9) << "a number without a name still travels";
+    t.mode = "MODE(254)";
+    t.custom_mode = 254;
+    EXPECT_EQ(make_sample(t).mode, 254);
+    t.mode = "MODE(999)";
+    t.custom_mode = 999;
+    EXPECT_EQ(make_sample(t).mode, protocol::kModeUnknown) << "too large for the byte";
+}
+
 TEST(TelemetryOnTheWire, ASampleCostsAtMostFortyEightBytesIncludingFraming) {
     TimePoint now = TimePoint{} + std::chrono::hours(1);
     Transport vehicle(keyed(0x1111), now), ground(keyed(0x2222), now);
@@ -44,6 +61,7 @@ TEST(TelemetryOnTheWire, ASampleCostsAtMostFortyEightBytesIncludingFraming) {
             t.gps_fix = autopilot::GpsFix::Fix3D;
             t.satellites = 9;
             t.mode = "AUTO";
+            t.custom_mode = 10;
             t.state = autopilot::VehicleState::WaypointNavigation;
             vehicle.send_fast(protocol::kPriorityTelemetry, protocol::kTopicTelemetry,
                               protocol::encode(make_sample(t)), now);

@@ -250,15 +250,9 @@ TEST(GroundProtocol, ReceptionReportRoundTrips) {
     EXPECT_FALSE(decode(std::vector<std::uint8_t>{kVersion, 0x13, 1, 2}).message);
 }
 
-TEST(GroundProtocol, StateAndModeNames) {
+TEST(GroundProtocol, StateNames) {
     EXPECT_STREQ(vehicle_state_name(4), "MANUAL_NAVIGATION");
     EXPECT_STREQ(vehicle_state_name(15), "?");
-    EXPECT_EQ(mode_code("AUTO"), 10);
-    EXPECT_STREQ(mode_name(10), "AUTO");
-    EXPECT_EQ(mode_code("MODE(9)"), 9);
-    EXPECT_EQ(mode_code("MODE(x)"), kModeUnknown);
-    EXPECT_EQ(mode_code("MODE(999)"), kModeUnknown);
-    EXPECT_STREQ(mode_name(200), "?");
 }
 
 }  // namespace
