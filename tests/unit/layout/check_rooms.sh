@@ -5,11 +5,8 @@ set -euo pipefail
 root=${1:?source dir}
 cd "$root"
 fail=0
-check() {
-  local what=$1 pattern=$2 allowed=$3
-  local hits
-  hits=$(grep -rlE "$pattern" --include='*.cpp' --include='*.hpp' --include='*.h' \
-           daemon services hal client tools 2>/dev/null | grep -vE "$allowed" || true)
+report() {
+  local what=$1 hits=$2
   if [ -n "$hits" ]; then
     echo "FAIL: $what outside its room:"
     echo "$hits" | sed 's/^/  /'
@@ -18,8 +15,21 @@ check() {
     echo "ok: $what"
   fi
 }
+check() {
+  local what=$1 pattern=$2 allowed=$3
+  report "$what" "$(grep -rlE "$pattern" --include='*.cpp' --include='*.hpp' --include='*.h' \
+                      daemon services hal client tools 2>/dev/null | grep -vE "$allowed" || true)"
+}
 check "termios/ioctl serial headers" '#include <(termios\.h|asm/termbits\.h|sys/ioctl\.h|pty\.h)>' '^hal/'
 check "libgpiod" '#include <gpiod\.h>' '^hal/'
 check "systemd notify protocol" '(#include <systemd/sd-daemon\.h>|sd_notify\(|NOTIFY_SOCKET)' '^daemon/'
 check "MAVLink outside the autopilot layer" '#include "services/autopilot/mavlink/' '^(services/autopilot/|tools/(mavdump|apmsim)/)'
+# groundlink and the flight plan service speak only the autopilot-neutral vocabulary (airseg_autopilot_api):
+# no ArduPilot driver or MAVLink header, and no library that brings them in.
+report "ArduPilot/MAVLink headers (included by groundlink or flightplan)" \
+  "$(grep -rlE '#include "services/autopilot/(ardupilot|mavlink)/' --include='*.cpp' --include='*.hpp' \
+       --include='*.h' services/groundlink services/flightplan || true)"
+report "the ArduPilot driver or MAVLink library (linked by groundlink or flightplan)" \
+  "$(grep -lE 'airseg_mavlink|airseg_autopilot([^_[:alnum:]]|$)' services/groundlink/CMakeLists.txt \
+       services/flightplan/CMakeLists.txt || true)"
 exit $fail
