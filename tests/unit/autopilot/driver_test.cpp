@@ -548,6 +548,7 @@ TEST(Driver, TelemetryFromTheStreams) {
     EXPECT_NEAR(t.position->alt, 12.0, 1e-9);
     EXPECT_NEAR(t.heading, 90.0, 1e-9);
     EXPECT_EQ(t.mode, "HOLD");
+    EXPECT_EQ(t.custom_mode, std::optional<std::uint32_t>(4));
     ASSERT_TRUE(rig.driver.status().position);
 }
 
