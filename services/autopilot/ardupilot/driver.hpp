@@ -24,6 +24,8 @@
 // boot banners right after a heartbeat gap) trigger a resync of parameters and mission and an
 // AutopilotRebooted event; an autopilot silent for unresponsive_timeout while its port is open makes the
 // driver ask for a reset pulse (at most max_reset_pulses times until it is READY again).
+// The link's timers and reboot evidence are LinkWatch's, a requested mode change from request to outcome is
+// ModeControl's; the driver feeds them and acts on what they report (events, frames, port actions).
 //
 // Contract (the service, on its strand): on_port_open/on_port_closed/on_reset_pulsed for the port; every byte
 // read to handle_bytes(); handle_timeout(now) when poll_timeout() is due; requests any time. After each call
