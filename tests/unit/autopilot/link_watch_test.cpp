@@ -137,6 +137,18 @@ TEST(LinkWatch, BaudProbingGoesRoundUntilTheAutopilotAnswers) {
     EXPECT_EQ(w.poll_timeout(), kOpen + seconds(20));  // only the unresponsive timer is left
 }
 
+TEST(LinkWatch, ANewBaudGetsHalfTheUnresponsiveTimeBeforeAPulse) {
+    LinkWatchConfig c = quiet_open();
+    c.bauds = {57600, 115200};
+    c.baud_probe = seconds(15);
+    LinkWatch w(c);
+    w.on_port_open(kOpen);
+    EXPECT_EQ(w.handle_timeout(kOpen + seconds(15)).baud, 115200u);
+    EXPECT_EQ(w.poll_timeout(), kOpen + seconds(25));  // not the 20 s from the open
+    EXPECT_FALSE(w.handle_timeout(kOpen + seconds(20)).pulse);
+    EXPECT_EQ(w.handle_timeout(kOpen + seconds(25)).pulse, 1u);
+}
+
 TEST(LinkWatch, OneBaudIsNeverProbed) {
     LinkWatch w(quiet_open());
     w.on_port_open(kOpen);
