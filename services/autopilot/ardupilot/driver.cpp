@@ -62,19 +62,17 @@ Driver::Driver(AutopilotConfig config)
       missions_(out_, config_.target_sysid, config_.target_compid, config_.mission),
       params_(out_, config_.target_sysid, config_.target_compid,
               ParamClientConfig{config_.param_timeout, config_.param_retries, config_.param_list_timeout}),
-      rc_(config_.rc_override, config_.target_sysid, config_.target_compid) {
-    if (config_.bauds.empty()) {
-        config_.bauds.push_back(115200);
-    }
-}
+      rc_(config_.rc_override, config_.target_sysid, config_.target_compid),
+      link_(LinkWatchConfig{config_.bauds, config_.baud_probe, config_.reset_on_open, config_.boot_timeout,
+                            config_.heartbeat_timeout, config_.unresponsive_timeout,
+                            config_.max_reset_pulses}),
+      modes_(config_.mode_timeout, config_.mode_retries) {}
 
 // --- port lifecycle ----------------------------------------------------------------------------------------
 
 void Driver::on_port_open(TimePoint now) {
-    port_open_ = true;
     opened_at_ = now;
-    quiet_since_ = now;
-    heard_frame_ = false;
+    link_.on_port_open(now);
     parser_ = mav::Parser{};
     missions_.forget_board();  // another board may be behind the port now
     stop_as_waypoint_ = false;
@@ -82,34 +80,25 @@ void Driver::on_port_open(TimePoint now) {
     auto_check_.cancel();
     forget_speed();
     speed_by_param_ = config_.board == Board::Apm2;  // ArduRover 2.x has no MAV_CMD_DO_CHANGE_SPEED command
-    time_boot_.reset();
     next_gcs_heartbeat_ = config_.gcs_heartbeat ? now : kNever;
-    baud_deadline_ = config_.bauds.size() > 1 ? now + config_.baud_probe : kNever;
-    if (config_.reset_on_open) {
-        // The open rebooted the autopilot: silence is expected until the boot window has passed.
-        quiet_since_ = now + config_.boot_timeout;
-    }
     enter(Phase::WaitBoot, now);
 }
 
 void Driver::on_port_closed(const std::string& reason, TimePoint now) {
-    port_open_ = false;
     auto_check_.cancel();
     cancel_everything("autopilot port closed: " + reason, now);
-    if (link_up_) {
-        link_up_ = false;
+    if (link_.on_port_closed()) {
         emit(LinkDown{reason});
     }
     phase_ = Phase::Closed;
     phase_deadline_ = kNever;
-    baud_deadline_ = kNever;
     next_gcs_heartbeat_ = kNever;
     last_error_ = reason;
     update_state(now, false);
 }
 
 void Driver::on_port_reopened(TimePoint now) {
-    if (!port_open_) {
+    if (!link_.port_open()) {
         on_port_open(now);
         return;
     }
@@ -117,8 +106,7 @@ void Driver::on_port_reopened(TimePoint now) {
 }
 
 void Driver::on_reset_pulsed(TimePoint now) {
-    quiet_since_ = now;
-    time_boot_.reset();
+    link_.on_reset_pulsed(now);
     cancel_everything("autopilot reset", now);
     enter(Phase::WaitBoot, now);
 }
@@ -142,41 +130,26 @@ void Driver::handle_timeout(TimePoint now) {
     params_.handle_timeout(now);
     drain_clients(now);
 
-    if (link_up_ && now >= last_heartbeat_ + config_.heartbeat_timeout) {
-        link_lost(now);
+    const LinkWatch::Due due = link_.handle_timeout(now);
+    if (due.lost) {
+        link_lost(*due.lost, now);
     }
     if (auto_check_.handle_timeout(now)) {
         report_current(telemetry_.mission_current);  // not back at the expected slot: say where it is
     }
     speed_timeout(now);
-    if (mode_request_ && now >= mode_request_->deadline) {
-        if (mode_request_->attempt >= config_.mode_retries) {
-            finish_mode(RequestResult::Timeout,
-                        std::string("no heartbeat in ") + rover_mode_name(mode_request_->mode) + " after " +
-                            std::to_string(mode_request_->attempt + 1) + " attempts",
-                        now);
-        } else {
-            ++mode_request_->attempt;
-            send_mode(mode_request_->mode);
-            mode_request_->deadline = now + config_.mode_timeout;
-        }
+    if (auto o = modes_.handle_timeout(now)) {
+        finish_mode(std::move(*o), now);
     }
-    if (port_open_ && now >= baud_deadline_ && !heard_frame_) {
-        baud_index_ = (baud_index_ + 1) % config_.bauds.size();
-        actions_.push_back(SwitchBaud{config_.bauds[baud_index_]});
-        baud_deadline_ = now + config_.baud_probe;
-        quiet_since_ = std::max(quiet_since_, now - config_.unresponsive_timeout / 2);
+    send_due_modes();
+    if (due.baud) {
+        actions_.push_back(SwitchBaud{*due.baud});
     }
-    if (port_open_ && !link_up_ && now >= quiet_since_ + config_.unresponsive_timeout) {
-        if (pulses_ < config_.max_reset_pulses) {
-            ++pulses_;
-            ++reset_pulses_;
-            actions_.push_back(PulseReset{pulses_});
-            last_error_ = "autopilot unresponsive, reset pulse " + std::to_string(pulses_);
-        } else {
-            last_error_ = "autopilot unresponsive; reset pulses exhausted";
-        }
-        quiet_since_ = now;  // give the pulse (or the operator) time before the next one
+    if (due.pulse) {
+        actions_.push_back(PulseReset{*due.pulse});
+        last_error_ = "autopilot unresponsive, reset pulse " + std::to_string(*due.pulse);
+    } else if (due.pulses_exhausted) {
+        last_error_ = "autopilot unresponsive; reset pulses exhausted";
     }
     if (now >= next_gcs_heartbeat_) {
         mav::Heartbeat hb;
@@ -190,12 +163,12 @@ void Driver::handle_timeout(TimePoint now) {
     if (now >= phase_deadline_) {
         phase_deadline_ = kNever;
         if (phase_ == Phase::WaitBoot) {
-            last_error_ = link_up_ ? "autopilot did not finish booting within boot_timeout"
-                                   : "no heartbeat from the autopilot within boot_timeout";
-            if (link_up_ && pulses_ < config_.max_reset_pulses) {
-                ++pulses_;
-                ++reset_pulses_;
-                actions_.push_back(PulseReset{pulses_});
+            last_error_ = link_.up() ? "autopilot did not finish booting within boot_timeout"
+                                     : "no heartbeat from the autopilot within boot_timeout";
+            if (link_.up()) {
+                if (const auto pulse = link_.take_pulse()) {
+                    actions_.push_back(PulseReset{*pulse});
+                }
             }
         } else if (retry_pending_) {
             retry_pending_ = false;
@@ -207,23 +180,10 @@ void Driver::handle_timeout(TimePoint now) {
 
 TimePoint Driver::poll_timeout() const {
     TimePoint t = std::min({missions_.poll_timeout(), params_.poll_timeout(), phase_deadline_,
-                            rc_.poll_timeout(), next_gcs_heartbeat_, auto_check_.poll_timeout()});
+                            rc_.poll_timeout(), next_gcs_heartbeat_, auto_check_.poll_timeout(),
+                            link_.poll_timeout(), modes_.poll_timeout()});
     if (speed_request_) {
         t = std::min(t, speed_request_->deadline);
-    }
-    if (link_up_) {
-        t = std::min(t, last_heartbeat_ + config_.heartbeat_timeout);
-    }
-    if (mode_request_) {
-        t = std::min(t, mode_request_->deadline);
-    }
-    if (port_open_) {
-        if (!heard_frame_) {
-            t = std::min(t, baud_deadline_);
-        }
-        if (!link_up_) {
-            t = std::min(t, quiet_since_ + config_.unresponsive_timeout);
-        }
     }
     return t;
 }
@@ -255,7 +215,7 @@ std::optional<DriverAction> Driver::poll_action() {
 }
 
 void Driver::flush_rc(TimePoint now) {
-    rc_.set_enabled(state_ == VehicleState::ManualNavigation && link_up_, now);
+    rc_.set_enabled(state_ == VehicleState::ManualNavigation && link_.up(), now);
     while (auto m = rc_.poll(now)) {
         out_.send(*m);
     }
@@ -272,7 +232,7 @@ void Driver::enter(Phase p, TimePoint now) {
             break;
         case Phase::WaitBoot:
             sequence_start_ = now;
-            time_boot_.reset();  // the clock of the boot being waited for starts again
+            link_.forget_boot_clock();
             ready_s_.reset();
             phase_deadline_ = now + config_.boot_timeout;
             break;
@@ -288,7 +248,7 @@ void Driver::enter(Phase p, TimePoint now) {
             break;
         case Phase::Ready:
             last_error_.clear();
-            pulses_ = 0;
+            link_.refill_pulses();
             ready_s_ = seconds_between(sequence_start_, now);
             emit(Ready{*ready_s_});
             break;
@@ -500,8 +460,8 @@ void Driver::cancel_everything(const std::string& why, TimePoint now) {
     params_.cancel_all(why);
     drain_clients(now);
     sequence_sets_.clear();
-    if (mode_request_) {
-        finish_mode(RequestResult::Cancelled, why, now);
+    if (auto o = modes_.cancel(why)) {
+        finish_mode(std::move(*o), now);
     }
     override_active_ = false;
 }
@@ -523,7 +483,7 @@ std::uint32_t Driver::reject_if_not_ready(RequestKind kind) {
     }
     const std::uint32_t id = next_id_++;
     done(id, kind, RequestResult::NotReady,
-         std::string("autopilot not ready (") + to_string(phase_) + (link_up_ ? "" : ", link down") + ")");
+         std::string("autopilot not ready (") + to_string(phase_) + (link_.up() ? "" : ", link down") + ")");
     return id;
 }
 
@@ -596,7 +556,7 @@ std::uint32_t Driver::clear_mission(TimePoint now) {
 }
 
 std::uint32_t Driver::get_param(const std::string& name, TimePoint now) {
-    if (!link_up_) {
+    if (!link_.up()) {
         const std::uint32_t id = next_id_++;
         done(id, RequestKind::GetParam, RequestResult::NotReady, "autopilot link down");
         return id;
@@ -632,9 +592,9 @@ void Driver::operator_reset(TimePoint now) {
 std::uint32_t Driver::request_state(VehicleState target, TimePoint now) {
     const std::uint32_t id = next_id_++;
     // The failsafe needs only a live link; everything else needs a READY autopilot.
-    if (!link_up_ || (target != VehicleState::Manual && !ready())) {
+    if (!link_.up() || (target != VehicleState::Manual && !ready())) {
         done(id, RequestKind::SetState, RequestResult::NotReady,
-             link_up_ ? "autopilot not ready" : "autopilot link down");
+             link_.up() ? "autopilot not ready" : "autopilot link down");
         return id;
     }
     if (auto why = transition_refusal(state_, target)) {
@@ -643,9 +603,8 @@ std::uint32_t Driver::request_state(VehicleState target, TimePoint now) {
         return id;
     }
     const auto mode = static_cast<std::uint32_t>(*mode_for(target));
-    if (mode_request_) {
-        finish_mode(RequestResult::Cancelled, std::string("superseded by a request for ") + to_string(target),
-                    now);
+    if (auto o = modes_.cancel(std::string("superseded by a request for ") + to_string(target))) {
+        finish_mode(std::move(*o), now);
     }
     if (mode_ && *mode_ == mode) {
         // Same autopilot mode (MANUAL for DIRECTED, MANUAL_NAVIGATION and failsafe MANUAL): only our side
@@ -657,11 +616,11 @@ std::uint32_t Driver::request_state(VehicleState target, TimePoint now) {
         done(id, RequestKind::SetState, RequestResult::Ok);
         return id;
     }
-    mode_request_ = ModeRequest{id, target, mode, 0, now + config_.mode_timeout};
+    modes_.start(id, target, mode, now);
     if (target == VehicleState::WaypointNavigation) {
         auto_check_.arm(board_slot(), now);
     }
-    send_mode(mode);
+    send_due_modes();
     return id;
 }
 
@@ -693,21 +652,25 @@ void Driver::send_mode(std::uint32_t mode) {
     }
 }
 
-void Driver::finish_mode(RequestResult r, std::string detail, TimePoint now) {
-    const ModeRequest req = *mode_request_;
-    mode_request_.reset();
-    if (r == RequestResult::Ok) {
-        override_active_ = req.target == VehicleState::ManualNavigation;
-        failsafe_latched_ = failsafe_latched_ || req.target == VehicleState::Manual;
+void Driver::send_due_modes() {
+    while (const auto mode = modes_.poll_send()) {
+        send_mode(*mode);
+    }
+}
+
+void Driver::finish_mode(ModeOutcome o, TimePoint now) {
+    if (o.result == RequestResult::Ok) {
+        override_active_ = o.target == VehicleState::ManualNavigation;
+        failsafe_latched_ = failsafe_latched_ || o.target == VehicleState::Manual;
         update_state(now, true);
         flush_rc(now);
     }
-    done(req.id, RequestKind::SetState, r, std::move(detail));
+    done(o.id, RequestKind::SetState, o.result, std::move(o.detail));
 }
 
 void Driver::update_state(TimePoint now, bool requested) {
     VehicleState s = VehicleState::Unknown;
-    if (link_up_ && mode_) {
+    if (link_.up() && mode_) {
         s = state_for(*mode_, phase_ != Phase::Ready, override_active_, failsafe_latched_);
     }
     const std::string name = mode_ ? rover_mode_name(*mode_) : std::string();
@@ -728,7 +691,7 @@ void Driver::update_state(TimePoint now, bool requested) {
 
 AutopilotStatus Driver::status() const {
     AutopilotStatus s;
-    s.link_up = link_up_;
+    s.link_up = link_.up();
     s.ready = ready();
     s.ready_s = ready_s_;
     s.state = state_;
@@ -736,7 +699,7 @@ AutopilotStatus Driver::status() const {
     s.position = telemetry_.position;
     s.mission_current = telemetry_.mission_current;
     s.reboots = reboots_;
-    s.reset_pulses = reset_pulses_;
+    s.reset_pulses = link_.reset_pulses();
     s.speed = speed_set_;
     s.mission_items = missions_.answers_int() ? "int" : "float";
     s.auto_restarts_corrected = auto_check_.corrections();

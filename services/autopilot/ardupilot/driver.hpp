@@ -24,6 +24,8 @@
 // boot banners right after a heartbeat gap) trigger a resync of parameters and mission and an
 // AutopilotRebooted event; an autopilot silent for unresponsive_timeout while its port is open makes the
 // driver ask for a reset pulse (at most max_reset_pulses times until it is READY again).
+// The link's timers and reboot evidence are LinkWatch's, a requested mode change from request to outcome is
+// ModeControl's; the driver feeds them and acts on what they report (events, frames, port actions).
 //
 // Contract (the service, on its strand): on_port_open/on_port_closed/on_reset_pulsed for the port; every byte
 // read to handle_bytes(); handle_timeout(now) when poll_timeout() is due; requests any time. After each call
@@ -39,7 +41,9 @@
 #include <vector>
 
 #include "services/autopilot/ardupilot/auto_entry_check.hpp"
+#include "services/autopilot/ardupilot/link_watch.hpp"
 #include "services/autopilot/ardupilot/mission_client.hpp"
+#include "services/autopilot/ardupilot/mode_control.hpp"
 #include "services/autopilot/ardupilot/outbox.hpp"
 #include "services/autopilot/ardupilot/param_client.hpp"
 #include "services/autopilot/ardupilot/rc_override.hpp"
@@ -113,7 +117,7 @@ class Driver {
     const MissionClient& mission_client() const { return missions_; }
     const RcOverride& rc_override() const { return rc_; }
     const mavlink::ParserStats& parser_stats() const { return parser_.stats(); }
-    unsigned current_baud() const { return config_.bauds[baud_index_]; }
+    unsigned current_baud() const { return link_.baud(); }
     const std::string& last_error() const { return last_error_; }
     const AutoEntryCheck& auto_entry_check() const { return auto_check_; }
     /// The speed the board last confirmed for the leg it drives (m/s), if any was set.
@@ -124,17 +128,10 @@ class Driver {
     bool speed_by_param() const { return speed_by_param_; }
     /// True when Stop items go as waypoints and the driver holds the vehicle on arrival.
     bool stops_as_waypoints() const { return stop_as_waypoint_; }
-    bool link_up() const { return link_up_; }
-    bool ready() const { return phase_ == Phase::Ready && link_up_; }
+    bool link_up() const { return link_.up(); }
+    bool ready() const { return phase_ == Phase::Ready && link_.up(); }
 
   private:
-    struct ModeRequest {
-        std::uint32_t id = 0;
-        VehicleState target = VehicleState::Unknown;
-        std::uint32_t mode = 0;
-        unsigned attempt = 0;
-        TimePoint deadline = kNever;
-    };
     struct SpeedRequest {
         double value = 0.0;
         unsigned attempt = 0;
@@ -162,7 +159,8 @@ class Driver {
     void done(std::uint32_t id, RequestKind kind, RequestResult result, std::string detail = {});
     std::uint32_t reject_if_not_ready(RequestKind kind);
     void send_mode(std::uint32_t mode);
-    void finish_mode(RequestResult r, std::string detail, TimePoint now);
+    void send_due_modes();
+    void finish_mode(ModeOutcome o, TimePoint now);
     void update_state(TimePoint now, bool requested);
     void emit(Event e) { events_.push_back(std::move(e)); }
     void flush_rc(TimePoint now);
@@ -175,7 +173,7 @@ class Driver {
     void on_command_ack(const mavlink::CommandAck& ack, TimePoint now);
     void on_reached(std::uint16_t seq, TimePoint now);
     void reboot_detected(const std::string& evidence, TimePoint now);
-    void link_lost(TimePoint now);
+    void link_lost(Duration silent, TimePoint now);
     void tap_incoming(const mavlink::Frame& f);
     void on_mission_current(std::uint16_t seq, TimePoint now);
     void report_current(std::uint16_t seq);
@@ -195,10 +193,11 @@ class Driver {
     MissionClient missions_;
     ParamClient params_;
     RcOverride rc_;
+    LinkWatch link_;
+    ModeControl modes_;
     FrameTap tap_;
 
     Phase phase_ = Phase::Closed;
-    bool port_open_ = false;
     TimePoint opened_at_{};
     TimePoint sequence_start_{};
     TimePoint phase_deadline_ = kNever;  // boot timeout, or the pause before retrying a failed step
@@ -206,17 +205,7 @@ class Driver {
     std::string last_error_;
     std::optional<double> ready_s_;
 
-    // Link.
-    bool link_up_ = false;
-    TimePoint last_heartbeat_{};
-    TimePoint quiet_since_{};  // reference for the unresponsive timer
-    bool heard_frame_ = false;
-    std::size_t baud_index_ = 0;
-    TimePoint baud_deadline_ = kNever;
     TimePoint next_gcs_heartbeat_ = kNever;
-    unsigned pulses_ = 0;
-    TimePoint gap_window_end_{};  // boot banners until then count as reboot evidence
-    std::optional<std::pair<std::uint32_t, TimePoint>> time_boot_;
 
     // Vehicle.
     std::optional<std::uint32_t> mode_;
@@ -225,7 +214,6 @@ class Driver {
     bool failsafe_latched_ = false;
     VehicleState state_ = VehicleState::Unknown;
     std::string mode_name_;
-    std::optional<ModeRequest> mode_request_;
     Telemetry telemetry_;
     std::optional<std::pair<std::uint16_t, TimePoint>> last_reached_;
     std::uint16_t reported_current_ = 0;  // the mission slot last reported (MissionCurrentChanged)
@@ -239,7 +227,6 @@ class Driver {
     bool speed_by_param_ = false;
     unsigned speed_changes_ = 0;
     unsigned reboots_ = 0;
-    unsigned reset_pulses_ = 0;
 
     // Mission and parameters.
     std::vector<MissionItem> mission_;

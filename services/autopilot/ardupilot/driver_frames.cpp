@@ -14,26 +14,13 @@ namespace airseg::autopilot::ardupilot {
 namespace mav = airseg::mavlink;
 
 namespace {
-constexpr Duration kGapWindow = seconds(10);   // boot banners this long after a heartbeat gap mean a reboot
 constexpr Duration kSameReached = seconds(3);  // the item-reached message and the text for the same slot
-constexpr Duration kClockSlack = seconds(2);   // latency jitter allowed when comparing time_boot_ms
 
 std::string lower(std::string_view s) {
     std::string out(s);
     std::transform(out.begin(), out.end(), out.begin(),
                    [](char c) { return static_cast<char>(std::tolower(static_cast<unsigned char>(c))); });
     return out;
-}
-
-const char* mav_result_name(std::uint8_t r) {
-    static const char* const kNames[] = {"ACCEPTED", "TEMPORARILY_REJECTED", "DENIED",   "UNSUPPORTED",
-                                         "FAILED",   "IN_PROGRESS",          "CANCELLED"};
-    return r < std::size(kNames) ? kNames[r] : "unknown";
-}
-
-bool is_boot_banner(const std::string& text) {
-    return text.starts_with("initialising apm") || text.starts_with("init ardu") ||
-           text.starts_with("ardurover") || text.starts_with("apm:rover");
 }
 }  // namespace
 
@@ -58,10 +45,7 @@ void Driver::on_frame(const mav::Frame& f, TimePoint now) {
     if (f.sysid != config_.target_sysid) {
         return;
     }
-    // Only the autopilot's own frames end baud probing: line noise at a wrong rate passes a checksum now
-    // and then, but hardly ever with the right system id as well.
-    heard_frame_ = true;
-    baud_deadline_ = kNever;
+    link_.on_frame();
     missions_.handle_frame(f, now);
     params_.handle_frame(f, now);
     const auto p = f.payload_view();
@@ -144,8 +128,7 @@ void Driver::on_frame(const mav::Frame& f, TimePoint now) {
 }
 
 void Driver::on_heartbeat(const mav::Heartbeat& hb, TimePoint now) {
-    last_heartbeat_ = now;
-    quiet_since_ = now;
+    const bool came_up = link_.on_heartbeat(now);
     system_status_ = hb.system_status;
     // APM:Rover 2.x reports MAV_STATE_UNINIT in HOLD (send_heartbeat() of its GCS_Mavlink.pde): in a running
     // mode UNINIT is that quirk, not a board starting up.
@@ -154,9 +137,7 @@ void Driver::on_heartbeat(const mav::Heartbeat& hb, TimePoint now) {
     const bool booting = uninit_booting || hb.system_status == mavlink::kMavStateBoot ||
                          hb.system_status == mavlink::kMavStateCalibrating ||
                          hb.custom_mode == static_cast<std::uint32_t>(RoverMode::Initialising);
-    if (!link_up_) {
-        link_up_ = true;
-        gap_window_end_ = now + kGapWindow;
+    if (came_up) {
         emit(LinkUp{});
         if (phase_ == Phase::Ready) {
             request_streams();  // the autopilot may have lost them in a reboot we cannot prove
@@ -167,8 +148,8 @@ void Driver::on_heartbeat(const mav::Heartbeat& hb, TimePoint now) {
     }
     const bool mode_changed = !mode_ || *mode_ != hb.custom_mode;
     mode_ = hb.custom_mode;
-    if (mode_request_ && hb.custom_mode == mode_request_->mode) {
-        finish_mode(RequestResult::Ok, {}, now);
+    if (auto o = modes_.on_heartbeat(hb.custom_mode)) {
+        finish_mode(std::move(*o), now);
     } else if (mode_changed) {
         override_active_ = false;  // the RC pilot or the autopilot took over
     }
@@ -176,7 +157,8 @@ void Driver::on_heartbeat(const mav::Heartbeat& hb, TimePoint now) {
         enter(Phase::Params, now);
     }
     update_state(now, false);
-    if (stop_hold_sent_ && hb.custom_mode == static_cast<std::uint32_t>(RoverMode::Auto) && !mode_request_) {
+    if (stop_hold_sent_ && hb.custom_mode == static_cast<std::uint32_t>(RoverMode::Auto) &&
+        !modes_.pending()) {
         if (now - *stop_hold_sent_ < config_.mode_timeout * config_.mode_retries) {
             send_mode(static_cast<std::uint32_t>(RoverMode::Hold));  // the first was lost
         } else {
@@ -265,27 +247,16 @@ void Driver::on_statustext(const mav::Statustext& t, TimePoint now) {
             on_reached(static_cast<std::uint16_t>(seq), now);
         }
     }
-    if (is_boot_banner(l) && now < gap_window_end_ && phase_ != Phase::WaitBoot && phase_ != Phase::Closed) {
+    if (link_.reboot_banner(l, now) && phase_ != Phase::WaitBoot && phase_ != Phase::Closed) {
         reboot_detected("heartbeat gap with boot messages (\"" + text + "\")", now);
     }
 }
 
 void Driver::on_time_boot(std::uint32_t time_boot_ms, TimePoint now) {
-    if (time_boot_ && phase_ != Phase::WaitBoot && phase_ != Phase::Closed) {
-        const auto [before, at] = *time_boot_;
-        const auto ours = std::chrono::duration_cast<milliseconds>(now - at).count();
-        const std::int64_t theirs =
-            static_cast<std::int64_t>(time_boot_ms) - static_cast<std::int64_t>(before);
-        const auto slack =
-            std::chrono::duration_cast<milliseconds>(std::max(kClockSlack, config_.heartbeat_timeout));
-        if (theirs + slack.count() < ours) {
-            time_boot_ = std::pair{time_boot_ms, now};
-            reboot_detected(theirs < 0 ? "time_boot_ms went back" : "time_boot_ms restarted during a silence",
-                            now);
-            return;
-        }
+    if (auto evidence =
+            link_.on_time_boot(time_boot_ms, now, phase_ != Phase::WaitBoot && phase_ != Phase::Closed)) {
+        reboot_detected(*evidence, now);
     }
-    time_boot_ = std::pair{time_boot_ms, now};
 }
 
 void Driver::on_command_ack(const mav::CommandAck& ack, TimePoint now) {
@@ -293,16 +264,12 @@ void Driver::on_command_ack(const mav::CommandAck& ack, TimePoint now) {
         on_speed_ack(ack.result, now);
         return;
     }
-    if (ack.command != mavlink::kCmdDoSetMode || !mode_request_) {
+    if (ack.command != mavlink::kCmdDoSetMode) {
         return;
     }
-    if (ack.result == 0 || ack.result == 5) {
-        return;  // accepted / in progress: the heartbeat confirms
+    if (auto o = modes_.on_ack(ack.result)) {
+        finish_mode(std::move(*o), now);
     }
-    finish_mode(RequestResult::Refused,
-                std::string("autopilot answered MAV_RESULT_") + mav_result_name(ack.result) + " to mode " +
-                    rover_mode_name(mode_request_->mode),
-                now);
 }
 
 void Driver::on_reached(std::uint16_t seq, TimePoint now) {
@@ -326,10 +293,9 @@ void Driver::reboot_detected(const std::string& evidence, TimePoint now) {
     enter(Phase::WaitBoot, now);
 }
 
-void Driver::link_lost(TimePoint now) {
-    link_up_ = false;
-    const auto silent = std::chrono::duration<double>(now - last_heartbeat_).count();
-    emit(LinkDown{"no heartbeat for " + std::to_string(static_cast<int>(silent)) + " s"});
+void Driver::link_lost(Duration silent, TimePoint now) {
+    const auto silent_s = std::chrono::duration<double>(silent).count();
+    emit(LinkDown{"no heartbeat for " + std::to_string(static_cast<int>(silent_s)) + " s"});
     // Transfers in progress are left to their own timeouts: a few lost heartbeats on a noisy radio must not
     // throw away a long upload that is still making progress.
     update_state(now, false);
