@@ -5,8 +5,8 @@
 #include <utility>
 #include <vector>
 
-#include "tools/apmsim/rover_sim.hpp"
 #include "cli/values.hpp"
+#include "tools/apmsim/rover_sim.hpp"
 
 namespace airseg::apmsim {
 
@@ -19,8 +19,8 @@ struct ApmSimOptions {
     Faults faults;
     std::vector<std::pair<std::string, float>> params;  // --param NAME=VALUE
     std::optional<Duration> reboot_at;                  // --reboot-at S (simulated seconds after start)
-    std::vector<cli::Window> hb_stalls;          // --hb-stall START:DUR
-    std::vector<cli::Window> unplugs;            // --unplug START:DUR
+    std::vector<cli::Window> hb_stalls;                 // --hb-stall START:DUR
+    std::vector<cli::Window> unplugs;                   // --unplug START:DUR
     bool quiet = false;                                 // --quiet
 };
 
