@@ -5,7 +5,9 @@
 
 #include <unistd.h>
 #include <algorithm>
+#include <climits>
 #include <csignal>
+#include <cstdint>
 #include <cstdlib>
 #include <functional>
 #include <iostream>
@@ -15,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "cli/command_line.hpp"
 #include "client/live_commands.hpp"
 #include "client/local_client.hpp"
 #include "client/plan_command.hpp"
@@ -28,7 +31,6 @@ namespace {
 // Exit codes shared by every subcommand.
 constexpr int kDone = 0;
 constexpr int kRefused = 1;
-constexpr int kUsage = 2;
 constexpr int kNoLink = 3;
 
 const char* kUsageText =
@@ -83,9 +85,6 @@ struct Options {
     std::vector<std::string> positional;
 };
 
-// The names a mistyped word is compared with, for "did you mean".
-const std::vector<std::string> kOptionNames{"--local", "--socket", "--link",    "--baud", "--mode",   "--udp",
-                                            "--key",   "--json",   "--timeout", "--help", "--version"};
 const std::vector<std::string> kCommandNames{"status", "watch",    "state",   "param", "rates",
                                              "log",    "joystick", "request", "plan"};
 const std::vector<std::string> kLiveOptionNames{"--duration", "--interval", "--device", "--rate", "--note"};
@@ -93,91 +92,61 @@ const std::vector<std::string> kLiveOptionNames{"--duration", "--interval", "--d
 /// A bad command line in one line and where the help is: the whole help would push the reason off the
 /// screen.
 int usage_error(const std::string& message) {
-    std::cerr << "airsegctl: " << message << "; see airsegctl --help\n";
-    return kUsage;
+    return airseg::cli::usage_error(std::cerr, "airsegctl", message);
 }
 
+/// The connection and output options; they may stand anywhere on the line. The first other word is the
+/// command, and options the table does not know after it are the command's own (watch --duration MS).
 std::optional<int> parse(int argc, char** argv, Options& o) {
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        auto value = [&](const char* name) -> std::optional<std::string> {
-            if (i + 1 >= argc) {
-                return std::nullopt;
-            }
-            (void)name;
-            return std::string(argv[++i]);
-        };
-        if (a == "--help" || a == "-h") {
-            std::cout << kUsageText;
-            return kDone;
-        } else if (a == "--version") {
-            std::cout << "airsegctl " << AIRSEG_VERSION << "\n";
-            return kDone;
-        } else if (a == "--local") {
-            o.use_radio = false;  // the default; named for scripts that want to be explicit
-        } else if (a == "--json") {
-            o.json = true;
-        } else if (a == "--socket") {
-            auto v = value("--socket");
-            if (!v) {
-                return usage_error("--socket needs a PATH");
-            }
-            o.socket = *v;
-        } else if (a == "--link") {
-            auto v = value("--link");
-            if (!v || v->empty()) {
-                return usage_error("--link needs PATH[,PATH2]");
-            }
-            o.radio.ports.clear();
-            std::size_t start = 0;
-            for (std::size_t comma; (comma = v->find(',', start)) != std::string::npos; start = comma + 1) {
-                o.radio.ports.push_back(v->substr(start, comma - start));
-            }
-            o.radio.ports.push_back(v->substr(start));
-            if (o.radio.ports.size() == 2 && o.radio.mode == "single") {
-                o.radio.mode = "split";
-            }
-            o.use_radio = true;
-        } else if (a == "--udp") {
-            auto v = value("--udp");
-            if (!v) {
-                return usage_error("--udp needs HOST:PORT");
-            }
-            o.radio.udp = *v;
-            o.use_radio = true;
-        } else if (a == "--baud" || a == "--mode" || a == "--key") {
-            auto v = value(a.c_str());
-            if (!v) {
-                return usage_error(a + " needs a value");
-            }
-            if (a == "--baud") {
-                char* end = nullptr;
-                o.radio.baud = static_cast<unsigned>(std::strtoul(v->c_str(), &end, 10));
-                if (*end != '\0') {
-                    return usage_error("--baud needs a number");
-                }
-            } else if (a == "--mode") {
-                o.radio.mode = *v;
-            } else {
-                o.radio.key_file = *v;
-            }
-        } else if (a == "--timeout") {
-            auto v = value("--timeout");
-            char* end = nullptr;
-            const long ms = v ? std::strtol(v->c_str(), &end, 10) : 0;
-            if (!v || *end != '\0' || ms <= 0) {
-                return usage_error("--timeout needs a positive number of milliseconds");
-            }
-            o.timeout_ms = ms;
-        } else if (a.starts_with("-") && a.size() > 1) {
-            if (o.positional.empty()) {
-                return usage_error("unknown option '" + a + "'" + airseg::did_you_mean(a, kOptionNames));
-            }
-            o.positional.push_back(a);  // an option of the command itself (watch --duration MS, ...)
-        } else {
-            o.positional.push_back(a);
-        }
+    using namespace airseg::cli;
+    OptionTable table;
+    table
+        .flag("local", "", [&o] { o.use_radio = false; })  // the default; named for scripts to be explicit
+        .value("socket", "PATH", "", text(o.socket))
+        .value("link", "PATH[,PATH2]", "",
+               [&o](std::string_view option, std::string_view v) {
+                   if (v.empty()) {
+                       throw UsageError(std::string(option) + ": expected PATH[,PATH2], got ''");
+                   }
+                   o.radio.ports.clear();
+                   std::size_t start = 0;
+                   for (std::size_t comma; (comma = v.find(',', start)) != std::string_view::npos;
+                        start = comma + 1) {
+                       o.radio.ports.emplace_back(v.substr(start, comma - start));
+                   }
+                   o.radio.ports.emplace_back(v.substr(start));
+                   if (o.radio.ports.size() == 2 && o.radio.mode == "single") {
+                       o.radio.mode = "split";
+                   }
+                   o.use_radio = true;
+               })
+        .value("udp", "HOST:PORT", "",
+               [&o](std::string_view, std::string_view v) {
+                   o.radio.udp = v;
+                   o.use_radio = true;
+               })
+        .value("baud", "N", "", number(o.radio.baud, 0, UINT32_MAX))
+        .value("mode", "MODE", "", text(o.radio.mode))
+        .value("key", "FILE", "", text(o.radio.key_file))
+        .value("timeout", "MS", "",
+               [&o](std::string_view option, std::string_view v) {
+                   try {
+                       o.timeout_ms = static_cast<long>(parse_unsigned(option, v, 1, LONG_MAX));
+                   } catch (const UsageError&) {
+                       throw UsageError(std::string(option) +
+                                        ": expected a positive number of milliseconds, got '" +
+                                        std::string(v) + "'");
+                   }
+               })
+        .flag("json", "", [&o] { o.json = true; })
+        .help_and_version();
+    const Program program{"airsegctl", [] { return std::string(kUsageText); }};
+    auto line = run(program, std::vector<std::string>(argv + std::min(argc, 1), argv + argc), table,
+                    std::cout, std::cerr, {.max = SIZE_MAX, .take_unknown_options = true});
+    if (line.exit_code) {
+        return line.exit_code;
     }
+    o.positional = std::move(line.operands);
     if (o.positional.empty()) {
         return usage_error("no command given");
     }

@@ -3,12 +3,14 @@
 #include <fmt/format.h>
 #include <boost/program_options.hpp>
 
+#include <algorithm>
 #include <sstream>
 
+#include "cli/command_line.hpp"
 #include "services/common/nearest_word.hpp"
 
 namespace airseg::daemon {
-namespace po = boost::program_options;
+namespace po = cli::po;
 
 namespace {
 
@@ -30,19 +32,12 @@ po::options_description describe() {
     return d;
 }
 
-/// A bad command line in one line, with the near miss of a mistyped option and where the help is: the
-/// whole help would push the reason off the screen.
-std::string usage_error(const std::string& message, const std::string& word = {}) {
-    std::string hint;
-    if (word.starts_with("--")) {
-        std::vector<std::string> names;
-        const auto options = describe();  // named: a temporary would die before the loop reads it
-        for (const auto& option : options.options()) {
-            names.push_back("--" + option->long_name());
-        }
-        hint = did_you_mean(word.substr(0, word.find('=')), names);
-    }
-    return fmt::format("airsegd: {}{}; see airsegd --help\n", message, hint);
+/// A bad command line in one line and where the help is: the whole help would push the reason off the
+/// screen.
+std::string usage_error(const std::string& message) {
+    std::ostringstream out;
+    cli::usage_error(out, "airsegd", message);
+    return out.str();
 }
 
 }  // namespace
@@ -72,16 +67,12 @@ CliResult parse_cli(int argc, const char* const* argv) {
     CliResult result;
     po::variables_map vm;
     try {
-        po::store(po::command_line_parser(argc, argv).options(describe()).run(), vm);
-        po::notify(vm);
-    } catch (const po::unknown_option& e) {
+        // Unique prefixes of the long names have always been accepted here ("--conf").
+        cli::parse(std::vector<std::string>(argv + std::min(argc, 1), argv + argc), describe(), vm,
+                   {.allow_guessing = true});
+    } catch (const cli::UsageError& e) {
         result.action = CliResult::Action::Exit;
-        result.exit_code = 2;
-        result.output = usage_error(e.what(), e.get_option_name());
-        return result;
-    } catch (const po::error& e) {
-        result.action = CliResult::Action::Exit;
-        result.exit_code = 2;
+        result.exit_code = cli::kUsageExit;
         result.output = usage_error(e.what());
         return result;
     }
@@ -106,7 +97,7 @@ CliResult parse_cli(int argc, const char* const* argv) {
                                                       "error", "critical", "off"};
         if (std::find(kLevels.begin(), kLevels.end(), level) == kLevels.end()) {
             result.action = CliResult::Action::Exit;
-            result.exit_code = 2;
+            result.exit_code = cli::kUsageExit;
             result.output = usage_error(fmt::format("--log-level: '{}' is not one of {}{}", level,
                                                     fmt::join(kLevels, ", "), did_you_mean(level, kLevels)));
             return result;

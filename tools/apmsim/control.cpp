@@ -3,7 +3,7 @@
 #include <sstream>
 #include <vector>
 
-#include "tools/common/cli.hpp"
+#include "cli/values.hpp"
 
 namespace airseg::apmsim {
 
@@ -127,7 +127,7 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
     const std::string& verb = w[0];
     const auto need = [&](std::size_t n, const char* form) {
         if (w.size() != n) {
-            throw toolcommon::UsageError(std::string("usage: ") + form);
+            throw cli::UsageError(std::string("usage: ") + form);
         }
     };
     try {
@@ -139,7 +139,7 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
                 return modes_json(sim).dump();
             }
             need(2, "modes [LAST_N]");
-            const auto n = toolcommon::parse_unsigned(verb, w[1], 1, UINT32_MAX);
+            const auto n = cli::parse_unsigned(verb, w[1], 1, UINT32_MAX);
             auto all = modes_json(sim);
             const auto skip = all.size() > n ? all.size() - n : 0;
             return nlohmann::json(all.begin() + static_cast<std::ptrdiff_t>(skip), all.end()).dump();
@@ -147,18 +147,18 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
         if (verb == "reached") {
             // Paged: a datagram holds a few hundred entries comfortably.
             if (w.size() > 3) {
-                throw toolcommon::UsageError("usage: reached [FROM [COUNT]]");
+                throw cli::UsageError("usage: reached [FROM [COUNT]]");
             }
-            const auto from = w.size() > 1 ? toolcommon::parse_unsigned(verb, w[1], 0, UINT64_MAX) : 0;
-            const auto count = w.size() > 2 ? toolcommon::parse_unsigned(verb, w[2], 1, 500) : 500;
+            const auto from = w.size() > 1 ? cli::parse_unsigned(verb, w[1], 0, UINT64_MAX) : 0;
+            const auto count = w.size() > 2 ? cli::parse_unsigned(verb, w[2], 1, 500) : 500;
             return reached_json(sim, from, count).dump();
         }
         if (verb == "speeds") {
             if (w.size() > 3) {
-                throw toolcommon::UsageError("usage: speeds [FROM [COUNT]]");
+                throw cli::UsageError("usage: speeds [FROM [COUNT]]");
             }
-            const auto from = w.size() > 1 ? toolcommon::parse_unsigned(verb, w[1], 0, UINT64_MAX) : 0;
-            const auto count = w.size() > 2 ? toolcommon::parse_unsigned(verb, w[2], 1, 500) : 500;
+            const auto from = w.size() > 1 ? cli::parse_unsigned(verb, w[1], 0, UINT64_MAX) : 0;
+            const auto count = w.size() > 2 ? cli::parse_unsigned(verb, w[2], 1, 500) : 500;
             return speeds_json(sim, from, count).dump();
         }
         if (verb == "stats") {
@@ -195,7 +195,7 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
                 return "ok rebooting";
             }
             need(2, "reboot [SECONDS]");
-            sim.schedule_reboot(now + toolcommon::parse_seconds(verb, w[1]));
+            sim.schedule_reboot(now + cli::parse_seconds(verb, w[1]));
             return "ok reboot in " + w[1] + " s";
         }
         if (verb == "unplug") {
@@ -208,22 +208,22 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
         }
         if (verb == "hbstall") {
             need(2, "hbstall SECONDS");
-            sim.stall_heartbeats(toolcommon::parse_seconds(verb, w[1]), now);
+            sim.stall_heartbeats(cli::parse_seconds(verb, w[1]), now);
             return "ok no heartbeats for " + w[1] + " s";
         }
         if (verb == "loss") {
             if (w.size() != 2 && w.size() != 3) {
-                throw toolcommon::UsageError("usage: loss P [BURST]");
+                throw cli::UsageError("usage: loss P [BURST]");
             }
-            const double p = toolcommon::parse_probability(verb, w[1]);
-            const double burst = w.size() == 3 ? toolcommon::parse_double(verb, w[2], 1, 10000) : 1.0;
+            const double p = cli::parse_probability(verb, w[1]);
+            const double burst = w.size() == 3 ? cli::parse_double(verb, w[2], 1, 10000) : 1.0;
             sim.faults().loss = p;
             sim.faults().loss_burst = burst;
             return "ok loss " + w[1] + (w.size() == 3 ? " in bursts of " + w[2] + " bytes" : "");
         }
         if (verb == "corrupt") {
             need(2, "corrupt P");
-            sim.faults().corrupt = toolcommon::parse_probability(verb, w[1]);
+            sim.faults().corrupt = cli::parse_probability(verb, w[1]);
             return "ok corrupt " + w[1];
         }
         if (verb == "ignore-mission") {
@@ -236,7 +236,7 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
         }
         if (verb == "slow") {
             need(2, "slow MS");
-            sim.faults().slow = toolcommon::parse_milliseconds(verb, w[1]);
+            sim.faults().slow = cli::parse_milliseconds(verb, w[1]);
             return "ok slow " + w[1] + " ms";
         }
         if (verb == "param") {
@@ -248,7 +248,7 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
                 return nlohmann::json{{"name", w[1]}, {"value", sim.params().at(*i).value}}.dump();
             }
             need(3, "param NAME [VALUE]");
-            const double v = toolcommon::parse_double(verb, w[2], -1e9, 1e9);
+            const double v = cli::parse_double(verb, w[2], -1e9, 1e9);
             if (!sim.set_param(w[1], static_cast<float>(v), now)) {
                 return "error: param: unknown parameter '" + w[1] + "'";
             }
@@ -261,7 +261,7 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
                    "ignore-mission on|off, slow MS, param NAME [VALUE]";
         }
         return "error: unknown command '" + verb + "' (try help)";
-    } catch (const toolcommon::UsageError& e) {
+    } catch (const cli::UsageError& e) {
         return std::string("error: ") + e.what();
     }
 }

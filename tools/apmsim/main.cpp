@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/command_line.hpp"
 #include "hal/asio.hpp"
 #include "tools/apmsim/control.hpp"
 #include "tools/apmsim/options.hpp"
@@ -18,9 +19,8 @@ int main(int argc, char** argv) {
     std::optional<ApmSimOptions> options;
     try {
         options = parse_options(std::vector<std::string>(argv + 1, argv + argc));
-    } catch (const airseg::toolcommon::UsageError& e) {
-        std::cerr << "airseg-apmsim: " << e.what() << '\n';
-        return 2;
+    } catch (const airseg::cli::UsageError& e) {
+        return airseg::cli::usage_error(std::cerr, "airseg-apmsim", e.what());
     }
     if (!options) {
         std::cout << usage();

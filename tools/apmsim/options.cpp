@@ -1,8 +1,12 @@
 #include "tools/apmsim/options.hpp"
 
+#include <functional>
+
+#include "cli/command_line.hpp"
+
 namespace airseg::apmsim {
 
-using toolcommon::UsageError;
+using cli::UsageError;
 
 const char* usage() {
     return R"(usage: airseg-apmsim --link PATH [options]
@@ -90,106 +94,91 @@ GeoPoint parse_lat_lon(std::string_view option, std::string_view text) {
     if (comma == std::string_view::npos) {
         throw UsageError(std::string(option) + ": expected LAT,LON, got '" + std::string(text) + "'");
     }
-    return GeoPoint{toolcommon::parse_double(option, text.substr(0, comma), -89, 89),
-                    toolcommon::parse_double(option, text.substr(comma + 1), -180, 180)};
+    return GeoPoint{cli::parse_double(option, text.substr(0, comma), -89, 89),
+                    cli::parse_double(option, text.substr(comma + 1), -180, 180)};
 }
 
 }  // namespace
 
 std::optional<ApmSimOptions> parse_options(const std::vector<std::string>& args) {
-    using namespace toolcommon;
+    using namespace cli;
     ApmSimOptions o;
     // The firmware sets defaults (MAVLink version, reached style, mission timers) that the other options
-    // may then change, wherever --firmware stands on the line.
-    for (std::size_t i = 0; i < args.size(); ++i) {
-        if (args[i] == "--firmware") {
-            if (i + 1 >= args.size()) {
-                throw UsageError("--firmware: missing value");
-            }
-            const auto f = parse_firmware(args[i + 1]);
-            if (!f) {
-                throw UsageError("--firmware: expected modern or rover2, got '" + args[i + 1] + "'");
-            }
-            o.sim = RoverSimConfig::for_firmware(*f);
-        }
-    }
-    for (std::size_t i = 0; i < args.size(); ++i) {
-        const std::string& arg = args[i];
-        auto value = [&]() -> std::string_view {
-            if (i + 1 >= args.size()) {
-                throw UsageError(arg + ": missing value");
-            }
-            return args[++i];
+    // may then change, wherever --firmware stands on the line: they act after the whole line is read.
+    std::vector<std::function<void()>> after_firmware;
+    auto later = [&after_firmware](Apply apply) -> Apply {
+        return [&after_firmware, apply = std::move(apply)](std::string_view option, std::string_view text) {
+            after_firmware.push_back(
+                [apply, option = std::string(option), text = std::string(text)] { apply(option, text); });
         };
-        if (arg == "--help" || arg == "-h") {
-            return std::nullopt;
-        } else if (arg == "--link") {
-            o.link_path = value();
-        } else if (arg == "--firmware") {
-            value();  // applied above
-        } else if (arg == "--control") {
-            o.control_path = value();
-        } else if (arg == "--boot-delay") {
-            o.sim.boot_delay = parse_seconds(arg, value());
-        } else if (arg == "--calib-time") {
-            o.sim.calib_time = parse_seconds(arg, value());
-        } else if (arg == "--no-reset-on-open") {
-            o.sim.reset_on_open = false;
-        } else if (arg == "--baud") {
-            o.baud = static_cast<unsigned>(parse_unsigned(arg, value(), 9600, 1500000));
-        } else if (arg == "--home") {
-            o.sim.home = parse_lat_lon(arg, value());
-        } else if (arg == "--home-alt") {
-            o.sim.home_alt = static_cast<float>(parse_double(arg, value(), -1000, 10000));
-        } else if (arg == "--mission-capacity") {
-            o.sim.mission_capacity = parse_unsigned(arg, value(), 1, 65535);
-        } else if (arg == "--reached-style") {
-            const std::string_view v = value();
-            if (v == "both") {
-                o.sim.reached_style = ReachedStyle::MessageAndText;
-            } else if (v == "text") {
-                o.sim.reached_style = ReachedStyle::TextOnly;
-            } else {
-                throw UsageError(arg + ": expected both or text, got '" + std::string(v) + "'");
-            }
-        } else if (arg == "--mavlink1") {
-            o.sim.version = mavlink::Version::V1;
-        } else if (arg == "--param") {
-            const std::string v(value());
-            const auto eq = v.find('=');
-            if (eq == std::string::npos || eq == 0) {
-                throw UsageError(arg + ": expected NAME=VALUE, got '" + v + "'");
-            }
-            const std::string name = v.substr(0, eq);
-            if (!ParamTable::rover_defaults().index_of(name)) {
-                throw UsageError(arg + ": unknown parameter '" + name + "'");
-            }
-            o.params.emplace_back(name, static_cast<float>(parse_double(arg, v.substr(eq + 1), -1e9, 1e9)));
-        } else if (arg == "--seed") {
-            o.sim.seed = parse_unsigned(arg, value(), 0, UINT64_MAX);
-        } else if (arg == "--speedup") {
-            o.speedup = parse_double(arg, value(), 0.01, 10000);
-        } else if (arg == "--loss") {
-            o.faults.loss = parse_probability(arg, value());
-        } else if (arg == "--loss-burst") {
-            o.faults.loss_burst = parse_double(arg, value(), 1, 10000);
-        } else if (arg == "--corrupt") {
-            o.faults.corrupt = parse_probability(arg, value());
-        } else if (arg == "--hb-stall") {
-            o.hb_stalls.push_back(parse_window(arg, value()));
-        } else if (arg == "--reboot-at") {
-            o.reboot_at = parse_seconds(arg, value());
-        } else if (arg == "--unplug") {
-            o.unplugs.push_back(parse_window(arg, value()));
-        } else if (arg == "--ignore-mission") {
-            o.faults.ignore_mission = true;
-        } else if (arg == "--slow") {
-            o.faults.slow = parse_milliseconds(arg, value());
-        } else if (arg == "--quiet") {
-            o.quiet = true;
-        } else {
-            throw UsageError(arg + ": unknown option (see --help)");
-        }
+    };
+    auto later_flag = [&after_firmware](std::function<void()> apply) {
+        return [&after_firmware, apply = std::move(apply)] { after_firmware.push_back(apply); };
+    };
+    OptionTable table;
+    table.value("link", "PATH", "", text(o.link_path))
+        .value("firmware", "PROFILE", "",
+               [&o](std::string_view option, std::string_view v) {
+                   const auto f = parse_firmware(v);
+                   if (!f) {
+                       throw UsageError(std::string(option) + ": expected modern or rover2, got '" +
+                                        std::string(v) + "'");
+                   }
+                   o.sim = RoverSimConfig::for_firmware(*f);
+               })
+        .value("control", "PATH", "", text(o.control_path))
+        .value("boot-delay", "S", "", later(in_seconds(o.sim.boot_delay)))
+        .value("calib-time", "S", "", later(in_seconds(o.sim.calib_time)))
+        .flag("no-reset-on-open", "", later_flag([&o] { o.sim.reset_on_open = false; }))
+        .value("baud", "N", "", number(o.baud, 9600, 1500000))
+        .value("home", "LAT,LON", "", later([&o](std::string_view option, std::string_view v) {
+                   o.sim.home = parse_lat_lon(option, v);
+               }))
+        .value("home-alt", "M", "", later(number(o.sim.home_alt, -1000, 10000)))
+        .value("mission-capacity", "N", "", later(number(o.sim.mission_capacity, 1, 65535)))
+        .value("reached-style", "STYLE", "", later([&o](std::string_view option, std::string_view v) {
+                   if (v == "both") {
+                       o.sim.reached_style = ReachedStyle::MessageAndText;
+                   } else if (v == "text") {
+                       o.sim.reached_style = ReachedStyle::TextOnly;
+                   } else {
+                       throw UsageError(std::string(option) + ": expected both or text, got '" +
+                                        std::string(v) + "'");
+                   }
+               }))
+        .flag("mavlink1", "", later_flag([&o] { o.sim.version = mavlink::Version::V1; }))
+        .value("param", "NAME=VALUE", "",
+               [&o](std::string_view option, std::string_view text) {
+                   const std::string v(text);
+                   const auto eq = v.find('=');
+                   if (eq == std::string::npos || eq == 0) {
+                       throw UsageError(std::string(option) + ": expected NAME=VALUE, got '" + v + "'");
+                   }
+                   const std::string name = v.substr(0, eq);
+                   if (!ParamTable::rover_defaults().index_of(name)) {
+                       throw UsageError(std::string(option) + ": unknown parameter '" + name + "'");
+                   }
+                   o.params.emplace_back(
+                       name, static_cast<float>(parse_double(option, v.substr(eq + 1), -1e9, 1e9)));
+               })
+        .value("seed", "N", "", later(number(o.sim.seed, 0, UINT64_MAX)))
+        .value("speedup", "N", "", number(o.speedup, 0.01, 10000))
+        .value("loss", "P", "", probability(o.faults.loss))
+        .value("loss-burst", "N", "", number(o.faults.loss_burst, 1, 10000))
+        .value("corrupt", "P", "", probability(o.faults.corrupt))
+        .value("hb-stall", "START:DUR", "", windows(o.hb_stalls))
+        .value("reboot-at", "S", "", in_seconds(o.reboot_at))
+        .value("unplug", "START:DUR", "", windows(o.unplugs))
+        .flag("ignore-mission", "", [&o] { o.faults.ignore_mission = true; })
+        .value("slow", "MS", "", in_milliseconds(o.faults.slow))
+        .flag("quiet", "", [&o] { o.quiet = true; })
+        .help_and_version(false);
+    parse(args, table);
+    if (table.help_requested()) {
+        return std::nullopt;
+    }
+    for (const auto& apply : after_firmware) {
+        apply();
     }
     if (o.link_path.empty()) {
         throw UsageError("--link PATH is required");

@@ -5,8 +5,8 @@
 #include <utility>
 #include <vector>
 
+#include "cli/values.hpp"
 #include "tools/apmsim/rover_sim.hpp"
-#include "tools/common/cli.hpp"
 
 namespace airseg::apmsim {
 
@@ -19,13 +19,13 @@ struct ApmSimOptions {
     Faults faults;
     std::vector<std::pair<std::string, float>> params;  // --param NAME=VALUE
     std::optional<Duration> reboot_at;                  // --reboot-at S (simulated seconds after start)
-    std::vector<toolcommon::Window> hb_stalls;          // --hb-stall START:DUR
-    std::vector<toolcommon::Window> unplugs;            // --unplug START:DUR
+    std::vector<cli::Window> hb_stalls;                 // --hb-stall START:DUR
+    std::vector<cli::Window> unplugs;                   // --unplug START:DUR
     bool quiet = false;                                 // --quiet
 };
 
 const char* usage();
-/// Parses the arguments (without argv[0]). nullopt for --help; throws toolcommon::UsageError.
+/// Parses the arguments (without argv[0]). nullopt for --help; throws cli::UsageError.
 std::optional<ApmSimOptions> parse_options(const std::vector<std::string>& args);
 
 }  // namespace airseg::apmsim

@@ -4,7 +4,7 @@
 #include <sstream>
 #include <vector>
 
-#include "tools/common/cli.hpp"
+#include "cli/values.hpp"
 
 namespace airseg::linksim {
 
@@ -30,7 +30,7 @@ std::vector<Side> directions(const std::vector<std::string>& w) {
     if (w[2] == "ba") {
         return {Side::B};
     }
-    throw toolcommon::UsageError(w[0] + ": direction must be ab, ba or both, got '" + w[2] + "'");
+    throw cli::UsageError(w[0] + ": direction must be ab, ba or both, got '" + w[2] + "'");
 }
 
 }  // namespace
@@ -53,27 +53,27 @@ std::string apply_control(RadioModel& model, std::string_view command, TimePoint
         Apply apply;
         if (verb == "outage") {
             apply = [&](Side s, std::string_view v) {
-                model.add_outage(s, now, toolcommon::parse_seconds(verb, v));
+                model.add_outage(s, now, cli::parse_seconds(verb, v));
             };
         } else if (verb == "loss") {
             apply = [&](Side s, std::string_view v) {
-                model.impairment(s).byte_loss = toolcommon::parse_probability(verb, v);
+                model.impairment(s).byte_loss = cli::parse_probability(verb, v);
             };
         } else if (verb == "ber") {
             apply = [&](Side s, std::string_view v) {
-                model.impairment(s).bit_error_rate = toolcommon::parse_probability(verb, v);
+                model.impairment(s).bit_error_rate = cli::parse_probability(verb, v);
             };
         } else if (verb == "corrupt") {
             apply = [&](Side s, std::string_view v) {
-                model.impairment(s).byte_corruption = toolcommon::parse_probability(verb, v);
+                model.impairment(s).byte_corruption = cli::parse_probability(verb, v);
             };
         } else if (verb == "frame-loss") {
             apply = [&](Side s, std::string_view v) {
-                model.impairment(s).frame_loss = toolcommon::parse_probability(verb, v);
+                model.impairment(s).frame_loss = cli::parse_probability(verb, v);
             };
         } else if (verb == "latency") {
             apply = [&](Side s, std::string_view v) {
-                model.impairment(s).latency = toolcommon::parse_milliseconds(verb, v);
+                model.impairment(s).latency = cli::parse_milliseconds(verb, v);
             };
         } else {
             return "error: unknown command '" + verb + "' (try help)";
@@ -88,7 +88,7 @@ std::string apply_control(RadioModel& model, std::string_view command, TimePoint
             apply(s, w[1]);
         }
         return "ok " + std::string(command);
-    } catch (const toolcommon::UsageError& e) {
+    } catch (const cli::UsageError& e) {
         return std::string("error: ") + e.what();
     }
 }

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "cli/command_line.hpp"
 #include "hal/asio.hpp"
-#include "tools/common/cli.hpp"
 #include "tools/linksim/link_emulator.hpp"
 #include "tools/linksim/options.hpp"
 
@@ -18,9 +18,8 @@ int main(int argc, char** argv) {
     std::optional<LinkSimOptions> options;
     try {
         options = parse_options(std::vector<std::string>(argv + 1, argv + argc));
-    } catch (const airseg::toolcommon::UsageError& e) {
-        std::cerr << "airseg-linksim: " << e.what() << '\n';
-        return 2;
+    } catch (const airseg::cli::UsageError& e) {
+        return airseg::cli::usage_error(std::cerr, "airseg-linksim", e.what());
     }
     if (!options) {
         std::cout << usage();

@@ -1,13 +1,12 @@
 #include "tools/linksim/options.hpp"
 
 #include <functional>
-#include <map>
 
-#include "tools/common/cli.hpp"
+#include "cli/command_line.hpp"
 
 namespace airseg::linksim {
 
-using toolcommon::UsageError;
+using cli::UsageError;
 
 const char* usage() {
     return R"(usage: airseg-linksim --a PATH --b PATH [options]
@@ -61,89 +60,63 @@ namespace {
 
 using Setter = std::function<void(DirectionImpairment&, std::string_view option, std::string_view value)>;
 
-void for_directions(RadioConfig& r, std::string_view suffix,
-                    const std::function<void(DirectionImpairment&)>& f) {
-    if (suffix.empty() || suffix == "-ab") {
-        f(r.impairment[index(Side::A)]);
-    }
-    if (suffix.empty() || suffix == "-ba") {
-        f(r.impairment[index(Side::B)]);
+/// An impairment as --NAME (both directions) and --NAME-ab / --NAME-ba (one).
+void add_impairment(cli::OptionTable& table, RadioConfig& radio, const std::string& name, const Setter& set) {
+    for (const std::string suffix : {"", "-ab", "-ba"}) {
+        const auto option = name + suffix;
+        table.value(option.c_str(), "V", "", [&radio, suffix, set](std::string_view opt, std::string_view v) {
+            if (suffix != "-ba") {
+                set(radio.impairment[index(Side::A)], opt, v);
+            }
+            if (suffix != "-ab") {
+                set(radio.impairment[index(Side::B)], opt, v);
+            }
+        });
     }
 }
 
 }  // namespace
 
 std::optional<LinkSimOptions> parse_options(const std::vector<std::string>& args) {
-    using namespace toolcommon;
+    using namespace cli;
     LinkSimOptions o;
-    const std::map<std::string, Setter, std::less<>> impairments{
-        {"--loss", [](DirectionImpairment& d, auto opt, auto v) { d.byte_loss = parse_probability(opt, v); }},
-        {"--ber",
-         [](DirectionImpairment& d, auto opt, auto v) { d.bit_error_rate = parse_probability(opt, v); }},
-        {"--corrupt",
-         [](DirectionImpairment& d, auto opt, auto v) { d.byte_corruption = parse_probability(opt, v); }},
-        {"--frame-loss",
-         [](DirectionImpairment& d, auto opt, auto v) { d.frame_loss = parse_probability(opt, v); }},
-        {"--latency",
-         [](DirectionImpairment& d, auto opt, auto v) { d.latency = parse_milliseconds(opt, v); }},
-        {"--outage",
-         [](DirectionImpairment& d, auto opt, auto v) {
-             const auto w = parse_window(opt, v);
-             d.outages.push_back({w.start, w.length});
-         }},
-    };
-    for (std::size_t i = 0; i < args.size(); ++i) {
-        const std::string& arg = args[i];
-        auto value = [&]() -> std::string_view {
-            if (i + 1 >= args.size()) {
-                throw UsageError(arg + ": missing value");
-            }
-            return args[++i];
-        };
-        if (arg == "--help" || arg == "-h") {
-            return std::nullopt;
-        } else if (arg == "--a") {
-            o.a_path = value();
-        } else if (arg == "--b") {
-            o.b_path = value();
-        } else if (arg == "--baud") {
-            o.radio.baud = static_cast<std::uint32_t>(parse_unsigned(arg, value(), 300, 4'000'000));
-        } else if (arg == "--air-rate") {
-            o.radio.air_rate_bps = static_cast<std::uint32_t>(parse_unsigned(arg, value(), 300, 100'000'000));
-        } else if (arg == "--half-duplex") {
-            o.radio.duplex = Duplex::Half;
-        } else if (arg == "--full-duplex") {
-            o.radio.duplex = Duplex::Full;
-        } else if (arg == "--turnaround") {
-            o.radio.turnaround = parse_milliseconds(arg, value());
-        } else if (arg == "--packet") {
-            o.radio.max_air_packet = parse_unsigned(arg, value(), 1, 65536);
-        } else if (arg == "--packet-overhead") {
-            o.radio.air_packet_overhead = parse_unsigned(arg, value(), 0, 65536);
-        } else if (arg == "--buffer") {
-            o.radio.radio_buffer = parse_unsigned(arg, value(), 1, 1U << 24);
-        } else if (arg == "--seed") {
-            o.radio.seed = parse_unsigned(arg, value(), 0, UINT64_MAX);
-        } else if (arg == "--control") {
-            o.control_path = value();
-        } else if (arg == "--stats-interval") {
-            o.stats_interval = parse_seconds(arg, value());
-        } else if (arg == "--json") {
-            o.json = true;
-        } else if (arg == "--host-backlog") {
-            o.host_backlog = parse_unsigned(arg, value(), 1, 1U << 26);
-        } else {
-            const auto dash = arg.size() > 3 ? arg.substr(arg.size() - 3) : std::string();
-            const bool directed = dash == "-ab" || dash == "-ba";
-            const std::string base = directed ? arg.substr(0, arg.size() - 3) : arg;
-            auto it = impairments.find(base);
-            if (it == impairments.end()) {
-                throw UsageError(arg + ": unknown option (see --help)");
-            }
-            const std::string_view v = value();
-            for_directions(o.radio, directed ? std::string_view(dash) : std::string_view(),
-                           [&](DirectionImpairment& d) { it->second(d, arg, v); });
-        }
+    OptionTable table;
+    table.value("a", "PATH", "", text(o.a_path))
+        .value("b", "PATH", "", text(o.b_path))
+        .value("baud", "N", "", number(o.radio.baud, 300, 4'000'000))
+        .value("air-rate", "BPS", "", number(o.radio.air_rate_bps, 300, 100'000'000))
+        .flag("half-duplex", "", [&] { o.radio.duplex = Duplex::Half; })
+        .flag("full-duplex", "", [&] { o.radio.duplex = Duplex::Full; })
+        .value("turnaround", "MS", "", in_milliseconds(o.radio.turnaround))
+        .value("packet", "BYTES", "", number(o.radio.max_air_packet, 1, 65536))
+        .value("packet-overhead", "B", "", number(o.radio.air_packet_overhead, 0, 65536))
+        .value("buffer", "BYTES", "", number(o.radio.radio_buffer, 1, 1U << 24))
+        .value("seed", "N", "", number(o.radio.seed, 0, UINT64_MAX))
+        .value("control", "PATH", "", text(o.control_path))
+        .value("stats-interval", "S", "", in_seconds(o.stats_interval))
+        .flag("json", "", [&] { o.json = true; })
+        .value("host-backlog", "BYTES", "", number(o.host_backlog, 1, 1U << 26))
+        .help_and_version(false);
+    add_impairment(table, o.radio, "loss",
+                   [](DirectionImpairment& d, auto opt, auto v) { d.byte_loss = parse_probability(opt, v); });
+    add_impairment(table, o.radio, "ber", [](DirectionImpairment& d, auto opt, auto v) {
+        d.bit_error_rate = parse_probability(opt, v);
+    });
+    add_impairment(table, o.radio, "corrupt", [](DirectionImpairment& d, auto opt, auto v) {
+        d.byte_corruption = parse_probability(opt, v);
+    });
+    add_impairment(table, o.radio, "frame-loss", [](DirectionImpairment& d, auto opt, auto v) {
+        d.frame_loss = parse_probability(opt, v);
+    });
+    add_impairment(table, o.radio, "latency",
+                   [](DirectionImpairment& d, auto opt, auto v) { d.latency = parse_milliseconds(opt, v); });
+    add_impairment(table, o.radio, "outage", [](DirectionImpairment& d, auto opt, auto v) {
+        const auto w = parse_window(opt, v);
+        d.outages.push_back({w.start, w.length});
+    });
+    parse(args, table);
+    if (table.help_requested()) {
+        return std::nullopt;
     }
     if (o.a_path.empty() || o.b_path.empty()) {
         throw UsageError("--a PATH and --b PATH are both required");

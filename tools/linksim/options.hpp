@@ -21,7 +21,7 @@ struct LinkSimOptions {
 /// The full --help text.
 const char* usage();
 
-/// Parses argv. Throws toolcommon::UsageError naming the option on bad input. Returns nullopt for --help.
+/// Parses argv. Throws cli::UsageError naming the option on bad input. Returns nullopt for --help.
 std::optional<LinkSimOptions> parse_options(const std::vector<std::string>& args);
 
 }  // namespace airseg::linksim

@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "cli/command_line.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
 #include "tools/mavdump/frame_json.hpp"
 #include "tools/mavdump/tlog_reader.hpp"
@@ -49,12 +50,6 @@ struct Options {
     std::string input = "-";
     std::string output = "-";
 };
-
-int usage_error(std::string_view message) {
-    std::fprintf(stderr, "airseg-mavdump: %.*s (see --help)\n", static_cast<int>(message.size()),
-                 message.data());
-    return 2;
-}
 
 std::FILE* open_or_std(const std::string& path, const char* mode, std::FILE* fallback) {
     return path == "-" ? fallback : std::fopen(path.c_str(), mode);
@@ -142,31 +137,20 @@ int encode(const Options& opt, std::istream& in, std::FILE* out) {
 
 int main(int argc, char** argv) {
     Options opt;
-    bool have_input = false;
-    for (int i = 1; i < argc; ++i) {
-        const std::string_view arg = argv[i];
-        if (arg == "-h" || arg == "--help") {
-            std::fwrite(kUsage.data(), 1, kUsage.size(), stdout);
-            return 0;
-        } else if (arg == "--encode") {
-            opt.encode = true;
-        } else if (arg == "--tlog") {
-            opt.format = Options::Format::Tlog;
-        } else if (arg == "--raw") {
-            opt.format = Options::Format::Raw;
-        } else if (arg == "-o") {
-            if (++i == argc) {
-                return usage_error("-o needs a file name");
-            }
-            opt.output = argv[i];
-        } else if (arg.size() > 1 && arg[0] == '-') {
-            return usage_error("unknown option " + std::string(arg));
-        } else if (have_input) {
-            return usage_error("only one input file can be given");
-        } else {
-            opt.input = arg;
-            have_input = true;
-        }
+    airseg::cli::OptionTable table;
+    table.flag("encode", "", [&] { opt.encode = true; })
+        .flag("tlog", "", [&] { opt.format = Options::Format::Tlog; })
+        .flag("raw", "", [&] { opt.format = Options::Format::Raw; })
+        .value(",o", "OUTPUT", "", airseg::cli::text(opt.output))
+        .help_and_version(false);
+    const airseg::cli::Program program{"airseg-mavdump", [] { return std::string(kUsage); }};
+    const auto line = airseg::cli::run(program, std::vector<std::string>(argv + 1, argv + argc), table,
+                                       std::cout, std::cerr, {.max = 1});
+    if (line.exit_code) {
+        return *line.exit_code;
+    }
+    if (!line.operands.empty()) {
+        opt.input = line.operands.front();
     }
     std::FILE* out = open_or_std(opt.output, "wb", stdout);
     if (out == nullptr) {

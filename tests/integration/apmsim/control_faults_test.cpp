@@ -82,10 +82,10 @@ TEST(ApmsimControl, OptionsParse) {
     EXPECT_EQ(o->hb_stalls[0].start, seconds(10));
     EXPECT_EQ(o->faults.slow, milliseconds(200));
     EXPECT_FALSE(parse_options({"--help"}));
-    EXPECT_THROW(parse_options({"--home", "1,2"}), toolcommon::UsageError) << "--link is required";
-    EXPECT_THROW(parse_options({"--link", "x", "--home", "95,2"}), toolcommon::UsageError);
-    EXPECT_THROW(parse_options({"--link", "x", "--reached-style", "loud"}), toolcommon::UsageError);
-    EXPECT_THROW(parse_options({"--link", "x", "--param", "CRUISE_SPEED"}), toolcommon::UsageError);
+    EXPECT_THROW(parse_options({"--home", "1,2"}), cli::UsageError) << "--link is required";
+    EXPECT_THROW(parse_options({"--link", "x", "--home", "95,2"}), cli::UsageError);
+    EXPECT_THROW(parse_options({"--link", "x", "--reached-style", "loud"}), cli::UsageError);
+    EXPECT_THROW(parse_options({"--link", "x", "--param", "CRUISE_SPEED"}), cli::UsageError);
 }
 
 TEST(ApmsimGuided, GoToHereOnlyInGuided) {

@@ -500,8 +500,8 @@ TEST(ApmsimRover2, OptionsAndControl) {
     ASSERT_TRUE(both);
     EXPECT_EQ(both->sim.reached_style, ReachedStyle::MessageAndText) << "explicit options win";
     EXPECT_EQ(parse_options({"--link", "x"})->sim.firmware, FirmwareProfile::modern());
-    EXPECT_THROW(parse_options({"--link", "x", "--firmware", "rover3"}), toolcommon::UsageError);
-    EXPECT_THROW(parse_options({"--link", "x", "--firmware"}), toolcommon::UsageError);
+    EXPECT_THROW(parse_options({"--link", "x", "--firmware", "rover3"}), cli::UsageError);
+    EXPECT_THROW(parse_options({"--link", "x", "--firmware"}), cli::UsageError);
 
     SimHarness h(rover2());
     boot_rover2(h);

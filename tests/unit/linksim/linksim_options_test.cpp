@@ -1,13 +1,13 @@
 #include <gtest/gtest.h>
 
-#include "tools/common/cli.hpp"
+#include "cli/values.hpp"
 #include "tools/linksim/control.hpp"
 #include "tools/linksim/options.hpp"
 
 namespace airseg::linksim {
 namespace {
 
-using toolcommon::UsageError;
+using cli::UsageError;
 
 LinkSimOptions parse(std::vector<std::string> extra) {
     std::vector<std::string> args{"--a", "/tmp/x/a", "--b", "/tmp/x/b"};

@@ -1,5 +1,6 @@
 #pragma once
-// Command-line value parsing shared by the simulators: every failure names the option and the bad text.
+// Command-line values shared by every program (also the simulators' control commands): every failure names
+// the option and the bad text.
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
@@ -8,7 +9,7 @@
 
 #include "services/common/time.hpp"
 
-namespace airseg::toolcommon {
+namespace airseg::cli {
 
 /// Thrown by the parsers below; what() is ready to print after the program's name.
 class UsageError : public std::runtime_error {
@@ -35,4 +36,4 @@ struct Window {
 /// "START:DURATION" in seconds, e.g. "60:30"; the duration must be positive.
 Window parse_window(std::string_view option, std::string_view text);
 
-}  // namespace airseg::toolcommon
+}  // namespace airseg::cli

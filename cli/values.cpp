@@ -1,9 +1,9 @@
-#include "tools/common/cli.hpp"
+#include "cli/values.hpp"
 
 #include <charconv>
 #include <cmath>
 
-namespace airseg::toolcommon {
+namespace airseg::cli {
 
 namespace {
 
@@ -63,4 +63,4 @@ Window parse_window(std::string_view option, std::string_view text) {
     return w;
 }
 
-}  // namespace airseg::toolcommon
+}  // namespace airseg::cli
