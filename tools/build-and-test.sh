@@ -4,6 +4,8 @@
 # Stages, in this order (AIRSEG_STAGES chooses a subset, e.g. AIRSEG_STAGES=native):
 #   sanitize  clang build of the whole tree with AddressSanitizer, UndefinedBehaviorSanitizer and libFuzzer
 #             coverage (build-san/); the whole ctest suite, unit to system tests, any report fails the test
+#   tidy      clang-tidy's braces and naming checks (.clang-tidy) on the sources changed since the whole tree
+#             last passed them (tools/clang-tidy-check.sh; build-tidy/ is configured, not built)
 #   fuzz      each libFuzzer target for AIRSEG_FUZZ_SECONDS (default 60) on its seed corpus (tests/fuzz/run.sh,
 #             same build directory); a crash or a broken property fails the stage
 #   tsan      GCC build with ThreadSanitizer (build-tsan/) of the test executables listed in
@@ -15,12 +17,12 @@
 #             installed, upgraded and removed in a throwaway chroot; each ARM package is cross-built with the
 #             whole test suite, which runs under qemu-arm or qemu-aarch64 (needs root)
 #   native    GCC build as shipped (build/, the one tools/demo.sh runs) and the whole ctest suite
-# Default: "sanitize fuzz tsan cross". The shipped GCC build is tested by the cross stage on the two ARM
+# Default: "sanitize tidy fuzz tsan cross". The shipped GCC build is tested by the cross stage on the two ARM
 # targets; "native" repeats that on amd64 and is the quickest check while developing.
 # docs/operations.md ("CI") has the figures for each stage.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-stages=${AIRSEG_STAGES:-sanitize fuzz tsan cross}
+stages=${AIRSEG_STAGES:-sanitize tidy fuzz tsan cross}
 jobs=$(nproc)
 # Test cases at once: most of them wait on real time (the simulated radios and autopilot run at real speed),
 # so four per core keep the CPU busy (measured: the suite under ASan uses under half of 2 cores at -j8).
@@ -46,8 +48,8 @@ run_ctest() {
 
 for s in $stages; do
   case "$s" in
-    sanitize|fuzz|tsan|cross|native) ;;
-    *) echo "build-and-test: unknown stage '$s' (expected sanitize, fuzz, tsan, cross, native)" >&2; exit 2 ;;
+    sanitize|tidy|fuzz|tsan|cross|native) ;;
+    *) echo "build-and-test: unknown stage '$s' (expected sanitize, tidy, fuzz, tsan, cross, native)" >&2; exit 2 ;;
   esac
 done
 
@@ -78,6 +80,12 @@ if has_stage sanitize; then
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=0:halt_on_error=1 \
     UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 run_ctest build-san
   elapsed "tests under ASan+UBSan" "$start"
+fi
+
+if has_stage tidy; then
+  start=$SECONDS
+  tools/clang-tidy-check.sh build-tidy
+  elapsed "clang-tidy" "$start"
 fi
 
 if has_stage fuzz; then

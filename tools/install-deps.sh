@@ -6,7 +6,7 @@ packages=(
   libboost-dev libboost-program-options-dev libyaml-cpp-dev libspdlog-dev libfmt-dev
   libgpiod-dev libsodium-dev nlohmann-json3-dev zlib1g-dev
   libgtest-dev libgmock-dev libbenchmark-dev valgrind
-  clang libclang-rt-14-dev
+  clang libclang-rt-14-dev clang-tidy
 )
 sudo=""
 if [ "$(id -u)" -ne 0 ]; then
