@@ -132,6 +132,14 @@ struct Rig {
         return n;
     }
 
+    /// A ready autopilot driving a plan whose link-loss reaction is `action`, the link up or down at start.
+    void run_plan(const std::string& action, bool link_up) {
+        ready();
+        c.on_link(link_up, now);
+        load(plan_text(action));
+        confirm_all();
+    }
+
     std::string state() const { return c.progress_json()["state"].get<std::string>(); }
 
     PlanController c;
@@ -230,10 +238,7 @@ TEST(FlightplanController, BadAppendsAndSkipsAreAnsweredAtOnceWithoutTouchingThe
 
 TEST(FlightplanController, LinkLostForTheConfiguredTimeHoldsTheVehicle) {
     Rig rig;
-    rig.ready();
-    rig.c.on_link(true, rig.now);
-    rig.load(plan_text("hold"));
-    rig.confirm_all();
+    rig.run_plan("hold", true);
     rig.c.on_link(false, rig.now);
     rig.drain();
     rig.advance(seconds(19));
@@ -250,10 +255,7 @@ TEST(FlightplanController, LinkLostForTheConfiguredTimeHoldsTheVehicle) {
 
 TEST(FlightplanController, ALinkNeverSeenUpIsNotLost) {
     Rig rig;
-    rig.ready();
-    rig.c.on_link(false, rig.now);
-    rig.load(plan_text("hold"));
-    rig.confirm_all();
+    rig.run_plan("hold", false);
     rig.advance(seconds(60));
     EXPECT_TRUE(rig.triggers.empty());
     EXPECT_EQ(rig.count(is_hold), 0u);
@@ -261,10 +263,7 @@ TEST(FlightplanController, ALinkNeverSeenUpIsNotLost) {
 
 TEST(FlightplanController, LinkLossReturnsHomeWhenThePlanSaysSo) {
     Rig rig;
-    rig.ready();
-    rig.c.on_link(true, rig.now);
-    rig.load(plan_text("return_home"));
-    rig.confirm_all();
+    rig.run_plan("return_home", true);
     const auto sent = rig.requests.size();
     rig.c.on_link(false, rig.now);
     rig.drain();
