@@ -57,8 +57,10 @@ struct Rig {
         }
         while (auto r = c.poll_reply())
             replies.push_back(*r);
-        while (auto s = c.poll_save())
-            c.on_saved(*s, std::nullopt);
+        while (auto s = c.poll_save()) {
+            saves.push_back(*s);
+            c.on_saved(*s, save_error);
+        }
         while (c.poll_status()) {
         }
         while (c.poll_log()) {
@@ -149,6 +151,8 @@ struct Rig {
     std::vector<autopilot::AutopilotRequest> pending;
     std::vector<CommandReply> replies;
     std::vector<ReactionTrigger> triggers;
+    std::vector<ProgressSave> saves;
+    std::optional<std::string> save_error;  // what the state store answers
 };
 
 bool is_hold(const autopilot::AutopilotRequest& r) {
@@ -339,6 +343,34 @@ TEST(FlightplanController, PauseThenResumeLeavesTheRunningPlanInAuto) {
     rig.advance(seconds(10));
     EXPECT_EQ(last_state_asked(rig), autopilot::VehicleState::WaypointNavigation)
         << "nothing parks the running plan afterwards";
+}
+
+TEST(FlightplanController, ProgressIsKeptOnceAndAWayHomeLeavesThePlanSavedAsPaused) {
+    PlanControllerConfig config;
+    config.keeps_progress = true;
+    Rig rig(config);
+    rig.run_plan("return_home", true);
+    ASSERT_FALSE(rig.saves.empty());
+    EXPECT_EQ(rig.saves.back().progress.state, PlanState::Running);
+    for (std::size_t i = 1; i < rig.saves.size(); ++i)
+        EXPECT_FALSE(rig.saves[i].progress == rig.saves[i - 1].progress) << "the same point saved twice";
+    const auto before = rig.saves.size();
+    rig.c.on_link(false, rig.now);
+    rig.drain();
+    rig.advance(seconds(21));
+    rig.confirm_all();
+    ASSERT_EQ(rig.saves.size(), before + 1) << "only the paused point: the way home is not a plan to resume";
+    EXPECT_EQ(rig.saves.back().progress.state, PlanState::Paused);
+    EXPECT_EQ(rig.saves.back().progress.next_index, rig.saves[before - 1].progress.next_index);
+}
+
+TEST(FlightplanController, AProgressTheStoreCannotKeepIsThePlansError) {
+    PlanControllerConfig config;
+    config.keeps_progress = true;
+    Rig rig(config);
+    rig.save_error = "disk full";
+    rig.run_plan("hold", true);
+    EXPECT_EQ(rig.c.progress_json()["error"], "disk full");
 }
 
 TEST(FlightplanController, StopFailsTheWaitingCommands) {
