@@ -1,0 +1,705 @@
+#include "services/flightplan/plan_controller.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <sstream>
+
+#include "services/flightplan/home_stream.hpp"
+#include "services/flightplan/plan_merge.hpp"
+
+namespace airseg::flightplan {
+
+namespace {
+
+using Level = LogLine::Level;
+using Status = CommandReply::Status;
+
+autopilot::MissionItem to_autopilot(const MissionItem& m) {
+    autopilot::MissionItem out;
+    switch (m.kind) {
+        case MissionItem::Kind::Waypoint:
+            out.kind = autopilot::MissionItem::Kind::Waypoint;
+            break;
+        case MissionItem::Kind::Stop:
+            out.kind = autopilot::MissionItem::Kind::Stop;
+            break;
+        case MissionItem::Kind::JumpTo:
+            out.kind = autopilot::MissionItem::Kind::JumpTo;
+            break;
+    }
+    out.lat = m.position.lat;
+    out.lon = m.position.lon;
+    out.alt = m.alt.value_or(0.0);
+    if (m.speed > 0.0)
+        out.speed = m.speed;
+    if (m.arrival_radius > 0.0)
+        out.radius = m.arrival_radius;
+    out.jump_slot = m.jump_slot;
+    return out;
+}
+
+std::vector<autopilot::MissionItem> to_autopilot(const std::vector<MissionItem>& items) {
+    std::vector<autopilot::MissionItem> out;
+    out.reserve(items.size());
+    for (const auto& m : items)
+        out.push_back(to_autopilot(m));
+    return out;
+}
+
+// The top-level element index from an element path such as "plan.elements[12].scan".
+std::uint32_t top_element_index(const std::string& path) {
+    const auto open = path.find('[');
+    const auto close = path.find(']', open);
+    if (open == std::string::npos || close == std::string::npos) {
+        return 0;
+    }
+    std::uint32_t n = 0;
+    for (auto i = open + 1; i < close && path[i] >= '0' && path[i] <= '9'; ++i) {
+        n = n * 10 + static_cast<std::uint32_t>(path[i] - '0');
+    }
+    return n;
+}
+
+Json optional_json(const std::optional<std::uint64_t>& v) {
+    return v ? Json(*v) : Json(nullptr);
+}
+
+template <typename T>
+std::optional<T> pop(std::deque<T>& q) {
+    if (q.empty())
+        return std::nullopt;
+    T out = std::move(q.front());
+    q.pop_front();
+    return out;
+}
+
+}  // namespace
+
+PlanController::PlanController(PlanControllerConfig config)
+    : config_(std::move(config)), feeder_(config_.feeder) {}
+
+// ---- life cycle ----------------------------------------------------------------------------------------
+
+void PlanController::start(TimePoint now) {
+    running_ = true;
+    pump(now);
+    publish_status(true);
+}
+
+void PlanController::stop(const std::string& why) {
+    running_ = false;
+    fail_waiters(why);
+}
+
+void PlanController::resume(ResumeResult result, TimePoint now) {
+    for (const auto& p : result.problems) {
+        log(Level::Warn, p);
+        problem_ = p;
+    }
+    if (!result.resumed)
+        return;
+    auto& r = *result.resumed;
+    if (!r.stream) {
+        log(Level::Info, fmt::format("stored plan '{}' was {}; nothing to resume", r.plan->name,
+                                     to_string(r.progress.state)));
+        return;
+    }
+    ActivePlan plan;
+    plan.plan = r.plan;
+    plan.text = std::move(r.plan_text);
+    plan.source = r.plan->source_file;
+    plan.digest = r.digest;
+    plan.stream = r.stream.get();
+    if (r.progress.state == PlanState::Paused)
+        feeder_.pause();
+    feeder_.restore_plan(PlanFeed{std::move(r.stream), r.plan->name}, r.progress.waypoints_reached, now);
+    reactions_ = std::make_unique<ReactionMonitor>(ReactionSettings::from_plan(*plan.plan));
+    tell_reactions_the_link(now);
+    log(Level::Info, fmt::format("resuming plan '{}' ({}) at waypoint {}, {} reached{}", r.plan->name,
+                                 plan.source, r.progress.next_index, r.progress.waypoints_reached,
+                                 r.progress.state == PlanState::Paused ? ", paused" : ""));
+    active_ = std::move(plan);
+}
+
+// ---- plans ---------------------------------------------------------------------------------------------
+
+void PlanController::start_plan(ActivePlan plan, bool append, TimePoint now) {
+    auto stream = std::make_unique<Expander>(plan.plan);
+    Expander* raw = stream.get();
+    if (append && active_ && active_->stream) {
+        // The merged plan expands like the running one up to its end: continue from the same place.
+        (void)raw->restore(active_->stream->origin(), active_->stream->position());  // probed by prepare_load
+        feeder_.continue_with(PlanFeed{std::move(stream), plan.plan->name}, now);
+    } else {
+        feeder_.replace_plan(PlanFeed{std::move(stream), plan.plan->name}, now);
+    }
+    plan.stream = raw;
+    reactions_ = std::make_unique<ReactionMonitor>(ReactionSettings::from_plan(*plan.plan));
+    tell_reactions_the_link(now);
+    active_ = std::move(plan);
+    returning_home_ = false;
+    problem_.clear();
+    last_saved_.reset();
+    save_progress();
+}
+
+// The link's state comes as a change (LinkState): a new plan's reactions start from the one last heard.
+void PlanController::tell_reactions_the_link(TimePoint now) {
+    if (groundlink_seen_up_ && reactions_)
+        reactions_->on_link(groundlink_up_, now);
+}
+
+void PlanController::save_progress() {
+    if (!config_.keeps_progress || !active_ || returning_home_)
+        return;
+    const FeederProgress p = feeder_.progress();
+    if (p.state == PlanState::None)
+        return;
+    SavedProgress s = SavedProgress::from(p, active_->digest);
+    if (p.state != PlanState::Done && !p.resume_index) {
+        return;  // between states (nothing queued yet): the last saved point still holds
+    }
+    if (last_saved_ && *last_saved_ == s)
+        return;
+    // Taken as saved until the store says otherwise (on_saved): the same point is not written twice.
+    last_saved_ = s;
+    saves_.push_back(ProgressSave{std::move(s), true});
+}
+
+void PlanController::on_saved(const ProgressSave& save, const std::optional<std::string>& error) {
+    if (!error) {
+        last_saved_ = save.progress;
+        return;
+    }
+    if (!save.report_failure)
+        return;
+    if (last_saved_ && *last_saved_ == save.progress)
+        last_saved_.reset();
+    if (problem_ != *error)
+        log(Level::Error, "cannot save progress: " + *error);
+    problem_ = *error;
+    publish_status(false);
+}
+
+bool PlanController::return_home(TimePoint now) {
+    std::optional<LatLon> home;
+    if (active_ && active_->plan->home) {
+        home = *active_->plan->home;
+    } else if (autopilot_home_) {
+        home = LatLon{autopilot_home_->lat, autopilot_home_->lon};
+    }
+    if (!home || !active_)
+        return false;
+    const auto& v = active_->plan->vehicle;
+    // The plan's progress stays saved where it was interrupted (paused), so a restart does not drive on.
+    if (config_.keeps_progress && last_saved_) {
+        SavedProgress paused = *last_saved_;
+        paused.state = PlanState::Paused;
+        saves_.push_back(ProgressSave{std::move(paused), false});
+    }
+    feeder_.replace_plan(
+        PlanFeed{std::make_unique<HomeStream>(*home, v.commanded_cruise_speed(), v.arrival_radius),
+                 active_->plan->name + " (return home)"},
+        now);
+    active_->stream = nullptr;
+    returning_home_ = true;
+    return true;
+}
+
+void PlanController::carry_out(const ReactionTrigger& t, TimePoint now) {
+    const std::string cause = to_string(t.cause);
+    std::string what;
+    switch (t.reaction.action) {
+        case ReactionAction::Hold:
+            feeder_.pause();
+            what = "hold";
+            break;
+        case ReactionAction::Continue:
+            what = "continue";
+            break;
+        case ReactionAction::GotoBlock:
+            what = feeder_.jump_to(t.reaction.target, now) ? "goto " + t.reaction.target
+                                                           : "goto " + t.reaction.target + " failed; hold";
+            if (what.ends_with("hold"))
+                feeder_.pause();
+            break;
+        case ReactionAction::ReturnHome:
+            what = return_home(now) ? "return home" : "return home impossible (no home known); hold";
+            if (what.ends_with("hold"))
+                feeder_.pause();
+            break;
+    }
+    if (t.cause == ReactionTrigger::Cause::LinkRecovered)
+        what = "nothing (the link-loss reaction stays in effect)";
+    last_reaction_ = cause + ": " + what + (t.detail.empty() ? "" : " (" + t.detail + ")");
+    log(Level::Warn, "reaction " + last_reaction_);
+    outputs_.emplace_back(t);
+}
+
+// ---- autopilot side ------------------------------------------------------------------------------------
+
+void PlanController::on_autopilot_status(const autopilot::AutopilotStatus& s, TimePoint now) {
+    if (s.ready == autopilot_ready_)
+        return;
+    autopilot_ready_ = s.ready;
+    const std::pair<unsigned, unsigned> counts{s.reconnects, s.reboots};
+    if (!autopilot_ready_) {
+        // Lost: the window is kept. A board that only went silent drives on, and the waypoints it reports
+        // reached meanwhile still count; a reboot (its own event) or a reopened port makes it unknown.
+        fail_waiters("the autopilot is not ready");
+        pump(now);
+        return;
+    }
+    const bool same_board = ready_counts_ && *ready_counts_ == counts;
+    ready_counts_ = counts;
+    if (same_board) {
+        pump(now);  // back, neither rebooted nor reconnected: it still holds the window
+        return;
+    }
+    // Connected afresh: what the autopilot holds is unknown; the window is uploaded again.
+    on_rebooted(now);
+}
+
+void PlanController::on_telemetry(const autopilot::Telemetry& t, TimePoint now) {
+    if (t.home)
+        autopilot_home_ = t.home;
+    if (!reactions_)
+        return;
+    if (t.battery_remaining)
+        reactions_->on_battery(*t.battery_remaining, now);
+    if (t.position)
+        reactions_->on_position(LatLon{t.position->lat, t.position->lon}, now);
+    pump(now);
+}
+
+void PlanController::on_reached(std::uint32_t seq, TimePoint now) {
+    feeder_.on_reached(seq, now);
+    pump(now);
+}
+
+void PlanController::on_current(std::uint32_t seq, TimePoint now) {
+    feeder_.on_current(seq, now);
+    pump(now);
+}
+
+void PlanController::on_rebooted(TimePoint now) {
+    feeder_.on_autopilot_rebooted(now);
+    in_flight_.clear();
+    pump(now);
+}
+
+void PlanController::on_mode_changed(const autopilot::ModeChanged& m, TimePoint now) {
+    using S = autopilot::VehicleState;
+    VehicleMode mode = VehicleMode::Unknown;
+    switch (m.to) {
+        case S::WaypointNavigation:
+            mode = VehicleMode::Auto;
+            break;
+        case S::Parking:
+            mode = VehicleMode::Hold;
+            break;
+        case S::Directed:
+        case S::ManualNavigation:
+        case S::Manual:
+            mode = VehicleMode::Manual;
+            break;
+        case S::Unknown:
+        case S::ConfigureCheck:
+            break;
+    }
+    ModeCause cause = ModeCause::Board;
+    if (m.cause == autopilot::ModeChangeCause::Requested) {
+        cause = ModeCause::Ours;
+    } else if (m.to == S::Directed) {
+        cause = ModeCause::RcPilot;  // MANUAL that nobody here asked for: the RC transmitter's switch
+    }
+    feeder_.on_mode(mode, cause, now);
+    pump(now);
+}
+
+void PlanController::on_request_done(const autopilot::RequestDone& done, TimePoint now) {
+    const auto it = in_flight_.find(done.id);
+    if (it == in_flight_.end())
+        return;  // another requester's, or forgotten after a reconnect
+    const std::uint32_t feeder_id = it->second.feeder_id;
+    log(Level::Debug,
+        fmt::format("#{} {} in {} ms", feeder_id, autopilot::to_string(done.result),
+                    std::chrono::duration_cast<std::chrono::milliseconds>(now - it->second.sent).count()));
+    in_flight_.erase(it);
+    const bool ok = done.result == autopilot::RequestResult::Ok;
+    // A mission the autopilot refused (its answer, after the driver's fallbacks) or one it cannot hold is
+    // final; anything else (timeouts, a busy or reconnecting autopilot) is asked again.
+    const bool refused =
+        done.result == autopilot::RequestResult::Refused || done.result == autopilot::RequestResult::Invalid;
+    if (ok) {
+        fault_.reset();
+    } else {
+        last_failure_ = std::string(autopilot::to_string(done.kind)) + ": " +
+                        autopilot::to_string(done.result) +
+                        (done.detail.empty() ? "" : " (" + done.detail + ")");
+    }
+    feeder_.on_request_result(feeder_id,
+                              ok        ? RequestResult::Ok
+                              : refused ? RequestResult::Refused
+                                        : RequestResult::Failed,
+                              now, last_failure_);
+    pump(now);
+}
+
+void PlanController::on_link(bool up, TimePoint now) {
+    // Link loss means losing a link that was there: a vehicle started without a ground station does not
+    // react to its absence.
+    groundlink_seen_up_ = groundlink_seen_up_ || up;
+    groundlink_up_ = up;
+    if (groundlink_seen_up_ && reactions_) {
+        reactions_->on_link(up, now);
+        pump(now);
+    }
+}
+
+void PlanController::send(const FeederRequest& request, TimePoint now) {
+    autopilot::AutopilotRequest r;
+    r.id = next_bus_id_;
+    next_bus_id_ = next_bus_id_ >= 0x7FFFFFFFu ? kFirstRequestId : next_bus_id_ + 1;
+    std::visit(
+        [&](const auto& op) {
+            using T = std::decay_t<decltype(op)>;
+            if constexpr (std::is_same_v<T, UploadMission>) {
+                r.op = autopilot::UploadMission{to_autopilot(op.items)};
+            } else if constexpr (std::is_same_v<T, WriteItems>) {
+                r.op = autopilot::WriteMissionItems{op.first_slot, to_autopilot(op.items)};
+            } else if constexpr (std::is_same_v<T, SetCurrent>) {
+                r.op = autopilot::SetMissionCurrent{op.slot};
+            } else if constexpr (std::is_same_v<T, HoldVehicle>) {
+                r.op = autopilot::RequestStateChange{autopilot::VehicleState::Parking};
+            } else {
+                r.op = autopilot::RequestStateChange{autopilot::VehicleState::WaypointNavigation};
+            }
+        },
+        request.op);
+    std::ostringstream o;
+    o << request;
+    log(Level::Debug, o.str());
+    in_flight_[r.id] = InFlight{request.id, now};
+    outputs_.emplace_back(std::move(r));
+}
+
+void PlanController::pump(TimePoint now) {
+    if (!running_)
+        return;
+    if (feeder_.poll_timeout() <= now)
+        feeder_.handle_timeout(now);
+    if (reactions_) {
+        if (reactions_->poll_timeout() <= now)
+            reactions_->handle_timeout(now);
+        while (auto t = reactions_->poll_trigger())
+            carry_out(*t, now);
+    }
+    if (autopilot_ready_) {
+        while (auto r = feeder_.poll_request(now))
+            send(*r, now);
+    }
+    while (auto e = feeder_.poll_event())
+        handle_event(*e);
+    save_progress();
+    answer_waiters(now);
+    publish_status(false);
+}
+
+void PlanController::handle_event(const FeederEvent& e) {
+    switch (e.kind) {
+        case FeederEvent::Kind::WaypointReached:
+            log(Level::Debug, fmt::format("waypoint {} reached ({})", e.plan_index, e.element_path));
+            break;
+        case FeederEvent::Kind::ElementStarted:
+        case FeederEvent::Kind::ElementFinished:
+        case FeederEvent::Kind::HoldStarted:
+        case FeederEvent::Kind::HoldEnded:
+            log(Level::Info, fmt::format("{} {}", to_string(e.kind), e.element_path));
+            break;
+        case FeederEvent::Kind::PlanDone:
+            log(Level::Info, fmt::format("plan '{}' done", feeder_.progress().plan_name));
+            break;
+        case FeederEvent::Kind::PlanBlocked:
+            log(Level::Error, "plan stopped: " + e.detail);
+            problem_ = e.detail;
+            break;
+        case FeederEvent::Kind::RequestFailed:
+            fault_ = last_failure_.empty() ? e.detail : last_failure_;
+            log(Level::Error, fmt::format("autopilot request failed after retries: {}; holding", *fault_));
+            fail_waiters("the autopilot did not confirm: " + *fault_);
+            break;
+        case FeederEvent::Kind::WindowStarved:
+            log(Level::Warn,
+                fmt::format("window starved at waypoint {}: holding until it is written", e.plan_index));
+            break;
+        case FeederEvent::Kind::Interrupted:
+            log(Level::Warn, fmt::format("plan interrupted at waypoint {}: {}", e.plan_index, e.detail));
+            break;
+        case FeederEvent::Kind::Continued:
+            log(Level::Info, fmt::format("plan continues at waypoint {} after: {}", e.plan_index, e.detail));
+            break;
+        case FeederEvent::Kind::PlanFailed:
+            log(Level::Error, "plan failed, the vehicle is held: " + e.detail);
+            problem_ = "the autopilot refused the plan: " + e.detail;
+            fail_waiters(problem_);
+            break;
+    }
+    outputs_.emplace_back(e);
+}
+
+// ---- commands ------------------------------------------------------------------------------------------
+
+void PlanController::wait_for_autopilot(CommandId id, std::string what, TimePoint now) {
+    waiters_.push_back(Waiter{id, std::move(what), now + config_.command_timeout});
+    pump(now);
+}
+
+void PlanController::answer_waiters(TimePoint now) {
+    if (waiters_.empty())
+        return;
+    if (!autopilot_ready_) {
+        fail_waiters("the autopilot is not ready (the plan is kept and starts when it is)");
+        return;
+    }
+    if (fault_) {
+        fail_waiters("the autopilot did not confirm: " + *fault_);
+        return;
+    }
+    // Idle: nothing in flight and nothing more to ask: everything the commands needed is confirmed.
+    if (in_flight_.empty()) {
+        auto done = std::move(waiters_);
+        waiters_.clear();
+        const Json progress = progress_json();
+        for (auto& w : done)
+            reply(w.id, Status::Ok, {}, progress);
+        return;
+    }
+    std::vector<Waiter> keep;
+    for (auto& w : waiters_) {
+        if (now >= w.deadline) {
+            reply(w.id, Status::Failed,
+                  w.what + ": the autopilot did not confirm in time" +
+                      (last_failure_.empty() ? "" : " (last failure: " + last_failure_ + ")"));
+        } else {
+            keep.push_back(std::move(w));
+        }
+    }
+    waiters_ = std::move(keep);
+}
+
+void PlanController::fail_waiters(const std::string& why) {
+    auto failed = std::move(waiters_);
+    waiters_.clear();
+    for (auto& w : failed)
+        reply(w.id, Status::Failed, w.what + ": " + why);
+}
+
+void PlanController::reply(CommandId id, CommandReply::Status status, std::string error, Json result) {
+    replies_.push_back(CommandReply{id, status, std::move(result), std::move(error)});
+}
+
+std::optional<ActivePlan> PlanController::prepare_load(CommandId id, LoadRequest in) {
+    const char* what = in.append ? "plan.append" : "plan.load";
+    if (in.append && !active_) {
+        reply(id, Status::Refused, "no plan to append to (use plan.load)");
+        return std::nullopt;
+    }
+    if (in.append && returning_home_) {
+        reply(id, Status::Refused, "the vehicle is returning home; load a plan instead");
+        return std::nullopt;
+    }
+    // The new text on its own first, so that its errors carry its own file:line.
+    auto loaded = load_plan_text(in.text, in.source, config_.load);
+    if (!loaded.ok()) {
+        log(Level::Warn,
+            fmt::format("{} {} rejected: {}", what, in.source, loaded.errors.front().to_string()));
+        reply(id, Status::BadRequest, "plan rejected, nothing changed:\n" + to_string(loaded.errors));
+        return std::nullopt;
+    }
+    ActivePlan plan;
+    if (in.append) {
+        auto merged = append_plan_text(active_->text, in.text);
+        if (!merged.text) {
+            reply(id, Status::BadRequest, "plan rejected, nothing changed: " + merged.error);
+            return std::nullopt;
+        }
+        auto combined = load_plan_text(*merged.text, active_->source + " + " + in.source, config_.load);
+        if (!combined.ok()) {
+            reply(id, Status::BadRequest,
+                  "plan rejected, nothing changed: " + in.source + " appended to " + active_->source +
+                      " does not validate:\n" + to_string(combined.errors));
+            return std::nullopt;
+        }
+        if (active_->stream) {
+            // The merged plan must continue exactly where the running stream stands.
+            Expander probe(combined.plan);
+            if (!probe.restore(active_->stream->origin(), active_->stream->position())) {
+                reply(id, Status::Failed,
+                      "plan.append: the merged plan cannot continue where the running one stands; nothing "
+                      "changed");
+                return std::nullopt;
+            }
+        }
+        plan.plan = combined.plan;
+        plan.text = std::move(*merged.text);
+        plan.source = active_->source + " + " + in.source;
+    } else {
+        plan.plan = loaded.plan;
+        plan.text = std::move(in.text);
+        plan.source = in.source;
+    }
+    plan.digest = hex64(fnv1a64(plan.text));
+    return plan;
+}
+
+void PlanController::load(CommandId id, ActivePlan plan, bool append, bool start_paused,
+                          const std::string& from, TimePoint now) {
+    log(Level::Info, fmt::format("{} '{}' from {}{}", append ? "appended to plan" : "plan", plan.plan->name,
+                                 from, start_paused ? ", paused" : ""));
+    if (!append) {
+        // A loaded plan is there to be driven, whatever the vehicle did before (parked, a finished plan, a
+        // paused one), unless the operator asked for it to wait.
+        if (start_paused) {
+            feeder_.pause();
+        } else {
+            feeder_.resume();
+        }
+    }
+    start_plan(std::move(plan), append, now);
+    wait_for_autopilot(id, append ? "plan.append" : "plan.load", now);
+}
+
+void PlanController::skip(CommandId id, std::variant<std::uint64_t, std::string> target, TimePoint now) {
+    if (!active_ || !active_->stream) {
+        reply(id, Status::Refused, "no plan running");
+        return;
+    }
+    if (const auto* n = std::get_if<std::uint64_t>(&target)) {
+        if (!feeder_.skip_to(*n, now)) {
+            reply(id, Status::BadRequest,
+                  "the plan has no waypoint " + std::to_string(*n) + " from where it stands");
+            return;
+        }
+    } else {
+        const auto& name = std::get<std::string>(target);
+        if (!feeder_.jump_to(name, now)) {
+            reply(id, Status::BadRequest, "the plan has no element named '" + name + "'");
+            return;
+        }
+    }
+    wait_for_autopilot(id, "plan.skip", now);
+}
+
+void PlanController::pause(CommandId id, TimePoint now) {
+    if (!active_ && feeder_.progress().state == PlanState::None) {
+        reply(id, Status::Refused, "no plan running");
+        return;
+    }
+    feeder_.pause();
+    wait_for_autopilot(id, "plan.pause", now);
+}
+
+void PlanController::resume_plan(CommandId id, TimePoint now) {
+    if (feeder_.progress().state == PlanState::None) {
+        reply(id, Status::Refused, "no plan running");
+        return;
+    }
+    feeder_.resume();
+    feeder_.release_hold(now);  // resume also ends a hold-until-released
+    wait_for_autopilot(id, "plan.resume", now);
+}
+
+Json PlanController::show() const {
+    Json j = progress_json();
+    const auto p = feeder_.progress();
+    j["source"] = active_ ? Json(active_->source) : Json(nullptr);
+    j["generation"] = p.generation;
+    j["starvation_holds"] = p.starvation_holds;
+    j["ignored_reached"] = p.ignored_reached;
+    j["retries"] = p.retries;
+    j["failures"] = p.failures;
+    if (active_) {
+        const Plan& plan = *active_->plan;
+        auto& elements = j["elements"] = Json::array();
+        for (auto id : plan.children(plan.main_list)) {
+            const Node& n = plan.nodes[id];
+            elements.push_back({{"path", plan.element_path(id)},
+                                {"kind", to_string(n.kind)},
+                                {"name", plan.element_name(id)},
+                                {"line", n.mark.line},
+                                {"waypoints", optional_json(plan.count(id))}});
+        }
+    }
+    return j;
+}
+
+Json PlanController::progress_json() const {
+    const auto p = feeder_.progress();
+    Json j;
+    j["state"] = to_string(p.state);
+    j["name"] = p.state == PlanState::None ? Json(nullptr) : Json(p.plan_name);
+    j["element"] = p.element.empty() ? Json(nullptr) : Json(p.element);
+    j["waypoints_reached"] = p.waypoints_reached;
+    j["next_waypoint"] = optional_json(p.next_waypoint);
+    j["window"] = p.window;
+    j["reaction"] = last_reaction_.empty() ? Json(nullptr) : Json(last_reaction_);
+    j["interruption"] = p.interruption.empty() ? Json(nullptr) : Json(p.interruption);
+    j["error"] = problem_.empty() ? Json(nullptr) : Json(problem_);
+    return j;
+}
+
+// ---- time and outputs ----------------------------------------------------------------------------------
+
+void PlanController::handle_timeout(TimePoint now) {
+    pump(now);
+}
+
+TimePoint PlanController::poll_timeout() const {
+    TimePoint next = feeder_.poll_timeout();
+    if (reactions_)
+        next = std::min(next, reactions_->poll_timeout());
+    for (const auto& w : waiters_)
+        next = std::min(next, w.deadline);
+    return next;
+}
+
+void PlanController::publish_status(bool force) {
+    const auto p = feeder_.progress();
+    StatusUpdate u{
+        PlanProgress{p.state, top_element_index(p.element), p.next_waypoint.value_or(0), p.waypoints_reached},
+        std::nullopt};
+    Json j = progress_json();
+    if (force || j != last_status_) {
+        last_status_ = j;
+        u.section = std::move(j);
+    }
+    statuses_.push_back(std::move(u));
+}
+
+void PlanController::log(LogLine::Level level, std::string text) {
+    logs_.push_back(LogLine{level, std::move(text)});
+}
+
+std::optional<PlanOutput> PlanController::poll_output() {
+    return pop(outputs_);
+}
+
+std::optional<CommandReply> PlanController::poll_reply() {
+    return pop(replies_);
+}
+
+std::optional<ProgressSave> PlanController::poll_save() {
+    return pop(saves_);
+}
+
+std::optional<StatusUpdate> PlanController::poll_status() {
+    return pop(statuses_);
+}
+
+std::optional<LogLine> PlanController::poll_log() {
+    return pop(logs_);
+}
+
+}  // namespace airseg::flightplan

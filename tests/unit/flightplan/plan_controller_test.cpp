@@ -1,0 +1,388 @@
+// PlanController in simulated time: what a plan asks of the autopilot, commands answered once or timed out,
+// the link-loss reaction, an autopilot that reboots or reconnects mid-plan, pause and resume.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "services/flightplan/plan_controller.hpp"
+
+namespace airseg::flightplan {
+namespace {
+
+using Status = CommandReply::Status;
+
+constexpr const char* kPlan = R"(plan:
+  name: ctl
+  vehicle: {type: rover, cruise_speed: 1.5}
+  home: {lat: 41.0, lon: 2.0}
+  reactions:
+    link_loss: {after: 20, action: ACTION}
+  elements:
+    - waypoint: {lat: 41.0001, lon: 2.0001}
+    - waypoint: {lat: 41.0002, lon: 2.0001}
+    - waypoint: {lat: 41.0003, lon: 2.0002}
+)";
+
+std::string plan_text(const std::string& action = "hold") {
+    std::string text = kPlan;
+    text.replace(text.find("ACTION"), 6, action);
+    return text;
+}
+
+bool is_state_change(const autopilot::AutopilotRequest& r, autopilot::VehicleState to) {
+    const auto* s = std::get_if<autopilot::RequestStateChange>(&r.op);
+    return s && s->state == to;
+}
+
+bool is_upload(const autopilot::AutopilotRequest& r) {
+    return std::holds_alternative<autopilot::UploadMission>(r.op);
+}
+
+// The controller, an autopilot that confirms what it is asked (or not, when told so) and the outputs seen.
+struct Rig {
+    explicit Rig(PlanControllerConfig config = {}) : c(std::move(config)) {
+        c.start(now);
+        drain();
+    }
+
+    void drain() {
+        while (auto o = c.poll_output()) {
+            if (auto* r = std::get_if<autopilot::AutopilotRequest>(&*o)) {
+                requests.push_back(*r);
+                pending.push_back(*r);
+            } else if (auto* t = std::get_if<ReactionTrigger>(&*o)) {
+                triggers.push_back(*t);
+            }
+        }
+        while (auto r = c.poll_reply())
+            replies.push_back(*r);
+        while (auto s = c.poll_save()) {
+            saves.push_back(*s);
+            c.on_saved(*s, save_error);
+        }
+        while (c.poll_status()) {
+        }
+        while (c.poll_log()) {
+        }
+    }
+
+    void ready(unsigned reconnects = 0, unsigned reboots = 0) {
+        autopilot::AutopilotStatus s;
+        s.ready = true;
+        s.reconnects = reconnects;
+        s.reboots = reboots;
+        c.on_autopilot_status(s, now);
+        drain();
+    }
+
+    void not_ready() {
+        c.on_autopilot_status(autopilot::AutopilotStatus{}, now);
+        drain();
+    }
+
+    /// Confirms every request, reporting the mode changes asked for, until nothing more is asked.
+    void confirm_all() {
+        for (int guard = 0; guard < 100 && !pending.empty(); ++guard) {
+            const auto r = pending.front();
+            pending.erase(pending.begin());
+            now += milliseconds(50);
+            c.on_request_done(autopilot::RequestDone{r.id, {}, autopilot::RequestResult::Ok, {}, {}, {}, {}},
+                              now);
+            drain();
+            if (const auto* s = std::get_if<autopilot::RequestStateChange>(&r.op)) {
+                autopilot::ModeChanged m;
+                m.to = s->state;
+                m.cause = autopilot::ModeChangeCause::Requested;
+                c.on_mode_changed(m, now);
+                drain();
+            }
+        }
+    }
+
+    void advance(Duration d) {
+        const TimePoint until = now + d;
+        while (c.poll_timeout() <= until) {
+            now = std::max(now, c.poll_timeout());
+            c.handle_timeout(now);
+            drain();
+        }
+        now = until;
+    }
+
+    CommandId load(const std::string& text, bool paused = false) {
+        const CommandId id = next_id++;
+        auto plan = c.prepare_load(id, LoadRequest{text, "test.yaml", false});
+        if (plan)
+            c.load(id, std::move(*plan), false, paused, "test.yaml", now);
+        drain();
+        return id;
+    }
+
+    std::vector<CommandReply> replies_to(CommandId id) const {
+        std::vector<CommandReply> out;
+        for (const auto& r : replies)
+            if (r.id == id)
+                out.push_back(r);
+        return out;
+    }
+
+    std::size_t count(bool (*pred)(const autopilot::AutopilotRequest&)) const {
+        std::size_t n = 0;
+        for (const auto& r : requests)
+            n += pred(r) ? 1 : 0;
+        return n;
+    }
+
+    /// A ready autopilot driving a plan whose link-loss reaction is `action`, the link up or down at start.
+    void run_plan(const std::string& action, bool link_up) {
+        ready();
+        c.on_link(link_up, now);
+        load(plan_text(action));
+        confirm_all();
+    }
+
+    std::string state() const { return c.progress_json()["state"].get<std::string>(); }
+
+    PlanController c;
+    TimePoint now{};
+    CommandId next_id = 1;
+    std::vector<autopilot::AutopilotRequest> requests;
+    std::vector<autopilot::AutopilotRequest> pending;
+    std::vector<CommandReply> replies;
+    std::vector<ReactionTrigger> triggers;
+    std::vector<ProgressSave> saves;
+    std::optional<std::string> save_error;  // what the state store answers
+};
+
+bool is_hold(const autopilot::AutopilotRequest& r) {
+    return is_state_change(r, autopilot::VehicleState::Parking);
+}
+
+bool is_auto(const autopilot::AutopilotRequest& r) {
+    return is_state_change(r, autopilot::VehicleState::WaypointNavigation);
+}
+
+/// The state change the vehicle was last asked for: Parking, WaypointNavigation, or Unknown when none.
+autopilot::VehicleState last_state_asked(const Rig& rig) {
+    for (auto it = rig.requests.rbegin(); it != rig.requests.rend(); ++it)
+        if (const auto* s = std::get_if<autopilot::RequestStateChange>(&it->op))
+            return s->state;
+    return autopilot::VehicleState::Unknown;
+}
+
+TEST(FlightplanController, LoadUploadsTheWindowStartsTheVehicleAndAnswersOnceConfirmed) {
+    Rig rig;
+    rig.ready();
+    const auto id = rig.load(plan_text());
+    ASSERT_FALSE(rig.requests.empty());
+    EXPECT_TRUE(is_upload(rig.requests.front()));
+    const auto& items = std::get<autopilot::UploadMission>(rig.requests.front().op).items;
+    ASSERT_GE(items.size(), 2u);
+    EXPECT_DOUBLE_EQ(items[1].lat, 41.0001);  // after the slot before the plan's first waypoint
+    EXPECT_GE(rig.requests.front().id, PlanController::kFirstRequestId);
+    EXPECT_TRUE(rig.replies_to(id).empty()) << "answered before the autopilot confirmed";
+    rig.confirm_all();
+    EXPECT_EQ(rig.count(is_auto), 1u);
+    EXPECT_EQ(rig.count(is_hold), 0u);
+    const auto replies = rig.replies_to(id);
+    ASSERT_EQ(replies.size(), 1u);
+    EXPECT_EQ(replies.front().status, Status::Ok);
+    EXPECT_EQ(replies.front().result["state"], "running");
+    EXPECT_EQ(rig.state(), "running");
+}
+
+TEST(FlightplanController, LoadWaitsForTheAutopilotAndFailsWhenItIsNotReady) {
+    Rig rig;
+    const auto id = rig.load(plan_text());
+    EXPECT_TRUE(rig.requests.empty()) << "nothing is sent to an autopilot that is not ready";
+    const auto replies = rig.replies_to(id);
+    ASSERT_EQ(replies.size(), 1u);
+    EXPECT_EQ(replies.front().status, Status::Failed);
+    EXPECT_NE(replies.front().error.find("not ready"), std::string::npos) << replies.front().error;
+    // The plan is kept and starts once the autopilot is there.
+    rig.ready();
+    ASSERT_FALSE(rig.requests.empty());
+    EXPECT_TRUE(is_upload(rig.requests.front()));
+}
+
+TEST(FlightplanController, ACommandTheAutopilotDoesNotConfirmTimesOutOnce) {
+    PlanControllerConfig config;
+    config.command_timeout = seconds(5);
+    Rig rig(config);
+    rig.ready();
+    const auto id = rig.load(plan_text());
+    EXPECT_LE(rig.c.poll_timeout(), rig.now + seconds(5));
+    rig.advance(milliseconds(4900));
+    EXPECT_TRUE(rig.replies_to(id).empty());
+    rig.advance(milliseconds(200));
+    auto replies = rig.replies_to(id);
+    ASSERT_EQ(replies.size(), 1u);
+    EXPECT_EQ(replies.front().status, Status::Failed);
+    EXPECT_NE(replies.front().error.find("plan.load: the autopilot did not confirm in time"),
+              std::string::npos)
+        << replies.front().error;
+    rig.confirm_all();  // late confirmations: no second answer
+    EXPECT_EQ(rig.replies_to(id).size(), 1u);
+}
+
+TEST(FlightplanController, BadAppendsAndSkipsAreAnsweredAtOnceWithoutTouchingTheVehicle) {
+    Rig rig;
+    rig.ready();
+    EXPECT_FALSE(rig.c.prepare_load(7, LoadRequest{plan_text(), "more.yaml", true}).has_value());
+    rig.c.skip(8, std::uint64_t{1}, rig.now);
+    EXPECT_FALSE(rig.c.prepare_load(9, LoadRequest{"plan: [", "bad.yaml", false}).has_value());
+    rig.drain();
+    ASSERT_EQ(rig.replies.size(), 3u);
+    EXPECT_EQ(rig.replies[0].status, Status::Refused);
+    EXPECT_EQ(rig.replies[1].status, Status::Refused);
+    EXPECT_EQ(rig.replies[2].status, Status::BadRequest);
+    EXPECT_TRUE(rig.requests.empty());
+}
+
+TEST(FlightplanController, LinkLostForTheConfiguredTimeHoldsTheVehicle) {
+    Rig rig;
+    rig.run_plan("hold", true);
+    rig.c.on_link(false, rig.now);
+    rig.drain();
+    rig.advance(seconds(19));
+    EXPECT_TRUE(rig.triggers.empty());
+    EXPECT_EQ(rig.count(is_hold), 0u);
+    rig.advance(seconds(2));
+    ASSERT_EQ(rig.triggers.size(), 1u);
+    EXPECT_EQ(rig.triggers.front().cause, ReactionTrigger::Cause::LinkLoss);
+    EXPECT_EQ(rig.count(is_hold), 1u);
+    rig.confirm_all();
+    EXPECT_EQ(rig.state(), "paused");
+    EXPECT_EQ(rig.c.progress_json()["reaction"], "link-loss: hold (ground link down for 20 s)");
+}
+
+TEST(FlightplanController, ALinkNeverSeenUpIsNotLost) {
+    Rig rig;
+    rig.run_plan("hold", false);
+    rig.advance(seconds(60));
+    EXPECT_TRUE(rig.triggers.empty());
+    EXPECT_EQ(rig.count(is_hold), 0u);
+}
+
+TEST(FlightplanController, LinkLossReturnsHomeWhenThePlanSaysSo) {
+    Rig rig;
+    rig.run_plan("return_home", true);
+    const auto sent = rig.requests.size();
+    rig.c.on_link(false, rig.now);
+    rig.drain();
+    rig.advance(seconds(21));
+    ASSERT_EQ(rig.triggers.size(), 1u);
+    EXPECT_TRUE(rig.c.returning_home());
+    // The way home replaces the plan in the window.
+    bool home_written = false;
+    for (auto i = sent; i < rig.requests.size(); ++i) {
+        if (const auto* w = std::get_if<autopilot::WriteMissionItems>(&rig.requests[i].op)) {
+            for (const auto& item : w->items)
+                home_written = home_written || (item.lat == 41.0 && item.lon == 2.0);
+        }
+    }
+    EXPECT_TRUE(home_written);
+    EXPECT_EQ(rig.c.progress_json()["reaction"], "link-loss: return home (ground link down for 20 s)");
+    // A plan.append is refused on the way home.
+    EXPECT_FALSE(rig.c.prepare_load(50, LoadRequest{plan_text(), "more.yaml", true}).has_value());
+    rig.drain();
+    ASSERT_EQ(rig.replies_to(50).size(), 1u);
+    EXPECT_EQ(rig.replies_to(50).front().status, Status::Refused);
+}
+
+TEST(FlightplanController, AnAutopilotThatRebootsMidPlanGetsTheWindowAgain) {
+    Rig rig;
+    rig.ready();
+    rig.load(plan_text());
+    rig.confirm_all();
+    ASSERT_EQ(rig.count(is_upload), 1u);
+    rig.c.on_reached(1, rig.now);
+    rig.drain();
+    rig.c.on_rebooted(rig.now);
+    rig.drain();
+    EXPECT_EQ(rig.count(is_upload), 2u);
+    rig.confirm_all();
+    EXPECT_EQ(rig.state(), "running");
+    EXPECT_EQ(last_state_asked(rig), autopilot::VehicleState::WaypointNavigation);
+}
+
+TEST(FlightplanController, AnAutopilotBackWithTheSameCountsKeepsItsWindowAReconnectedOneDoesNot) {
+    Rig rig;
+    rig.ready(0, 0);
+    rig.load(plan_text());
+    rig.confirm_all();
+    ASSERT_EQ(rig.count(is_upload), 1u);
+    rig.not_ready();
+    rig.ready(0, 0);  // it only went silent
+    EXPECT_EQ(rig.count(is_upload), 1u);
+    rig.not_ready();
+    rig.ready(1, 0);  // the port was reopened: what it holds is unknown
+    EXPECT_EQ(rig.count(is_upload), 2u);
+}
+
+TEST(FlightplanController, PauseThenResumeLeavesTheRunningPlanInAuto) {
+    Rig rig;
+    rig.ready();
+    rig.load(plan_text());
+    rig.confirm_all();
+    rig.c.pause(20, rig.now);
+    rig.drain();
+    EXPECT_EQ(last_state_asked(rig), autopilot::VehicleState::Parking);
+    rig.confirm_all();
+    ASSERT_EQ(rig.replies_to(20).size(), 1u);
+    EXPECT_EQ(rig.replies_to(20).front().status, Status::Ok);
+    EXPECT_EQ(rig.state(), "paused");
+    rig.c.resume_plan(21, rig.now);
+    rig.drain();
+    rig.confirm_all();
+    ASSERT_EQ(rig.replies_to(21).size(), 1u);
+    EXPECT_EQ(rig.replies_to(21).front().status, Status::Ok);
+    EXPECT_EQ(rig.state(), "running");
+    EXPECT_EQ(last_state_asked(rig), autopilot::VehicleState::WaypointNavigation);
+    rig.advance(seconds(10));
+    EXPECT_EQ(last_state_asked(rig), autopilot::VehicleState::WaypointNavigation)
+        << "nothing parks the running plan afterwards";
+}
+
+TEST(FlightplanController, ProgressIsKeptOnceAndAWayHomeLeavesThePlanSavedAsPaused) {
+    PlanControllerConfig config;
+    config.keeps_progress = true;
+    Rig rig(config);
+    rig.run_plan("return_home", true);
+    ASSERT_FALSE(rig.saves.empty());
+    EXPECT_EQ(rig.saves.back().progress.state, PlanState::Running);
+    for (std::size_t i = 1; i < rig.saves.size(); ++i)
+        EXPECT_FALSE(rig.saves[i].progress == rig.saves[i - 1].progress) << "the same point saved twice";
+    const auto before = rig.saves.size();
+    rig.c.on_link(false, rig.now);
+    rig.drain();
+    rig.advance(seconds(21));
+    rig.confirm_all();
+    ASSERT_EQ(rig.saves.size(), before + 1) << "only the paused point: the way home is not a plan to resume";
+    EXPECT_EQ(rig.saves.back().progress.state, PlanState::Paused);
+    EXPECT_EQ(rig.saves.back().progress.next_index, rig.saves[before - 1].progress.next_index);
+}
+
+TEST(FlightplanController, AProgressTheStoreCannotKeepIsThePlansError) {
+    PlanControllerConfig config;
+    config.keeps_progress = true;
+    Rig rig(config);
+    rig.save_error = "disk full";
+    rig.run_plan("hold", true);
+    EXPECT_EQ(rig.c.progress_json()["error"], "disk full");
+}
+
+TEST(FlightplanController, StopFailsTheWaitingCommands) {
+    Rig rig;
+    rig.ready();
+    const auto id = rig.load(plan_text());
+    rig.c.stop("the daemon is stopping");
+    rig.drain();
+    const auto replies = rig.replies_to(id);
+    ASSERT_EQ(replies.size(), 1u);
+    EXPECT_EQ(replies.front().error, "plan.load: the daemon is stopping");
+}
+
+}  // namespace
+}  // namespace airseg::flightplan
