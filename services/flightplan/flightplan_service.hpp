@@ -9,7 +9,7 @@
 // everything it required (the feeder has nothing left to ask), or with the failure.
 //
 // Bus: subscribes autopilot::AutopilotStatus, Telemetry, WaypointReached, MissionCurrentChanged, ModeChanged,
-// AutopilotRebooted, RequestDone, status::StatusSection ("groundlink": the ground link's up/down state);
+// AutopilotRebooted, RequestDone, groundlink::LinkState (the ground link's up/down state, a typed variable);
 // publishes AutopilotRequest, FeederEvent and ReactionTrigger (events) and the "plan" status section.
 // Log prefix: flightplan: .
 #include <map>
