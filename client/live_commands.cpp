@@ -104,8 +104,8 @@ int run_log(RadioClient& radio, const LiveOptions& o) {
             return;
         }
         if (o.json) {
-            const char* sev = e->severity == proto::Event::Severity::error     ? "error"
-                              : e->severity == proto::Event::Severity::warning ? "warning"
+            const char* sev = e->severity == proto::Event::Severity::Error     ? "error"
+                              : e->severity == proto::Event::Severity::Warning ? "warning"
                                                                                : "info";
             std::cout << nlohmann::json{{"severity", sev}, {"text", e->text}}.dump() << "\n" << std::flush;
         } else {

@@ -33,7 +33,7 @@ constexpr int kDone = 0;
 constexpr int kRefused = 1;
 constexpr int kNoLink = 3;
 
-const char* kUsageText =
+const char* const kUsageText =
     "Usage: airsegctl [CONNECTION] [--json] [--timeout MS] COMMAND [ARGS]\n"
     "\n"
     "Talks to airsegd, the on-board daemon, and shows what it says. Nothing is shown as done before\n"

@@ -59,9 +59,9 @@ class RadioClient::Impl {
         } else {
             t.link_rate_bytes_per_s = options_.baud / 10.0;
             t.paths = options_.ports.size();
-            t.path_mode = options_.mode == "split"       ? gl::PathMode::split
-                          : options_.mode == "redundant" ? gl::PathMode::redundant
-                                                         : gl::PathMode::single;
+            t.path_mode = options_.mode == "split"       ? gl::PathMode::Split
+                          : options_.mode == "redundant" ? gl::PathMode::Redundant
+                                                         : gl::PathMode::Single;
             // The vehicle transmits on its first pair in split mode, so the ground transmits on the second.
             t.split_tx_path = t.paths == 2 ? 1 : 0;
         }
@@ -78,8 +78,8 @@ class RadioClient::Impl {
             strand_, t,
             gl::LinkDriver::Handlers{[this](gl::Delivered m) { on_delivered(std::move(m)); },
                                      [this](const gl::TransportEvent& e) {
-                                         if (e.kind == gl::TransportEvent::Kind::session_established ||
-                                             e.kind == gl::TransportEvent::Kind::peer_restarted) {
+                                         if (e.kind == gl::TransportEvent::Kind::SessionEstablished ||
+                                             e.kind == gl::TransportEvent::Kind::PeerRestarted) {
                                              pushed_received_ = 0;  // the vehicle counts per session too
                                          }
                                      }});
@@ -136,12 +136,12 @@ class RadioClient::Impl {
         asio::dispatch(strand_, [this, id, req, &not_sent] {
             const auto bytes = proto::encode(proto::Command{id, req});
             const auto r = driver_->send_safe(proto::kPriorityControl, bytes);
-            if (r == gl::SendResult::too_large) {
+            if (r == gl::SendResult::TooLarge) {
                 not_sent = fmt::format(
                     "the command is {} bytes, more than the link carries in one message ({} "
                     "bytes); not sent",
                     bytes.size(), driver_->core().config().max_message_size);
-            } else if (r != gl::SendResult::accepted) {
+            } else if (r != gl::SendResult::Accepted) {
                 not_sent =
                     fmt::format("the command could not be queued ({})", (std::ostringstream{} << r).str());
             }

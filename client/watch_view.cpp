@@ -38,9 +38,9 @@ const char* mode_name(std::uint8_t code) {
 
 const char* severity_name(proto::Event::Severity s) {
     switch (s) {
-        case proto::Event::Severity::warning:
+        case proto::Event::Severity::Warning:
             return "warning";
-        case proto::Event::Severity::error:
+        case proto::Event::Severity::Error:
             return "error";
         default:
             return "info";

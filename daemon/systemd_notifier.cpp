@@ -13,13 +13,15 @@ namespace {
 
 template <typename T>
 std::optional<T> parse_number(const char* text) {
-    if (text == nullptr)
+    if (text == nullptr) {
         return std::nullopt;
+    }
     const std::string_view s(text);
     T value{};
     const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
-    if (ec != std::errc() || end != s.data() + s.size() || s.empty())
+    if (ec != std::errc() || end != s.data() + s.size() || s.empty()) {
         return std::nullopt;
+    }
     return value;
 }
 
@@ -28,12 +30,14 @@ std::optional<T> parse_number(const char* text) {
 std::optional<std::chrono::microseconds> watchdog_period_from(const char* usec, const char* pid,
                                                               long own_pid) {
     const auto period = parse_number<unsigned long long>(usec);
-    if (!period || *period == 0)
+    if (!period || *period == 0) {
         return std::nullopt;
+    }
     if (pid != nullptr) {
         const auto target = parse_number<long>(pid);
-        if (!target || *target != own_pid)
+        if (!target || *target != own_pid) {
             return std::nullopt;
+        }
     }
     return std::chrono::microseconds(static_cast<std::chrono::microseconds::rep>(*period));
 }
@@ -41,8 +45,9 @@ std::optional<std::chrono::microseconds> watchdog_period_from(const char* usec, 
 SystemdNotifier::SystemdNotifier() {
     watchdog_ = watchdog_period_from(std::getenv("WATCHDOG_USEC"), std::getenv("WATCHDOG_PID"), getpid());
     const char* socket_name = std::getenv("NOTIFY_SOCKET");
-    if (socket_name == nullptr || *socket_name == '\0')
+    if (socket_name == nullptr || *socket_name == '\0') {
         return;
+    }
     const std::string_view name(socket_name);
     // A path, or '@' for Linux's abstract namespace (the name then starts with a NUL byte).
     if ((name.front() != '/' && name.front() != '@') || name.size() >= sizeof(address_.sun_path)) {
@@ -52,27 +57,32 @@ SystemdNotifier::SystemdNotifier() {
     }
     address_.sun_family = AF_UNIX;
     std::memcpy(address_.sun_path, name.data(), name.size());
-    if (name.front() == '@')
+    if (name.front() == '@') {
         address_.sun_path[0] = '\0';
+    }
     address_length_ =
         static_cast<socklen_t>(offsetof(sockaddr_un, sun_path) + name.size() + (name.front() == '/' ? 1 : 0));
     fd_ = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-    if (fd_ < 0)
+    if (fd_ < 0) {
         spdlog::warn("systemd: cannot open a socket for NOTIFY_SOCKET: {}", std::strerror(errno));
+    }
 }
 
 SystemdNotifier::~SystemdNotifier() {
-    if (fd_ >= 0)
+    if (fd_ >= 0) {
         ::close(fd_);
+    }
 }
 
 void SystemdNotifier::send(std::string_view state) {
-    if (fd_ < 0)
+    if (fd_ < 0) {
         return;
+    }
     const auto sent = ::sendto(fd_, state.data(), state.size(), MSG_NOSIGNAL,
                                reinterpret_cast<const sockaddr*>(&address_), address_length_);
-    if (sent < 0)
+    if (sent < 0) {
         spdlog::debug("systemd: notify failed: {}", std::strerror(errno));
+    }
 }
 
 void SystemdNotifier::ready() {

@@ -30,8 +30,9 @@ std::atomic<std::int64_t> g_live{0};
 std::atomic<std::int64_t> g_peak{0};
 
 void note_alloc(void* p) {
-    if (p == nullptr)
+    if (p == nullptr) {
         return;
+    }
     const auto now = g_live.fetch_add(static_cast<std::int64_t>(malloc_usable_size(p))) +
                      static_cast<std::int64_t>(malloc_usable_size(p));
     auto peak = g_peak.load();
@@ -42,14 +43,16 @@ void note_alloc(void* p) {
 
 void* operator new(std::size_t n) {
     void* p = std::malloc(n == 0 ? 1 : n);
-    if (p == nullptr)
+    if (p == nullptr) {
         throw std::bad_alloc();
+    }
     note_alloc(p);
     return p;
 }
 void operator delete(void* p) noexcept {
-    if (p == nullptr)
+    if (p == nullptr) {
         return;
+    }
     g_live.fetch_sub(static_cast<std::int64_t>(malloc_usable_size(p)));
     std::free(p);
 }
@@ -61,7 +64,7 @@ namespace airseg::flightplan {
 namespace {
 
 // 4.0 km x 4.0 km, lines 4 m apart, a waypoint every 4 m: 1000 lines x 1001 points = 1,001,000 waypoints.
-const char* kMillionScan = R"(plan:
+const char* const kMillionScan = R"(plan:
   name: million
   vehicle: {type: rover}
   no_fly:
@@ -75,8 +78,9 @@ const char* kMillionScan = R"(plan:
 std::shared_ptr<const Plan> million_plan() {
     static std::shared_ptr<const Plan> plan = [] {
         auto r = load_plan_text(kMillionScan, "million.yaml");
-        if (!r.ok())
+        if (!r.ok()) {
             std::abort();
+        }
         return r.plan;
     }();
     return plan;
@@ -153,8 +157,9 @@ void BM_LoadExplicitList(benchmark::State& state, bool from_file) {
     const std::string text = explicit_list_plan(count);
     const auto file = std::filesystem::temp_directory_path() /
                       ("airseg-bench-explicit-" + std::to_string(::getpid()) + ".yaml");
-    if (from_file)
+    if (from_file) {
         std::ofstream(file, std::ios::binary) << text;
+    }
     LoadOptions options;
     options.max_elements = 1'000'000;
     std::int64_t kept = 0, peak = 0;
@@ -164,15 +169,17 @@ void BM_LoadExplicitList(benchmark::State& state, bool from_file) {
         g_peak.store(base);
         auto r = from_file ? load_plan_file(file.string(), options)
                            : load_plan_text(text, "explicit.yaml", options);
-        if (!r.ok())
+        if (!r.ok()) {
             std::abort();
+        }
         peak = g_peak.load() - base;
         kept = g_live.load() - base;
         elements = r.plan->children(r.plan->main_list).size();
         benchmark::DoNotOptimize(r.plan);
     }
-    if (from_file)
+    if (from_file) {
         std::filesystem::remove(file);
+    }
     state.counters["elements"] = static_cast<double>(elements);
     state.counters["file_bytes"] = static_cast<double>(text.size());
     state.counters["kept_bytes_per_element"] = static_cast<double>(kept) / static_cast<double>(elements);
@@ -194,8 +201,9 @@ void BM_AppendToExplicitList(benchmark::State& state) {
         const auto base = g_live.load();
         g_peak.store(base);
         auto merged = append_plan_text(running, appended);
-        if (!merged.text)
+        if (!merged.text) {
             std::abort();
+        }
         peak = g_peak.load() - base;
         whole_tree = merged.whole_tree;
         benchmark::DoNotOptimize(merged.text);
@@ -220,8 +228,9 @@ void BM_FeederPerReachedWaypoint(benchmark::State& state) {
     TimePoint now{};
     feeder.replace_plan({std::make_unique<Expander>(plan), "million"}, now);
     auto settle = [&] {
-        while (auto r = feeder.poll_request(now))
+        while (auto r = feeder.poll_request(now)) {
             feeder.on_request_result(r->id, RequestResult::Ok, now);
+        }
         while (feeder.poll_event()) {
         }
     };

@@ -20,11 +20,11 @@ struct BenchMessage {
 
 /// How a scenario wires the ends: one radio pair for both directions, or two pairs with each end transmitting
 /// on its own pair (the seed's "serialduo", the transport's split mode).
-enum class LinkMode : std::uint8_t { single, dual };
+enum class LinkMode : std::uint8_t { Single, Dual };
 
 struct EndpointSetup {
     std::uint32_t baud = 57600;
-    LinkMode mode = LinkMode::single;
+    LinkMode mode = LinkMode::Single;
     bool is_a = true;  ///< end A transmits on path 0 in dual mode, end B on path 1
     TimePoint now{};
     double pacing_factor = 1.0;  ///< a pacing protocol's link rate as a fraction of baud/10

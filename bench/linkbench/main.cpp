@@ -56,7 +56,7 @@ struct Knobs {
 std::vector<Scenario> scenarios(const Knobs& k) {
     std::vector<Scenario> list;
     for (std::uint32_t baud : {57600U, 115200U}) {
-        for (LinkMode mode : {LinkMode::single, LinkMode::dual}) {
+        for (LinkMode mode : {LinkMode::Single, LinkMode::Dual}) {
             Scenario base;
             base.baud = baud;
             base.mode = mode;

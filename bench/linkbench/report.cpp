@@ -47,7 +47,7 @@ std::string where(const Row& r) {
 }  // namespace
 
 const char* to_string(LinkMode m) {
-    return m == LinkMode::single ? "single" : "dual";
+    return m == LinkMode::Single ? "single" : "dual";
 }
 
 void print_table(std::ostream& os, const std::vector<Row>& rows) {
@@ -104,7 +104,7 @@ std::vector<TargetCheck> check_targets(const std::vector<Row>& rows) {
         checks.push_back(std::move(c));
     };
     for (std::uint32_t baud : {57600U, 115200U}) {
-        for (LinkMode mode : {LinkMode::single, LinkMode::dual}) {
+        for (LinkMode mode : {LinkMode::Single, LinkMode::Dual}) {
             add(
                 "clean goodput >= 95 %", find(rows, baud, mode, "clean"),
                 [](const ScenarioResult& r) { return r.goodput_pct >= 95.0; }, &ScenarioResult::goodput_pct);
@@ -139,8 +139,8 @@ std::vector<TargetCheck> check_targets(const std::vector<Row>& rows) {
                     &ScenarioResult::fast_p99_ms);
             }
         }
-        const Row* single = find(rows, baud, LinkMode::single, "bidir");
-        const Row* dual = find(rows, baud, LinkMode::dual, "bidir");
+        const Row* single = find(rows, baud, LinkMode::Single, "bidir");
+        const Row* dual = find(rows, baud, LinkMode::Dual, "bidir");
         if (single != nullptr && dual != nullptr) {
             auto ratio = [](const ScenarioResult& d, const ScenarioResult& s) {
                 return s.goodput_pct > 0.0 ? d.goodput_pct / s.goodput_pct : 0.0;

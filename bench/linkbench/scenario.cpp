@@ -98,7 +98,7 @@ namespace {
 // drive it the same way: deliver what the radios output, then write what the ends have to send.
 struct Wiring {
     Wiring(const Scenario& s, const EndpointFactory& make, std::uint64_t seed, TimePoint t0)
-        : paths(s.mode == LinkMode::dual ? 2 : 1),
+        : paths(s.mode == LinkMode::Dual ? 2 : 1),
           ends{make({s.baud, s.mode, true, t0, s.pacing_factor}),
                make({s.baud, s.mode, false, t0, s.pacing_factor})} {
         for (std::size_t p = 0; p < paths; ++p) {

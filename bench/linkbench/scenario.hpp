@@ -13,7 +13,7 @@ namespace airseg::linkbench {
 
 struct Scenario {
     std::uint32_t baud = 57600;
-    LinkMode mode = LinkMode::single;
+    LinkMode mode = LinkMode::Single;
     std::string impairment = "clean";       ///< label printed in the table
     double byte_corruption = 0.0;           ///< both directions, every pair
     double byte_loss = 0.0;                 ///< independent byte loss, both directions, every pair

@@ -10,7 +10,7 @@ namespace {
 class SeedBenchEndpoint final : public BenchEndpoint {
   public:
     explicit SeedBenchEndpoint(const EndpointSetup& setup)
-        : tx_path_(setup.mode == LinkMode::dual && !setup.is_a ? 1 : 0) {}
+        : tx_path_(setup.mode == LinkMode::Dual && !setup.is_a ? 1 : 0) {}
 
     bool send_safe(std::span<const std::uint8_t> msg, TimePoint now) override {
         return seed_.send_safe(msg, now);

@@ -82,7 +82,7 @@ std::vector<std::vector<std::uint8_t>> SeedEndpoint::fragment(FrameType type, st
 }
 
 bool SeedEndpoint::send_safe(std::span<const std::uint8_t> msg, TimePoint /*now*/) {
-    auto frames = fragment(FrameType::safe, next_safe_seq_, msg);
+    auto frames = fragment(FrameType::Safe, next_safe_seq_, msg);
     if (frames.empty()) {
         return false;
     }
@@ -97,7 +97,7 @@ bool SeedEndpoint::send_safe(std::span<const std::uint8_t> msg, TimePoint /*now*
 }
 
 bool SeedEndpoint::send_fast(std::span<const std::uint8_t> msg, TimePoint /*now*/) {
-    auto frames = fragment(FrameType::fast, next_fast_seq_, msg);
+    auto frames = fragment(FrameType::Fast, next_fast_seq_, msg);
     if (frames.empty()) {
         return false;
     }
@@ -239,14 +239,14 @@ void SeedEndpoint::on_frame(std::span<const std::uint8_t> f, TimePoint now) {
     const std::uint8_t total = f[4];
     if (!valid) {
         ++stats_.crc_errors;
-        if (f[0] == static_cast<std::uint8_t>(FrameType::safe)) {
-            queue_control(FrameType::nack, key, total);  // the header may itself be damaged: best guess
+        if (f[0] == static_cast<std::uint8_t>(FrameType::Safe)) {
+            queue_control(FrameType::Nack, key, total);  // the header may itself be damaged: best guess
         }
         return;
     }
     const auto data = f.subspan(kHeader, f.size() - kHeader - kCrc);
     switch (static_cast<FrameType>(f[0])) {
-        case FrameType::ack: {
+        case FrameType::Ack: {
             ++stats_.acks_received;
             if (sent_.erase(key) != 0) {
                 auto it = unacked_fragments_.find(key.seq);
@@ -256,15 +256,15 @@ void SeedEndpoint::on_frame(std::span<const std::uint8_t> f, TimePoint now) {
             }
             return;
         }
-        case FrameType::nack:
+        case FrameType::Nack:
             ++stats_.nacks_received;
             if (auto it = sent_.find(key); it != sent_.end() && !it->second.queued) {
                 ++stats_.resent_on_nack;
                 requeue(key);
             }
             return;
-        case FrameType::safe:
-        case FrameType::fast:
+        case FrameType::Safe:
+        case FrameType::Fast:
             on_data(static_cast<FrameType>(f[0]), key, total, data, now);
             return;
     }
@@ -273,9 +273,9 @@ void SeedEndpoint::on_frame(std::span<const std::uint8_t> f, TimePoint now) {
 
 void SeedEndpoint::on_data(FrameType type, FragmentKey key, std::uint8_t total,
                            std::span<const std::uint8_t> data, TimePoint now) {
-    const bool safe = type == FrameType::safe;
+    const bool safe = type == FrameType::Safe;
     if (safe) {
-        queue_control(FrameType::ack, key, total);
+        queue_control(FrameType::Ack, key, total);
         if (completed_.count(key.seq) != 0) {
             ++stats_.safe_duplicates;
             return;
@@ -319,7 +319,7 @@ void SeedEndpoint::on_data(FrameType type, FragmentKey key, std::uint8_t total,
 
 void SeedEndpoint::queue_control(FrameType type, FragmentKey key, std::uint8_t total) {
     control_queue_.push_back(encode_frame(header(type, key.seq, key.frag, total)));
-    ++(type == FrameType::ack ? stats_.acks_sent : stats_.nacks_sent);
+    ++(type == FrameType::Ack ? stats_.acks_sent : stats_.nacks_sent);
 }
 
 void SeedEndpoint::requeue(FragmentKey key) {

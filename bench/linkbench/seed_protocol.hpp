@@ -45,7 +45,7 @@ namespace airseg::linkbench::seed {
 inline constexpr std::uint8_t kDle = 0x10;
 inline constexpr std::uint8_t kEtx = 0x03;
 
-enum class FrameType : std::uint8_t { fast = 171, safe = 18, ack = 35, nack = 36 };
+enum class FrameType : std::uint8_t { Fast = 171, Safe = 18, Ack = 35, Nack = 36 };
 
 struct SeedConfig {
     Duration time_to_resend = std::chrono::milliseconds(1500);  ///< network.xml TimeToResend

@@ -14,9 +14,9 @@ groundlink::TransportConfig bench_config(const EndpointSetup& setup) {
     groundlink::TransportConfig c;
     c.link_rate_bytes_per_s = setup.pacing_factor * setup.baud / 10.0;
     c.half_duplex = true;
-    if (setup.mode == LinkMode::dual) {
+    if (setup.mode == LinkMode::Dual) {
         c.paths = 2;
-        c.path_mode = groundlink::PathMode::split;
+        c.path_mode = groundlink::PathMode::Split;
         c.split_tx_path = setup.is_a ? 0 : 1;
     }
     c.boot_nonce = setup.is_a ? 0xA11CE : 0xB0B;
@@ -29,10 +29,10 @@ class TransportBenchEndpoint final : public BenchEndpoint {
 
     bool send_safe(std::span<const std::uint8_t> msg, TimePoint now) override {
         const auto r = core_.send_safe(kBulkPriority, msg, now);
-        return r == groundlink::SendResult::accepted;
+        return r == groundlink::SendResult::Accepted;
     }
     bool send_urgent(std::span<const std::uint8_t> msg, TimePoint now) override {
-        return core_.send_safe(kCommandPriority, msg, now) == groundlink::SendResult::accepted;
+        return core_.send_safe(kCommandPriority, msg, now) == groundlink::SendResult::Accepted;
     }
     void send_fast(std::uint16_t stream, std::span<const std::uint8_t> msg, TimePoint now) override {
         core_.send_fast(kFastPriority, stream, msg, now);
@@ -53,7 +53,7 @@ class TransportBenchEndpoint final : public BenchEndpoint {
         if (!m) {
             return std::nullopt;
         }
-        return BenchMessage{m->cls == groundlink::MessageClass::safe, std::move(m->bytes)};
+        return BenchMessage{m->cls == groundlink::MessageClass::Safe, std::move(m->bytes)};
     }
     TimePoint poll_timeout() const override { return core_.poll_timeout(); }
     std::size_t safe_backlog() const override { return core_.safe_pending(kBulkPriority); }

@@ -41,7 +41,7 @@ struct Options {
     double seconds = 60.0;
     std::size_t read_bytes = 16;
     bool keyed = true;
-    Selection measure = Selection::none;
+    Selection measure = Selection::None;
 };
 
 Options parse(int argc, char** argv) {
@@ -63,11 +63,11 @@ Options parse(int argc, char** argv) {
         } else if (a == "--unkeyed") {
             o.keyed = false;
         } else if (auto m = value("--measure=")) {
-            static const std::map<std::string, Selection> names{{"none", Selection::none},
-                                                                {"a", Selection::end_a},
-                                                                {"b", Selection::end_b},
-                                                                {"both", Selection::both},
-                                                                {"poll_transmit", Selection::poll_transmit}};
+            static const std::map<std::string, Selection> names{{"none", Selection::None},
+                                                                {"a", Selection::EndA},
+                                                                {"b", Selection::EndB},
+                                                                {"both", Selection::Both},
+                                                                {"poll_transmit", Selection::PollTransmit}};
             const auto it = names.find(*m);
             if (it == names.end()) {
                 throw std::invalid_argument("unknown --measure " + *m);
@@ -201,14 +201,14 @@ class Scenario {
 
     void send_safe(int end, std::uint8_t priority, std::size_t bytes) {
         const std::uint32_t id = next_id_[static_cast<std::size_t>(end)][priority]++;
-        if (link_.send_safe(end, priority, message(bytes, id)) != gl::SendResult::accepted) {
+        if (link_.send_safe(end, priority, message(bytes, id)) != gl::SendResult::Accepted) {
             throw std::runtime_error("transport bench: a Safe message was refused");
         }
         ++safe_sent_;
     }
 
     void on_message(int end, const gl::Delivered& m) {
-        if (m.cls != gl::MessageClass::safe) {
+        if (m.cls != gl::MessageClass::Safe) {
             return;
         }
         ++safe_delivered_;

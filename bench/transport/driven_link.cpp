@@ -27,15 +27,15 @@ DrivenLink::DrivenLink(const groundlink::TransportConfig& a, const groundlink::T
 
 bool DrivenLink::selected(int end, bool is_poll_transmit) const {
     switch (selection_) {
-        case Selection::none:
+        case Selection::None:
             return false;
-        case Selection::end_a:
+        case Selection::EndA:
             return end == 0;
-        case Selection::end_b:
+        case Selection::EndB:
             return end == 1;
-        case Selection::both:
+        case Selection::Both:
             return true;
-        case Selection::poll_transmit:
+        case Selection::PollTransmit:
             return is_poll_transmit;
     }
     return false;

@@ -20,7 +20,7 @@
 namespace airseg::transport_bench {
 
 /// Which transport calls a callgrind run counts.
-enum class Selection : std::uint8_t { none, end_a, end_b, both, poll_transmit };
+enum class Selection : std::uint8_t { None, EndA, EndB, Both, PollTransmit };
 
 struct CallCounts {
     std::uint64_t poll_transmit = 0;

@@ -8,16 +8,18 @@ std::string Diagnostic::to_string() const {
         out += ':' + std::to_string(line) + ':' + std::to_string(col);
     }
     out += ": ";
-    if (!path.empty())
+    if (!path.empty()) {
         out += path + ": ";
+    }
     out += message;
     return out;
 }
 
 std::string to_string(const std::vector<Diagnostic>& diagnostics) {
     std::string out;
-    for (const auto& d : diagnostics)
+    for (const auto& d : diagnostics) {
         out += d.to_string() + '\n';
+    }
     return out;
 }
 

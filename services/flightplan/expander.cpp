@@ -19,11 +19,13 @@ const char* to_string(WaypointAction action) {
 
 Expander::Expander(std::shared_ptr<const Plan> plan, bool enforce_no_fly, bool fold_repeats)
     : plan_(std::move(plan)), enforce_no_fly_(enforce_no_fly), fold_repeats_(fold_repeats) {
-    for (const auto& zone : plan_->no_fly)
+    for (const auto& zone : plan_->no_fly) {
         zone_boxes_.push_back(Box::around(zone.local, zone.buffer));
+    }
     for (std::uint32_t i = 0; i < plan_->nodes.size(); ++i) {
-        if (plan_->nodes[i].kind != NodeKind::Repeat)
+        if (plan_->nodes[i].kind != NodeKind::Repeat) {
             continue;
+        }
         std::optional<std::uint64_t> sum = 0;
         for (auto c : plan_->children(i)) {
             const auto cc = plan_->count(c);
@@ -55,8 +57,9 @@ void Expander::reset_to_origin() {
     last_position_.reset();
     error_.reset();
     if (origin_.element == StreamOrigin::kStreamStart) {
-        if (plan_->main_list != kNoNode)
+        if (plan_->main_list != kNoNode) {
             stack_.push_back({plan_->main_list, 0, 0});
+        }
     } else {
         place_at(origin_.element);
     }
@@ -73,19 +76,22 @@ void Expander::place_at(std::uint32_t target) {
     std::uint32_t child = target;
     for (std::uint32_t p = nodes[target].parent; p != kNoNode; p = nodes[p].parent) {
         chain.emplace_back(p, child);
-        if (nodes[p].kind == NodeKind::ElementList)
+        if (nodes[p].kind == NodeKind::ElementList) {
             break;
+        }
         child = p;
     }
     std::reverse(chain.begin(), chain.end());
     for (auto [ancestor, on_path] : chain) {
-        if (ancestor == plan_->blocks_list)
+        if (ancestor == plan_->blocks_list) {
             continue;  // a detached block ends the plan when it ends
+        }
         const std::uint32_t next = plan_->index_in_parent(on_path) + (on_path == target ? 0 : 1);
         stack_.push_back({ancestor, next, 0});
     }
-    if (nodes[target].parent == plan_->blocks_list)
+    if (nodes[target].parent == plan_->blocks_list) {
         stack_.push_back({target, 0, 0});
+    }
 }
 
 bool Expander::activate_next_leaf(std::uint64_t* skip_budget) {
@@ -96,13 +102,15 @@ bool Expander::activate_next_leaf(std::uint64_t* skip_budget) {
     // elements inside it still take effect.
     auto fast_forward = [&](Frame& f) {
         const auto& per = body_count(f.node);
-        if (skip_budget == nullptr || !per || *per == 0)
+        if (skip_budget == nullptr || !per || *per == 0) {
             return;
+        }
         const auto& total = plan_->extra(f.node).repeat_count;
         const std::uint64_t left = total ? *total - f.iteration : std::numeric_limits<std::uint64_t>::max();
         const std::uint64_t k = std::min(*skip_budget / *per, left);
-        if (k < 2)
+        if (k < 2) {
             return;
+        }
         f.iteration += k - 1;
         position_ += (k - 1) * *per;
         *skip_budget -= (k - 1) * *per;
@@ -116,8 +124,9 @@ bool Expander::activate_next_leaf(std::uint64_t* skip_budget) {
         }
         Frame& f = stack_.back();
         const Node& container = nodes[f.node];
-        if (f.box == nullptr)
+        if (f.box == nullptr) {
             f.box = &plan_->extra(f.node);
+        }
         const NodeExtra& box = *f.box;
         if (f.next_child >= box.children.size()) {
             if (fold_repeats_ && container.kind == NodeKind::Repeat && f.iteration >= 1 &&
@@ -151,8 +160,9 @@ bool Expander::activate_next_leaf(std::uint64_t* skip_budget) {
             case NodeKind::Repeat:
             case NodeKind::Block:
                 stack_.push_back({id, 0, 0});
-                if (n.kind == NodeKind::Repeat)
+                if (n.kind == NodeKind::Repeat) {
                     fast_forward(stack_.back());
+                }
                 break;
             case NodeKind::Goto:
                 place_at(plan_->extra(id).goto_target);
@@ -164,8 +174,9 @@ bool Expander::activate_next_leaf(std::uint64_t* skip_budget) {
             case NodeKind::Scan:
             case NodeKind::Orbit: {
                 const std::uint64_t count = plan_->count(id).value_or(0);
-                if (count == 0)
+                if (count == 0) {
                     break;
+                }
                 if (skip_budget != nullptr && *skip_budget >= count) {
                     *skip_budget -= count;
                     position_ += count;
@@ -241,12 +252,14 @@ Waypoint Expander::make_waypoint() {
 }
 
 std::optional<Waypoint> Expander::next() {
-    if (error_)
+    if (error_) {
         return std::nullopt;
+    }
     if (leaf_ == kNoNode || leaf_offset_ >= leaf_count_) {
         leaf_ = kNoNode;
-        if (!activate_next_leaf(nullptr))
+        if (!activate_next_leaf(nullptr)) {
             return std::nullopt;
+        }
     }
     Waypoint w = make_waypoint();
     if (enforce_no_fly_ && w.has_position && last_position_) {
@@ -262,8 +275,9 @@ std::optional<Waypoint> Expander::next() {
             }
         }
     }
-    if (w.has_position)
+    if (w.has_position) {
         last_position_ = w.local;
+    }
     ++leaf_offset_;
     ++position_;
     speed_changed_ = false;
@@ -271,10 +285,12 @@ std::optional<Waypoint> Expander::next() {
 }
 
 bool Expander::seek(std::uint64_t index) {
-    if (index < origin_.index)
+    if (index < origin_.index) {
         return false;
-    if (index < position_ || error_)
+    }
+    if (index < position_ || error_) {
         reset_to_origin();
+    }
     std::uint64_t budget = index - position_;
     last_position_.reset();
     if (leaf_ != kNoNode && leaf_offset_ < leaf_count_) {
@@ -288,8 +304,9 @@ bool Expander::seek(std::uint64_t index) {
         position_ += available;
     }
     leaf_ = kNoNode;
-    if (!activate_next_leaf(&budget))
+    if (!activate_next_leaf(&budget)) {
         return false;
+    }
     activate_leaf(leaf_, budget);
     position_ += budget;
     return true;
@@ -301,16 +318,18 @@ bool Expander::jump_to(std::string_view element_name) {
 }
 
 bool Expander::jump_to_node(std::uint32_t node) {
-    if (node >= plan_->nodes.size())
+    if (node >= plan_->nodes.size()) {
         return false;
+    }
     origin_ = {node, position_};
     reset_to_origin();
     return true;
 }
 
 bool Expander::restore(StreamOrigin origin, std::uint64_t index) {
-    if (origin.element != StreamOrigin::kStreamStart && origin.element >= plan_->nodes.size())
+    if (origin.element != StreamOrigin::kStreamStart && origin.element >= plan_->nodes.size()) {
         return false;
+    }
     origin_ = origin;
     reset_to_origin();
     return seek(index);

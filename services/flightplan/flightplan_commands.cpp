@@ -35,8 +35,9 @@ PlanText plan_text_of(const Json& req) {
             source != req.end() && source->is_string() && !source->get_ref<const std::string&>().empty()
                 ? source->get<std::string>()
                 : std::string("<inline>");
-        if (out.text.size() > kMaxPlanTextBytes)
+        if (out.text.size() > kMaxPlanTextBytes) {
             out.error = "plan larger than " + std::to_string(kMaxPlanTextBytes) + " bytes";
+        }
         return out;
     }
     if (!path->is_string() || path->get_ref<const std::string&>().empty()) {
@@ -64,13 +65,15 @@ PlanText plan_text_of(const Json& req) {
         out.text.resize(have + want);
         in.read(out.text.data() + have, static_cast<std::streamsize>(want));
         out.text.resize(have + static_cast<std::size_t>(in.gcount()));
-        if (!in || out.text.size() > kMaxPlanTextBytes || in.peek() == std::char_traits<char>::eof())
+        if (!in || out.text.size() > kMaxPlanTextBytes || in.peek() == std::char_traits<char>::eof()) {
             break;
+        }
         want = std::min(out.text.size(), kMaxPlanTextBytes + 1 - out.text.size());
     }
     out.text.shrink_to_fit();
-    if (out.text.size() > kMaxPlanTextBytes)
+    if (out.text.size() > kMaxPlanTextBytes) {
         out.error = out.source + ": plan larger than " + std::to_string(kMaxPlanTextBytes) + " bytes";
+    }
     return out;
 }
 

@@ -55,8 +55,9 @@ FlightplanService::FlightplanService(ServiceContext& ctx, FlightplanServiceConfi
       controller_(controller_config(config_)),
       timer_(strand()),
       status_timer_(strand()) {
-    if (!config_.state_dir.empty())
+    if (!config_.state_dir.empty()) {
         store_.emplace(config_.state_dir, config_.durability);
+    }
     register_commands();
 }
 
@@ -105,8 +106,9 @@ void FlightplanService::on_start() {
             controller_.on_link(s.up, SteadyClock::now());
             flush();
         }));
-    if (store_)
+    if (store_) {
         controller_.resume(resume_from(store_->load(), config_.load), SteadyClock::now());
+    }
     set_health(Health::Up);
     controller_.start(SteadyClock::now());
     flush();
@@ -123,32 +125,39 @@ void FlightplanService::on_stop() {
 }
 
 void FlightplanService::flush() {
-    while (auto out = controller_.poll_output())
+    while (auto out = controller_.poll_output()) {
         std::visit([this](auto&& m) { ctx_.bus.publish(std::move(m)); }, std::move(*out));
-    while (auto save = controller_.poll_save())
+    }
+    while (auto save = controller_.poll_save()) {
         controller_.on_saved(*save, store_ ? store_->save_progress(save->progress) : std::nullopt);
+    }
     while (auto r = controller_.poll_reply()) {
         const auto it = replies_.find(r->id);
-        if (it == replies_.end())
+        if (it == replies_.end()) {
             continue;
+        }
         auto reply = std::move(it->second);
         replies_.erase(it);
         reply(r->status == CommandReply::Status::Ok
                   ? CommandResult::ok(std::move(r->result))
                   : CommandResult::fail(to_command_status(r->status), std::move(r->error)));
     }
-    while (auto line = controller_.poll_log())
+    while (auto line = controller_.poll_log()) {
         spdlog::log(to_spdlog(line->level), "{}{}", kPrefix, line->text);
+    }
     while (auto s = controller_.poll_status()) {
         ctx_.bus.publish_latest(s->progress);
-        if (s->section)
+        if (s->section) {
             ctx_.bus.publish(status::StatusSection{"plan", std::move(*s->section), {}});
+        }
     }
-    if (!running_)
+    if (!running_) {
         return;
+    }
     timer_.arm(controller_.poll_timeout(), [this] {
-        if (!running_)
+        if (!running_) {
             return;
+        }
         controller_.handle_timeout(SteadyClock::now());
         flush();
     });
@@ -158,8 +167,9 @@ void FlightplanService::schedule_status() {
     // On the grid the services' progress ticks use: one wake-up for both (time.hpp).
     status_timer_.expires_at(next_on_grid(SteadyClock::now(), config_.status_period));
     status_timer_.async_wait([this](const boost::system::error_code& ec) {
-        if (ec || !running_)
+        if (ec || !running_) {
             return;
+        }
         controller_.publish_status(true);
         flush();
         schedule_status();

@@ -29,19 +29,23 @@ LocalFrame::LocalFrame(LatLon reference) : ref_(reference) {
 
 Enu LocalFrame::to_local(LatLon p) const {
     double dlon = p.lon - ref_.lon;
-    if (dlon > 180.0)
+    if (dlon > 180.0) {
         dlon -= 360.0;
-    if (dlon < -180.0)
+    }
+    if (dlon < -180.0) {
         dlon += 360.0;
+    }
     return {dlon * kDegToRad * metres_per_rad_lon_, (p.lat - ref_.lat) * kDegToRad * metres_per_rad_lat_};
 }
 
 LatLon LocalFrame::to_geo(Enu p) const {
     double lon = ref_.lon + p.e / metres_per_rad_lon_ / kDegToRad;
-    if (lon > 180.0)
+    if (lon > 180.0) {
         lon -= 360.0;
-    if (lon < -180.0)
+    }
+    if (lon < -180.0) {
         lon += 360.0;
+    }
     return {ref_.lat + p.n / metres_per_rad_lat_ / kDegToRad, lon};
 }
 
@@ -68,23 +72,26 @@ double distance(Enu a, Enu b) {
 double distance_point_segment(Enu p, Enu a, Enu b) {
     const double de = b.e - a.e, dn = b.n - a.n;
     const double len2 = de * de + dn * dn;
-    if (len2 <= 0.0)
+    if (len2 <= 0.0) {
         return distance(p, a);
+    }
     const double t = std::clamp(((p.e - a.e) * de + (p.n - a.n) * dn) / len2, 0.0, 1.0);
     return distance(p, {a.e + t * de, a.n + t * dn});
 }
 
 bool segments_intersect(Enu a, Enu b, Enu c, Enu d) {
     const double d1 = cross(c, d, a), d2 = cross(c, d, b), d3 = cross(a, b, c), d4 = cross(a, b, d);
-    if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0)))
+    if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0))) {
         return true;
+    }
     return (d1 == 0 && on_segment(a, c, d)) || (d2 == 0 && on_segment(b, c, d)) ||
            (d3 == 0 && on_segment(c, a, b)) || (d4 == 0 && on_segment(d, a, b));
 }
 
 double distance_segment_segment(Enu a, Enu b, Enu c, Enu d) {
-    if (segments_intersect(a, b, c, d))
+    if (segments_intersect(a, b, c, d)) {
         return 0.0;
+    }
     return std::min({distance_point_segment(a, c, d), distance_point_segment(b, c, d),
                      distance_point_segment(c, a, b), distance_point_segment(d, a, b)});
 }
@@ -96,8 +103,9 @@ bool point_in_polygon(Enu p, std::span<const Enu> polygon) {
         const Enu a = polygon[i], b = polygon[j];
         if ((a.n > p.n) != (b.n > p.n)) {
             const double e_cross = a.e + (p.n - a.n) * (b.e - a.e) / (b.n - a.n);
-            if (p.e < e_cross)
+            if (p.e < e_cross) {
                 inside = !inside;
+            }
         }
     }
     return inside;
@@ -113,10 +121,12 @@ double distance_to_boundary(Enu p, std::span<const Enu> polygon) {
 }
 
 bool segment_violates_zone(Enu a, Enu b, std::span<const Enu> polygon, double buffer) {
-    if (polygon.size() < 3)
+    if (polygon.size() < 3) {
         return false;
-    if (point_in_polygon(a, polygon) || point_in_polygon(b, polygon))
+    }
+    if (point_in_polygon(a, polygon) || point_in_polygon(b, polygon)) {
         return true;
+    }
     const std::size_t n = polygon.size();
     for (std::size_t i = 0; i < n; ++i) {
         const Enu c = polygon[i], d = polygon[(i + 1) % n];
@@ -132,10 +142,12 @@ bool polygon_self_intersects(std::span<const Enu> polygon) {
     for (std::size_t i = 0; i < n; ++i) {
         for (std::size_t j = i + 1; j < n; ++j) {
             // Adjacent edges share a vertex by construction.
-            if (j == i + 1 || (i == 0 && j == n - 1))
+            if (j == i + 1 || (i == 0 && j == n - 1)) {
                 continue;
-            if (segments_intersect(polygon[i], polygon[(i + 1) % n], polygon[j], polygon[(j + 1) % n]))
+            }
+            if (segments_intersect(polygon[i], polygon[(i + 1) % n], polygon[j], polygon[(j + 1) % n])) {
                 return true;
+            }
         }
     }
     return false;

@@ -11,15 +11,17 @@ HomeStream::HomeStream(LatLon home, double speed, double arrival_radius) {
 }
 
 std::optional<Waypoint> HomeStream::next() {
-    if (given_)
+    if (given_) {
         return std::nullopt;
+    }
     given_ = true;
     return home_;
 }
 
 bool HomeStream::seek(std::uint64_t index) {
-    if (index > 0)
+    if (index > 0) {
         return false;
+    }
     given_ = false;
     return true;
 }

@@ -21,8 +21,9 @@ std::string errno_text(const char* what, const std::filesystem::path& path) {
 }
 
 bool parse_u64(std::string_view s, std::uint64_t& out, int base = 10) {
-    if (s.empty())
+    if (s.empty()) {
         return false;
+    }
     auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), out, base);
     return ec == std::errc{} && ptr == s.data() + s.size();
 }
@@ -30,8 +31,9 @@ bool parse_u64(std::string_view s, std::uint64_t& out, int base = 10) {
 /// Reads at most `limit` + 1 bytes, so an oversized file is noticed without being read whole.
 std::optional<std::string> read_bounded(const std::filesystem::path& path, std::size_t limit) {
     std::ifstream in(path, std::ios::binary);
-    if (!in)
+    if (!in) {
         return std::nullopt;
+    }
     std::string data(limit + 1, '\0');
     in.read(data.data(), static_cast<std::streamsize>(data.size()));
     data.resize(static_cast<std::size_t>(in.gcount()));
@@ -45,8 +47,9 @@ const char* state_name(PlanState s) {
 std::optional<PlanState> parse_state(std::string_view s) {
     for (auto st : {PlanState::None, PlanState::Running, PlanState::Paused, PlanState::Done,
                     PlanState::Interrupted, PlanState::Failed}) {
-        if (s == to_string(st))
+        if (s == to_string(st)) {
             return st;
+        }
     }
     return std::nullopt;
 }
@@ -76,8 +79,9 @@ std::optional<SavedProgress> parse_progress(std::string_view data, std::string& 
     }
     const std::string_view body = data.substr(0, check_pos);
     std::string_view check = data.substr(check_pos + 6);
-    if (!check.empty() && check.back() == '\n')
+    if (!check.empty() && check.back() == '\n') {
         check.remove_suffix(1);
+    }
     std::uint64_t expected = 0;
     if (!parse_u64(check, expected, 16) || expected != fnv1a64(body)) {
         why = "checksum mismatch";
@@ -86,8 +90,9 @@ std::optional<SavedProgress> parse_progress(std::string_view data, std::string& 
     std::vector<std::string_view> lines;
     for (std::size_t pos = 0; pos < body.size();) {
         const auto nl = body.find('\n', pos);
-        if (nl == std::string_view::npos)
+        if (nl == std::string_view::npos) {
             break;
+        }
         lines.push_back(body.substr(pos, nl - pos));
         pos = nl + 1;
     }
@@ -155,14 +160,16 @@ std::optional<std::string> write_file_atomically(const std::filesystem::path& pa
                                                  Durability durability) {
     const std::filesystem::path tmp = path.string() + ".tmp";
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0)
+    if (fd < 0) {
         return errno_text("cannot create", tmp);
+    }
     std::size_t done = 0;
     while (done < bytes.size()) {
         const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
         if (n < 0) {
-            if (errno == EINTR)
+            if (errno == EINTR) {
                 continue;
+            }
             auto err = errno_text("cannot write", tmp);
             ::close(fd);
             ::unlink(tmp.c_str());
@@ -176,8 +183,9 @@ std::optional<std::string> write_file_atomically(const std::filesystem::path& pa
         ::unlink(tmp.c_str());
         return err;
     }
-    if (::close(fd) != 0)
+    if (::close(fd) != 0) {
         return errno_text("cannot close", tmp);
+    }
     if (::rename(tmp.c_str(), path.c_str()) != 0) {
         auto err = errno_text("cannot rename to", path);
         ::unlink(tmp.c_str());
@@ -199,12 +207,14 @@ StateStore::StateStore(std::filesystem::path directory, Durability durability)
     : dir_(std::move(directory)), durability_(durability) {}
 
 std::optional<std::string> StateStore::save_plan(std::string_view text, std::string_view source_name) {
-    if (text.size() > kMaxPlanBytes)
+    if (text.size() > kMaxPlanBytes) {
         return "plan too large to store";
+    }
     std::string source(source_name);
     for (char& c : source) {
-        if (c == '\n' || c == '\r')
+        if (c == '\n' || c == '\r') {
             c = ' ';
+        }
     }
     std::string out = std::string(kPlanMagic) + "fnv64=" + hex64(fnv1a64(text)) +
                       " bytes=" + std::to_string(text.size()) + " source=" + source + "\n";
@@ -225,11 +235,13 @@ std::optional<std::string> StateStore::save_progress(const SavedProgress& progre
 std::optional<std::string> StateStore::clear() {
     std::error_code ec;
     std::filesystem::remove(progress_path(), ec);
-    if (ec)
+    if (ec) {
         return "cannot remove " + progress_path().string() + ": " + ec.message();
+    }
     std::filesystem::remove(plan_path(), ec);
-    if (ec)
+    if (ec) {
         return "cannot remove " + plan_path().string() + ": " + ec.message();
+    }
     return std::nullopt;
 }
 
@@ -237,11 +249,13 @@ std::optional<std::string> StateStore::set_aside(const std::filesystem::path& pa
     std::error_code ec;
     for (int n = 1; n < 10000; ++n) {
         const std::filesystem::path target = path.string() + ".corrupt-" + std::to_string(n);
-        if (std::filesystem::exists(target, ec))
+        if (std::filesystem::exists(target, ec)) {
             continue;
+        }
         std::filesystem::rename(path, target, ec);
-        if (ec)
+        if (ec) {
             return "cannot set aside " + path.string() + ": " + ec.message();
+        }
         return std::nullopt;
     }
     return "too many corrupt copies of " + path.string();
@@ -251,8 +265,9 @@ StoredState StateStore::load() {
     StoredState out;
     std::error_code ec;
     // Leftovers of a write interrupted before its rename: never the current state.
-    for (const auto& p : {plan_path(), progress_path()})
+    for (const auto& p : {plan_path(), progress_path()}) {
         std::filesystem::remove(p.string() + ".tmp", ec);
+    }
 
     std::string digest;
     if (std::filesystem::exists(plan_path(), ec)) {
@@ -287,8 +302,9 @@ StoredState StateStore::load() {
         }
         if (!out.plan_text) {
             out.problems.push_back(plan_path().string() + ": " + why + "; set aside");
-            if (auto err = set_aside(plan_path()))
+            if (auto err = set_aside(plan_path())) {
                 out.problems.push_back(*err);
+            }
         }
     }
 
@@ -311,8 +327,9 @@ StoredState StateStore::load() {
             out.progress = p;
         } else {
             out.problems.push_back(progress_path().string() + ": " + why + "; set aside");
-            if (auto err = set_aside(progress_path()))
+            if (auto err = set_aside(progress_path())) {
                 out.problems.push_back(*err);
+            }
         }
     }
     return out;

@@ -55,23 +55,29 @@ Enu OrbitPattern::point(std::uint64_t k) const {
 }
 
 std::optional<VehicleProfile> VehicleProfile::defaults_for(std::string_view type) {
-    if (type == "rover")
+    if (type == "rover") {
         return VehicleProfile{"rover", 4.0, 2.0, 2.0};
-    if (type == "boat")
+    }
+    if (type == "boat") {
         return VehicleProfile{"boat", 5.0, 3.0, 2.0};
-    if (type == "plane")
+    }
+    if (type == "plane") {
         return VehicleProfile{"plane", 100.0, 30.0, 18.0};
-    if (type == "copter")
+    }
+    if (type == "copter") {
         return VehicleProfile{"copter", 2.0, 1.0, 5.0};
+    }
     return std::nullopt;
 }
 
 std::uint32_t Plan::find(std::string_view wanted) const {
-    if (wanted.empty())
+    if (wanted.empty()) {
         return kNoNode;
+    }
     for (const auto& x : extras) {
-        if (x.name == wanted)
+        if (x.name == wanted) {
             return x.node;
+        }
     }
     return kNoNode;
 }
@@ -91,10 +97,12 @@ NodeExtra extra_of(std::uint32_t id) {
 
 const NodeExtra& Plan::extra(std::uint32_t id) const {
     static const NodeExtra kNone;
-    if (id >= nodes.size() || !nodes[id].has_extra)
+    if (id >= nodes.size() || !nodes[id].has_extra) {
         return kNone;
-    if (!extras.empty() && extras.back().node == id)
+    }
+    if (!extras.empty() && extras.back().node == id) {
         return extras.back();
+    }
     auto it = extra_at(extras, id);
     return it != extras.end() && it->node == id ? *it : kNone;
 }
@@ -106,8 +114,9 @@ NodeExtra& Plan::extra_for(std::uint32_t id) {
         return extras.emplace_back(extra_of(id));
     }
     auto it = extra_at(extras, id);
-    if (it != extras.end() && it->node == id)
+    if (it != extras.end() && it->node == id) {
         return *it;
+    }
     n.has_extra = true;
     return *extras.insert(it, extra_of(id));
 }
@@ -147,21 +156,27 @@ std::optional<std::uint64_t> Plan::count(std::uint32_t id) const {
 std::string Plan::element_path(std::uint32_t id) const {
     // Paths are rebuilt from the parent chain rather than stored: a long list would otherwise keep a string
     // per element. Shapes: plan.elements[i], <container>.<kind>.elements[i], plan.blocks[i].elements[j].
-    if (id >= nodes.size())
+    if (id >= nodes.size()) {
         return {};
-    if (id == main_list)
+    }
+    if (id == main_list) {
         return "plan.elements";
-    if (id == blocks_list)
+    }
+    if (id == blocks_list) {
         return "plan.blocks";
+    }
     const Node& n = nodes[id];
-    if (n.parent == kNoNode)
+    if (n.parent == kNoNode) {
         return {};
+    }
     const std::string index = "[" + std::to_string(index_in_parent(id)) + "]";
     const Node& p = nodes[n.parent];
-    if (p.kind == NodeKind::ElementList)
+    if (p.kind == NodeKind::ElementList) {
         return element_path(n.parent) + index;
-    if (p.kind == NodeKind::Block && p.parent == blocks_list && blocks_list != kNoNode)
+    }
+    if (p.kind == NodeKind::Block && p.parent == blocks_list && blocks_list != kNoNode) {
         return element_path(n.parent) + ".elements" + index;
+    }
     return element_path(n.parent) + "." + to_string(p.kind) + ".elements" + index;
 }
 

@@ -31,10 +31,12 @@ autopilot::MissionItem to_autopilot(const MissionItem& m) {
     out.lat = m.position.lat;
     out.lon = m.position.lon;
     out.alt = m.alt.value_or(0.0);
-    if (m.speed > 0.0)
+    if (m.speed > 0.0) {
         out.speed = m.speed;
-    if (m.arrival_radius > 0.0)
+    }
+    if (m.arrival_radius > 0.0) {
         out.radius = m.arrival_radius;
+    }
     out.jump_slot = m.jump_slot;
     return out;
 }
@@ -42,8 +44,9 @@ autopilot::MissionItem to_autopilot(const MissionItem& m) {
 std::vector<autopilot::MissionItem> to_autopilot(const std::vector<MissionItem>& items) {
     std::vector<autopilot::MissionItem> out;
     out.reserve(items.size());
-    for (const auto& m : items)
+    for (const auto& m : items) {
         out.push_back(to_autopilot(m));
+    }
     return out;
 }
 
@@ -67,8 +70,9 @@ Json optional_json(const std::optional<std::uint64_t>& v) {
 
 template <typename T>
 std::optional<T> pop(std::deque<T>& q) {
-    if (q.empty())
+    if (q.empty()) {
         return std::nullopt;
+    }
     T out = std::move(q.front());
     q.pop_front();
     return out;
@@ -97,8 +101,9 @@ void PlanController::resume(ResumeResult result, TimePoint now) {
         log(Level::Warn, p);
         problem_ = p;
     }
-    if (!result.resumed)
+    if (!result.resumed) {
         return;
+    }
     auto& r = *result.resumed;
     if (!r.stream) {
         log(Level::Info, fmt::format("stored plan '{}' was {}; nothing to resume", r.plan->name,
@@ -111,8 +116,9 @@ void PlanController::resume(ResumeResult result, TimePoint now) {
     plan.source = r.plan->source_file;
     plan.digest = r.digest;
     plan.stream = r.stream.get();
-    if (r.progress.state == PlanState::Paused)
+    if (r.progress.state == PlanState::Paused) {
         feeder_.pause();
+    }
     feeder_.restore_plan(PlanFeed{std::move(r.stream), r.plan->name}, r.progress.waypoints_reached, now);
     reactions_ = std::make_unique<ReactionMonitor>(ReactionSettings::from_plan(*plan.plan));
     tell_reactions_the_link(now);
@@ -146,22 +152,26 @@ void PlanController::start_plan(ActivePlan plan, bool append, TimePoint now) {
 
 // The link's state comes as a change (LinkState): a new plan's reactions start from the one last heard.
 void PlanController::tell_reactions_the_link(TimePoint now) {
-    if (groundlink_seen_up_ && reactions_)
+    if (groundlink_seen_up_ && reactions_) {
         reactions_->on_link(groundlink_up_, now);
+    }
 }
 
 void PlanController::save_progress() {
-    if (!config_.keeps_progress || !active_ || returning_home_)
+    if (!config_.keeps_progress || !active_ || returning_home_) {
         return;
+    }
     const FeederProgress p = feeder_.progress();
-    if (p.state == PlanState::None)
+    if (p.state == PlanState::None) {
         return;
+    }
     SavedProgress s = SavedProgress::from(p, active_->digest);
     if (p.state != PlanState::Done && !p.resume_index) {
         return;  // between states (nothing queued yet): the last saved point still holds
     }
-    if (last_saved_ && *last_saved_ == s)
+    if (last_saved_ && *last_saved_ == s) {
         return;
+    }
     // Taken as saved until the store says otherwise (on_saved): the same point is not written twice.
     last_saved_ = s;
     saves_.push_back(ProgressSave{std::move(s), true});
@@ -172,12 +182,15 @@ void PlanController::on_saved(const ProgressSave& save, const std::optional<std:
         last_saved_ = save.progress;
         return;
     }
-    if (!save.report_failure)
+    if (!save.report_failure) {
         return;
-    if (last_saved_ && *last_saved_ == save.progress)
+    }
+    if (last_saved_ && *last_saved_ == save.progress) {
         last_saved_.reset();
-    if (problem_ != *error)
+    }
+    if (problem_ != *error) {
         log(Level::Error, "cannot save progress: " + *error);
+    }
     problem_ = *error;
     publish_status(false);
 }
@@ -189,8 +202,9 @@ bool PlanController::return_home(TimePoint now) {
     } else if (autopilot_home_) {
         home = LatLon{autopilot_home_->lat, autopilot_home_->lon};
     }
-    if (!home || !active_)
+    if (!home || !active_) {
         return false;
+    }
     const auto& v = active_->plan->vehicle;
     // The plan's progress stays saved where it was interrupted (paused), so a restart does not drive on.
     if (config_.keeps_progress && last_saved_) {
@@ -221,17 +235,20 @@ void PlanController::carry_out(const ReactionTrigger& t, TimePoint now) {
         case ReactionAction::GotoBlock:
             what = feeder_.jump_to(t.reaction.target, now) ? "goto " + t.reaction.target
                                                            : "goto " + t.reaction.target + " failed; hold";
-            if (what.ends_with("hold"))
+            if (what.ends_with("hold")) {
                 feeder_.pause();
+            }
             break;
         case ReactionAction::ReturnHome:
             what = return_home(now) ? "return home" : "return home impossible (no home known); hold";
-            if (what.ends_with("hold"))
+            if (what.ends_with("hold")) {
                 feeder_.pause();
+            }
             break;
     }
-    if (t.cause == ReactionTrigger::Cause::LinkRecovered)
+    if (t.cause == ReactionTrigger::Cause::LinkRecovered) {
         what = "nothing (the link-loss reaction stays in effect)";
+    }
     last_reaction_ = cause + ": " + what + (t.detail.empty() ? "" : " (" + t.detail + ")");
     log(Level::Warn, "reaction " + last_reaction_);
     outputs_.emplace_back(t);
@@ -240,8 +257,9 @@ void PlanController::carry_out(const ReactionTrigger& t, TimePoint now) {
 // ---- autopilot side ------------------------------------------------------------------------------------
 
 void PlanController::on_autopilot_status(const autopilot::AutopilotStatus& s, TimePoint now) {
-    if (s.ready == autopilot_ready_)
+    if (s.ready == autopilot_ready_) {
         return;
+    }
     autopilot_ready_ = s.ready;
     const std::pair<unsigned, unsigned> counts{s.reconnects, s.reboots};
     if (!autopilot_ready_) {
@@ -262,14 +280,18 @@ void PlanController::on_autopilot_status(const autopilot::AutopilotStatus& s, Ti
 }
 
 void PlanController::on_telemetry(const autopilot::Telemetry& t, TimePoint now) {
-    if (t.home)
+    if (t.home) {
         autopilot_home_ = t.home;
-    if (!reactions_)
+    }
+    if (!reactions_) {
         return;
-    if (t.battery_remaining)
+    }
+    if (t.battery_remaining) {
         reactions_->on_battery(*t.battery_remaining, now);
-    if (t.position)
+    }
+    if (t.position) {
         reactions_->on_position(LatLon{t.position->lat, t.position->lon}, now);
+    }
     pump(now);
 }
 
@@ -320,8 +342,9 @@ void PlanController::on_mode_changed(const autopilot::ModeChanged& m, TimePoint 
 
 void PlanController::on_request_done(const autopilot::RequestDone& done, TimePoint now) {
     const auto it = in_flight_.find(done.id);
-    if (it == in_flight_.end())
+    if (it == in_flight_.end()) {
         return;  // another requester's, or forgotten after a reconnect
+    }
     const std::uint32_t feeder_id = it->second.feeder_id;
     log(Level::Debug,
         fmt::format("#{} {} in {} ms", feeder_id, autopilot::to_string(done.result),
@@ -386,22 +409,28 @@ void PlanController::send(const FeederRequest& request, TimePoint now) {
 }
 
 void PlanController::pump(TimePoint now) {
-    if (!running_)
+    if (!running_) {
         return;
-    if (feeder_.poll_timeout() <= now)
+    }
+    if (feeder_.poll_timeout() <= now) {
         feeder_.handle_timeout(now);
+    }
     if (reactions_) {
-        if (reactions_->poll_timeout() <= now)
+        if (reactions_->poll_timeout() <= now) {
             reactions_->handle_timeout(now);
-        while (auto t = reactions_->poll_trigger())
+        }
+        while (auto t = reactions_->poll_trigger()) {
             carry_out(*t, now);
+        }
     }
     if (autopilot_ready_) {
-        while (auto r = feeder_.poll_request(now))
+        while (auto r = feeder_.poll_request(now)) {
             send(*r, now);
+        }
     }
-    while (auto e = feeder_.poll_event())
+    while (auto e = feeder_.poll_event()) {
         handle_event(*e);
+    }
     save_progress();
     answer_waiters(now);
     publish_status(false);
@@ -457,8 +486,9 @@ void PlanController::wait_for_autopilot(CommandId id, std::string what, TimePoin
 }
 
 void PlanController::answer_waiters(TimePoint now) {
-    if (waiters_.empty())
+    if (waiters_.empty()) {
         return;
+    }
     if (!autopilot_ready_) {
         fail_waiters("the autopilot is not ready (the plan is kept and starts when it is)");
         return;
@@ -472,8 +502,9 @@ void PlanController::answer_waiters(TimePoint now) {
         auto done = std::move(waiters_);
         waiters_.clear();
         const Json progress = progress_json();
-        for (auto& w : done)
+        for (auto& w : done) {
             reply(w.id, Status::Ok, {}, progress);
+        }
         return;
     }
     std::vector<Waiter> keep;
@@ -492,8 +523,9 @@ void PlanController::answer_waiters(TimePoint now) {
 void PlanController::fail_waiters(const std::string& why) {
     auto failed = std::move(waiters_);
     waiters_.clear();
-    for (auto& w : failed)
+    for (auto& w : failed) {
         reply(w.id, Status::Failed, w.what + ": " + why);
+    }
 }
 
 void PlanController::reply(CommandId id, CommandReply::Status status, std::string error, Json result) {
@@ -658,10 +690,12 @@ void PlanController::handle_timeout(TimePoint now) {
 
 TimePoint PlanController::poll_timeout() const {
     TimePoint next = feeder_.poll_timeout();
-    if (reactions_)
+    if (reactions_) {
         next = std::min(next, reactions_->poll_timeout());
-    for (const auto& w : waiters_)
+    }
+    for (const auto& w : waiters_) {
         next = std::min(next, w.deadline);
+    }
     return next;
 }
 

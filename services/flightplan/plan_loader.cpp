@@ -48,17 +48,19 @@ LoadResult load_from(Open open, const std::string& source_name, const LoadOption
 }  // namespace
 
 LoadResult load_plan_text(std::string_view text, const std::string& source_name, const LoadOptions& options) {
-    if (text.size() > kMaxPlanTextBytes)
+    if (text.size() > kMaxPlanTextBytes) {
         return one_error(source_name, 0, 0,
                          "plan larger than " + std::to_string(kMaxPlanTextBytes) + " bytes");
+    }
     return load_from([&]() -> std::unique_ptr<std::istream> { return std::make_unique<TextStream>(text); },
                      source_name, options);
 }
 
 LoadResult load_plan_file(const std::string& path, const LoadOptions& options) {
     std::ifstream in(path, std::ios::binary);
-    if (!in)
+    if (!in) {
         return one_error(path, 0, 0, "cannot open the file");
+    }
     in.seekg(0, std::ios::end);
     const std::streamoff size = in.tellg();
     if (size < 0) {
@@ -71,8 +73,9 @@ LoadResult load_plan_file(const std::string& path, const LoadOptions& options) {
         text.shrink_to_fit();
         return load_plan_text(text, path, options);
     }
-    if (static_cast<std::uint64_t>(size) > kMaxPlanTextBytes)
+    if (static_cast<std::uint64_t>(size) > kMaxPlanTextBytes) {
         return one_error(path, 0, 0, "plan larger than " + std::to_string(kMaxPlanTextBytes) + " bytes");
+    }
     // The file is read as it is parsed, never held whole.
     return load_from(
         [&]() -> std::unique_ptr<std::istream> {

@@ -41,10 +41,12 @@ struct ListCopied {};
 // The merge as it was: both documents as yaml-cpp trees (append_plan_text_as_trees).
 
 void append_list(YAML::Node into, const YAML::Node& from) {
-    if (!from.IsSequence())
+    if (!from.IsSequence()) {
         return;
-    for (const auto& item : from)
+    }
+    for (const auto& item : from) {
         into.push_back(YAML::Clone(item));
+    }
 }
 
 }  // namespace merge
@@ -65,10 +67,12 @@ MergedPlan append_plan_text_as_trees(std::string_view running, std::string_view 
         }
         for (const std::string_view key : kLists) {
             const std::string k(key);
-            if (!more[k].IsDefined() || more[k].IsNull())
+            if (!more[k].IsDefined() || more[k].IsNull()) {
                 continue;
-            if (!plan[k].IsDefined() || plan[k].IsNull())
+            }
+            if (!plan[k].IsDefined() || plan[k].IsNull()) {
                 plan[k] = YAML::Node(YAML::NodeType::Sequence);
+            }
             YAML::Node list = plan[k];
             append_list(list, more[k]);
         }
@@ -107,15 +111,17 @@ class TextSink : public std::streambuf {
         const auto count = static_cast<std::size_t>(n);
         size_ += count;
         // One byte stays free for the final newline.
-        if (!overflowed_ && text_.size() + count < text_.capacity())
+        if (!overflowed_ && text_.size() + count < text_.capacity()) {
             text_.append(s, count);
-        else
+        } else {
             overflowed_ = true;
+        }
         return n;
     }
     int_type overflow(int_type ch) override {
-        if (traits_type::eq_int_type(ch, traits_type::eof()))
+        if (traits_type::eq_int_type(ch, traits_type::eof())) {
             return traits_type::not_eof(ch);
+        }
         const char c = traits_type::to_char_type(ch);
         xsputn(&c, 1);
         return ch;
@@ -150,10 +156,11 @@ class EventWriter {
     void begin(bool map, const std::string& tag, anchor_t anchor, Style style) {
         begin_node();
         props(tag, anchor);
-        if (style == Style::Block)
+        if (style == Style::Block) {
             emitter_ << YAML::Block;
-        else if (style == Style::Flow)
+        } else if (style == Style::Flow) {
             emitter_ << YAML::Flow;
+        }
         // The node's style must not outlive it.
         emitter_.RestoreGlobalModifiedSettings();
         emitter_ << (map ? YAML::BeginMap : YAML::BeginSeq);
@@ -168,8 +175,9 @@ class EventWriter {
     enum class State : unsigned char { Entry, Key, Value };
 
     void begin_node() {
-        if (states_.empty())
+        if (states_.empty()) {
             return;
+        }
         State& s = states_.back();
         if (s == State::Key) {
             emitter_ << YAML::Key;
@@ -181,10 +189,12 @@ class EventWriter {
     }
     void props(const std::string& tag, anchor_t anchor) {
         // "?" and "!" are the parser's non-specific tags: the emitter chooses again.
-        if (!tag.empty() && tag != "?" && tag != "!")
+        if (!tag.empty() && tag != "?" && tag != "!") {
             emitter_ << YAML::VerbatimTag(tag);
-        if (anchor != 0)
+        }
+        if (anchor != 0) {
             emitter_ << YAML::Anchor(std::to_string(anchor));
+        }
     }
 
     YAML::Emitter& emitter_;
@@ -205,12 +215,15 @@ class Output {
     /// its own list is copied); the second copy goes without the anchor, and later aliases refer to the
     /// first, which is the same node.
     anchor_t define(anchor_t a) {
-        if (a == 0)
+        if (a == 0) {
             return 0;
-        if (a > written_.size())
+        }
+        if (a > written_.size()) {
             throw NeedsWholeTree{};
-        if (written_[a - 1])
+        }
+        if (written_[a - 1]) {
             return 0;
+        }
         written_[a - 1] = true;
         return appended(a);
     }
@@ -244,16 +257,20 @@ class PlanWalker {
   public:
     /// Where the node whose event is being handled sits.
     Slot slot() const {
-        if (stack_.empty())
+        if (stack_.empty()) {
             return {Place::Root, kNone};
+        }
         const Frame& p = stack_.back();
-        if (p.place == Place::List || p.place == Place::Item)
+        if (p.place == Place::List || p.place == Place::Item) {
             return {Place::Item, p.list};
+        }
         if (p.map && !p.want_key) {
-            if (p.pending == kPlanKey)
+            if (p.pending == kPlanKey) {
                 return {Place::Plan, kNone};
-            if (p.pending >= 0)
+            }
+            if (p.pending >= 0) {
                 return {Place::List, p.pending};
+            }
         }
         return {};
     }
@@ -270,25 +287,30 @@ class PlanWalker {
     void leaf(const std::string* scalar, bool alias) {
         // yaml-cpp matches an alias used as a key (or as the plan) by the node it stands for; following
         // that would mean keeping every anchored node of the document.
-        if (alias && slot().place == Place::Plan)
+        if (alias && slot().place == Place::Plan) {
             throw NeedsWholeTree{};
+        }
         if (!stack_.empty()) {
             Frame& p = stack_.back();
             if (p.map && p.want_key && (p.place == Place::Root || p.place == Place::Plan)) {
-                if (alias)
+                if (alias) {
                     throw NeedsWholeTree{};
-                if (scalar != nullptr)
+                }
+                if (scalar != nullptr) {
                     p.pending = match(p.place, *scalar);
+                }
             }
         }
         advance();
     }
     void open(bool map) {
         Slot s = slot();
-        if (((s.place == Place::Root || s.place == Place::Plan) && !map) || (s.place == Place::List && map))
+        if (((s.place == Place::Root || s.place == Place::Plan) && !map) || (s.place == Place::List && map)) {
             s = {};
-        if (s.place == Place::Plan)
+        }
+        if (s.place == Place::Plan) {
             plan_is_map_ = true;
+        }
         stack_.push_back({s.place, s.list, map});
     }
     void close() {
@@ -307,15 +329,17 @@ class PlanWalker {
 
     int match(Place where, const std::string& key) {
         if (where == Place::Root) {
-            if (plan_seen_ || key != "plan")
+            if (plan_seen_ || key != "plan") {
                 return kNone;
+            }
             plan_seen_ = true;
             return kPlanKey;
         }
         for (std::size_t k = 0; k < kLists.size(); ++k) {
             if (key == kLists[k]) {
-                if (list_seen_[k])
+                if (list_seen_[k]) {
                     return kNone;
+                }
                 list_seen_[k] = true;
                 return static_cast<int>(k);
             }
@@ -323,8 +347,9 @@ class PlanWalker {
         return kNone;
     }
     void advance() {
-        if (stack_.empty() || !stack_.back().map)
+        if (stack_.empty() || !stack_.back().map) {
             return;
+        }
         Frame& p = stack_.back();
         if (p.want_key) {
             p.want_key = false;
@@ -382,8 +407,9 @@ class FactsReader final : public YAML::EventHandler {
             while (!unvisited.empty()) {
                 const anchor_t a = unvisited.back();
                 unvisited.pop_back();
-                if (list.needs[a - 1])
+                if (list.needs[a - 1]) {
                     continue;
+                }
                 list.needs[a - 1] = true;
                 list.any_needs = true;
                 const auto& refs = anchors_[a - 1].outer_refs;
@@ -400,17 +426,20 @@ class FactsReader final : public YAML::EventHandler {
         walk_.leaf(nullptr, false);
     }
     void OnAlias(const YAML::Mark&, anchor_t target) override {
-        if (target == 0 || target > anchors_.size())
+        if (target == 0 || target > anchors_.size()) {
             throw NeedsWholeTree{};
+        }
         const Slot s = walk_.slot();
         const Anchor& t = anchors_[target - 1];
         node(s, 0, t.value);
         for (const Open& o : open_) {
-            if (o.anchor != 0 && target < o.anchor)
+            if (o.anchor != 0 && target < o.anchor) {
                 anchors_[o.anchor - 1].outer_refs.push_back(target);
+            }
         }
-        if (s.place == Place::Item && t.list != s.list)
+        if (s.place == Place::Item && t.list != s.list) {
             seeds_[static_cast<std::size_t>(s.list)].push_back(target);
+        }
         if (s.place == Place::List) {
             facts_.lists[static_cast<std::size_t>(s.list)].has_items = t.has_items;
             seeds_[static_cast<std::size_t>(s.list)].push_back(target);
@@ -453,15 +482,19 @@ class FactsReader final : public YAML::EventHandler {
     };
 
     void node(const Slot& s, anchor_t anchor, ListFacts::Value value) {
-        if (!open_.empty())
+        if (!open_.empty()) {
             open_.back().any = true;
-        if (s.place == Place::Item && walk_.directly_in_list())
+        }
+        if (s.place == Place::Item && walk_.directly_in_list()) {
             facts_.lists[static_cast<std::size_t>(s.list)].has_items = true;
-        if (s.place == Place::List)
+        }
+        if (s.place == Place::List) {
             facts_.lists[static_cast<std::size_t>(s.list)].value = value;
+        }
         if (anchor != 0) {
-            if (anchors_.size() < anchor)
+            if (anchors_.size() < anchor) {
                 anchors_.resize(anchor);
+            }
             anchors_[anchor - 1].list = s.place == Place::Item ? s.list : kNone;
             anchors_[anchor - 1].value = value;
         }
@@ -469,8 +502,9 @@ class FactsReader final : public YAML::EventHandler {
     void end() {
         const Open o = open_.back();
         open_.pop_back();
-        if (o.anchor != 0)
+        if (o.anchor != 0) {
             anchors_[o.anchor - 1].has_items = o.any;
+        }
         walk_.close();
     }
 
@@ -564,21 +598,25 @@ class ListCopy final : public YAML::EventHandler {
             return;
         }
         if (s.place == Place::List && s.list == list_) {
-            if (e.kind != Kind::SeqStart)
+            if (e.kind != Kind::SeqStart) {
                 throw ListCopied{};  // not a list: nothing to copy
+            }
             return;
         }
         const bool opens = e.kind == Kind::SeqStart || e.kind == Kind::MapStart;
         const anchor_t anchor = e.kind == Kind::Alias ? 0 : e.anchor;  // an alias's is its target's
-        if (!needed(anchor) && keeping_.empty())
+        if (!needed(anchor) && keeping_.empty()) {
             return;
+        }
         log_.push_back(std::move(e));
-        if (!needed(anchor))
+        if (!needed(anchor)) {
             return;
-        if (opens)
+        }
+        if (opens) {
             keeping_.push_back({anchor, log_.size() - 1, walk_.depth() + 1});
-        else
+        } else {
             kept_[anchor - 1] = {log_.size() - 1, log_.size()};
+        }
     }
     /// A collection's end event.
     void close(Event&& e) {
@@ -587,10 +625,12 @@ class ListCopy final : public YAML::EventHandler {
             put(e);
             return;
         }
-        if (s.place == Place::List && s.list == list_)
+        if (s.place == Place::List && s.list == list_) {
             throw ListCopied{};
-        if (keeping_.empty())
+        }
+        if (keeping_.empty()) {
             return;
+        }
         log_.push_back(std::move(e));
         if (keeping_.back().depth == walk_.depth()) {
             kept_[keeping_.back().anchor - 1] = {keeping_.back().begin, log_.size()};
@@ -605,10 +645,11 @@ class ListCopy final : public YAML::EventHandler {
                 w.null(out_.define(e.anchor));
                 break;
             case Kind::Alias:
-                if (out_.written(e.anchor))
+                if (out_.written(e.anchor)) {
                     w.alias(Output::appended(e.anchor));
-                else
+                } else {
                     replay(e.anchor, false);
+                }
                 break;
             case Kind::Scalar:
                 w.scalar(e.tag, out_.define(e.anchor), e.value);
@@ -627,18 +668,21 @@ class ListCopy final : public YAML::EventHandler {
     void replay(anchor_t a, bool items_only) {
         // Not kept: it encloses the list being copied (an alias to an ancestor). Also guards a list given as
         // an alias to itself from recursing.
-        if (a == 0 || a > kept_.size() || kept_[a - 1].end == 0 || replaying_[a - 1])
+        if (a == 0 || a > kept_.size() || kept_[a - 1].end == 0 || replaying_[a - 1]) {
             throw NeedsWholeTree{};
+        }
         Range r = kept_[a - 1];
         if (items_only) {
-            if (log_[r.begin].kind != Kind::SeqStart)
+            if (log_[r.begin].kind != Kind::SeqStart) {
                 return;
+            }
             ++r.begin;
             --r.end;
         }
         replaying_[a - 1] = true;
-        for (std::size_t i = r.begin; i < r.end; ++i)
+        for (std::size_t i = r.begin; i < r.end; ++i) {
             put(log_[i]);
+        }
         replaying_[a - 1] = false;
     }
 
@@ -682,8 +726,9 @@ class RunningMerge final : public YAML::EventHandler {
     }
     void OnAlias(const YAML::Mark&, anchor_t anchor) override {
         // Appending to a list given as an alias appends to the anchored node, which was written earlier.
-        if (const Slot s = walk_.slot(); s.place == Place::List && adds(s.list))
+        if (const Slot s = walk_.slot(); s.place == Place::List && adds(s.list)) {
             throw NeedsWholeTree{};
+        }
         out_.write.alias(Output::running(anchor));
         walk_.leaf(nullptr, true);
     }
@@ -694,8 +739,9 @@ class RunningMerge final : public YAML::EventHandler {
             root_scalar = true;
             root_mark = mark;
         }
-        if (s.place == Place::List && has_items(s.list))
+        if (s.place == Place::List && has_items(s.list)) {
             pushback = true;
+        }
         out_.write.scalar(tag, Output::running(anchor), value);
         walk_.leaf(&value, false);
     }
@@ -704,14 +750,16 @@ class RunningMerge final : public YAML::EventHandler {
         walk_.open(false);
     }
     void OnSequenceEnd() override {
-        if (const Slot s = walk_.open_slot(); s.place == Place::List)
+        if (const Slot s = walk_.open_slot(); s.place == Place::List) {
             copy_items(s.list);
+        }
         out_.write.end();
         walk_.close();
     }
     void OnMapStart(const YAML::Mark&, const std::string& tag, anchor_t anchor, Style style) override {
-        if (const Slot s = walk_.slot(); s.place == Place::List && has_items(s.list))
+        if (const Slot s = walk_.slot(); s.place == Place::List && has_items(s.list)) {
             pushback = true;
+        }
         out_.write.begin(true, tag, Output::running(anchor), style);
         walk_.open(true);
     }
@@ -719,8 +767,9 @@ class RunningMerge final : public YAML::EventHandler {
         if (walk_.open_slot().place == Place::Plan) {
             for (std::size_t k = 0; k < kLists.size(); ++k) {
                 const int list = static_cast<int>(k);
-                if (walk_.has_list(list) || !adds(list))
+                if (walk_.has_list(list) || !adds(list)) {
                     continue;
+                }
                 out_.write.scalar("", 0, std::string(kLists[k]));
                 out_.write.begin(false, "", 0, Style::Default);
                 copy_items(list);
@@ -736,8 +785,9 @@ class RunningMerge final : public YAML::EventHandler {
     bool has_items(int k) const { return facts_ != nullptr && facts_->has_items(k); }
 
     void copy_items(int k) {
-        if (!has_items(k))
+        if (!has_items(k)) {
             return;
+        }
         ListCopy copy(k, *facts_, out_);
         TextStream in(appended_);
         YAML::Parser parser(in);
@@ -778,21 +828,26 @@ bool stream_merge(std::string_view running, std::string_view appended, const App
             return true;
         }
         // Subscripting a scalar document for its plan threw, the running plan's first.
-        if (merge.root_scalar)
+        if (merge.root_scalar) {
             throw YAML::BadSubscript(merge.root_mark, std::string("plan"));
-        if (facts.root_scalar)
+        }
+        if (facts.root_scalar) {
             throw YAML::BadSubscript(facts.root_mark, std::string("plan"));
-        if (merge.plan_is_map() && !facts.has_plan)
+        }
+        if (merge.plan_is_map() && !facts.has_plan) {
             throw YAML::InvalidNode("plan");  // what yaml-cpp's const lookup of a missing key gave
+        }
         if (!merge.plan_is_map() || !facts.plan_is_map) {
             out.error = "both plans need a 'plan' mapping";
             return true;
         }
-        if (merge.pushback)
+        if (merge.pushback) {
             throw YAML::BadPushback();
+        }
         good = emitter.good();
-        if (!good)
+        if (!good) {
             emitter_error = emitter.GetLastError();
+        }
     }
     if (!good) {
         out.error = "cannot write the merged plan: " + emitter_error;
@@ -806,8 +861,9 @@ bool stream_merge(std::string_view running, std::string_view appended, const App
     text.push_back('\n');
     // Reserved for a merged text as long as both inputs; give back a large excess (comments, indentation
     // that the emitter writes shorter). The copy is smaller than what the parser held.
-    if (text.size() < text.capacity() / 2)
+    if (text.size() < text.capacity() / 2) {
         text.shrink_to_fit();
+    }
     out.text = std::move(text);
     return true;
 }
@@ -831,16 +887,18 @@ MergedPlan append_plan_text(std::string_view running, std::string_view appended)
             // Reported after the running plan's own syntax errors, as before.
             appended_error = e.what();
         }
-        if (!facts)
+        if (!facts) {
             facts.emplace();
+        }
         const AppendedFacts* usable =
             appended_error.empty() && !facts->root_scalar && facts->plan_is_map ? &*facts : nullptr;
         // A merged text is about as long as both texts (the emitter writes what it reads much as a plan is
         // usually written); when it is longer, the second pass knows its exact size.
         std::size_t capacity = running.size() + appended.size() + 64;
         if (!stream_merge(running, appended, *facts, usable, appended_error, capacity, out, capacity) &&
-            !stream_merge(running, appended, *facts, usable, appended_error, capacity, out, capacity))
+            !stream_merge(running, appended, *facts, usable, appended_error, capacity, out, capacity)) {
             throw NeedsWholeTree{};  // the same text came out longer twice: not expected, but not fatal
+        }
     } catch (const NeedsWholeTree&) {
         // Layouts merged as whole trees, each detected where it is met: a running list that gets items and
         // is itself an alias (the items belong in the anchored node, written before); `plan:` given as an

@@ -14,11 +14,13 @@ namespace airseg::flightplan {
 namespace {
 
 SourceMark mark_of(const YRef& node) {
-    if (!node.IsDefined())
+    if (!node.IsDefined()) {
         return {};
+    }
     const YAML::Mark m = node.Mark();
-    if (m.line < 0)
+    if (m.line < 0) {
         return {};
+    }
     return {m.line + 1, m.column + 1};
 }
 
@@ -35,8 +37,9 @@ void PlanParser::error(const YRef& at, const std::string& path, std::string mess
 }
 
 bool PlanParser::is_map(const YRef& node, const std::string& path) {
-    if (node.IsMap())
+    if (node.IsMap()) {
         return true;
+    }
     error(node, path, "must be a mapping");
     return false;
 }
@@ -46,12 +49,14 @@ void PlanParser::check_keys(const YRef& map, const std::string& path,
     for (std::size_t i = 0; i < map.size(); ++i) {
         const std::string key = map.key(i).Scalar();
         bool known = false;
-        for (auto a : allowed)
+        for (auto a : allowed) {
             known = known || key == a;
+        }
         if (!known) {
             std::string list;
-            for (auto a : allowed)
+            for (auto a : allowed) {
                 list += (list.empty() ? "" : ", ") + std::string(a);
+            }
             error(map.key(i), path + "." + key,
                   "unknown field" + did_you_mean(key, allowed) + " (expected one of: " + list + ")");
         }
@@ -63,8 +68,9 @@ std::optional<double> PlanParser::number(const YRef& map, const char* key, const
     const YRef value = map[key];
     const std::string where = path + "." + key;
     if (!value.IsDefined() || value.IsNull()) {
-        if (required)
+        if (required) {
             error(map, where, "missing required field");
+        }
         return std::nullopt;
     }
     return number_value(value, where, lo, hi, lo_open);
@@ -102,8 +108,9 @@ std::optional<std::string> PlanParser::text(const YRef& map, const char* key, co
                                             bool required) {
     const YRef value = map[key];
     if (!value.IsDefined() || value.IsNull()) {
-        if (required)
+        if (required) {
             error(map, path + "." + key, "missing required field");
+        }
         return std::nullopt;
     }
     if (!value.IsScalar() || value.Scalar().empty()) {
@@ -115,12 +122,14 @@ std::optional<std::string> PlanParser::text(const YRef& map, const char* key, co
 
 std::optional<LatLon> PlanParser::lat_lon_fields(const YRef& map, const std::string& path, bool required) {
     const bool has_lat = map["lat"].IsDefined(), has_lon = map["lon"].IsDefined();
-    if (!required && !has_lat && !has_lon)
+    if (!required && !has_lat && !has_lon) {
         return std::nullopt;
+    }
     const auto lat = number(map, "lat", path, true, -90.0, 90.0);
     const auto lon = number(map, "lon", path, true, -180.0, 180.0);
-    if (!lat || !lon)
+    if (!lat || !lon) {
         return std::nullopt;
+    }
     note_coordinate({*lat, *lon});
     return LatLon{*lat, *lon};
 }
@@ -153,11 +162,13 @@ std::optional<std::vector<LatLon>> PlanParser::polygon(const YRef& node, const s
     for (std::size_t i = 0; i < node.size(); ++i) {
         const auto p = point(node[i], path + "[" + std::to_string(i) + "]");
         ok = ok && p.has_value();
-        if (p)
+        if (p) {
             out.push_back(*p);
+        }
     }
-    if (!ok)
+    if (!ok) {
         return std::nullopt;
+    }
     return out;
 }
 
@@ -167,23 +178,27 @@ std::uint32_t PlanParser::add_node(NodeKind kind, std::uint32_t parent, SourceMa
     node.kind = kind;
     node.parent = parent;
     node.mark = mark;
-    if (parent != kNoNode)
+    if (parent != kNoNode) {
         plan_.extra_for(parent).children.push_back(id);
+    }
     // Scans and orbits get their patterns at the end; their extras are made now, in id order.
-    if (kind == NodeKind::Scan || kind == NodeKind::Orbit)
+    if (kind == NodeKind::Scan || kind == NodeKind::Orbit) {
         plan_.extra_for(id);
+    }
     return id;
 }
 
 void PlanParser::set_name(std::uint32_t id, std::optional<std::string> name) {
-    if (name)
+    if (name) {
         plan_.extra_for(id).name = std::move(*name);
+    }
 }
 
 void PlanParser::set_optional(std::uint32_t id, std::optional<double> NodeExtra::*field,
                               std::optional<double> v) {
-    if (v)
+    if (v) {
         plan_.extra_for(id).*field = v;
+    }
 }
 
 void PlanParser::parse_leaf_common(const YRef& body, std::uint32_t id, const std::string& path) {
@@ -196,16 +211,18 @@ void PlanParser::parse_leaf_common(const YRef& body, std::uint32_t id, const std
 }
 
 void PlanParser::parse_element(const YRef& item, std::uint32_t parent, const std::string& path) {
-    if (auto list = element_head(item, parent, path))
+    if (auto list = element_head(item, parent, path)) {
         parse_elements(list->body["elements"], list->id, list->path);
+    }
 }
 
 std::optional<PlanParser::ListTarget> PlanParser::element_head(const YRef& item, std::uint32_t parent,
                                                                const std::string& path) {
     // YAML aliases can make a small file describe an exponential number of elements.
     if (plan_.nodes.size() >= max_elements_) {
-        if (!too_many_elements_)
+        if (!too_many_elements_) {
             error(item, path, "more than " + std::to_string(max_elements_) + " elements");
+        }
         too_many_elements_ = true;
         return std::nullopt;
     }
@@ -221,8 +238,9 @@ std::optional<PlanParser::ListTarget> PlanParser::element_head(const YRef& item,
     const SourceMark mark = mark_of(item);
 
     if (kind == "waypoint") {
-        if (!is_map(body, where))
+        if (!is_map(body, where)) {
             return std::nullopt;
+        }
         check_keys(body, where, {"name", "lat", "lon", "alt", "speed", "radius"});
         const auto id = add_node(NodeKind::Waypoint, parent, mark);
         parse_leaf_common(body, id, where);
@@ -233,8 +251,9 @@ std::optional<PlanParser::ListTarget> PlanParser::element_head(const YRef& item,
             plan_.nodes[id].has_position = true;
         }
     } else if (kind == "hold") {
-        if (!is_map(body, where))
+        if (!is_map(body, where)) {
             return std::nullopt;
+        }
         check_keys(body, where, {"name", "lat", "lon", "alt", "radius", "seconds", "until_released"});
         const auto id = add_node(NodeKind::Hold, parent, mark);
         parse_leaf_common(body, id, where);
@@ -248,15 +267,17 @@ std::optional<PlanParser::ListTarget> PlanParser::element_head(const YRef& item,
                      number(body, "seconds", where, false, 0.0, 7.0 * 86400.0, true));
         bool until_released = false;
         if (const YRef u = body["until_released"]; u.IsDefined()) {
-            if (!decode_bool(u, until_released))
+            if (!decode_bool(u, until_released)) {
                 error(u, where + ".until_released", "must be true or false");
+            }
         }
         if (body["seconds"].IsDefined() == until_released) {
             error(body, where, "needs exactly one of: seconds, until_released: true");
         }
     } else if (kind == "scan") {
-        if (!is_map(body, where))
+        if (!is_map(body, where)) {
             return std::nullopt;
+        }
         check_keys(body, where,
                    {"name", "polygon", "rectangle", "spacing", "heading", "step", "alt", "speed"});
         const auto id = add_node(NodeKind::Scan, parent, mark);
@@ -266,8 +287,9 @@ std::optional<PlanParser::ListTarget> PlanParser::element_head(const YRef& item,
         if (poly.IsDefined() == rect.IsDefined()) {
             error(body, where, "needs exactly one of: polygon, rectangle");
         } else if (poly.IsDefined()) {
-            if (auto p = polygon(poly, where + ".polygon"))
+            if (auto p = polygon(poly, where + ".polygon")) {
                 raw.polygon = *p;
+            }
         } else if (is_map(rect, where + ".rectangle")) {
             check_keys(rect, where + ".rectangle", {"sw", "ne"});
             const YRef sw_node = rect["sw"], ne_node = rect["ne"];
@@ -303,8 +325,9 @@ std::optional<PlanParser::ListTarget> PlanParser::element_head(const YRef& item,
         raw.step = step.value_or(0.0);
         scans_[id] = std::move(raw);
     } else if (kind == "orbit") {
-        if (!is_map(body, where))
+        if (!is_map(body, where)) {
             return std::nullopt;
+        }
         check_keys(body, where, {"name", "lat", "lon", "radius", "turns", "direction", "alt", "speed"});
         const auto id = add_node(NodeKind::Orbit, parent, mark);
         parse_leaf_common(body, id, where);
@@ -337,8 +360,9 @@ std::optional<PlanParser::ListTarget> PlanParser::element_head(const YRef& item,
             set_optional(id, &NodeExtra::speed, number(body, "value", where, true, 0.0, 1000.0, true));
         }
     } else if (kind == "repeat") {
-        if (!is_map(body, where))
+        if (!is_map(body, where)) {
             return std::nullopt;
+        }
         check_keys(body, where, {"name", "count", "elements"});
         const auto id = add_node(NodeKind::Repeat, parent, mark);
         set_name(id, text(body, "name", where, false));
@@ -355,8 +379,9 @@ std::optional<PlanParser::ListTarget> PlanParser::element_head(const YRef& item,
         }
         return ListTarget{id, where + ".elements", body};
     } else if (kind == "block") {
-        if (!is_map(body, where))
+        if (!is_map(body, where)) {
             return std::nullopt;
+        }
         check_keys(body, where, {"name", "elements"});
         const auto id = add_node(NodeKind::Block, parent, mark);
         set_name(id, text(body, "name", where, true));
@@ -368,8 +393,9 @@ std::optional<PlanParser::ListTarget> PlanParser::element_head(const YRef& item,
         } else if (is_map(body, where)) {
             check_keys(body, where, {"name", "target"});
             set_name(id, text(body, "name", where, false));
-            if (auto target = text(body, "target", where, true))
+            if (auto target = text(body, "target", where, true)) {
                 plan_.extra_for(id).goto_target_name = *target;
+            }
         }
     } else {
         static constexpr std::string_view kKinds[] = {"waypoint", "hold",   "scan",  "orbit",
@@ -391,8 +417,9 @@ void PlanParser::parse_elements(const YRef& list, std::uint32_t parent, const st
         empty_list(list, parent, path);
         return;
     }
-    for (std::size_t i = 0; i < list.size(); ++i)
+    for (std::size_t i = 0; i < list.size(); ++i) {
         parse_element(list[i], parent, path + "[" + std::to_string(i) + "]");
+    }
 }
 
 void PlanParser::begin_blocks(const YRef& list) {
@@ -401,25 +428,29 @@ void PlanParser::begin_blocks(const YRef& list) {
 
 void PlanParser::parse_blocks(const YRef& list, const std::string& path) {
     begin_blocks(list);
-    if (!list.IsDefined())
+    if (!list.IsDefined()) {
         return;
+    }
     if (!list.IsSequence()) {
         error(list, path, "must be a list of named blocks");
         return;
     }
-    for (std::size_t i = 0; i < list.size(); ++i)
+    for (std::size_t i = 0; i < list.size(); ++i) {
         parse_block(list[i], i);
+    }
 }
 
 void PlanParser::parse_block(const YRef& b, std::size_t index) {
-    if (auto list = block_head(b, index))
+    if (auto list = block_head(b, index)) {
         parse_elements(list->body["elements"], list->id, list->path);
+    }
 }
 
 std::optional<PlanParser::ListTarget> PlanParser::block_head(const YRef& b, std::size_t index) {
     const std::string where = "plan.blocks[" + std::to_string(index) + "]";
-    if (!is_map(b, where))
+    if (!is_map(b, where)) {
         return std::nullopt;
+    }
     check_keys(b, where, {"name", "elements"});
     const auto id = add_node(NodeKind::Block, plan_.blocks_list, mark_of(b));
     set_name(id, text(b, "name", where, true));
@@ -427,10 +458,12 @@ std::optional<PlanParser::ListTarget> PlanParser::block_head(const YRef& b, std:
 }
 
 void PlanParser::parse_vehicle(const YRef& v, const std::string& path) {
-    if (!v.IsDefined())
+    if (!v.IsDefined()) {
         return;
-    if (!is_map(v, path))
+    }
+    if (!is_map(v, path)) {
         return;
+    }
     check_keys(v, path, {"type", "min_spacing", "arrival_radius", "cruise_speed"});
     if (auto type = text(v, "type", path, false)) {
         if (auto d = VehicleProfile::defaults_for(*type)) {
@@ -439,10 +472,12 @@ void PlanParser::parse_vehicle(const YRef& v, const std::string& path) {
             error(v["type"], path + ".type", "unknown vehicle type (expected rover, boat, plane or copter)");
         }
     }
-    if (auto x = number(v, "min_spacing", path, false, 0.1, 1e5))
+    if (auto x = number(v, "min_spacing", path, false, 0.1, 1e5)) {
         plan_.vehicle.min_spacing = *x;
-    if (auto x = number(v, "arrival_radius", path, false, 0.0, 1e5, true))
+    }
+    if (auto x = number(v, "arrival_radius", path, false, 0.0, 1e5, true)) {
         plan_.vehicle.arrival_radius = *x;
+    }
     if (auto x = number(v, "cruise_speed", path, false, 0.0, 1000.0, true)) {
         plan_.vehicle.cruise_speed = *x;
         plan_.vehicle.cruise_speed_given = true;
@@ -452,8 +487,9 @@ void PlanParser::parse_vehicle(const YRef& v, const std::string& path) {
 std::optional<Reaction> PlanParser::parse_reaction(const YRef& node, const std::string& path) {
     Reaction r;
     const auto action = text(node, "action", path, true);
-    if (!action)
+    if (!action) {
         return std::nullopt;
+    }
     if (*action == "hold") {
         r.action = ReactionAction::Hold;
     } else if (*action == "return_home") {
@@ -462,8 +498,9 @@ std::optional<Reaction> PlanParser::parse_reaction(const YRef& node, const std::
         r.action = ReactionAction::Continue;
     } else if (*action == "goto") {
         r.action = ReactionAction::GotoBlock;
-        if (auto t = text(node, "target", path, true))
+        if (auto t = text(node, "target", path, true)) {
             r.target = *t;
+        }
         reaction_paths_.emplace_back(path + ".target", mark_of(node));
     } else {
         error(node["action"], path + ".action", "must be one of: hold, return_home, continue, goto");
@@ -476,10 +513,12 @@ std::optional<Reaction> PlanParser::parse_reaction(const YRef& node, const std::
 }
 
 void PlanParser::parse_reactions(const YRef& r, const std::string& path) {
-    if (!r.IsDefined())
+    if (!r.IsDefined()) {
         return;
-    if (!is_map(r, path))
+    }
+    if (!is_map(r, path)) {
         return;
+    }
     check_keys(r, path, {"link_loss", "low_battery", "geofence"});
     if (const YRef n = r["link_loss"]; n.IsDefined() && is_map(n, path + ".link_loss")) {
         check_keys(n, path + ".link_loss", {"after", "action", "target"});
@@ -515,8 +554,9 @@ PlanParser::ListTarget PlanParser::plan_head(const YRef& p) {
     check_keys(
         p, path,
         {"name", "vehicle", "reference", "home", "no_fly", "geofence", "reactions", "elements", "blocks"});
-    if (auto name = text(p, "name", path, true))
+    if (auto name = text(p, "name", path, true)) {
         plan_.name = *name;
+    }
     // The vehicle first: its min_spacing bounds the scans and orbits below.
     parse_vehicle(p["vehicle"], path + ".vehicle");
     if (const YRef r = p["reference"]; r.IsDefined() && is_map(r, path + ".reference")) {
@@ -533,8 +573,9 @@ PlanParser::ListTarget PlanParser::plan_head(const YRef& p) {
         } else {
             for (std::size_t i = 0; i < z.size(); ++i) {
                 const std::string where = path + ".no_fly[" + std::to_string(i) + "]";
-                if (!is_map(z[i], where))
+                if (!is_map(z[i], where)) {
                     continue;
+                }
                 check_keys(z[i], where, {"name", "buffer", "polygon"});
                 NoFlyZone zone;
                 zone.mark = mark_of(z[i]);
@@ -550,8 +591,9 @@ PlanParser::ListTarget PlanParser::plan_head(const YRef& p) {
         }
     }
     if (const YRef g = p["geofence"]; g.IsDefined()) {
-        if (auto poly = polygon(g, path + ".geofence"))
+        if (auto poly = polygon(g, path + ".geofence")) {
             plan_.geofence = *poly;
+        }
     }
     parse_reactions(p["reactions"], path + ".reactions");
     plan_.main_list = add_node(NodeKind::ElementList, kNoNode, mark_of(p));
@@ -564,8 +606,9 @@ void PlanParser::finish_geometry() {
     auto to_local = [&](const std::vector<LatLon>& poly) {
         std::vector<Enu> out;
         out.reserve(poly.size());
-        for (auto p : poly)
+        for (auto p : poly) {
             out.push_back(f.to_local(p));
+        }
         return out;
     };
     for (auto& zone : plan_.no_fly) {
@@ -577,8 +620,9 @@ void PlanParser::finish_geometry() {
     plan_.geofence_local = to_local(plan_.geofence);
     for (auto& [id, raw] : scans_) {
         const SourceMark mark = plan_.nodes[id].mark;
-        if (raw.polygon.empty() || !(raw.spacing > 0.0))
+        if (raw.polygon.empty() || !(raw.spacing > 0.0)) {
             continue;
+        }
         auto local = to_local(raw.polygon);
         if (polygon_self_intersects(local)) {
             error(mark, plan_.element_path(id) + ".scan.polygon", "polygon edges cross each other");
@@ -596,8 +640,9 @@ void PlanParser::finish_geometry() {
         }
     }
     for (auto& [id, raw] : orbits_) {
-        if (!(raw.radius > 0.0))
+        if (!(raw.radius > 0.0)) {
             continue;
+        }
         OrbitPattern o;
         o.centre = plan_.nodes[id].has_position ? plan_.local(id) : Enu{};
         o.radius = raw.radius;
@@ -613,8 +658,9 @@ void PlanParser::resolve_names() {
     std::map<std::string, std::uint32_t> names;
     for (std::uint32_t i = 0; i < plan_.nodes.size(); ++i) {
         const std::string& name = plan_.element_name(i);
-        if (name.empty())
+        if (name.empty()) {
             continue;
+        }
         auto [it, inserted] = names.emplace(name, i);
         if (!inserted) {
             error(plan_.nodes[i].mark, plan_.element_path(i) + ".name",
@@ -622,8 +668,9 @@ void PlanParser::resolve_names() {
         }
     }
     for (std::uint32_t i = 0; i < plan_.nodes.size(); ++i) {
-        if (plan_.nodes[i].kind != NodeKind::Goto || plan_.extra(i).goto_target_name.empty())
+        if (plan_.nodes[i].kind != NodeKind::Goto || plan_.extra(i).goto_target_name.empty()) {
             continue;
+        }
         NodeExtra& x = plan_.extra_for(i);
         auto it = names.find(x.goto_target_name);
         if (it == names.end()) {
@@ -638,12 +685,14 @@ void PlanParser::resolve_names() {
                              plan_.reactions.geofence ? &*plan_.reactions.geofence : nullptr};
     std::size_t goto_index = 0;
     for (Reaction* r : reactions) {
-        if (r == nullptr || r->action != ReactionAction::GotoBlock)
+        if (r == nullptr || r->action != ReactionAction::GotoBlock) {
             continue;
+        }
         const auto& [path, mark] = reaction_paths_.at(goto_index++);
         auto it = names.find(r->target);
-        if (r->target.empty())
+        if (r->target.empty()) {
             continue;
+        }
         if (it == names.end()) {
             error(mark, path, "target '" + r->target + "' is not the name of any element");
         } else {
@@ -659,16 +708,18 @@ void PlanParser::derive_counts(const LoadOptions& options) {
     for (std::size_t i = plan_.nodes.size(); i-- > 0;) {
         const auto id = static_cast<std::uint32_t>(i);
         const Node& n = plan_.nodes[i];
-        if (n.kind != NodeKind::ElementList && n.kind != NodeKind::Block && n.kind != NodeKind::Repeat)
+        if (n.kind != NodeKind::ElementList && n.kind != NodeKind::Block && n.kind != NodeKind::Repeat) {
             continue;
+        }
         NodeExtra& x = plan_.extra_for(id);
         std::optional<std::uint64_t> sum = 0;
         for (auto c : x.children) {
             const auto cc = plan_.count(c);
             if (!cc || !sum || *sum + *cc > cap) {
-                if (cc && sum)
+                if (cc && sum) {
                     error(n.mark, plan_.element_path(id),
                           "expands to more than " + std::to_string(cap) + " waypoints");
+                }
                 sum.reset();
                 break;
             }
@@ -700,8 +751,9 @@ LoadResult PlanParser::run(const YRef& doc, const LoadOptions& options) {
         error(doc, "", "the document must be a mapping with a top-level 'plan' key");
     } else {
         check_keys(doc, "", {"plan"});
-        if (is_map(doc["plan"], "plan"))
+        if (is_map(doc["plan"], "plan")) {
             parse_plan(doc["plan"]);
+        }
     }
     return finish(options);
 }
@@ -712,8 +764,9 @@ LoadResult PlanParser::finish(const LoadOptions& options) {
         resolve_names();
         derive_counts(options);
     }
-    if (errors_.empty())
+    if (errors_.empty()) {
         check_legs(plan_, options.leg_check_limit, errors_);
+    }
     LoadResult result;
     if (errors_.empty()) {
         result.plan = std::make_shared<const Plan>(std::move(plan_));

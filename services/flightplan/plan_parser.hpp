@@ -79,8 +79,9 @@ class PlanParser {
     std::optional<LatLon> point(const YRef& node, const std::string& path);
     std::optional<std::vector<LatLon>> polygon(const YRef& node, const std::string& path);
     void note_coordinate(LatLon p) {
-        if (!first_coordinate_)
+        if (!first_coordinate_) {
             first_coordinate_ = p;
+        }
     }
 
     std::uint32_t add_node(NodeKind kind, std::uint32_t parent, SourceMark mark);

@@ -28,8 +28,9 @@ PlanEventReader::PlanEventReader(PlanParser& parser, const LoadOptions& options,
 PlanEventReader::~PlanEventReader() = default;
 
 LoadResult PlanEventReader::result() {
-    if (!result_)
+    if (!result_) {
         result_ = parser_.run(YRef(), options_);  // no document at all
+    }
     return std::move(*result_);
 }
 
@@ -41,11 +42,13 @@ bool PlanEventReader::next_is_key() const {
 
 void PlanEventReader::before_node(const YNode* key, bool is_key) {
     Level& l = level();
-    if (!stream_ || l.open.empty())
+    if (!stream_ || l.open.empty()) {
         return;
+    }
     Open& o = l.open.back();
-    if (!is_key)
+    if (!is_key) {
         return;
+    }
     ++o.keys;
     const bool scalar = key != nullptr && key->type == YNode::Type::Scalar;
     const std::string_view name = scalar ? std::string_view(key->scalar) : std::string_view();
@@ -53,15 +56,18 @@ void PlanEventReader::before_node(const YNode* key, bool is_key) {
         case Role::Plain:
             break;
         case Role::Root:
-            if (o.streamed)
+            if (o.streamed) {
                 throw NotStreamable{};  // a key after the plan: its check comes first in document order
-            if (o.keys == 1 && name == "plan")
+            }
+            if (o.keys == 1 && name == "plan") {
                 pending_ = Pending::PlanValue;
+            }
             break;
         case Role::PlanBody:
             if (o.streamed) {
-                if (name != "blocks" || o.blocks)
+                if (name != "blocks" || o.blocks) {
                     throw NotStreamable{};
+                }
                 o.blocks = true;
                 pending_ = Pending::PlanBlocks;
             } else if (name == "blocks") {
@@ -71,54 +77,64 @@ void PlanEventReader::before_node(const YNode* key, bool is_key) {
             }
             break;
         case Role::Item:
-            if (o.streamed)
+            if (o.streamed) {
                 throw NotStreamable{};  // a second key: the element is refused as a whole
-            if (o.keys == 1 && (name == "repeat" || name == "block"))
+            }
+            if (o.keys == 1 && (name == "repeat" || name == "block")) {
                 pending_ = Pending::BodyValue;
+            }
             break;
         case Role::Body:
         case Role::BlockItem:
-            if (o.streamed)
+            if (o.streamed) {
                 throw NotStreamable{};
-            if (name == "elements" && !std::exchange(o.elements, true))
+            }
+            if (name == "elements" && !std::exchange(o.elements, true)) {
                 pending_ = Pending::Elements;
+            }
             break;
     }
 }
 
 void PlanEventReader::OnNull(const YAML::Mark& mark, YAML::anchor_t anchor) {
     Level& l = level();
-    if (l.kind == Level::Kind::Skip)
+    if (l.kind == Level::Kind::Skip) {
         return;
+    }
     pending_ = Pending::None;
     before_node(nullptr, next_is_key());
-    if (const YNode* tree = l.builder.null(mark, anchor))
+    if (const YNode* tree = l.builder.null(mark, anchor)) {
         finished(tree, Open{});
+    }
 }
 
 void PlanEventReader::OnAlias(const YAML::Mark&, YAML::anchor_t anchor) {
     Level& l = level();
-    if (l.kind == Level::Kind::Skip)
+    if (l.kind == Level::Kind::Skip) {
         return;
+    }
     pending_ = Pending::None;
     before_node(nullptr, next_is_key());
-    if (const YNode* tree = l.builder.alias(anchor))
+    if (const YNode* tree = l.builder.alias(anchor)) {
         finished(tree, Open{});
+    }
 }
 
 void PlanEventReader::OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
                                const std::string& value) {
     Level& l = level();
-    if (l.kind == Level::Kind::Skip)
+    if (l.kind == Level::Kind::Skip) {
         return;
+    }
     pending_ = Pending::None;
     const bool key = next_is_key();
     YNode probe;
     probe.type = YNode::Type::Scalar;
     probe.scalar = value;
     before_node(&probe, key);
-    if (const YNode* tree = l.builder.scalar(mark, anchor, value))
+    if (const YNode* tree = l.builder.scalar(mark, anchor, value)) {
         finished(tree, Open{});
+    }
 }
 
 void PlanEventReader::OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
@@ -194,12 +210,13 @@ void PlanEventReader::start(YNode::Type type, const YAML::Mark& mark, YAML::anch
     Open o;
     if (stream_) {
         if (!l.builder.building()) {
-            if (l.kind == Level::Kind::Document && plain_map)
+            if (l.kind == Level::Kind::Document && plain_map) {
                 o.role = Role::Root;
-            else if (l.kind == Level::Kind::Elements && plain_map)
+            } else if (l.kind == Level::Kind::Elements && plain_map) {
                 o.role = Role::Item;
-            else if (l.kind == Level::Kind::Blocks && plain_map)
+            } else if (l.kind == Level::Kind::Blocks && plain_map) {
                 o.role = Role::BlockItem;
+            }
         } else if (plain_map && pending == Pending::PlanValue) {
             o.role = Role::PlanBody;
         } else if (plain_map && pending == Pending::BodyValue) {
@@ -236,10 +253,12 @@ void PlanEventReader::end() {
     const Open o = l.open.back();
     l.open.pop_back();
     // The blocks follow the elements in the parser's order: read whole unless streamed after them.
-    if (o.role == Role::PlanBody && o.streamed && !o.blocks_streamed)
+    if (o.role == Role::PlanBody && o.streamed && !o.blocks_streamed) {
         parser_.parse_blocks(YRef(l.builder.top())["blocks"], "plan.blocks");
-    if (const YNode* tree = l.builder.end())
+    }
+    if (const YNode* tree = l.builder.end()) {
         finished(tree, o);
+    }
 }
 
 void PlanEventReader::finished(const YNode* tree, const Open& role) {
@@ -253,12 +272,14 @@ void PlanEventReader::finished(const YNode* tree, const Open& role) {
             }
             return;
         case Level::Kind::Elements:
-            if (!role.streamed)
+            if (!role.streamed) {
                 parser_.parse_element(YRef(tree), l.parent, l.path + "[" + std::to_string(l.items) + "]");
+            }
             break;
         case Level::Kind::Blocks:
-            if (!role.streamed)
+            if (!role.streamed) {
                 parser_.parse_block(YRef(tree), l.items);
+            }
             break;
         case Level::Kind::Skip:
             break;
@@ -269,8 +290,9 @@ void PlanEventReader::finished(const YNode* tree, const Open& role) {
 
 void PlanEventReader::list_ended() {
     Level& l = level();
-    if (l.kind == Level::Kind::Elements && l.items == 0)
+    if (l.kind == Level::Kind::Elements && l.items == 0) {
         parser_.empty_list(YRef(&l.list), l.parent, l.path);
+    }
     const YAML::Mark mark = l.list.mark;
     l.builder.release();
     levels_.pop_back();

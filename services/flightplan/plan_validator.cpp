@@ -21,39 +21,46 @@ void check_legs(const Plan& plan, std::uint64_t limit, std::vector<Diagnostic>& 
     std::vector<std::uint32_t> entries;
     entries.push_back(kNoNode);
     if (plan.blocks_list != kNoNode) {
-        for (auto b : plan.children(plan.blocks_list))
+        for (auto b : plan.children(plan.blocks_list)) {
             entries.push_back(b);
+        }
     }
     std::vector<Box> boxes;
-    for (const auto& zone : plan.no_fly)
+    for (const auto& zone : plan.no_fly) {
         boxes.push_back(Box::around(zone.local, zone.buffer));
+    }
     std::set<std::pair<std::uint32_t, std::size_t>> reported;  // (element, zone)
     for (auto entry : entries) {
         Expander stream(view, /*enforce_no_fly=*/false, /*fold_repeats=*/true);
-        if (entry != kNoNode)
+        if (entry != kNoNode) {
             stream.jump_to_node(entry);
+        }
         std::optional<Enu> last;
         for (std::uint64_t n = 0; n < limit; ++n) {
             auto w = stream.next();
-            if (!w)
+            if (!w) {
                 break;
-            if (!w->has_position)
+            }
+            if (!w->has_position) {
                 continue;
+            }
             for (std::size_t z = 0; z < plan.no_fly.size(); ++z) {
                 const auto& zone = plan.no_fly[z];
                 const Enu from = last.value_or(w->local);
                 const bool bad = boxes[z].may_touch(from, w->local) &&
                                  (last ? segment_violates_zone(*last, w->local, zone.local, zone.buffer)
                                        : point_violates(w->local, zone));
-                if (!bad || !reported.emplace(w->element, z).second)
+                if (!bad || !reported.emplace(w->element, z).second) {
                     continue;
+                }
                 const Node& node = plan.nodes[w->element];
                 errors.push_back(
                     {plan.source_file, node.mark.line, node.mark.col, plan.element_path(w->element),
                      "the leg to waypoint " + std::to_string(w->index) + " crosses no-fly zone '" +
                          zone.name + "' (buffer " + std::to_string(zone.buffer) + " m)"});
-                if (errors.size() >= kMaxLegErrors)
+                if (errors.size() >= kMaxLegErrors) {
                     return;
+                }
             }
             last = w->local;
         }

@@ -41,14 +41,16 @@ void ReactionMonitor::fire(ReactionTrigger::Cause cause, const Reaction& reactio
 
 void ReactionMonitor::on_link(bool up, TimePoint now) {
     if (up) {
-        if (link_fired_ && s_.link_loss)
+        if (link_fired_ && s_.link_loss) {
             fire(ReactionTrigger::Cause::LinkRecovered, *s_.link_loss, now, {});
+        }
         link_down_since_.reset();
         link_fired_ = false;
         return;
     }
-    if (!link_down_since_)
+    if (!link_down_since_) {
         link_down_since_ = now;
+    }
     handle_timeout(now);
 }
 
@@ -57,8 +59,9 @@ void ReactionMonitor::on_battery(double percent, TimePoint now) {
         ++rejected_samples_;
         return;
     }
-    if (!s_.low_battery)
+    if (!s_.low_battery) {
         return;
+    }
     if (!battery_fired_ && percent < s_.low_battery_percent) {
         battery_fired_ = true;
         std::ostringstream d;
@@ -75,8 +78,9 @@ void ReactionMonitor::on_position(LatLon position, TimePoint now) {
         ++rejected_samples_;
         return;
     }
-    if (!s_.geofence || s_.fence.size() < 3)
+    if (!s_.geofence || s_.fence.size() < 3) {
         return;
+    }
     const Enu p = s_.frame.to_local(position);
     const bool inside = point_in_polygon(p, s_.fence);
     if (!fence_fired_ && !inside) {
@@ -101,14 +105,16 @@ void ReactionMonitor::handle_timeout(TimePoint now) {
 }
 
 TimePoint ReactionMonitor::poll_timeout() const {
-    if (link_down_since_ && !link_fired_ && s_.link_loss)
+    if (link_down_since_ && !link_fired_ && s_.link_loss) {
         return *link_down_since_ + s_.link_loss_after;
+    }
     return kNever;
 }
 
 std::optional<ReactionTrigger> ReactionMonitor::poll_trigger() {
-    if (triggers_.empty())
+    if (triggers_.empty()) {
         return std::nullopt;
+    }
     ReactionTrigger t = std::move(triggers_.front());
     triggers_.pop_front();
     return t;

@@ -5,8 +5,9 @@ namespace airseg::flightplan {
 ResumeResult resume_from(StoredState stored, const LoadOptions& options) {
     ResumeResult out;
     out.problems = std::move(stored.problems);
-    if (!stored.plan_text)
+    if (!stored.plan_text) {
         return out;
+    }
     auto loaded = load_plan_text(*stored.plan_text, stored.plan_source, options);
     if (!loaded.ok()) {
         // The text passed its checksum, so it was accepted once: the loader or its options changed since.

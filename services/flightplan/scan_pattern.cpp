@@ -20,16 +20,18 @@ ScanPattern::ScanPattern(std::vector<Enu> polygon, double spacing, double headin
         vmin_ = std::min(vmin_, r.n);
         vmax_ = std::max(vmax_, r.n);
     }
-    if (rotated_.size() < 3 || !(spacing_ > 0.0) || !(vmax_ > vmin_))
+    if (rotated_.size() < 3 || !(spacing_ > 0.0) || !(vmax_ > vmin_)) {
         return;
+    }
     const double lines = std::ceil((vmax_ - vmin_) / spacing_ - 1e-9);
     if (lines > static_cast<double>(kMaxLines)) {
         too_many_lines_ = true;
         return;
     }
     lines_ = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(lines));
-    for (std::uint64_t k = 0; k < lines_; ++k)
+    for (std::uint64_t k = 0; k < lines_; ++k) {
         total_ += line(k).count;
+    }
 }
 
 ScanPattern::Line ScanPattern::line(std::uint64_t k) const {
@@ -40,14 +42,16 @@ ScanPattern::Line ScanPattern::line(std::uint64_t k) const {
     const std::size_t n = rotated_.size();
     for (std::size_t i = 0; i < n; ++i) {
         const Enu a = rotated_[i], b = rotated_[(i + 1) % n];
-        if ((a.n <= out.v) == (b.n <= out.v))
+        if ((a.n <= out.v) == (b.n <= out.v)) {
             continue;  // half-open rule: a vertex is counted once
+        }
         const double u = a.e + (out.v - a.n) * (b.e - a.e) / (b.n - a.n);
         lo = std::min(lo, u);
         hi = std::max(hi, u);
     }
-    if (!(hi >= lo))
+    if (!(hi >= lo)) {
         return out;
+    }
     out.u0 = lo;
     out.u1 = hi;
     const double len = hi - lo;

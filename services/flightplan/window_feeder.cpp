@@ -5,16 +5,21 @@
 namespace airseg::flightplan {
 
 std::optional<std::string> FeederConfig::validate() const {
-    if (window < 3)
+    if (window < 3) {
         return "flightplan.window must be >= 3";
-    if (window > 250)
+    }
+    if (window > 250) {
         return "flightplan.window must be <= 250";
-    if (request_timeout <= Duration::zero())
+    }
+    if (request_timeout <= Duration::zero()) {
         return "flightplan.request_timeout must be > 0";
-    if (fault_backoff < Duration::zero())
+    }
+    if (fault_backoff < Duration::zero()) {
         return "flightplan.fault_backoff must be >= 0";
-    if (lost_reached_tolerance + 2 > window)
+    }
+    if (lost_reached_tolerance + 2 > window) {
         return "flightplan.lost_reached_tolerance must be <= window - 2";
+    }
     return std::nullopt;
 }
 
@@ -22,8 +27,9 @@ WindowFeeder::WindowFeeder(FeederConfig config)
     : config_(config), confirmed_(config.window + 1u + kWrapSlots) {}
 
 std::vector<MissionItem> WindowFeeder::slot_items(std::uint16_t slot, const MissionItem& item) const {
-    if (slot != wrap_slot())
+    if (slot != wrap_slot()) {
         return {item};
+    }
     MissionItem jump;
     jump.kind = MissionItem::Kind::JumpTo;
     jump.jump_slot = kFirstRingSlot;
@@ -45,12 +51,14 @@ bool WindowFeeder::confirmed(const Entry& e) const {
 }
 
 bool WindowFeeder::holds(std::uint16_t slot, const MissionItem& item) const {
-    if (!mission_ok_ || static_cast<std::size_t>(slot) + kWrapSlots > confirmed_.size())
+    if (!mission_ok_ || static_cast<std::size_t>(slot) + kWrapSlots > confirmed_.size()) {
         return false;
+    }
     const auto want = slot_items(slot, item);
     for (std::size_t i = 0; i < want.size(); ++i) {
-        if (confirmed_[slot + i] != want[i])
+        if (confirmed_[slot + i] != want[i]) {
             return false;
+        }
     }
     return true;
 }
@@ -103,15 +111,17 @@ void WindowFeeder::restore_plan(PlanFeed feed, std::uint64_t waypoints_reached, 
 }
 
 bool WindowFeeder::skip_to(std::uint64_t index, TimePoint now) {
-    if (!stream_ || !stream_->seek(index))
+    if (!stream_ || !stream_->seek(index)) {
         return false;
+    }
     restart(now);
     return true;
 }
 
 bool WindowFeeder::jump_to(std::string_view element_name, TimePoint now) {
-    if (!stream_ || !stream_->jump_to(element_name))
+    if (!stream_ || !stream_->jump_to(element_name)) {
         return false;
+    }
     restart(now);
     return true;
 }
@@ -141,11 +151,13 @@ void WindowFeeder::start_fresh(std::uint16_t first_slot, TimePoint now) {
 
 void WindowFeeder::continue_with(PlanFeed feed, TimePoint now) {
     stream_ = std::move(feed.stream);
-    if (!feed.name.empty())
+    if (!feed.name.empty()) {
         plan_name_ = std::move(feed.name);
+    }
     cleared_ = false;
-    if (!stream_ended_)
+    if (!stream_ended_) {
         return;  // the queue goes on filling from the new stream
+    }
     stream_ended_ = false;
     done_ = false;
     std::optional<std::uint16_t> stop_slot;
@@ -190,8 +202,9 @@ void WindowFeeder::resume() {
 }
 
 void WindowFeeder::release_hold(TimePoint now) {
-    if (!holding_)
+    if (!holding_) {
         return;
+    }
     end_hold(now);
     check_done();
 }
@@ -220,8 +233,9 @@ void WindowFeeder::refill(TimePoint now) {
             if (queue_.empty()) {
                 // Nothing to hold after: the vehicle holds where it is, now.
                 holds_.push_back(*w);
-                if (!holding_)
+                if (!holding_) {
                     begin_hold(now);
+                }
             } else {
                 queue_.back().holds_after.push_back(*w);
             }
@@ -241,27 +255,31 @@ void WindowFeeder::complete_through(std::size_t position, TimePoint now) {
         Entry e = std::move(queue_.front());
         queue_.pop_front();
         emit(FeederEvent::Kind::WaypointReached, &e.wp, e.generation, e.element_path);
-        if (e.generation == generation_)
+        if (e.generation == generation_) {
             ++reached_;
+        }
         if (e.wp.last_of_element) {
             emit(FeederEvent::Kind::ElementFinished, &e.wp, e.generation, e.element_path);
         }
         const bool last = i == position;
-        if (last && e.wp.action != WaypointAction::Go)
+        if (last && e.wp.action != WaypointAction::Go) {
             holds_.push_back(e.wp);
+        }
         for (auto& h : e.holds_after) {
             if (last) {
                 holds_.push_back(h);
             } else {
                 // Passed without a reached report: the hold cannot be held any more; report it done.
                 emit(FeederEvent::Kind::WaypointReached, &h, e.generation, stream_path(h));
-                if (e.generation == generation_)
+                if (e.generation == generation_) {
                     ++reached_;
+                }
             }
         }
     }
-    if (!holds_.empty() && !holding_)
+    if (!holds_.empty() && !holding_) {
         begin_hold(now);
+    }
     refill(now);
     announce_head();
     check_starvation();
@@ -274,8 +292,9 @@ std::string WindowFeeder::stream_path(const Waypoint& wp) const {
 
 void WindowFeeder::announce_head() {
     // Elements are reported strictly one after the other: the head's start waits for any hold to end.
-    if (holding_ || queue_.empty() || queue_[0].stop || queue_[0].announced)
+    if (holding_ || queue_.empty() || queue_[0].stop || queue_[0].announced) {
         return;
+    }
     queue_[0].announced = true;
     if (queue_[0].wp.first_of_element) {
         emit(FeederEvent::Kind::ElementStarted, &queue_[0].wp, queue_[0].generation, queue_[0].element_path);
@@ -288,8 +307,9 @@ void WindowFeeder::begin_hold(TimePoint now) {
     hold_wp_ = wp;
     if (!wp.has_position) {
         // A hold without a position has no reached report of its own: reaching it is starting it.
-        if (wp.first_of_element)
+        if (wp.first_of_element) {
             emit(FeederEvent::Kind::ElementStarted, &wp, generation_, stream_path(wp));
+        }
         emit(FeederEvent::Kind::WaypointReached, &wp, generation_, stream_path(wp));
         ++reached_;
     }
@@ -303,17 +323,20 @@ void WindowFeeder::begin_hold(TimePoint now) {
 }
 
 void WindowFeeder::end_hold(TimePoint now) {
-    if (!holding_)
+    if (!holding_) {
         return;
+    }
     const Waypoint wp = *hold_wp_;
     emit(FeederEvent::Kind::HoldEnded, &wp, generation_, stream_path(wp));
-    if (!wp.has_position && wp.last_of_element)
+    if (!wp.has_position && wp.last_of_element) {
         emit(FeederEvent::Kind::ElementFinished, &wp, generation_, stream_path(wp));
+    }
     holding_ = false;
     hold_until_.reset();
     hold_wp_.reset();
-    if (!holds_.empty())
+    if (!holds_.empty()) {
         holds_.pop_front();
+    }
     if (!holds_.empty()) {
         begin_hold(now);
     } else {
@@ -322,8 +345,9 @@ void WindowFeeder::end_hold(TimePoint now) {
 }
 
 void WindowFeeder::check_done() {
-    if (done_ || holding_ || !stream_)
+    if (done_ || holding_ || !stream_) {
         return;
+    }
     if ((queue_.empty() && stream_ended_) || (!queue_.empty() && queue_[0].stop)) {
         done_ = true;
         emit(FeederEvent::Kind::PlanDone, nullptr, generation_);
@@ -331,8 +355,9 @@ void WindowFeeder::check_done() {
 }
 
 void WindowFeeder::check_starvation() {
-    if (!mission_ok_ || need_set_current_ || queue_.empty() || starving_)
+    if (!mission_ok_ || need_set_current_ || queue_.empty() || starving_) {
         return;
+    }
     if (!confirmed(queue_[0])) {
         const auto* in_flight = outstanding_ ? std::get_if<WriteItems>(&outstanding_->request.op) : nullptr;
         if (in_flight && mode_ == Mode::Auto && in_flight->first_slot <= queue_[0].slot &&
@@ -367,8 +392,9 @@ void WindowFeeder::on_reached(std::uint16_t slot, TimePoint now) {
     const std::size_t limit = std::min<std::size_t>(queue_.size(), config_.lost_reached_tolerance + 1);
     for (std::size_t p = 0; p < limit; ++p) {
         const Entry& e = queue_[p];
-        if (e.stop)
+        if (e.stop) {
             break;
+        }
         if (e.slot == slot && confirmed(e)) {
             ap_target_ = ring_next(slot);
             current_mismatches_ = 0;
@@ -380,8 +406,9 @@ void WindowFeeder::on_reached(std::uint16_t slot, TimePoint now) {
 }
 
 void WindowFeeder::on_current(std::uint16_t slot, TimePoint now) {
-    if (queue_.empty() || !mission_ok_)
+    if (queue_.empty() || !mission_ok_) {
         return;
+    }
     slot = ring_position(slot);
     if (need_set_current_) {
         ap_target_ = slot;
@@ -394,8 +421,9 @@ void WindowFeeder::on_current(std::uint16_t slot, TimePoint now) {
     }
     const std::size_t limit = std::min<std::size_t>(queue_.size(), config_.lost_reached_tolerance + 2);
     for (std::size_t p = 1; p < limit; ++p) {
-        if (queue_[p - 1].stop)
+        if (queue_[p - 1].stop) {
             break;
+        }
         if (queue_[p].slot == slot && confirmed(queue_[p])) {
             // The autopilot moved past entries whose reached reports were lost (or are still on the way).
             ap_target_ = slot;
@@ -507,14 +535,16 @@ void WindowFeeder::on_autopilot_rebooted(TimePoint) {
     need_set_current_ = true;
     repoint_only_ = false;
     starving_ = false;
-    if (!config_.resume_after_reboot && !queue_.empty() && !done_)
+    if (!config_.resume_after_reboot && !queue_.empty() && !done_) {
         paused_ = true;
+    }
 }
 
 void WindowFeeder::on_request_result(std::uint32_t id, RequestResult result, TimePoint now,
                                      std::string_view detail) {
-    if (!outstanding_ || outstanding_->request.id != id)
+    if (!outstanding_ || outstanding_->request.id != id) {
         return;  // stale: retried or reset since
+    }
     const FeederRequest request = std::move(outstanding_->request);
     outstanding_.reset();
     if (result == RequestResult::Ok) {
@@ -560,8 +590,9 @@ void WindowFeeder::request_failed(TimePoint now) {
 void WindowFeeder::request_succeeded(const FeederRequest& request) {
     if (const auto* up = std::get_if<UploadMission>(&request.op)) {
         std::fill(confirmed_.begin(), confirmed_.end(), std::nullopt);
-        for (std::size_t i = 0; i < up->items.size() && i + 1 < confirmed_.size(); ++i)
+        for (std::size_t i = 0; i < up->items.size() && i + 1 < confirmed_.size(); ++i) {
             confirmed_[i + 1] = up->items[i];
+        }
         mission_ok_ = true;
         need_set_current_ = true;
         repoint_only_ = false;
@@ -569,8 +600,9 @@ void WindowFeeder::request_succeeded(const FeederRequest& request) {
     } else if (const auto* wr = std::get_if<WriteItems>(&request.op)) {
         for (std::size_t i = 0; i < wr->items.size(); ++i) {
             const std::size_t slot = wr->first_slot + i;
-            if (slot < confirmed_.size())
+            if (slot < confirmed_.size()) {
                 confirmed_[slot] = wr->items[i];
+            }
         }
     } else if (const auto* sc = std::get_if<SetCurrent>(&request.op)) {
         ap_target_ = sc->slot;
@@ -600,17 +632,21 @@ void WindowFeeder::handle_timeout(TimePoint now) {
 // ---- outputs -------------------------------------------------------------------------------------------
 
 std::optional<WindowFeeder::Mode> WindowFeeder::desired_mode() const {
-    if (failed_)
+    if (failed_) {
         return Mode::Hold;
-    if (interrupted_by_hand_)
+    }
+    if (interrupted_by_hand_) {
         return std::nullopt;  // whoever took the vehicle keeps it until resume()
+    }
     if (!stream_ && queue_.empty()) {
         return cleared_ ? std::optional<Mode>(Mode::Hold) : std::nullopt;
     }
-    if (paused_ || starving_ || fault_ || holding_)
+    if (paused_ || starving_ || fault_ || holding_) {
         return Mode::Hold;
-    if (done_ || queue_.empty())
+    }
+    if (done_ || queue_.empty()) {
         return std::nullopt;  // parked on the Stop item
+    }
     return Mode::Auto;
 }
 
@@ -634,15 +670,17 @@ std::optional<FeederRequest> WindowFeeder::next_write(std::size_t from, std::siz
         return !confirmed(queue_[i]) && (i == 0 || held_for_set_current || ap_target_ != queue_[i].slot);
     };
     for (std::size_t i = from; i < to; ++i) {
-        if (!writable(i))
+        if (!writable(i)) {
             continue;
+        }
         WriteItems w;
         w.first_slot = queue_[i].slot;
         w.items = slot_items(queue_[i].slot, queue_[i].item());
         for (std::size_t j = i + 1;
              j < queue_.size() && queue_[j].slot == queue_[j - 1].slot + 1 && writable(j); ++j) {
-            for (const auto& m : slot_items(queue_[j].slot, queue_[j].item()))
+            for (const auto& m : slot_items(queue_[j].slot, queue_[j].item())) {
                 w.items.push_back(m);
+            }
         }
         return issue(std::move(w), now);
     }
@@ -650,38 +688,44 @@ std::optional<FeederRequest> WindowFeeder::next_write(std::size_t from, std::siz
 }
 
 std::optional<FeederRequest> WindowFeeder::poll_request(TimePoint now) {
-    if (outstanding_)
+    if (outstanding_) {
         return std::nullopt;
+    }
     const auto want = desired_mode();
     // Holding is tried at once after a fault, then at the backoff pace like everything else.
     if (want == Mode::Hold && mode_ != Mode::Hold && (now >= retry_not_before_ || fault_hold_pending_)) {
         fault_hold_pending_ = false;
         return issue(HoldVehicle{}, now);
     }
-    if (queue_.empty() || now < retry_not_before_ || failed_)
+    if (queue_.empty() || now < retry_not_before_ || failed_) {
         return std::nullopt;
+    }
     if (!mission_ok_) {
         // Slots the window does not use (slot 1 among them) get a Stop at the last position: harmless if
         // ever reached.
         MissionItem filler = queue_.back().item();
         filler.kind = MissionItem::Kind::Stop;
         std::vector<MissionItem> at(wrap_slot() + 1u, filler);  // by ring position; [0] unused
-        for (const auto& e : queue_)
+        for (const auto& e : queue_) {
             at[e.slot] = e.item();
+        }
         UploadMission up;
         for (std::uint16_t s = 1; s <= wrap_slot(); ++s) {
-            for (const auto& m : slot_items(s, at[s]))
+            for (const auto& m : slot_items(s, at[s])) {
                 up.items.push_back(m);
+            }
         }
         return issue(std::move(up), now);
     }
-    if (auto w = next_write(0, 2, now))
+    if (auto w = next_write(0, 2, now)) {
         return w;
+    }
     if (need_set_current_ && confirmed(queue_[0]) && (queue_.size() < 2 || confirmed(queue_[1]))) {
         return issue(SetCurrent{queue_[0].slot}, now);
     }
-    if (auto w = next_write(2, queue_.size(), now))
+    if (auto w = next_write(2, queue_.size(), now)) {
         return w;
+    }
     if (ready_for_auto()) {
         starving_ = false;
         if (fault_ &&
@@ -702,10 +746,12 @@ std::optional<FeederRequest> WindowFeeder::poll_request(TimePoint now) {
 // still be on its way (the feeder also moves on by MISSION_CURRENT), and found naming a Stop it would hold
 // the vehicle there, short of the end.
 std::optional<FeederRequest> WindowFeeder::next_stop_filler(TimePoint now) {
-    if (!stream_ended_ || queue_.empty() || !queue_.back().stop || need_set_current_)
+    if (!stream_ended_ || queue_.empty() || !queue_.back().stop || need_set_current_) {
         return std::nullopt;
-    if (!std::all_of(queue_.begin(), queue_.end(), [&](const Entry& e) { return confirmed(e); }))
+    }
+    if (!std::all_of(queue_.begin(), queue_.end(), [&](const Entry& e) { return confirmed(e); })) {
         return std::nullopt;
+    }
     const MissionItem stop = queue_.back().item();
     const int ring = wrap_slot() - kFirstRingSlot + 1;
     const int settled =
@@ -718,15 +764,17 @@ std::optional<FeederRequest> WindowFeeder::next_stop_filler(TimePoint now) {
     // From the slot after the Stop round the ring: the slot the board reaches first is written first.
     std::uint16_t slot = ring_next(queue_.back().slot);
     for (std::uint16_t n = 0; n < wrap_slot(); ++n, slot = ring_next(slot)) {
-        if (!free_slot(slot) || holds(slot, stop))
+        if (!free_slot(slot) || holds(slot, stop)) {
             continue;
+        }
         WriteItems w;
         w.first_slot = slot;
         w.items = slot_items(slot, stop);
         for (std::uint16_t next = slot + 1; next <= wrap_slot() && free_slot(next) && !holds(next, stop);
              ++next) {
-            for (const auto& m : slot_items(next, stop))
+            for (const auto& m : slot_items(next, stop)) {
                 w.items.push_back(m);
+            }
         }
         return issue(std::move(w), now);
     }
@@ -735,18 +783,22 @@ std::optional<FeederRequest> WindowFeeder::next_stop_filler(TimePoint now) {
 
 TimePoint WindowFeeder::poll_timeout() const {
     TimePoint t = kNever;
-    if (outstanding_)
+    if (outstanding_) {
         t = std::min(t, outstanding_->deadline);
-    if (holding_ && hold_until_)
+    }
+    if (holding_ && hold_until_) {
         t = std::min(t, *hold_until_);
-    if (fault_ && retry_not_before_ != TimePoint::min())
+    }
+    if (fault_ && retry_not_before_ != TimePoint::min()) {
         t = std::min(t, retry_not_before_);
+    }
     return t;
 }
 
 std::optional<FeederEvent> WindowFeeder::poll_event() {
-    if (events_.empty())
+    if (events_.empty()) {
         return std::nullopt;
+    }
     FeederEvent e = std::move(events_.front());
     events_.pop_front();
     return e;
@@ -772,14 +824,18 @@ FeederProgress WindowFeeder::progress() const {
     p.interruption = last_interruption_;
     const Entry* first_of_plan = nullptr;
     for (const auto& e : queue_) {
-        if (e.stop)
+        if (e.stop) {
             break;
-        if (e.generation != generation_)
+        }
+        if (e.generation != generation_) {
             continue;
-        if (first_of_plan == nullptr)
+        }
+        if (first_of_plan == nullptr) {
             first_of_plan = &e;
-        if (confirmed(e))
+        }
+        if (confirmed(e)) {
             ++p.window;
+        }
     }
     if (!queue_.empty() && !queue_[0].stop) {
         p.next_waypoint = queue_[0].wp.index;

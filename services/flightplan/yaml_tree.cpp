@@ -10,26 +10,31 @@ const std::string& YRef::Scalar() const {
 }
 
 std::size_t YRef::size() const {
-    if (IsSequence())
+    if (IsSequence()) {
         return node_->items.size();
-    if (IsMap())
+    }
+    if (IsMap()) {
         return node_->items.size() / 2;
+    }
     return 0;
 }
 
 YRef YRef::operator[](std::size_t index) const {
-    if (!IsSequence() || index >= node_->items.size())
+    if (!IsSequence() || index >= node_->items.size()) {
         return {};
+    }
     return YRef(node_->items[index]);
 }
 
 YRef YRef::operator[](std::string_view wanted) const {
-    if (!IsMap())
+    if (!IsMap()) {
         return {};
+    }
     for (std::size_t i = 0; i + 1 < node_->items.size(); i += 2) {
         const YNode* k = node_->items[i];
-        if (k->type == YNode::Type::Scalar && k->scalar == wanted)
+        if (k->type == YNode::Type::Scalar && k->scalar == wanted) {
             return YRef(node_->items[i + 1]);
+        }
     }
     return {};
 }
@@ -47,8 +52,9 @@ YNode* YTreeBuilder::make(YNode::Type type, const YAML::Mark& mark, YAML::anchor
     n.type = type;
     n.mark = mark;
     if (anchor != YAML::NullAnchor) {
-        if (anchors_.by_id.size() < anchor)
+        if (anchors_.by_id.size() < anchor) {
             anchors_.by_id.resize(anchor, nullptr);
+        }
         anchors_.by_id[anchor - 1] = &n;
         arena_anchored_ = true;
     }
@@ -56,8 +62,9 @@ YNode* YTreeBuilder::make(YNode::Type type, const YAML::Mark& mark, YAML::anchor
 }
 
 const YNode* YTreeBuilder::attach(const YNode* node) {
-    if (open_.empty())
+    if (open_.empty()) {
         return node;
+    }
     open_.back()->items.push_back(node);
     return nullptr;
 }
@@ -76,8 +83,9 @@ const YNode* YTreeBuilder::alias(YAML::anchor_t anchor) {
     // yaml-cpp's parser refuses unknown anchors before this point.
     const YNode* target =
         anchor >= 1 && anchor <= anchors_.by_id.size() ? anchors_.by_id[anchor - 1] : nullptr;
-    if (target == nullptr)
+    if (target == nullptr) {
         target = make(YNode::Type::Null, YAML::Mark::null_mark(), YAML::NullAnchor);
+    }
     return attach(target);
 }
 
@@ -94,10 +102,12 @@ const YNode* YTreeBuilder::end() {
 }
 
 void YTreeBuilder::release() {
-    if (!open_.empty())
+    if (!open_.empty()) {
         return;
-    if (arena_anchored_)
+    }
+    if (arena_anchored_) {
         anchors_.kept.push_back(std::move(arena_));
+    }
     arena_.clear();
     arena_anchored_ = false;
 }

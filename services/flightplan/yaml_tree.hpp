@@ -28,6 +28,8 @@ class YRef {
     YRef() = default;
     explicit YRef(const YNode* node) : node_(node) {}
 
+    // Spelled as YAML::Node's members, whose behaviour these copy, so the parser reads as yaml-cpp code.
+    // NOLINTBEGIN(readability-identifier-naming)
     bool IsDefined() const { return node_ != nullptr; }
     bool IsNull() const { return is(YNode::Type::Null); }
     bool IsScalar() const { return is(YNode::Type::Scalar); }
@@ -35,6 +37,7 @@ class YRef {
     bool IsMap() const { return is(YNode::Type::Map); }
     const std::string& Scalar() const;
     YAML::Mark Mark() const { return node_ ? node_->mark : YAML::Mark::null_mark(); }
+    // NOLINTEND(readability-identifier-naming)
     /// Items of a sequence, pairs of a mapping, 0 otherwise.
     std::size_t size() const;
     YRef operator[](std::size_t index) const;

@@ -43,10 +43,10 @@ inline protocol::Event::Severity status_text_severity(int mav_severity, std::str
          has("initialising apm") || has("ground start") || has("warming up") || has("demo servos")) &&
         !has("fail") && !has("error") && !has("bad") && !has("prearm");
     if (mav_severity <= 3 && !routine_boot) {
-        return protocol::Event::Severity::error;
+        return protocol::Event::Severity::Error;
     }
-    return mav_severity == 4 && !routine_boot ? protocol::Event::Severity::warning
-                                              : protocol::Event::Severity::info;
+    return mav_severity == 4 && !routine_boot ? protocol::Event::Severity::Warning
+                                              : protocol::Event::Severity::Info;
 }
 
 }  // namespace airseg::groundlink

@@ -130,24 +130,24 @@ void GroundlinkService::subscribe_bus() {
             publish_status();
         }));
     subscriptions_.push_back(bus.subscribe<autopilot::ModeChanged>(
-        strand(), [this](const autopilot::ModeChanged& m) { send_event(Sev::info, mode_change_text(m)); }));
+        strand(), [this](const autopilot::ModeChanged& m) { send_event(Sev::Info, mode_change_text(m)); }));
     subscriptions_.push_back(
         bus.subscribe<autopilot::StatusText>(strand(), [this](const autopilot::StatusText& t) {
             send_event(status_text_severity(t.severity, t.text), "autopilot: " + t.text);
         }));
     subscriptions_.push_back(bus.subscribe<autopilot::LinkUp>(
-        strand(), [this](const autopilot::LinkUp&) { send_event(Sev::info, "autopilot link up"); }));
+        strand(), [this](const autopilot::LinkUp&) { send_event(Sev::Info, "autopilot link up"); }));
     subscriptions_.push_back(
         bus.subscribe<autopilot::LinkDown>(strand(), [this](const autopilot::LinkDown& d) {
-            send_event(Sev::error, "autopilot link down: " + d.reason);
+            send_event(Sev::Error, "autopilot link down: " + d.reason);
         }));
     subscriptions_.push_back(
         bus.subscribe<autopilot::AutopilotRebooted>(strand(), [this](const autopilot::AutopilotRebooted& r) {
-            send_event(Sev::warning, "autopilot rebooted: " + r.evidence);
+            send_event(Sev::Warning, "autopilot rebooted: " + r.evidence);
         }));
     subscriptions_.push_back(
         bus.subscribe<autopilot::WaypointReached>(strand(), [this](const autopilot::WaypointReached& w) {
-            send_event(Sev::info, fmt::format("mission slot {} reached", w.seq));
+            send_event(Sev::Info, fmt::format("mission slot {} reached", w.seq));
         }));
 }
 

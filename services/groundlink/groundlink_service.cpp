@@ -38,14 +38,14 @@ TransportConfig transport_config_for(const GroundlinkServiceConfig& config) {
     TransportConfig t = config.transport;
     if (config.mode == "udp") {
         t.paths = 1;
-        t.path_mode = PathMode::single;
+        t.path_mode = PathMode::Single;
         t.half_duplex = false;
     } else {
         t.link_rate_bytes_per_s = config.baud / 10.0;
         t.paths = config.ports.size();
-        t.path_mode = config.mode == "split"       ? PathMode::split
-                      : config.mode == "redundant" ? PathMode::redundant
-                                                   : PathMode::single;
+        t.path_mode = config.mode == "split"       ? PathMode::Split
+                      : config.mode == "redundant" ? PathMode::Redundant
+                                                   : PathMode::Single;
     }
     return t;
 }
@@ -228,7 +228,7 @@ void GroundlinkService::on_command(const protocol::Command& command) {
             }
             const auto bytes = protocol::encode(protocol::Result{id, result.to_json()});
             const auto r = driver_->send_safe(protocol::kPriorityControl, bytes);
-            if (r != SendResult::accepted) {
+            if (r != SendResult::Accepted) {
                 spdlog::warn("groundlink: could not queue the answer to request {}", id);
             }
         });
@@ -248,24 +248,24 @@ void GroundlinkService::on_joystick(const protocol::Joystick& joystick) {
 
 void GroundlinkService::on_event(const TransportEvent& event) {
     switch (event.kind) {
-        case TransportEvent::Kind::link_up:
+        case TransportEvent::Kind::LinkUp:
             spdlog::info("groundlink: link up ({} key)",
                          ground_role() == Role::Control ? "control" : "monitor");
             break;
-        case TransportEvent::Kind::link_down:
+        case TransportEvent::Kind::LinkDown:
             spdlog::warn("groundlink: link down");
             break;
-        case TransportEvent::Kind::peer_restarted:
+        case TransportEvent::Kind::PeerRestarted:
             spdlog::info("groundlink: the ground end restarted; session resynchronised");
             delivery_.reset();
             break;
-        case TransportEvent::Kind::session_established:
+        case TransportEvent::Kind::SessionEstablished:
             delivery_.reset();
             break;
-        case TransportEvent::Kind::path_up:
+        case TransportEvent::Kind::PathUp:
             spdlog::info("groundlink: path {} up", event.path);
             break;
-        case TransportEvent::Kind::path_down:
+        case TransportEvent::Kind::PathDown:
             spdlog::warn("groundlink: path {} silent", event.path);
             break;
         default:
@@ -284,7 +284,7 @@ void GroundlinkService::send_event(protocol::Event::Severity severity, std::stri
     }
     const auto r =
         driver_->send_safe(protocol::kPriorityStatus, protocol::encode(protocol::Event{severity, text}));
-    if (r == SendResult::accepted) {
+    if (r == SendResult::Accepted) {
         ++events_sent_;
     } else {
         ++events_dropped_;
@@ -342,12 +342,12 @@ void GroundlinkService::on_telemetry_timer() {
         if (!driver_ || !driver_->link_up()) {
             continue;  // nobody listens: a sample queued now would only be stale when the link comes back
         }
-        if (*kind == TelemetryKind::vehicle && vehicle_) {
+        if (*kind == TelemetryKind::Vehicle && vehicle_) {
             driver_->send_fast(protocol::kPriorityTelemetry, protocol::kTopicTelemetry,
                                protocol::encode(make_sample(*vehicle_, plan_)));
             ++samples_sent_;
             delivery_.on_pushed(now);
-        } else if (*kind == TelemetryKind::link_stats) {
+        } else if (*kind == TelemetryKind::LinkStats) {
             send_link_stats(now);
         }
     }

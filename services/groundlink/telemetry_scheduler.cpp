@@ -17,9 +17,9 @@ Duration period_of(double hz) {
 
 const char* to_string(TelemetryKind kind) {
     switch (kind) {
-        case TelemetryKind::vehicle:
+        case TelemetryKind::Vehicle:
             return "vehicle";
-        case TelemetryKind::link_stats:
+        case TelemetryKind::LinkStats:
             return "link_stats";
     }
     return "?";

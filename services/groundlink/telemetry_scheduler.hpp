@@ -22,10 +22,10 @@
 
 namespace airseg::groundlink {
 
-enum class TelemetryKind : std::uint8_t { vehicle, link_stats };
+enum class TelemetryKind : std::uint8_t { Vehicle, LinkStats };
 inline constexpr std::size_t kTelemetryKinds = 2;
-inline constexpr std::array<TelemetryKind, kTelemetryKinds> kAllTelemetryKinds{TelemetryKind::vehicle,
-                                                                               TelemetryKind::link_stats};
+inline constexpr std::array<TelemetryKind, kTelemetryKinds> kAllTelemetryKinds{TelemetryKind::Vehicle,
+                                                                               TelemetryKind::LinkStats};
 const char* to_string(TelemetryKind kind);  // "vehicle", "link_stats"
 std::optional<TelemetryKind> telemetry_kind_from_string(std::string_view name);
 

@@ -9,11 +9,11 @@
 namespace airseg::status {
 
 namespace fs = std::filesystem;
-using stream = asio::local::stream_protocol;
+using Protocol = asio::local::stream_protocol;
 
 class LocalCommandServer::Session : public std::enable_shared_from_this<Session> {
   public:
-    Session(LocalCommandServer& server, stream::socket socket)
+    Session(LocalCommandServer& server, Protocol::socket socket)
         : server_(server),
           server_alive_(server.alive_),
           socket_(std::move(socket)),
@@ -108,7 +108,7 @@ class LocalCommandServer::Session : public std::enable_shared_from_this<Session>
 
     LocalCommandServer& server_;
     std::shared_ptr<bool> server_alive_;  // handlers may outlive the server during shutdown
-    stream::socket socket_;
+    Protocol::socket socket_;
     asio::streambuf input_;
     std::deque<std::string> outbox_;
     bool close_after_ = false;
@@ -139,9 +139,9 @@ std::string LocalCommandServer::open(const std::string& path, unsigned mode) {
         return path + " exists and is not a socket";
     }
     boost::system::error_code ec;
-    acceptor_.open(stream(), ec);
+    acceptor_.open(Protocol(), ec);
     if (!ec) {
-        acceptor_.bind(stream::endpoint(path), ec);
+        acceptor_.bind(Protocol::endpoint(path), ec);
     }
     if (!ec) {
         acceptor_.listen(asio::socket_base::max_listen_connections, ec);
@@ -174,7 +174,7 @@ void LocalCommandServer::close() {
 
 void LocalCommandServer::do_accept() {
     acceptor_.async_accept(
-        asio::bind_executor(strand_, [this](boost::system::error_code ec, stream::socket socket) {
+        asio::bind_executor(strand_, [this](boost::system::error_code ec, Protocol::socket socket) {
             if (ec == asio::error::operation_aborted) {
                 return;
             }

@@ -210,31 +210,31 @@ std::vector<std::uint8_t> encode(const Message& message) {
         [&w](const auto& m) {
             using T = std::decay_t<decltype(m)>;
             if constexpr (std::is_same_v<T, Telemetry>) {
-                w.u8(static_cast<std::uint8_t>(MessageType::telemetry));
+                w.u8(static_cast<std::uint8_t>(MessageType::Telemetry));
                 encode_body(w, m);
             } else if constexpr (std::is_same_v<T, LinkStatsReport>) {
-                w.u8(static_cast<std::uint8_t>(MessageType::link_stats));
+                w.u8(static_cast<std::uint8_t>(MessageType::LinkStats));
                 w.le(m.rtt_ms, 2);
                 w.le(m.loss_permille, 2);
                 w.le(m.goodput_bps, 4);
                 w.le(m.retransmissions, 4);
                 w.le(m.mac_failures, 4);
             } else if constexpr (std::is_same_v<T, Event>) {
-                w.u8(static_cast<std::uint8_t>(MessageType::event));
+                w.u8(static_cast<std::uint8_t>(MessageType::Event));
                 w.u8(static_cast<std::uint8_t>(m.severity));
                 const auto n = std::min(m.text.size(), kMaxEventText);
                 w.bytes(std::span(reinterpret_cast<const std::uint8_t*>(m.text.data()), n));
             } else if constexpr (std::is_same_v<T, Command>) {
-                encode_payload(w, MessageType::command, MessageType::command_deflated, m.request_id,
+                encode_payload(w, MessageType::Command, MessageType::CommandDeflated, m.request_id,
                                m.request);
             } else if constexpr (std::is_same_v<T, Result>) {
-                encode_payload(w, MessageType::result, MessageType::result_deflated, m.request_id, m.answer);
+                encode_payload(w, MessageType::Result, MessageType::ResultDeflated, m.request_id, m.answer);
             } else if constexpr (std::is_same_v<T, Joystick>) {
-                w.u8(static_cast<std::uint8_t>(MessageType::joystick));
+                w.u8(static_cast<std::uint8_t>(MessageType::Joystick));
                 w.le(twos(clamp_round<std::int64_t>(m.steering * 10000, -10000, 10000), 2), 2);
                 w.le(twos(clamp_round<std::int64_t>(m.throttle * 10000, -10000, 10000), 2), 2);
             } else if constexpr (std::is_same_v<T, ReceptionReport>) {
-                w.u8(static_cast<std::uint8_t>(MessageType::reception));
+                w.u8(static_cast<std::uint8_t>(MessageType::Reception));
                 w.le(m.received, 4);
             } else {
                 w.u8(m.type);
@@ -266,14 +266,14 @@ DecodeResult decode(std::span<const std::uint8_t> bytes) {
         return !into.is_discarded();
     };
     switch (static_cast<MessageType>(type)) {
-        case MessageType::telemetry:
+        case MessageType::Telemetry:
             if (body < kTelemetryBody) {
                 out.error = "telemetry body too short";
                 return out;
             }
             out.message = decode_telemetry(r);  // longer bodies come from newer versions: extra bytes ignored
             return out;
-        case MessageType::link_stats: {
+        case MessageType::LinkStats: {
             if (body < kLinkStatsBody) {
                 out.error = "link statistics body too short";
                 return out;
@@ -287,30 +287,30 @@ DecodeResult decode(std::span<const std::uint8_t> bytes) {
             out.message = s;
             return out;
         }
-        case MessageType::event: {
+        case MessageType::Event: {
             if (body < 1 || body > 1 + kMaxEventText) {
                 out.error = "event body has a bad length";
                 return out;
             }
             Event e;
             const auto sev = r.le(1);
-            e.severity = sev <= 2 ? static_cast<Event::Severity>(sev) : Event::Severity::error;
+            e.severity = sev <= 2 ? static_cast<Event::Severity>(sev) : Event::Severity::Error;
             const auto text = r.rest();
             e.text.assign(text.begin(), text.end());
             out.message = e;
             return out;
         }
-        case MessageType::command:
-        case MessageType::result:
-        case MessageType::command_deflated:
-        case MessageType::result_deflated: {
+        case MessageType::Command:
+        case MessageType::Result:
+        case MessageType::CommandDeflated:
+        case MessageType::ResultDeflated: {
             if (body < 5) {
                 out.error = "command/result body too short";
                 return out;
             }
             const auto id = static_cast<std::uint32_t>(r.le(4));
-            const bool deflated = type == static_cast<std::uint8_t>(MessageType::command_deflated) ||
-                                  type == static_cast<std::uint8_t>(MessageType::result_deflated);
+            const bool deflated = type == static_cast<std::uint8_t>(MessageType::CommandDeflated) ||
+                                  type == static_cast<std::uint8_t>(MessageType::ResultDeflated);
             std::optional<std::vector<std::uint8_t>> inflated;
             if (deflated) {
                 inflated = inflate_payload(r.rest());
@@ -326,15 +326,15 @@ DecodeResult decode(std::span<const std::uint8_t> bytes) {
                 out.error = "command/result payload is not valid CBOR (or nested deeper than 32)";
                 return out;
             }
-            if (type == static_cast<std::uint8_t>(MessageType::command) ||
-                type == static_cast<std::uint8_t>(MessageType::command_deflated)) {
+            if (type == static_cast<std::uint8_t>(MessageType::Command) ||
+                type == static_cast<std::uint8_t>(MessageType::CommandDeflated)) {
                 out.message = Command{id, std::move(value)};
             } else {
                 out.message = Result{id, std::move(value)};
             }
             return out;
         }
-        case MessageType::joystick: {
+        case MessageType::Joystick: {
             if (body < kJoystickBody) {
                 out.error = "joystick body too short";
                 return out;
@@ -345,7 +345,7 @@ DecodeResult decode(std::span<const std::uint8_t> bytes) {
             out.message = j;
             return out;
         }
-        case MessageType::reception: {
+        case MessageType::Reception: {
             if (body < 4) {
                 out.error = "reception report body too short";
                 return out;

@@ -27,15 +27,15 @@ inline constexpr std::uint16_t kTopicJoystick = 3;
 inline constexpr std::uint16_t kTopicReception = 4;
 
 enum class MessageType : std::uint8_t {
-    telemetry = 0x01,
-    link_stats = 0x02,
-    event = 0x04,
-    command = 0x10,
-    result = 0x11,
-    joystick = 0x12,
-    reception = 0x13,
-    command_deflated = 0x14,  ///< a command whose CBOR is compressed (deflate_codec.hpp)
-    result_deflated = 0x15,   ///< a result whose CBOR is compressed
+    Telemetry = 0x01,
+    LinkStats = 0x02,
+    Event = 0x04,
+    Command = 0x10,
+    Result = 0x11,
+    Joystick = 0x12,
+    Reception = 0x13,
+    CommandDeflated = 0x14,  ///< a command whose CBOR is compressed (deflate_codec.hpp)
+    ResultDeflated = 0x15,   ///< a result whose CBOR is compressed
 };
 
 /// One vehicle telemetry sample. Units are chosen so the whole message fits 29 bytes.
@@ -70,8 +70,8 @@ struct LinkStatsReport {
 };
 
 struct Event {
-    enum class Severity : std::uint8_t { info = 0, warning = 1, error = 2 };
-    Severity severity = Severity::info;
+    enum class Severity : std::uint8_t { Info = 0, Warning = 1, Error = 2 };
+    Severity severity = Severity::Info;
     std::string text;  // at most kMaxEventText bytes
     bool operator==(const Event&) const = default;
 };

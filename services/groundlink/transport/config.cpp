@@ -18,8 +18,8 @@ std::vector<std::string> TransportConfig::validate() const {
     need(paths == 1 || paths == 2, "paths must be 1 or 2");
     need(!second_key || key, "second_key needs key");
     need(!second_key || !key || *second_key != *key, "second_key must differ from key");
-    need(path_mode == PathMode::single || paths == 2, "path_mode split/redundant needs paths: 2");
-    need(path_mode != PathMode::single || paths == 1, "path_mode single needs paths: 1");
+    need(path_mode == PathMode::Single || paths == 2, "path_mode split/redundant needs paths: 2");
+    need(path_mode != PathMode::Single || paths == 1, "path_mode single needs paths: 1");
     need(split_tx_path < paths, "split_tx_path must be a path index below paths");
     need(max_frame_payload >= 32 && max_frame_payload <= 4096, "max_frame_payload must be 32..4096");
     need(min_frame_payload >= 16 && min_frame_payload <= max_frame_payload,
@@ -63,17 +63,17 @@ std::vector<std::string> TransportConfig::validate() const {
 
 std::ostream& operator<<(std::ostream& os, SendResult r) {
     switch (r) {
-        case SendResult::accepted:
+        case SendResult::Accepted:
             return os << "accepted";
-        case SendResult::replaced:
+        case SendResult::Replaced:
             return os << "replaced";
-        case SendResult::dropped_oldest:
+        case SendResult::DroppedOldest:
             return os << "dropped_oldest";
-        case SendResult::queue_full:
+        case SendResult::QueueFull:
             return os << "queue_full";
-        case SendResult::too_large:
+        case SendResult::TooLarge:
             return os << "too_large";
-        case SendResult::bad_priority:
+        case SendResult::BadPriority:
             return os << "bad_priority";
     }
     return os << "SendResult(" << static_cast<int>(r) << ")";
@@ -82,19 +82,19 @@ std::ostream& operator<<(std::ostream& os, SendResult r) {
 std::ostream& operator<<(std::ostream& os, TransportEvent::Kind k) {
     using K = TransportEvent::Kind;
     switch (k) {
-        case K::session_established:
+        case K::SessionEstablished:
             return os << "session_established";
-        case K::peer_restarted:
+        case K::PeerRestarted:
             return os << "peer_restarted";
-        case K::link_up:
+        case K::LinkUp:
             return os << "link_up";
-        case K::link_down:
+        case K::LinkDown:
             return os << "link_down";
-        case K::path_up:
+        case K::PathUp:
             return os << "path_up";
-        case K::path_down:
+        case K::PathDown:
             return os << "path_down";
-        case K::safe_resent:
+        case K::SafeResent:
             return os << "safe_resent";
     }
     return os << "TransportEvent::Kind(" << static_cast<int>(k) << ")";

@@ -8,10 +8,10 @@ SendResult FastQueue::push(std::uint16_t topic, std::span<const std::uint8_t> ms
     for (auto& e : queue_) {
         if (e.topic == topic && !e.started) {
             e.bytes.assign(msg.begin(), msg.end());
-            return SendResult::replaced;
+            return SendResult::Replaced;
         }
     }
-    SendResult result = SendResult::accepted;
+    SendResult result = SendResult::Accepted;
     if (queue_.size() >= cap_) {
         // The oldest message not being sent goes; a message half sent finishes so its fragments are not
         // wasted.
@@ -20,7 +20,7 @@ SendResult FastQueue::push(std::uint16_t topic, std::span<const std::uint8_t> ms
             victim = queue_.begin();
         }
         queue_.erase(victim);
-        result = SendResult::dropped_oldest;
+        result = SendResult::DroppedOldest;
     }
     queue_.push_back(Entry{topic, std::vector<std::uint8_t>(msg.begin(), msg.end())});
     return result;

@@ -89,29 +89,29 @@ ShardId shard_id(std::span<const std::uint8_t> plain) {
 ShardAssembler::Result ShardAssembler::add(std::span<const std::uint8_t> plain, TimePoint now,
                                            std::vector<std::uint8_t>& frame) {
     if (!is_shard(plain) || plain.size() < kShardHeaderBytes + kShardCrcBytes + 1) {
-        return Result::bad;
+        return Result::Bad;
     }
     const auto body = plain.first(plain.size() - kShardCrcBytes);
     const auto crc = static_cast<std::uint16_t>(plain[body.size()] | (plain[body.size() + 1] << 8));
     if (crc16_ccitt(body) != crc) {
-        return Result::bad;
+        return Result::Bad;
     }
     const auto [id, index8] = shard_id(body);
     const std::size_t index = index8;
     const std::size_t n = static_cast<std::size_t>(body[2]) + 1;
     const auto bytes = body.subspan(kShardHeaderBytes);
     if (index >= kMaxShards || n > kMaxShards) {
-        return Result::bad;
+        return Result::Bad;
     }
     Group& g = slot_for(id, n, bytes.size(), now);
     g.last = now;
     if (g.done || std::find(g.indices.begin(), g.indices.end(), index) != g.indices.end()) {
-        return Result::redundant;
+        return Result::Redundant;
     }
     g.indices.push_back(index);
     g.shards.emplace_back(bytes.begin(), bytes.end());
     if (g.indices.size() < n) {
-        return Result::stored;
+        return Result::Stored;
     }
     std::vector<Shard> have;
     have.reserve(g.indices.size());
@@ -125,7 +125,7 @@ ShardAssembler::Result ShardAssembler::add(std::span<const std::uint8_t> plain, 
     g.indices.clear();
     g.shards.clear();
     if (!data) {
-        return Result::bad;
+        return Result::Bad;
     }
     ++decoded_;
     if (!all_data) {
@@ -137,11 +137,11 @@ ShardAssembler::Result ShardAssembler::add(std::span<const std::uint8_t> plain, 
     }
     const std::size_t pad = frame.empty() ? 0 : frame[0];
     if (frame.size() < 1 + pad) {
-        return Result::bad;
+        return Result::Bad;
     }
     frame.erase(frame.end() - static_cast<std::ptrdiff_t>(pad), frame.end());
     frame.erase(frame.begin());
-    return Result::complete;
+    return Result::Complete;
 }
 
 }  // namespace airseg::groundlink::fec

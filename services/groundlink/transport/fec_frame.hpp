@@ -50,10 +50,10 @@ void encode_frame(std::span<const std::uint8_t> sealed, std::uint8_t group, std:
 class ShardAssembler {
   public:
     enum class Result : std::uint8_t {
-        bad,        ///< CRC-16 failed or the header does not parse
-        stored,     ///< a good shard, the group is not complete yet
-        redundant,  ///< a good shard of a group already decoded (or a duplicate index)
-        complete,   ///< the group's frame is in `frame`
+        Bad,        ///< CRC-16 failed or the header does not parse
+        Stored,     ///< a good shard, the group is not complete yet
+        Redundant,  ///< a good shard of a group already decoded (or a duplicate index)
+        Complete,   ///< the group's frame is in `frame`
     };
     static constexpr std::size_t kGroups = 8;
     /// A group that heard nothing for this long is dropped when its slot is needed.

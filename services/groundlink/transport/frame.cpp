@@ -9,7 +9,11 @@
 namespace airseg::groundlink::frame {
 namespace {
 
-enum ChunkType : std::uint8_t { kSafe = 1, kFast = 2, kAck = 3, kReport = 4 };
+// A chunk's type: the top three bits of its type byte.
+constexpr std::uint8_t kSafe = 1;
+constexpr std::uint8_t kFast = 2;
+constexpr std::uint8_t kAck = 3;
+constexpr std::uint8_t kReport = 4;
 constexpr std::uint8_t kToEnd = 0x01;
 constexpr std::uint8_t kFlag1 = 0x02;  // Safe: end of message; Fast: fragmented
 
@@ -91,7 +95,7 @@ std::vector<std::uint8_t> encode_data(std::uint8_t header_flags, std::uint32_t f
     std::vector<std::uint8_t> out;
     out.reserve(size);
     out.push_back(
-        static_cast<std::uint8_t>((static_cast<std::uint8_t>(Kind::data) << 6) | (header_flags & 0x07U)));
+        static_cast<std::uint8_t>((static_cast<std::uint8_t>(Kind::Data) << 6) | (header_flags & 0x07U)));
     wire::put_u24(out, frame_number24 & kFrameNumberMask);
     for (std::size_t i = 0; i < chunks.size(); ++i) {
         const bool last = i + 1 == chunks.size() && (std::holds_alternative<SafeChunk>(chunks[i]) ||
@@ -104,7 +108,7 @@ std::vector<std::uint8_t> encode_data(std::uint8_t header_flags, std::uint32_t f
 std::vector<std::uint8_t> encode_hello(const Hello& h) {
     std::vector<std::uint8_t> out;
     out.push_back(
-        static_cast<std::uint8_t>((static_cast<std::uint8_t>(Kind::hello) << 6) | (h.heard_mask & 0x03U)));
+        static_cast<std::uint8_t>((static_cast<std::uint8_t>(Kind::Hello) << 6) | (h.heard_mask & 0x03U)));
     wire::put_u8(out, kProtocolVersion);
     wire::put_u64(out, h.sender_nonce);
     wire::put_u64(out, h.echo_nonce);
@@ -160,7 +164,7 @@ std::optional<Kind> kind_of(std::span<const std::uint8_t> frame) {
         return std::nullopt;
     }
     const auto k = static_cast<std::uint8_t>(frame[0] >> 6);
-    if (k > static_cast<std::uint8_t>(Kind::hello)) {
+    if (k > static_cast<std::uint8_t>(Kind::Hello)) {
         return std::nullopt;
     }
     return static_cast<Kind>(k);

@@ -13,7 +13,7 @@
 
 namespace airseg::groundlink::frame {
 
-enum class Kind : std::uint8_t { data = 0, hello = 1 };
+enum class Kind : std::uint8_t { Data = 0, Hello = 1 };
 
 inline constexpr std::uint8_t kProtocolVersion = 2;
 inline constexpr std::size_t kCrcBytes = 4;

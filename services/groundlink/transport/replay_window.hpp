@@ -10,7 +10,7 @@ namespace airseg::groundlink {
 
 class ReplayWindow {
   public:
-    enum class Check : std::uint8_t { fresh, duplicate, too_old };
+    enum class Check : std::uint8_t { Fresh, Duplicate, TooOld };
 
     [[nodiscard]] std::uint64_t reconstruct(std::uint32_t truncated) const {
         constexpr std::uint64_t kWin = std::uint64_t{1} << 24;
@@ -27,13 +27,13 @@ class ReplayWindow {
 
     [[nodiscard]] Check check(std::uint64_t n) const {
         if (!any_ || n > largest_) {
-            return Check::fresh;
+            return Check::Fresh;
         }
         const std::uint64_t age = largest_ - n;
         if (age >= 64) {
-            return Check::too_old;
+            return Check::TooOld;
         }
-        return ((seen_ >> age) & 1U) != 0 ? Check::duplicate : Check::fresh;
+        return ((seen_ >> age) & 1U) != 0 ? Check::Duplicate : Check::Fresh;
     }
 
     /// Records `n`, which check() reported fresh.

@@ -7,19 +7,19 @@ namespace airseg::groundlink {
 SafeReceiver::Accept SafeReceiver::on_segment(const frame::SafeChunk& seg) {
     const auto ahead = static_cast<std::uint16_t>(seg.seq - static_cast<std::uint16_t>(next_));
     if (ahead >= 0x8000U) {
-        return Accept::duplicate;  // behind next_: already delivered
+        return Accept::Duplicate;  // behind next_: already delivered
     }
     if (ahead >= window_) {
-        return Accept::out_of_window;
+        return Accept::OutOfWindow;
     }
     const std::uint64_t seq = next_ + ahead;
     if (seq != next_) {
         if (held_.contains(seq)) {
-            return Accept::duplicate;
+            return Accept::Duplicate;
         }
         held_.emplace(seq,
                       std::make_pair(std::vector<std::uint8_t>(seg.data.begin(), seg.data.end()), seg.end));
-        return Accept::fresh;
+        return Accept::Fresh;
     }
     consume(std::vector<std::uint8_t>(seg.data.begin(), seg.data.end()), seg.end);
     ++next_;
@@ -28,7 +28,7 @@ SafeReceiver::Accept SafeReceiver::on_segment(const frame::SafeChunk& seg) {
         consume(std::move(node.mapped().first), node.mapped().second);
         ++next_;
     }
-    return Accept::fresh;
+    return Accept::Fresh;
 }
 
 void SafeReceiver::consume(std::vector<std::uint8_t>&& data, bool end) {

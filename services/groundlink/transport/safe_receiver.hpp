@@ -19,9 +19,9 @@ class SafeReceiver {
     SafeReceiver(std::size_t window, std::size_t max_message) : window_(window), max_message_(max_message) {}
 
     enum class Accept : std::uint8_t {
-        fresh,          ///< new segment stored or delivered
-        duplicate,      ///< seen before (its acknowledgement was probably lost)
-        out_of_window,  ///< beyond the window: dropped, will be resent
+        Fresh,        ///< new segment stored or delivered
+        Duplicate,    ///< seen before (its acknowledgement was probably lost)
+        OutOfWindow,  ///< beyond the window: dropped, will be resent
     };
     Accept on_segment(const frame::SafeChunk& seg);
 

@@ -7,14 +7,14 @@ namespace airseg::groundlink {
 
 SendResult SafeSender::enqueue(std::span<const std::uint8_t> msg) {
     if (msg.size() > max_message_) {
-        return SendResult::too_large;
+        return SendResult::TooLarge;
     }
     if (bytes_held_ + msg.size() > queue_bytes_) {
-        return SendResult::queue_full;
+        return SendResult::QueueFull;
     }
     queue_.emplace_back(msg.begin(), msg.end());
     bytes_held_ += msg.size();
-    return SendResult::accepted;
+    return SendResult::Accepted;
 }
 
 std::size_t SafeSender::lost_size() const {

@@ -24,7 +24,7 @@ TransportConfig checked(TransportConfig c) {
 
 Transport::Impl::Impl(TransportConfig config, TimePoint now)
     : cfg(checked(std::move(config))),
-      now_(now),
+      current_time(now),
       reassembly(cfg.fast_reassembly_timeout, cfg.max_message_size),
       rtt(cfg.rto_initial, cfg.rto_min, cfg.rto_max, cfg.ack_delay,
           std::chrono::duration_cast<Duration>(std::chrono::duration<double>(
@@ -59,52 +59,52 @@ Transport::Impl::Impl(TransportConfig config, TimePoint now)
 
 SendResult Transport::Impl::send_safe(std::uint8_t priority, std::span<const std::uint8_t> msg,
                                       TimePoint now) {
-    now_ = std::max(now_, now);
+    current_time = std::max(current_time, now);
     if (priority >= cfg.priorities) {
-        return SendResult::bad_priority;
+        return SendResult::BadPriority;
     }
     const SendResult r = senders[priority].enqueue(msg);
-    if (r == SendResult::accepted) {
+    if (r == SendResult::Accepted) {
         ++stats.tx_safe.messages;
         stats.tx_safe.bytes += msg.size();
         if (priority + 1U < cfg.priorities) {
-            mark_urgent(now_);
+            mark_urgent(current_time);
         }
     }
-    refresh(now_);
+    refresh(current_time);
     return r;
 }
 
 SendResult Transport::Impl::send_fast(std::uint8_t priority, std::uint16_t topic,
                                       std::span<const std::uint8_t> msg, TimePoint now) {
-    now_ = std::max(now_, now);
+    current_time = std::max(current_time, now);
     if (priority >= cfg.priorities) {
-        return SendResult::bad_priority;
+        return SendResult::BadPriority;
     }
     if (msg.size() > cfg.max_message_size) {
-        return SendResult::too_large;
+        return SendResult::TooLarge;
     }
     const SendResult r = fast[priority].push(topic, msg);
     ++stats.tx_fast.messages;
     stats.tx_fast.bytes += msg.size();
-    if (r == SendResult::replaced) {
+    if (r == SendResult::Replaced) {
         ++stats.tx_fast.replaced;
-    } else if (r == SendResult::dropped_oldest) {
+    } else if (r == SendResult::DroppedOldest) {
         ++stats.tx_fast.drops;
     }
-    mark_urgent(now_);
-    refresh(now_);
+    mark_urgent(current_time);
+    refresh(current_time);
     return r;
 }
 
 void Transport::Impl::handle_timeout(TimePoint now) {
-    now_ = std::max(now_, now);
+    current_time = std::max(current_time, now);
     // The timers are exact as of the latest input: a Safe window or the reassembly is looked through only
     // when its own deadline has come (most wake-ups are for pacing).
     bool expired = false;
-    if (now_ >= timers[static_cast<std::size_t>(Timer::retransmit)]) {
+    if (current_time >= timers[static_cast<std::size_t>(Timer::Retransmit)]) {
         for (std::size_t l = 0; l < senders.size(); ++l) {
-            const std::size_t lost = senders[l].on_timeout(now_, rtt.rto(backoff[l]));
+            const std::size_t lost = senders[l].on_timeout(current_time, rtt.rto(backoff[l]));
             if (lost > 0) {
                 backoff[l] = std::min(backoff[l] + 1, kMaxBackoff);
                 lost_window += static_cast<double>(lost);
@@ -112,23 +112,23 @@ void Transport::Impl::handle_timeout(TimePoint now) {
             }
         }
     }
-    if (now_ >= timers[static_cast<std::size_t>(Timer::reassembly)]) {
-        stats.rx_fast.drops += reassembly.expire(now_);
+    if (current_time >= timers[static_cast<std::size_t>(Timer::Reassembly)]) {
+        stats.rx_fast.drops += reassembly.expire(current_time);
         expired = true;
     }
     for (std::size_t p = 0; p < paths.size(); ++p) {
         Path& ps = paths[p];
-        if (ps.alive && ps.last_heard + cfg.link_down_after <= now_) {
+        if (ps.alive && ps.last_heard + cfg.link_down_after <= current_time) {
             ps.alive = false;
             ps.streak = 0;
-            push_event(TransportEvent::Kind::path_down, p);
+            push_event(TransportEvent::Kind::PathDown, p);
         }
     }
     update_link_state();
     if (expired) {
-        refresh(now_);
+        refresh(current_time);
     } else {
-        refresh_transmit(now_);
+        refresh_transmit(current_time);
     }
 }
 
@@ -145,7 +145,7 @@ void Transport::Impl::update_link_state() {
     const bool up = confirmed && any_alive;
     if (up != link) {
         link = up;
-        push_event(up ? TransportEvent::Kind::link_up : TransportEvent::Kind::link_down);
+        push_event(up ? TransportEvent::Kind::LinkUp : TransportEvent::Kind::LinkDown);
     }
 }
 
@@ -155,13 +155,13 @@ void Transport::Impl::refresh(TimePoint now) {
     for (std::size_t l = 0; l < senders.size(); ++l) {
         rto = std::min(rto, senders[l].next_timeout(rtt.rto(backoff[l])));
     }
-    timers[static_cast<std::size_t>(Timer::retransmit)] = rto;
-    timers[static_cast<std::size_t>(Timer::reassembly)] = reassembly.next_deadline();
+    timers[static_cast<std::size_t>(Timer::Retransmit)] = rto;
+    timers[static_cast<std::size_t>(Timer::Reassembly)] = reassembly.next_deadline();
     earliest = *std::min_element(timers.begin(), timers.end());
 }
 
 void Transport::Impl::refresh_transmit(TimePoint now) {
-    now_ = std::max(now_, now);
+    current_time = std::max(current_time, now);
     TimePoint tx = kNever;
     for (std::size_t p = 0; p < paths.size(); ++p) {
         const TimePoint due = content_due(p);
@@ -169,19 +169,19 @@ void Transport::Impl::refresh_transmit(TimePoint now) {
             tx = std::min(tx, std::max(due, paths[p].next_free));
         }
     }
-    timers[static_cast<std::size_t>(Timer::transmit)] = tx;
+    timers[static_cast<std::size_t>(Timer::Transmit)] = tx;
     TimePoint live = kNever;
     for (const Path& ps : paths) {
         if (ps.alive) {
             live = std::min(live, ps.last_heard + cfg.link_down_after);
         }
     }
-    if (peer_mask_known && peer_mask_time + cfg.link_down_after > now_) {
+    if (peer_mask_known && peer_mask_time + cfg.link_down_after > current_time) {
         live = std::min(live, peer_mask_time + cfg.link_down_after);  // path selection changes then
     }
-    timers[static_cast<std::size_t>(Timer::liveness)] = live;
+    timers[static_cast<std::size_t>(Timer::Liveness)] = live;
     earliest = *std::min_element(timers.begin(), timers.end());
-    refreshed_at = now_;
+    refreshed_at = current_time;
 }
 
 void Transport::Impl::snapshot_stats() {
@@ -230,7 +230,7 @@ std::optional<Delivered> Transport::poll_message() {
     }
     Delivered d = std::move(impl_->deliveries.front());
     impl_->deliveries.pop_front();
-    (d.cls == MessageClass::safe ? impl_->stats.rx_safe : impl_->stats.rx_fast).queue_depth -= 1;
+    (d.cls == MessageClass::Safe ? impl_->stats.rx_safe : impl_->stats.rx_fast).queue_depth -= 1;
     return d;
 }
 std::optional<TransportEvent> Transport::poll_event() {

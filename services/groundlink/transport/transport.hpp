@@ -24,15 +24,15 @@ inline constexpr std::size_t kMaxSafeWindow = 128;
 
 /// How the core spreads traffic over its paths (serial radio pairs).
 enum class PathMode : std::uint8_t {
-    single,     ///< one path carries both directions
-    split,      ///< each end transmits on its own path (split_tx_path); falls back to the other when it goes
+    Single,     ///< one path carries both directions
+    Split,      ///< each end transmits on its own path (split_tx_path); falls back to the other when it goes
                 ///< silent
-    redundant,  ///< every frame goes on every live path; the receiver drops the duplicates
+    Redundant,  ///< every frame goes on every live path; the receiver drops the duplicates
 };
 
 enum class MessageClass : std::uint8_t {
-    safe,  ///< exactly once, in order per priority channel, retransmitted until acknowledged
-    fast,  ///< best effort, freshest value wins per topic, never retransmitted
+    Safe,  ///< exactly once, in order per priority channel, retransmitted until acknowledged
+    Fast,  ///< best effort, freshest value wins per topic, never retransmitted
 };
 
 /// Every field has its YAML key (under `groundlink.transport`) next to it. Durations are std::chrono
@@ -43,7 +43,7 @@ struct TransportConfig {
     /// paths: 1 or 2 serial radio pairs.
     std::size_t paths = 1;
     /// path_mode: single | split | redundant.
-    PathMode path_mode = PathMode::single;
+    PathMode path_mode = PathMode::Single;
     /// split_tx_path: this end's transmit path in split mode (the peer configures the other one).
     std::size_t split_tx_path = 0;
     /// split_borrow: in split mode, also send on the peer's transmit path while the peer leaves it mostly
@@ -131,17 +131,17 @@ struct TransportConfig {
 };
 
 enum class SendResult : std::uint8_t {
-    accepted,
-    replaced,        ///< Fast: an unsent message of the same topic was replaced by this one
-    dropped_oldest,  ///< Fast: accepted; the queue was full and its oldest message was dropped
-    queue_full,      ///< Safe: refused, the channel's queue is full; retry after messages are acknowledged
-    too_large,       ///< refused: larger than max_message_size
-    bad_priority,    ///< refused: priority >= TransportConfig::priorities
+    Accepted,
+    Replaced,       ///< Fast: an unsent message of the same topic was replaced by this one
+    DroppedOldest,  ///< Fast: accepted; the queue was full and its oldest message was dropped
+    QueueFull,      ///< Safe: refused, the channel's queue is full; retry after messages are acknowledged
+    TooLarge,       ///< refused: larger than max_message_size
+    BadPriority,    ///< refused: priority >= TransportConfig::priorities
 };
 std::ostream& operator<<(std::ostream& os, SendResult r);
 
 struct Delivered {
-    MessageClass cls = MessageClass::safe;
+    MessageClass cls = MessageClass::Safe;
     std::uint8_t priority = 0;  ///< for Safe: the channel
     std::uint16_t topic = 0;    ///< Fast only (0 for Safe)
     std::vector<std::uint8_t> bytes;
@@ -149,17 +149,17 @@ struct Delivered {
 
 struct TransportEvent {
     enum class Kind : std::uint8_t {
-        session_established,  ///< a session with the peer is up (first time, or after either end restarted)
-        peer_restarted,       ///< the peer came back with a new boot nonce; stream state was reset
-        link_up,
-        link_down,
-        path_up,    ///< `path` hears valid frames again
-        path_down,  ///< `path` went silent
+        SessionEstablished,  ///< a session with the peer is up (first time, or after either end restarted)
+        PeerRestarted,       ///< the peer came back with a new boot nonce; stream state was reset
+        LinkUp,
+        LinkDown,
+        PathUp,    ///< `path` hears valid frames again
+        PathDown,  ///< `path` went silent
         /// the peer restarted while `count` Safe messages were in flight: they are sent again from the start
         /// in the new session (the old incarnation may have received some of them)
-        safe_resent,
+        SafeResent,
     };
-    Kind kind = Kind::link_up;
+    Kind kind = Kind::LinkUp;
     std::size_t path = 0;
     std::uint64_t count = 0;
 };

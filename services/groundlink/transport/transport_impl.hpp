@@ -32,7 +32,7 @@ inline double decayed_rate(double rate, TimePoint then, TimePoint now) {
 }
 
 /// The core's deadlines; poll_timeout() is the earliest of them.
-enum class Timer : std::uint8_t { transmit, retransmit, reassembly, liveness, count };
+enum class Timer : std::uint8_t { Transmit, Retransmit, Reassembly, Liveness, Count };
 
 class Transport::Impl {
   public:
@@ -99,7 +99,7 @@ class Transport::Impl {
     }
     /// Half-duplex air gate of a path: open; only urgent (non-bulk) traffic, for an end using less than half
     /// the air; closed until the shared budget is paid.
-    enum class AirGate : std::uint8_t { open, urgent_only, closed };
+    enum class AirGate : std::uint8_t { Open, UrgentOnly, Closed };
     [[nodiscard]] AirGate air_gate(std::size_t path) const;
     [[nodiscard]] TimePoint ack_due() const;
     [[nodiscard]] TimePoint content_due(std::size_t path) const;
@@ -135,7 +135,7 @@ class Transport::Impl {
     std::size_t hello_reply_key = 0;
     std::uint64_t unestablished_hellos = 0;  // alternates the key of hellos sent before any session
     LinkStats stats;
-    TimePoint now_;
+    TimePoint current_time;
 
     // Session (handshake in docs/ground-link.md, "Sessions").
     std::uint64_t nonce_counter = 0;
@@ -232,7 +232,7 @@ class Transport::Impl {
 
     std::deque<Delivered> deliveries;
     std::deque<TransportEvent> events;
-    std::array<TimePoint, static_cast<std::size_t>(Timer::count)> timers{};
+    std::array<TimePoint, static_cast<std::size_t>(Timer::Count)> timers{};
     // When refresh() last ran: the timers describe the state as of then, until any input changes it.
     TimePoint refreshed_at{};
     TimePoint earliest = kNever;  // the earliest of the timers: poll_timeout()

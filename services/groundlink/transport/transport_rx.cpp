@@ -12,16 +12,17 @@ constexpr std::int64_t kVanishedPerGap = 4;  // frames counted vanished for one 
 }  // namespace
 
 void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_t> bytes, TimePoint now) {
-    now_ = std::max(now_, now);
+    current_time = std::max(current_time, now);
     if (path >= paths.size() || bytes.empty()) {
         return;
     }
     Path& ps = paths[path];
     stats.bytes_received += bytes.size();
     stats.path[path].bytes_received += bytes.size();
-    if (cfg.path_mode == PathMode::split && cfg.split_borrow) {  // only borrowing reads it (an exp() a read)
-        ps.rx_rate = decayed_rate(ps.rx_rate, ps.rx_rate_time, now_) + static_cast<double>(bytes.size());
-        ps.rx_rate_time = now_;
+    if (cfg.path_mode == PathMode::Split && cfg.split_borrow) {  // only borrowing reads it (an exp() a read)
+        ps.rx_rate =
+            decayed_rate(ps.rx_rate, ps.rx_rate_time, current_time) + static_cast<double>(bytes.size());
+        ps.rx_rate_time = current_time;
     }
     if (cfg.half_duplex) {
         // The peer's bytes took air time of the shared pair: they count against the air budget of both ends,
@@ -30,12 +31,13 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
         // that budget (air_ok), so a saturating end cannot starve the other.
         const auto air = std::chrono::duration_cast<Duration>(
             std::chrono::duration<double>(static_cast<double>(bytes.size()) / cfg.link_rate_bytes_per_s));
-        ps.air_debt = std::max(ps.air_debt, now_ - air) + (peer_urgent ? air + air / 2 : air + air / 4);
+        ps.air_debt =
+            std::max(ps.air_debt, current_time - air) + (peer_urgent ? air + air / 2 : air + air / 4);
     }
     // Each frame heard also cost the radios a change of sender and back.
     const auto turnaround = [&] {
         if (cfg.half_duplex) {
-            ps.air_debt = std::max(ps.air_debt, now_) + 2 * cfg.air_turnaround;
+            ps.air_debt = std::max(ps.air_debt, current_time) + 2 * cfg.air_turnaround;
         }
     };
     bool framed = false;  // a frame (or a damaged one) ended in these bytes
@@ -46,11 +48,11 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
             const std::size_t wire = ps.deframer.last_encoded_bytes();
             if (fec::is_shard(plain)) {
                 // Shards come in bursts of one frame: one change of sender per group, not per shard.
-                on_shard(path, plain, wire, now_);
+                on_shard(path, plain, wire, current_time);
                 return;
             }
             turnaround();
-            on_plain_frame(path, plain, wire, now_);
+            on_plain_frame(path, plain, wire, current_time);
         },
         [&] {
             framed = true;
@@ -62,11 +64,11 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
         });
     if (!framed) {
         // Most serial reads are part of a frame: they move only the clock and the air budget.
-        refresh_transmit(now_);
+        refresh_transmit(current_time);
         return;
     }
     update_link_state();
-    refresh(now_);
+    refresh(current_time);
     update_plan();  // the error rate is measured only on frames heard
 }
 
@@ -74,7 +76,7 @@ void Transport::Impl::on_shard(std::size_t path, std::span<const std::uint8_t> p
                                TimePoint now) {
     Path& ps = paths[path];
     const auto result = shards.add(plain, now, rebuilt);
-    if (result == fec::ShardAssembler::Result::bad) {
+    if (result == fec::ShardAssembler::Result::Bad) {
         ++stats.fec_shard_errors;
         ++ps.bad_since_shard;
         meter.on_frame(wire_bytes, false);
@@ -96,11 +98,11 @@ void Transport::Impl::on_shard(std::size_t path, std::span<const std::uint8_t> p
     ps.bad_since_shard = 0;
     meter.on_frame(wire_bytes, true);
     shards_heard_since_report = true;
-    if (result == fec::ShardAssembler::Result::complete) {
+    if (result == fec::ShardAssembler::Result::Complete) {
         stats.fec_frames_decoded = shards.groups_decoded();
         stats.fec_frames_repaired = shards.groups_repaired();
         if (cfg.half_duplex) {
-            paths[path].air_debt = std::max(paths[path].air_debt, now_) + 2 * cfg.air_turnaround;
+            paths[path].air_debt = std::max(paths[path].air_debt, current_time) + 2 * cfg.air_turnaround;
         }
         const std::vector<std::uint8_t> frame = std::move(rebuilt);
         on_plain_frame(path, frame, 0, now);
@@ -119,13 +121,13 @@ void Transport::Impl::on_plain_frame(std::size_t path, std::span<const std::uint
         return;
     }
     MacContext ctx{};
-    if (*kind == frame::Kind::data) {
+    if (*kind == frame::Kind::Data) {
         ctx = MacContext{peer_nonce, my_nonce, 0};
     }
     const auto body = frame::check_crc(plain, keyed, ctx);
     if (!body || body->size() < tag_bytes + 1) {
         ++stats.crc_errors;
-        if (keyed || established || *kind == frame::Kind::hello) {
+        if (keyed || established || *kind == frame::Kind::Hello) {
             ++damaged_since_numbered;
             meter.on_frame(wire_bytes, false);
         }
@@ -134,7 +136,7 @@ void Transport::Impl::on_plain_frame(std::size_t path, std::span<const std::uint
     meter.on_frame(wire_bytes, true);
     const auto frame_bytes = body->first(body->size() - tag_bytes);
     const auto tag = body->subspan(body->size() - tag_bytes);
-    if (*kind == frame::Kind::hello) {
+    if (*kind == frame::Kind::Hello) {
         std::size_t key = 0;
         if (keyed) {
             while (key < keys.size() && !(keys[key] && keys[key]->verify(ctx, frame_bytes, tag))) {
@@ -168,7 +170,7 @@ void Transport::Impl::on_plain_frame(std::size_t path, std::span<const std::uint
         ++stats.mac_failures;
         return;
     }
-    if (rx_window.check(number) != ReplayWindow::Check::fresh) {
+    if (rx_window.check(number) != ReplayWindow::Check::Fresh) {
         ++stats.replays;
         return;
     }
@@ -198,7 +200,7 @@ void Transport::Impl::on_authentic(std::size_t path, std::uint8_t peer_heard_mas
         }
         if (++ps.streak >= cfg.link_up_frames) {
             ps.alive = true;
-            push_event(TransportEvent::Kind::path_up, path);
+            push_event(TransportEvent::Kind::PathUp, path);
         }
     }
     ps.last_heard = now;
@@ -250,24 +252,24 @@ void Transport::Impl::on_safe(const frame::SafeChunk& c, TimePoint now) {
     }
     ack.needed = true;
     switch (result) {
-        case SafeReceiver::Accept::fresh:
+        case SafeReceiver::Accept::Fresh:
             ++ack.unacked;
             if (rx.has_gap() || ack.unacked >= cfg.ack_every) {
                 ack.immediate = true;
             }
             break;
-        case SafeReceiver::Accept::duplicate:
+        case SafeReceiver::Accept::Duplicate:
             ++stats.rx_safe.drops;
             ack.immediate = true;
             break;
-        case SafeReceiver::Accept::out_of_window:
+        case SafeReceiver::Accept::OutOfWindow:
             ack.immediate = true;
             break;
     }
     while (auto m = rx.pop_message()) {
         ++stats.rx_safe.messages;
         stats.rx_safe.bytes += m->size();
-        deliveries.push_back(Delivered{MessageClass::safe, c.channel, 0, std::move(*m)});
+        deliveries.push_back(Delivered{MessageClass::Safe, c.channel, 0, std::move(*m)});
         ++stats.rx_safe.queue_depth;
     }
 }
@@ -297,7 +299,7 @@ void Transport::Impl::on_fast(const frame::FastChunk& c, TimePoint now) {
     }
     ++stats.rx_fast.messages;
     stats.rx_fast.bytes += whole->size();
-    deliveries.push_back(Delivered{MessageClass::fast, c.priority, c.topic, std::move(*whole)});
+    deliveries.push_back(Delivered{MessageClass::Fast, c.priority, c.topic, std::move(*whole)});
     ++stats.rx_fast.queue_depth;
 }
 
@@ -400,13 +402,13 @@ void Transport::Impl::accept_session(std::uint64_t peer, std::size_t key, TimePo
     }
     if (had_session) {
         ++stats.peer_restarts;
-        push_event(TransportEvent::Kind::peer_restarted);
+        push_event(TransportEvent::Kind::PeerRestarted);
         if (resent > 0) {
             stats.safe_resent += resent;
-            push_event(TransportEvent::Kind::safe_resent, 0, resent);
+            push_event(TransportEvent::Kind::SafeResent, 0, resent);
         }
     }
-    push_event(TransportEvent::Kind::session_established);
+    push_event(TransportEvent::Kind::SessionEstablished);
 }
 
 }  // namespace airseg::groundlink

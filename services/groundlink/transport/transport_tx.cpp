@@ -25,7 +25,7 @@ constexpr unsigned kUnansweredHellosBeforeEchoingNothing = 3;
 }  // namespace
 
 bool Transport::Impl::peer_mask_fresh() const {
-    return peer_mask_known && now_ - peer_mask_time < cfg.link_down_after;
+    return peer_mask_known && current_time - peer_mask_time < cfg.link_down_after;
 }
 
 std::uint8_t Transport::Impl::heard_mask() const {
@@ -39,18 +39,18 @@ std::uint8_t Transport::Impl::heard_mask() const {
 }
 
 std::uint8_t Transport::Impl::header_flags() const {
-    return static_cast<std::uint8_t>(heard_mask() | (now_ < urgent_until ? frame::kUrgentFlag : 0));
+    return static_cast<std::uint8_t>(heard_mask() | (current_time < urgent_until ? frame::kUrgentFlag : 0));
 }
 
 bool Transport::Impl::borrowed(std::size_t path) const {
-    return cfg.path_mode == PathMode::split && path != cfg.split_tx_path && carries_data(cfg.split_tx_path);
+    return cfg.path_mode == PathMode::Split && path != cfg.split_tx_path && carries_data(cfg.split_tx_path);
 }
 
 bool Transport::Impl::may_borrow(std::size_t path) const {
     const Path& ps = paths[path];
     // Not under heavy loss: the peer's acknowledgements on that pair matter more then.
     return cfg.split_borrow && ps.alive && !(peer_mask_fresh() && peer_urgent) && !lossy() &&
-           decayed_rate(ps.rx_rate, ps.rx_rate_time, now_) < 0.25 * cfg.link_rate_bytes_per_s;
+           decayed_rate(ps.rx_rate, ps.rx_rate_time, current_time) < 0.25 * cfg.link_rate_bytes_per_s;
 }
 
 Duration Transport::Impl::reorder_slack() const {
@@ -65,9 +65,9 @@ Duration Transport::Impl::reorder_slack() const {
 bool Transport::Impl::carries_data(std::size_t path) const {
     const auto bit = static_cast<std::uint8_t>(1U << path);
     switch (cfg.path_mode) {
-        case PathMode::single:
+        case PathMode::Single:
             return path == 0;
-        case PathMode::split: {
+        case PathMode::Split: {
             const std::size_t primary = cfg.split_tx_path;
             const bool fallback = peer_mask_fresh() && ((peer_mask >> primary) & 1U) == 0;
             if (fallback) {
@@ -75,7 +75,7 @@ bool Transport::Impl::carries_data(std::size_t path) const {
             }
             return path == primary || may_borrow(path);
         }
-        case PathMode::redundant:
+        case PathMode::Redundant:
             // A path the peer reports silent stops carrying data while another one works.
             return !peer_mask_fresh() || (peer_mask & bit) != 0 || (peer_mask & 0x03U & ~bit) == 0;
     }
@@ -84,11 +84,11 @@ bool Transport::Impl::carries_data(std::size_t path) const {
 
 bool Transport::Impl::keeps_alive(std::size_t path) const {
     switch (cfg.path_mode) {
-        case PathMode::single:
+        case PathMode::Single:
             return path == 0;
-        case PathMode::split:
+        case PathMode::Split:
             return path == cfg.split_tx_path || carries_data(path);
-        case PathMode::redundant:
+        case PathMode::Redundant:
             return true;
     }
     return false;
@@ -120,7 +120,7 @@ std::size_t Transport::Impl::payload_cap() const {
     // Under urgent traffic they bound how long a frame already on its way holds the urgent message back; the
     // peer's urgent traffic waits for this end's frames on shared air, so it counts as well.
     const bool peer_waiting = cfg.half_duplex && peer_urgent && peer_mask_fresh();
-    if (now_ < urgent_until || peer_waiting) {
+    if (current_time < urgent_until || peer_waiting) {
         cap = std::min(cap, cfg.latency_frame_payload);
     }
     return std::max(cap, cfg.min_frame_payload);
@@ -128,26 +128,26 @@ std::size_t Transport::Impl::payload_cap() const {
 
 Transport::Impl::AirGate Transport::Impl::air_gate(std::size_t path) const {
     const Path& ps = paths[path];
-    if (!cfg.half_duplex || now_ >= ps.air_debt) {
-        return AirGate::open;
+    if (!cfg.half_duplex || current_time >= ps.air_debt) {
+        return AirGate::Open;
     }
     // An end using less than its fair share of the air (a little under half) is not held back, so a
     // saturating peer cannot starve it and two saturating ends share the air; while the peer has urgent
     // traffic only its urgent traffic goes. A heavier end waits for the air budget both ends share.
     // The average decays between frames; half a frame restores its mean over the sawtooth.
     const double rate =
-        decayed_rate(ps.tx_rate, ps.tx_rate_time, now_) + 0.5 * static_cast<double>(ps.last_frame);
+        decayed_rate(ps.tx_rate, ps.tx_rate_time, current_time) + 0.5 * static_cast<double>(ps.last_frame);
     if (rate >= kFairShare * cfg.link_rate_bytes_per_s) {
-        return AirGate::closed;
+        return AirGate::Closed;
     }
-    return peer_urgent && peer_mask_fresh() ? AirGate::urgent_only : AirGate::open;
+    return peer_urgent && peer_mask_fresh() ? AirGate::UrgentOnly : AirGate::Open;
 }
 
 TimePoint Transport::Impl::ack_due() const {
     TimePoint t = kNever;
     for (const AckState& a : acks) {
         if (a.needed) {
-            t = std::min(t, a.immediate ? now_ : a.first + cfg.ack_delay);
+            t = std::min(t, a.immediate ? current_time : a.first + cfg.ack_delay);
         }
     }
     return t;
@@ -167,14 +167,14 @@ TimePoint Transport::Impl::content_due(std::size_t path) const {
         if (borrowed(path)) {
             // A borrowed path carries bulk only: urgent traffic keeps to this end's own pair.
             if (level_ready(senders.size() - 1, true)) {
-                t = std::min(t, air_gate(path) == AirGate::open ? now_ : ps.air_debt);
+                t = std::min(t, air_gate(path) == AirGate::Open ? current_time : ps.air_debt);
             }
         } else if (!ps.mirror.empty()) {
-            return std::min(t, now_);
+            return std::min(t, current_time);
         } else if (data_ready(true)) {
             const AirGate gate = air_gate(path);
-            if (gate == AirGate::open || (gate == AirGate::urgent_only && data_ready(false))) {
-                return std::min(t, now_);
+            if (gate == AirGate::Open || (gate == AirGate::UrgentOnly && data_ready(false))) {
+                return std::min(t, current_time);
             }
             t = std::min(t, ps.air_debt);
         }
@@ -187,25 +187,25 @@ TimePoint Transport::Impl::content_due(std::size_t path) const {
 }
 
 std::optional<std::vector<std::uint8_t>> Transport::Impl::poll_transmit(std::size_t path, TimePoint now) {
-    now_ = std::max(now_, now);
-    if (path >= paths.size() || now_ < paths[path].next_free) {
+    current_time = std::max(current_time, now);
+    if (path >= paths.size() || current_time < paths[path].next_free) {
         return std::nullopt;
     }
     // The transmit deadline refresh() computed at this very time still holds (every input refreshes): no
     // path has anything to send before it, so no frame needs building. The driver polls after every serial
     // read, most of which complete no frame.
-    if (refreshed_at == now_ && now_ < timers[static_cast<std::size_t>(Timer::transmit)]) {
+    if (refreshed_at == current_time && current_time < timers[static_cast<std::size_t>(Timer::Transmit)]) {
         return std::nullopt;
     }
-    auto out = build_hello(path, now_);
+    auto out = build_hello(path, current_time);
     if (!out && confirmed) {
-        out = build_data(path, now_);
+        out = build_data(path, current_time);
     }
     if (out) {
-        account_sent(path, out->size(), now_);
+        account_sent(path, out->size(), current_time);
     }
     update_link_state();
-    refresh(now_);
+    refresh(current_time);
     return out;
 }
 
@@ -405,9 +405,9 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
     }
     std::size_t data_chunks = 0;
     const AirGate gate = air_gate(path);  // closed: only acknowledgements and keepalives go out
-    bulk_blocked = gate == AirGate::urgent_only;
+    bulk_blocked = gate == AirGate::UrgentOnly;
     bulk_only = borrowed(path);
-    while (gate != AirGate::closed && data_chunks < kMaxDataChunks &&
+    while (gate != AirGate::Closed && data_chunks < kMaxDataChunks &&
            add_data_chunk(chunks, storage, room, data_chunks == 0, now)) {
         ++data_chunks;
         if (room <= frame::safe_chunk_overhead()) {
@@ -454,7 +454,7 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
     const MacContext ctx{my_nonce, peer_nonce, next_frame_number++};
     auto sealed = to_wire(std::move(plain), mac, ctx);
     for (std::size_t q = 0; q < paths.size(); ++q) {
-        if (q != path && cfg.path_mode == PathMode::redundant && carries_data(q)) {
+        if (q != path && cfg.path_mode == PathMode::Redundant && carries_data(q)) {
             if (paths[q].mirror.size() >= kMirrorCap) {
                 paths[q].mirror.pop_front();
             }

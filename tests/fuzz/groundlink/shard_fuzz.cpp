@@ -24,7 +24,7 @@ void raw_shards(std::span<const std::uint8_t> data) {
     deframer.feed(
         data,
         [&](std::vector<std::uint8_t>&& plain) {
-            if (assembler.add(plain, airseg::TimePoint{}, out) == fec::ShardAssembler::Result::complete) {
+            if (assembler.add(plain, airseg::TimePoint{}, out) == fec::ShardAssembler::Result::Complete) {
                 require(out.size() <= fec::kMaxShards * 1024);
             }
         },
@@ -72,7 +72,7 @@ void damaged_group(std::span<const std::uint8_t> data) {
     deframer.feed(
         damaged,
         [&](std::vector<std::uint8_t>&& plain) {
-            if (assembler.add(plain, airseg::TimePoint{}, out) == fec::ShardAssembler::Result::complete) {
+            if (assembler.add(plain, airseg::TimePoint{}, out) == fec::ShardAssembler::Result::Complete) {
                 ++complete;
                 // A CRC-16 can be fooled by a damaged shard; the transport's CRC-32 of the frame catches
                 // that. With an undamaged wire the frame must come back exactly.

@@ -66,7 +66,7 @@ void check_received(const test::Endpoint& rx, const std::vector<Incarnation>& se
         const auto it = senders[inc].sent.find(id);
         require(it != senders[inc].sent.end());
         require(it->second == d.bytes);
-        if (d.cls == MessageClass::safe) {
+        if (d.cls == MessageClass::Safe) {
             require(d.priority < 4);
             safe_got[d.priority][inc].push_back(id);
         } else {
@@ -138,7 +138,7 @@ void run_scenario(Script& s) {
                     if (shape & 0x40) {
                         link.end(end).core->send_fast(prio, static_cast<std::uint16_t>(shape >> 2 & 7), msg,
                                                       link.now());
-                    } else if (link.end(end).core->send_safe(prio, msg, link.now()) == SendResult::accepted) {
+                    } else if (link.end(end).core->send_safe(prio, msg, link.now()) == SendResult::Accepted) {
                         inc.safe_order[prio].push_back(id);
                     }
                 }

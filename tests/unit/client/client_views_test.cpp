@@ -67,7 +67,7 @@ TEST(WatchState, ShowsTheLatestSampleTheLinkAndRecentEvents) {
         w.take(t, t0 + std::chrono::milliseconds(500 * i));
     }
     for (int i = 0; i < 12; ++i) {
-        w.take(proto::Event{proto::Event::Severity::warning, "event " + std::to_string(i)}, t0);
+        w.take(proto::Event{proto::Event::Severity::Warning, "event " + std::to_string(i)}, t0);
     }
     w.take(proto::LinkStatsReport{120, 200, 300, 4, 0}, t0);
     const auto now = t0 + std::chrono::milliseconds(4600);

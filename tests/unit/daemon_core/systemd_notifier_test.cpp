@@ -21,18 +21,21 @@ using namespace std::chrono_literals;
 class ScopedEnv {
   public:
     ScopedEnv(const char* name, const char* value) : name_(name) {
-        if (const char* old = std::getenv(name))
+        if (const char* old = std::getenv(name)) {
             old_ = old;
-        if (value != nullptr)
+        }
+        if (value != nullptr) {
             ::setenv(name, value, 1);
-        else
+        } else {
             ::unsetenv(name);
+        }
     }
     ~ScopedEnv() {
-        if (old_)
+        if (old_) {
             ::setenv(name_, old_->c_str(), 1);
-        else
+        } else {
             ::unsetenv(name_);
+        }
     }
 
   private:

@@ -55,8 +55,9 @@ struct Rig {
                 triggers.push_back(*t);
             }
         }
-        while (auto r = c.poll_reply())
+        while (auto r = c.poll_reply()) {
             replies.push_back(*r);
+        }
         while (auto s = c.poll_save()) {
             saves.push_back(*s);
             c.on_saved(*s, save_error);
@@ -113,24 +114,28 @@ struct Rig {
     CommandId load(const std::string& text, bool paused = false) {
         const CommandId id = next_id++;
         auto plan = c.prepare_load(id, LoadRequest{text, "test.yaml", false});
-        if (plan)
+        if (plan) {
             c.load(id, std::move(*plan), false, paused, "test.yaml", now);
+        }
         drain();
         return id;
     }
 
     std::vector<CommandReply> replies_to(CommandId id) const {
         std::vector<CommandReply> out;
-        for (const auto& r : replies)
-            if (r.id == id)
+        for (const auto& r : replies) {
+            if (r.id == id) {
                 out.push_back(r);
+            }
+        }
         return out;
     }
 
     std::size_t count(bool (*pred)(const autopilot::AutopilotRequest&)) const {
         std::size_t n = 0;
-        for (const auto& r : requests)
+        for (const auto& r : requests) {
             n += pred(r) ? 1 : 0;
+        }
         return n;
     }
 
@@ -165,9 +170,11 @@ bool is_auto(const autopilot::AutopilotRequest& r) {
 
 /// The state change the vehicle was last asked for: Parking, WaypointNavigation, or Unknown when none.
 autopilot::VehicleState last_state_asked(const Rig& rig) {
-    for (auto it = rig.requests.rbegin(); it != rig.requests.rend(); ++it)
-        if (const auto* s = std::get_if<autopilot::RequestStateChange>(&it->op))
+    for (auto it = rig.requests.rbegin(); it != rig.requests.rend(); ++it) {
+        if (const auto* s = std::get_if<autopilot::RequestStateChange>(&it->op)) {
             return s->state;
+        }
+    }
     return autopilot::VehicleState::Unknown;
 }
 
@@ -278,8 +285,9 @@ TEST(FlightplanController, LinkLossReturnsHomeWhenThePlanSaysSo) {
     bool home_written = false;
     for (auto i = sent; i < rig.requests.size(); ++i) {
         if (const auto* w = std::get_if<autopilot::WriteMissionItems>(&rig.requests[i].op)) {
-            for (const auto& item : w->items)
+            for (const auto& item : w->items) {
                 home_written = home_written || (item.lat == 41.0 && item.lon == 2.0);
+            }
         }
     }
     EXPECT_TRUE(home_written);
@@ -352,8 +360,9 @@ TEST(FlightplanController, ProgressIsKeptOnceAndAWayHomeLeavesThePlanSavedAsPaus
     rig.run_plan("return_home", true);
     ASSERT_FALSE(rig.saves.empty());
     EXPECT_EQ(rig.saves.back().progress.state, PlanState::Running);
-    for (std::size_t i = 1; i < rig.saves.size(); ++i)
+    for (std::size_t i = 1; i < rig.saves.size(); ++i) {
         EXPECT_FALSE(rig.saves[i].progress == rig.saves[i - 1].progress) << "the same point saved twice";
+    }
     const auto before = rig.saves.size();
     rig.c.on_link(false, rig.now);
     rig.drain();

@@ -20,8 +20,9 @@ inline std::shared_ptr<const Plan> load(const std::string& text) {
 /// A failed load's diagnostics as the user reads them, one per line.
 inline std::vector<std::string> messages(const LoadResult& r) {
     std::vector<std::string> out;
-    for (const auto& d : r.errors)
+    for (const auto& d : r.errors) {
         out.push_back(d.to_string());
+    }
     return out;
 }
 

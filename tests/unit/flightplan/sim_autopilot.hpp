@@ -28,23 +28,28 @@ class SimAutopilot {
     RequestResult apply(const FeederRequest& r) {
         if (const auto* up = std::get_if<UploadMission>(&r.op)) {
             slots_.assign(1, home());
-            for (const auto& item : up->items)
+            for (const auto& item : up->items) {
                 slots_.push_back(item);
-            if (current_ == 0 || current_ >= slots_.size())
+            }
+            if (current_ == 0 || current_ >= slots_.size()) {
                 current_ = 1;
+            }
             return RequestResult::Ok;
         }
         if (const auto* w = std::get_if<WriteItems>(&r.op)) {
-            if (w->first_slot == 0 || w->first_slot + w->items.size() > slots_.size())
+            if (w->first_slot == 0 || w->first_slot + w->items.size() > slots_.size()) {
                 return RequestResult::Failed;
-            for (std::size_t i = 0; i < w->items.size(); ++i)
+            }
+            for (std::size_t i = 0; i < w->items.size(); ++i) {
                 slots_[w->first_slot + i] = w->items[i];
+            }
             ++writes_;
             return RequestResult::Ok;
         }
         if (const auto* s = std::get_if<SetCurrent>(&r.op)) {
-            if (s->slot == 0 || s->slot >= slots_.size())
+            if (s->slot == 0 || s->slot >= slots_.size()) {
                 return RequestResult::Failed;
+            }
             current_ = s->slot;
             parked_ = false;
             return RequestResult::Ok;
@@ -67,8 +72,9 @@ class SimAutopilot {
 
     /// Drives to the current target: returns the reached slot, if any.
     std::optional<std::uint16_t> step() {
-        if (!auto_ || current_ == 0 || current_ >= slots_.size())
+        if (!auto_ || current_ == 0 || current_ >= slots_.size()) {
             return std::nullopt;
+        }
         const MissionItem& item = slots_[current_];
         if (item.kind == MissionItem::Kind::Stop) {
             parked_ = true;
@@ -164,15 +170,18 @@ class SyntheticStream final : public WaypointStream {
     }
 
     std::optional<Waypoint> next() override {
-        if (pos_ >= n_)
+        if (pos_ >= n_) {
             return std::nullopt;
+        }
         Waypoint w;
-        if (auto it = overrides_.find(pos_); it != overrides_.end())
+        if (auto it = overrides_.find(pos_); it != overrides_.end()) {
             w = it->second;
+        }
         w.index = pos_;
         w.element = 0;
-        if (w.has_position)
+        if (w.has_position) {
             w.position = position_of(base_lat_, pos_);
+        }
         w.speed = 2.0;
         w.arrival_radius = 2.0;
         w.first_of_element = pos_ == 0;
@@ -181,14 +190,16 @@ class SyntheticStream final : public WaypointStream {
         return w;
     }
     bool seek(std::uint64_t index) override {
-        if (index >= n_)
+        if (index >= n_) {
             return false;
+        }
         pos_ = index;
         return true;
     }
     bool jump_to(std::string_view name) override {
-        if (name != "second-half")
+        if (name != "second-half") {
             return false;
+        }
         pos_ = n_ / 2;
         return true;
     }
@@ -224,8 +235,9 @@ class Harness {
         int budget = imp_.requests_per_step;
         while (budget-- > 0) {
             auto r = feeder.poll_request(now);
-            if (!r)
+            if (!r) {
                 break;
+            }
             const bool fail =
                 chance(imp_.fail_request) || (imp_.fail_writes && std::holds_alternative<WriteItems>(r->op));
             const bool refuse = imp_.refuse_missions && (std::holds_alternative<WriteItems>(r->op) ||
@@ -249,8 +261,9 @@ class Harness {
                 late_.push_back(*reached);
             } else {
                 deliver.insert(deliver.begin(), *reached);
-                if (chance(imp_.duplicate_reached))
+                if (chance(imp_.duplicate_reached)) {
                     deliver.push_back(*reached);
+                }
             }
         }
         for (auto s : deliver) {
@@ -262,16 +275,18 @@ class Harness {
             drain();
         }
         now += seconds(1);
-        if (feeder.poll_timeout() <= now)
+        if (feeder.poll_timeout() <= now) {
             feeder.handle_timeout(now);
+        }
         drain();
     }
 
     /// Steps until the plan is done (or the limit); returns the steps taken.
     int run_until_done(int limit) {
         for (int i = 0; i < limit; ++i) {
-            if (feeder.progress().state == PlanState::Done)
+            if (feeder.progress().state == PlanState::Done) {
                 return i;
+            }
             step();
         }
         return limit;
@@ -286,16 +301,18 @@ class Harness {
 
     void drain() {
         while (auto e = feeder.poll_event()) {
-            if (e->kind == FeederEvent::Kind::WaypointReached)
+            if (e->kind == FeederEvent::Kind::WaypointReached) {
                 reached.push_back(e->plan_index);
+            }
             events.push_back(*e);
         }
     }
 
     std::size_t count(FeederEvent::Kind kind) const {
         std::size_t n = 0;
-        for (const auto& e : events)
+        for (const auto& e : events) {
             n += e.kind == kind;
+        }
         return n;
     }
 

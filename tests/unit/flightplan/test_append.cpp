@@ -21,8 +21,9 @@ std::string line_plan(const std::string& name, double lat, int count, const std:
     std::ostringstream o;
     o.precision(9);
     o << "plan:\n  name: " << name << "\n" << extra << "  elements:\n";
-    for (int i = 0; i < count; ++i)
+    for (int i = 0; i < count; ++i) {
         o << "    - waypoint: {lat: " << lat + i * 1e-4 << ", lon: 1.98}\n";
+    }
     return o.str();
 }
 
@@ -31,8 +32,9 @@ using test::load;
 std::vector<LatLon> expand(const std::shared_ptr<const Plan>& plan) {
     std::vector<LatLon> out;
     Expander e(plan);
-    while (auto w = e.next())
+    while (auto w = e.next()) {
         out.push_back(w->position);
+    }
     return out;
 }
 
@@ -68,8 +70,9 @@ TEST(FlightplanAppend, FeederContinuesMidRouteAndAfterTheEndWithoutStopping) {
     auto stream = std::make_unique<Expander>(load(a));
     Expander* running = stream.get();
     h.feeder.replace_plan(PlanFeed{std::move(stream), "a"}, h.now);
-    for (int i = 0; i < 5; ++i)
+    for (int i = 0; i < 5; ++i) {
         h.step();
+    }
     ASSERT_GT(h.reached.size(), 0u);
     const auto writes_before = h.ap.writes();
 
@@ -82,8 +85,9 @@ TEST(FlightplanAppend, FeederContinuesMidRouteAndAfterTheEndWithoutStopping) {
     h.feeder.continue_with(PlanFeed{std::move(next), "a"}, h.now);
     EXPECT_EQ(h.ap.writes(), writes_before) << "the window on the autopilot was already right";
     ASSERT_LT(h.run_until_done(200), 200);
-    for (int i = 0; i < 3; ++i)
+    for (int i = 0; i < 3; ++i) {
         h.step();
+    }
     EXPECT_EQ(h.ap.visited(), expand(plan_ab));
     EXPECT_TRUE(h.ap.parked());
 
@@ -96,8 +100,9 @@ TEST(FlightplanAppend, FeederContinuesMidRouteAndAfterTheEndWithoutStopping) {
     h.feeder.continue_with(PlanFeed{std::move(third), "a"}, h.now);
     EXPECT_EQ(h.feeder.progress().state, PlanState::Running);
     ASSERT_LT(h.run_until_done(200), 200);
-    for (int i = 0; i < 3; ++i)
+    for (int i = 0; i < 3; ++i) {
         h.step();
+    }
     EXPECT_EQ(h.ap.visited(), expand(plan_abc));
     std::vector<std::uint64_t> all(22);
     std::iota(all.begin(), all.end(), 0);
@@ -123,29 +128,34 @@ std::string describe(const std::string& text) {
     std::ostringstream o;
     o.precision(12);
     if (!r.ok()) {
-        for (const auto& d : r.errors)
+        for (const auto& d : r.errors) {
             o << "error " << d.path << ": " << d.message << "\n";
+        }
         return o.str();
     }
     const Plan& p = *r.plan;
     o << "name " << p.name << "\nvehicle " << p.vehicle.type << ' ' << p.vehicle.min_spacing << ' '
       << p.vehicle.arrival_radius << ' ' << p.vehicle.cruise_speed << ' ' << p.vehicle.cruise_speed_given
       << "\n";
-    if (p.home)
+    if (p.home) {
         o << "home " << p.home->lat << ',' << p.home->lon << "\n";
+    }
     for (const auto& z : p.no_fly) {
         o << "no_fly " << z.name << ' ' << z.buffer;
-        for (const auto& c : z.polygon)
+        for (const auto& c : z.polygon) {
             o << ' ' << c.lat << ',' << c.lon;
+        }
         o << "\n";
     }
     o << "geofence";
-    for (const auto& c : p.geofence)
+    for (const auto& c : p.geofence) {
         o << ' ' << c.lat << ',' << c.lon;
+    }
     o << "\n";
     for (const auto* reaction : {&p.reactions.link_loss, &p.reactions.low_battery, &p.reactions.geofence}) {
-        if (*reaction)
+        if (*reaction) {
             o << "reaction " << to_string((*reaction)->action) << ' ' << (*reaction)->target << "\n";
+        }
     }
     std::vector<std::string> names;
     for (std::uint32_t i = 0; i < p.nodes.size(); ++i) {
@@ -154,20 +164,23 @@ std::string describe(const std::string& text) {
         o << p.element_path(i) << " kind " << static_cast<int>(n.kind) << " name '" << p.element_name(i)
           << "' at " << n.geo.lat << ',' << n.geo.lon << " alt " << n.alt().value_or(NAN) << " count "
           << (count ? std::to_string(*count) : "-") << "\n";
-        if (!p.element_name(i).empty())
+        if (!p.element_name(i).empty()) {
             names.push_back(p.element_name(i));
+        }
     }
     auto stream = [&](Expander& e, int limit) {
         for (int i = 0; i < limit; ++i) {
             auto w = e.next();
-            if (!w)
+            if (!w) {
                 break;
+            }
             o << "  " << w->index << ' ' << e.element_path(w->element) << ' ' << to_string(w->action) << ' '
               << w->position.lat << ',' << w->position.lon << " alt " << w->alt.value_or(NAN) << " speed "
               << w->speed << " hold " << w->hold_seconds << "\n";
         }
-        if (e.error())
+        if (e.error()) {
             o << "  stopped: " << *e.error() << "\n";
+        }
     };
     o << "stream\n";
     Expander main(r.plan);
@@ -287,8 +300,9 @@ plan:  # its mapping
          [] {
              // The emitter writes this longer than it is: the merge runs again at the exact size.
              std::string t = "plan:\n name: short\n elements:\n";
-             for (int i = 0; i < 300; ++i)
+             for (int i = 0; i < 300; ++i) {
                  t += " - waypoint: {lat: 41.0" + std::to_string(100 + i) + ",lon: 2.0}\n";
+             }
              return t;
          }()},
     };
@@ -433,8 +447,9 @@ TEST(FlightplanAppend, StreamingMergeLoadsLikeTheWholeTreeMerge) {
             ASSERT_EQ(got.text.has_value(), want.text.has_value()) << got.error << " / " << want.error;
             EXPECT_EQ(got.error, want.error);
             EXPECT_EQ(got.whole_tree, r.aliased_list != nullptr && adds_to(a.text, r.aliased_list));
-            if (!want.text)
+            if (!want.text) {
                 continue;
+            }
             const std::string meaning = describe(*want.text);
             EXPECT_EQ(describe(*got.text), meaning) << "merged:\n" << *got.text << "before:\n" << *want.text;
             loaded += meaning.rfind("error ", 0) != 0;

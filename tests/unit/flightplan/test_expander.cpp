@@ -19,8 +19,9 @@ std::vector<Waypoint> expand_all(std::shared_ptr<const Plan> plan, std::size_t l
     std::vector<Waypoint> out;
     while (out.size() < limit) {
         auto w = e.next();
-        if (!w)
+        if (!w) {
             break;
+        }
         out.push_back(*w);
     }
     return out;
@@ -99,8 +100,9 @@ TEST(FlightplanExpander, ConcavePolygonIsCoveredAndStepAddsPoints) {
     // Along a line (lines run north: same easting) waypoints are at most `step` apart.
     std::size_t along_line = 0;
     for (std::size_t i = 0; i + 1 < wps.size(); ++i) {
-        if (std::abs(wps[i].local.e - wps[i + 1].local.e) > 1e-6)
+        if (std::abs(wps[i].local.e - wps[i + 1].local.e) > 1e-6) {
             continue;
+        }
         ++along_line;
         EXPECT_LE(distance(wps[i].local, wps[i + 1].local), 10.0 + 1e-6);
     }
@@ -110,8 +112,9 @@ TEST(FlightplanExpander, ConcavePolygonIsCoveredAndStepAddsPoints) {
     int inside = 0;
     for (int k = 0; k < 3000; ++k) {
         const Enu p{ue(rng), un(rng)};
-        if (!point_in_polygon(p, poly))
+        if (!point_in_polygon(p, poly)) {
             continue;
+        }
         ++inside;
         double best = 1e9;
         for (std::size_t i = 0; i + 1 < wps.size(); ++i) {
@@ -183,8 +186,9 @@ TEST(FlightplanExpander, RepeatSpeedHoldAndOrbitSemantics) {
     EXPECT_FALSE(hold.has_position);
     EXPECT_EQ(plan->element_path(hold.element), "plan.elements[3]");
     std::size_t until_released = 0;
-    for (const auto& w : wps)
+    for (const auto& w : wps) {
         until_released += w.action == WaypointAction::HoldUntilReleased;
+    }
     EXPECT_EQ(until_released, 6u);
 }
 
@@ -217,8 +221,9 @@ TEST(FlightplanExpander, JumpIntoDetachedBlockThenGotoBackIntoLoop) {
     auto plan = load(kMixedPlan);
     ASSERT_TRUE(plan);
     Expander e(plan);
-    for (int i = 0; i < 5; ++i)
+    for (int i = 0; i < 5; ++i) {
         e.next();
+    }
     ASSERT_TRUE(e.jump_to("home-run"));
     const auto origin = e.origin();
     EXPECT_EQ(origin.index, 5u);
@@ -229,8 +234,9 @@ TEST(FlightplanExpander, JumpIntoDetachedBlockThenGotoBackIntoLoop) {
     // The goto lands on 'r' inside a repeat of 3: r, (x, hold) x2, then two more iterations, then the last
     // waypoint of the plan; the detached block does not run again.
     std::vector<Waypoint> rest;
-    while (auto n = e.next())
+    while (auto n = e.next()) {
         rest.push_back(*n);
+    }
     EXPECT_EQ(rest.size(), 3u * 5u + 1u);
     EXPECT_EQ(plan->element_name(rest[0].element), "r");
     // Restore reproduces the stream after the jump.
@@ -274,8 +280,9 @@ TEST(FlightplanExpander, StopsOnALegIntoANoFlyZoneAddedAfterValidation) {
     plan->no_fly.push_back(zone);
     Expander e(plan);
     std::size_t produced = 0;
-    while (e.next())
+    while (e.next()) {
         ++produced;
+    }
     ASSERT_TRUE(e.error().has_value());
     EXPECT_NE(e.error()->find("late-zone"), std::string::npos);
     EXPECT_LT(produced, plan->count(plan->children(plan->main_list)[0]).value());
@@ -297,8 +304,9 @@ TEST(FlightplanExpander, MillionWaypointScanStreamsInSmallMemory) {
     Enu last{};
     double max_gap = 0;
     while (auto w = e.next()) {
-        if (n > 0)
+        if (n > 0) {
             max_gap = std::max(max_gap, distance(last, w->local));
+        }
         last = w->local;
         ++n;
     }

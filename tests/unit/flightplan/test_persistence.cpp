@@ -116,8 +116,9 @@ TEST(FlightplanPersistence, GarbageAndEveryTruncationNeverCrash) {
     }
     for (int k = 0; k < 20; ++k) {
         std::string junk(std::uniform_int_distribution<std::size_t>(0, 6000)(rng), '\0');
-        for (char& c : junk)
+        for (char& c : junk) {
             c = static_cast<char>(rng());
+        }
         write(store.plan_path(), junk);
         write(store.progress_path(), junk);
         const auto loaded = store.load();
@@ -178,8 +179,9 @@ TEST(FlightplanPersistence, RestartResumesAtTheFirstUnreachedWaypoint) {
     std::vector<LatLon> expected;
     {
         Expander all(loaded.plan);
-        while (auto w = all.next())
+        while (auto w = all.next()) {
             expected.push_back(w->position);
+        }
     }
     const std::string digest = hex64(fnv1a64(text));
     // Durability against power loss is fsync's business; this scenario is about kill -9, so skip the fsyncs.
@@ -220,8 +222,9 @@ TEST(FlightplanPersistence, RestartResumesAtTheFirstUnreachedWaypoint) {
     // The vehicle drove every waypoint, the first unreached one right after the restart.
     const auto& visited = h.ap.visited();
     ASSERT_EQ(visited.size(), expected.size());
-    for (std::size_t i = 0; i < expected.size(); ++i)
+    for (std::size_t i = 0; i < expected.size(); ++i) {
         ASSERT_EQ(visited[i], expected[i]) << i;
+    }
 }
 
 }  // namespace

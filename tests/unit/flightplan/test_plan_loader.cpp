@@ -15,8 +15,9 @@ using test::messages;
 TEST(FlightplanLoader, ExamplePlansLoad) {
     int loaded = 0;
     for (const auto& entry : std::filesystem::directory_iterator(AIRSEG_SOURCE_DIR "/config/plans")) {
-        if (entry.path().extension() != ".yaml")
+        if (entry.path().extension() != ".yaml") {
             continue;
+        }
         const auto r = load_plan_file(entry.path().string());
         EXPECT_TRUE(r.ok()) << entry.path() << "\n" << to_string(r.errors);
         ++loaded;
@@ -267,8 +268,9 @@ TEST(FlightplanLoader, MutatedPlansNeverCrash) {
                     t.insert(pos, 1, alphabet[rng() % alphabet.size()]);
                     break;
                 case 2:
-                    if (std::isdigit(static_cast<unsigned char>(t[pos])))
+                    if (std::isdigit(static_cast<unsigned char>(t[pos]))) {
                         t[pos] = static_cast<char>('0' + rng() % 10);
+                    }
                     break;
                 default:
                     t.insert(pos, t.substr(pos, rng() % 40));
@@ -308,8 +310,9 @@ TEST(FlightplanLoader, AliasExplosionIsBounded) {
     const auto r = load_plan_text(text, "bomb.yaml", options);
     ASSERT_FALSE(r.ok());
     bool bounded = false;
-    for (const auto& d : r.errors)
+    for (const auto& d : r.errors) {
         bounded = bounded || d.message.find("more than 2000 elements") != std::string::npos;
+    }
     EXPECT_TRUE(bounded) << to_string(r.errors);
 }
 

@@ -44,8 +44,9 @@ TEST(FlightplanFeeder, LongPlanReachedOnceInOrderWithoutStarvation) {
     h.feeder.replace_plan(test::synthetic(2500), h.now);
     const int steps = h.run_until_done(6000);
     ASSERT_LT(steps, 6000);
-    for (int i = 0; i < 3; ++i)
+    for (int i = 0; i < 3; ++i) {
         h.step();
+    }
     EXPECT_EQ(h.reached, iota(0, 2500));
     expect_visited(h, 41.0, 0, 2500);
     EXPECT_EQ(h.ap.visited().size(), 2500u);
@@ -130,11 +131,13 @@ TEST(FlightplanFeeder, FailedRequestsAreRetried) {
 TEST(FlightplanFeeder, PersistentWriteFailuresHoldTheVehicleUntilTheWindowIsBack) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(300), h.now);
-    for (int i = 0; i < 30; ++i)
+    for (int i = 0; i < 30; ++i) {
         h.step();
+    }
     h.impairments().fail_writes = true;
-    for (int i = 0; i < 40; ++i)
+    for (int i = 0; i < 40; ++i) {
         h.step();
+    }
     EXPECT_GE(h.count(FeederEvent::Kind::RequestFailed), 1u);
     EXPECT_FALSE(h.ap.in_auto());
     EXPECT_GE(h.ap.hold_requests(), 1);
@@ -150,8 +153,9 @@ TEST(FlightplanFeeder, PersistentWriteFailuresHoldTheVehicleUntilTheWindowIsBack
 TEST(FlightplanFeeder, RebootMidPlanRebuildsTheWindowAndCarriesOn) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(800), h.now);
-    for (int i = 0; i < 300; ++i)
+    for (int i = 0; i < 300; ++i) {
         h.step();
+    }
     const auto before = h.reached.size();
     ASSERT_GT(before, 250u);
     h.ap.reboot();
@@ -166,8 +170,9 @@ TEST(FlightplanFeeder, RebootMidPlanRebuildsTheWindowAndCarriesOn) {
 TEST(FlightplanFeeder, ReplacePlanKeepsCurrentTargetThenFollowsNewPlanWithoutStopping) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(1000, 41.0), h.now);
-    for (int i = 0; i < 100; ++i)
+    for (int i = 0; i < 100; ++i) {
         h.step();
+    }
     const auto target = *h.feeder.progress().next_waypoint;
     const auto visited_before = h.ap.visited().size();
     h.feeder.replace_plan(test::synthetic(200, 43.0), h.now);
@@ -186,8 +191,9 @@ TEST(FlightplanFeeder, ReplacePlanKeepsCurrentTargetThenFollowsNewPlanWithoutSto
 TEST(FlightplanFeeder, SkipHeadsForTheRequestedWaypointNow) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(1000), h.now);
-    for (int i = 0; i < 50; ++i)
+    for (int i = 0; i < 50; ++i) {
         h.step();
+    }
     const auto visited_before = h.ap.visited().size();
     ASSERT_TRUE(h.feeder.skip_to(600, h.now));
     EXPECT_FALSE(h.feeder.skip_to(5000, h.now));
@@ -200,8 +206,9 @@ TEST(FlightplanFeeder, SkipHeadsForTheRequestedWaypointNow) {
 TEST(FlightplanFeeder, JumpToNamedElementContinuesThere) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(100), h.now);
-    for (int i = 0; i < 10; ++i)
+    for (int i = 0; i < 10; ++i) {
         h.step();
+    }
     const auto visited_before = h.ap.visited().size();
     ASSERT_TRUE(h.feeder.jump_to("second-half", h.now));
     EXPECT_FALSE(h.feeder.jump_to("nowhere", h.now));
@@ -212,14 +219,16 @@ TEST(FlightplanFeeder, JumpToNamedElementContinuesThere) {
 TEST(FlightplanFeeder, PauseHoldsTheVehicleAndResumeContinues) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(100), h.now);
-    for (int i = 0; i < 20; ++i)
+    for (int i = 0; i < 20; ++i) {
         h.step();
+    }
     h.feeder.pause();
     EXPECT_EQ(h.feeder.progress().state, PlanState::Paused);
     h.step();
     const auto reached_when_paused = h.reached.size();
-    for (int i = 0; i < 30; ++i)
+    for (int i = 0; i < 30; ++i) {
         h.step();
+    }
     EXPECT_LE(h.reached.size(), reached_when_paused + 1);
     EXPECT_FALSE(h.ap.in_auto());
     h.feeder.resume();
@@ -231,13 +240,15 @@ TEST(FlightplanFeeder, PauseHoldsTheVehicleAndResumeContinues) {
 TEST(FlightplanFeeder, ResumeAfterTheOperatorDroveTheVehicleByHandPutsItBackOnThePlan) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(100), h.now);
-    for (int i = 0; i < 20; ++i)
+    for (int i = 0; i < 20; ++i) {
         h.step();
+    }
     ASSERT_TRUE(h.ap.in_auto());
     h.ap.operator_takes_over();  // e.g. MANUAL_NAVIGATION and a joystick session from the ground
     const auto reached_by_hand = h.reached.size();
-    for (int i = 0; i < 30; ++i)
+    for (int i = 0; i < 30; ++i) {
         h.step();
+    }
     EXPECT_EQ(h.reached.size(), reached_by_hand) << "out of AUTO the vehicle follows no plan";
     h.feeder.resume();
     ASSERT_LT(h.run_until_done(500), 500) << "resume must bring the vehicle back to AUTO";
@@ -247,8 +258,9 @@ TEST(FlightplanFeeder, ResumeAfterTheOperatorDroveTheVehicleByHandPutsItBackOnTh
 TEST(FlightplanFeeder, TheBoardsOwnHoldMidPlanIsUndoneAndThePlanGoesOnInOrder) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(100), h.now);
-    for (int i = 0; i < 20; ++i)
+    for (int i = 0; i < 20; ++i) {
         h.step();
+    }
     ASSERT_TRUE(h.ap.in_auto());
     const auto target_before = h.ap.current();
     h.ap.board_holds();
@@ -275,8 +287,9 @@ TEST(FlightplanFeeder, TheBoardsOwnHoldMidPlanIsUndoneAndThePlanGoesOnInOrder) {
 TEST(FlightplanFeeder, AReachedReportThatCrossesTheBoardsOwnHoldStillCounts) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(40), h.now);
-    for (int i = 0; i < 10; ++i)
+    for (int i = 0; i < 10; ++i) {
         h.step();
+    }
     // The vehicle reaches its target and the board holds by itself; the reached report arrives after the
     // mode change.
     const auto reached = h.ap.step();
@@ -294,15 +307,17 @@ TEST(FlightplanFeeder, AReachedReportThatCrossesTheBoardsOwnHoldStillCounts) {
 TEST(FlightplanFeeder, TheRcPilotTakingTheVehicleInterruptsThePlanUntilResume) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(60), h.now);
-    for (int i = 0; i < 10; ++i)
+    for (int i = 0; i < 10; ++i) {
         h.step();
+    }
     h.ap.operator_takes_over();
     h.step();
     EXPECT_EQ(h.feeder.progress().state, PlanState::Interrupted);
     EXPECT_NE(h.feeder.progress().interruption.find("RC pilot"), std::string::npos);
     const auto reached = h.reached.size();
-    for (int i = 0; i < 20; ++i)
+    for (int i = 0; i < 20; ++i) {
         h.step();
+    }
     EXPECT_FALSE(h.ap.in_auto()) << "the RC pilot keeps the vehicle: no AUTO behind the pilot's back";
     EXPECT_EQ(h.ap.hold_requests(), 0) << "nor a HOLD";
     EXPECT_EQ(h.reached.size(), reached);
@@ -314,11 +329,13 @@ TEST(FlightplanFeeder, TheRcPilotTakingTheVehicleInterruptsThePlanUntilResume) {
 TEST(FlightplanFeeder, AnOperatorsParkingCommandPausesThePlan) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(60), h.now);
-    for (int i = 0; i < 10; ++i)
+    for (int i = 0; i < 10; ++i) {
         h.step();
+    }
     h.ap.operator_parks();
-    for (int i = 0; i < 10; ++i)
+    for (int i = 0; i < 10; ++i) {
         h.step();
+    }
     EXPECT_EQ(h.feeder.progress().state, PlanState::Paused);
     EXPECT_FALSE(h.ap.in_auto());
     EXPECT_EQ(h.count(FeederEvent::Kind::Interrupted), 0u);
@@ -333,8 +350,9 @@ TEST(FlightplanFeeder, ANewPlanAfterTheOperatorParkedAFinishedOneDrives) {
     ASSERT_LT(h.run_until_done(100), 100);
     h.step();
     h.ap.operator_parks();
-    for (int i = 0; i < 3; ++i)
+    for (int i = 0; i < 3; ++i) {
         h.step();
+    }
     ASSERT_FALSE(h.ap.in_auto());
     h.feeder.resume();  // what plan.load does unless --paused
     h.feeder.replace_plan(test::synthetic(10, 42.0), h.now);
@@ -348,8 +366,9 @@ TEST(FlightplanFeeder, AMissionTheAutopilotRefusesFailsThePlanInsteadOfRetryingF
     imp.refuse_missions = true;
     Harness h({}, imp);
     h.feeder.replace_plan(test::synthetic(30), h.now);
-    for (int i = 0; i < 60; ++i)
+    for (int i = 0; i < 60; ++i) {
         h.step();
+    }
     const auto p = h.feeder.progress();
     EXPECT_EQ(p.state, PlanState::Failed);
     EXPECT_NE(p.failure.find("UNSUPPORTED_FRAME"), std::string::npos) << p.failure;
@@ -365,8 +384,9 @@ TEST(FlightplanFeeder, AMissionTheAutopilotRefusesFailsThePlanInsteadOfRetryingF
 TEST(FlightplanFeeder, AReplacementWhoseFirstWriteLandsJustAfterTheTargetIsReachedRetargetsWithoutAHold) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(40, 41.0), h.now);
-    for (int i = 0; i < 10; ++i)
+    for (int i = 0; i < 10; ++i) {
         h.step();
+    }
     ASSERT_TRUE(h.ap.in_auto());
     const std::size_t a_done = h.ap.visited().size();
     h.feeder.replace_plan(test::synthetic(20, 42.0), h.now);
@@ -388,8 +408,9 @@ TEST(FlightplanFeeder, AReplacementWhoseFirstWriteLandsJustAfterTheTargetIsReach
     EXPECT_EQ(h.feeder.progress().retargets, 1u);
     // A up to the kept target, then B from its first waypoint: never A's stale next one.
     ASSERT_EQ(h.ap.visited().size(), a_done + 1 + 20);
-    for (std::uint64_t i = 0; i < 20; ++i)
+    for (std::uint64_t i = 0; i < 20; ++i) {
         EXPECT_EQ(h.ap.visited()[a_done + 1 + i], test::SyntheticStream::position_of(42.0, i)) << i;
+    }
 }
 
 TEST(FlightplanFeeder, HoldWaypointsHoldForTheirTimeOrUntilReleased) {
@@ -405,18 +426,22 @@ TEST(FlightplanFeeder, HoldWaypointsHoldForTheirTimeOrUntilReleased) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(40, 41.0, {{10, timed}, {20, until}, {30, here}}), h.now);
     int steps = 0;
-    while (h.reached.size() < 11 && steps++ < 100)
+    while (h.reached.size() < 11 && steps++ < 100) {
         h.step();
+    }
     ASSERT_EQ(h.reached.size(), 11u);
     const TimePoint hold_start = h.now;
-    while (h.reached.size() < 12 && steps++ < 200)
+    while (h.reached.size() < 12 && steps++ < 200) {
         h.step();
+    }
     EXPECT_GE(h.now - hold_start, seconds(30));
     EXPECT_LE(h.now - hold_start, seconds(36));
-    while (h.reached.size() < 21 && steps++ < 300)
+    while (h.reached.size() < 21 && steps++ < 300) {
         h.step();
-    for (int i = 0; i < 100; ++i)
+    }
+    for (int i = 0; i < 100; ++i) {
         h.step();
+    }
     EXPECT_EQ(h.reached.size(), 21u);  // held until released
     EXPECT_FALSE(h.ap.in_auto());
     h.feeder.release_hold(h.now);
@@ -433,8 +458,9 @@ TEST(FlightplanFeeder, ShortPlanEndsOnStopItem) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(2), h.now);
     ASSERT_LT(h.run_until_done(50), 50);
-    for (int i = 0; i < 10; ++i)
+    for (int i = 0; i < 10; ++i) {
         h.step();
+    }
     EXPECT_EQ(h.reached, iota(0, 2));
     EXPECT_TRUE(h.ap.parked());
     EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
@@ -449,8 +475,9 @@ TEST(FlightplanFeeder, AfterTheEndTheRingSlotsHoldTheStopSoDrivingOnGoesNowhere)
     Harness h(c);
     h.feeder.replace_plan(test::synthetic(23), h.now);
     ASSERT_LT(h.run_until_done(200), 200);
-    for (int i = 0; i < 40; ++i)
+    for (int i = 0; i < 40; ++i) {
         h.step();
+    }
     const LatLon end = SyntheticStream::position_of(41.0, 22);
     const auto& slots = h.ap.slots();
     ASSERT_EQ(slots.size(), 15u);
@@ -459,19 +486,23 @@ TEST(FlightplanFeeder, AfterTheEndTheRingSlotsHoldTheStopSoDrivingOnGoesNowhere)
     };
     // The 24th entry, the Stop, went to ring position 2 + 23 % 10 = 5.
     EXPECT_TRUE(holds_stop(5));
-    for (std::size_t s : {6, 7, 8, 9, 10, 11, 12, 14})
+    for (std::size_t s : {6, 7, 8, 9, 10, 11, 12, 14}) {
         EXPECT_TRUE(holds_stop(s)) << "slot " << s;
+    }
     EXPECT_EQ(slots[13].kind, MissionItem::Kind::JumpTo);
     // The slots left last keep their waypoints while the vehicle may still report reaching them.
-    for (std::size_t s : {2, 3, 4})
+    for (std::size_t s : {2, 3, 4}) {
         EXPECT_FALSE(holds_stop(s)) << "slot " << s;
+    }
 
     // Held at the end, no report can still come: the whole ring gets the Stop.
     h.ap.board_holds();
-    for (int i = 0; i < 40; ++i)
+    for (int i = 0; i < 40; ++i) {
         h.step();
-    for (std::size_t s : {2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 14})
+    }
+    for (std::size_t s : {2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 14}) {
         EXPECT_TRUE(holds_stop(s)) << "slot " << s;
+    }
     EXPECT_EQ(h.reached, iota(0, 23));
     EXPECT_EQ(h.feeder.progress().state, PlanState::Done);
     EXPECT_FALSE(h.feeder.poll_request(h.now).has_value()) << "nothing more to write once the ring is full";
@@ -481,8 +512,9 @@ TEST(FlightplanFeeder, ProgressReportsWindowAndResumePoint) {
     Harness h;
     EXPECT_EQ(h.feeder.progress().state, PlanState::None);
     h.feeder.replace_plan(test::synthetic(100), h.now);
-    for (int i = 0; i < 12; ++i)
+    for (int i = 0; i < 12; ++i) {
         h.step();
+    }
     const auto p = h.feeder.progress();
     EXPECT_EQ(p.state, PlanState::Running);
     EXPECT_EQ(p.plan_name, "synthetic");
@@ -528,8 +560,9 @@ TEST(FlightplanFeeder, ExampleSurveyPlanElementsStartAndFinishInOrder) {
     std::vector<Waypoint> expected;
     {
         Expander all(r.plan);
-        while (auto w = all.next())
+        while (auto w = all.next()) {
             expected.push_back(*w);
+        }
     }
     test::Harness h;
     h.feeder.replace_plan({std::make_unique<Expander>(r.plan), r.plan->name}, h.now);
@@ -568,14 +601,16 @@ TEST(FlightplanFeeder, ExampleSurveyPlanElementsStartAndFinishInOrder) {
                                            "plan.elements[8]"};
     EXPECT_EQ(started, want);
     std::vector<std::uint64_t> all(expected.size());
-    for (std::size_t i = 0; i < all.size(); ++i)
+    for (std::size_t i = 0; i < all.size(); ++i) {
         all[i] = i;
+    }
     EXPECT_EQ(h.reached, all);
     // Only positioned waypoints go to the autopilot, in plan order.
     std::vector<LatLon> positioned;
     for (const auto& w : expected) {
-        if (w.has_position)
+        if (w.has_position) {
             positioned.push_back(w.position);
+        }
     }
     EXPECT_EQ(h.ap.visited(), positioned);
     EXPECT_EQ(h.count(FeederEvent::Kind::HoldStarted), 2u);
@@ -592,13 +627,15 @@ namespace {
 TEST(FlightplanFeeder, ClearPlanHoldsTheVehicleAndStopsFeeding) {
     test::Harness h;
     h.feeder.replace_plan(test::synthetic(100), h.now);
-    for (int i = 0; i < 20; ++i)
+    for (int i = 0; i < 20; ++i) {
         h.step();
+    }
     h.feeder.clear_plan();
     EXPECT_EQ(h.feeder.progress().state, PlanState::None);
     const int writes = h.ap.writes();
-    for (int i = 0; i < 20; ++i)
+    for (int i = 0; i < 20; ++i) {
         h.step();
+    }
     EXPECT_FALSE(h.ap.in_auto());
     EXPECT_EQ(h.ap.writes(), writes);
     EXPECT_LE(h.ap.visited().size(), 21u);
@@ -608,8 +645,9 @@ TEST(FlightplanFeeder, NewPlanAfterDoneStartsFromTheParkedVehicle) {
     test::Harness h;
     h.feeder.replace_plan(test::synthetic(12, 41.0), h.now);
     ASSERT_LT(h.run_until_done(100), 100);
-    for (int i = 0; i < 3; ++i)
+    for (int i = 0; i < 3; ++i) {
         h.step();
+    }
     ASSERT_TRUE(h.ap.parked());
     h.feeder.replace_plan(test::synthetic(30, 42.0), h.now);
     ASSERT_LT(h.run_until_done(200), 200);
@@ -649,8 +687,9 @@ TEST(FlightplanFeeder, ChaosKeepsTheInvariants) {
                 h.feeder.replace_plan(test::synthetic(300 + rng() % 300, base_lat(++generation)), h.now);
             } else if (dice < 6) {
                 // Forward skips only: a backward skip legitimately revisits waypoints.
-                if (auto next = h.feeder.progress().next_waypoint)
+                if (auto next = h.feeder.progress().next_waypoint) {
                     h.feeder.skip_to(*next + 1 + rng() % 50, h.now);
+                }
             } else if (dice < 9) {
                 h.ap.reboot();
                 h.feeder.on_autopilot_rebooted(h.now);
@@ -684,8 +723,9 @@ TEST(FlightplanFeeder, ChaosKeepsTheInvariants) {
         }
         std::map<std::uint32_t, std::uint64_t> last_reached;
         for (const auto& e : h.events) {
-            if (e.kind != FeederEvent::Kind::WaypointReached)
+            if (e.kind != FeederEvent::Kind::WaypointReached) {
                 continue;
+            }
             auto it = last_reached.find(e.generation);
             if (it != last_reached.end()) {
                 ASSERT_GT(e.plan_index, it->second) << "seed " << seed;

@@ -248,7 +248,7 @@ TEST(GroundlinkFrame, ChunksRoundTripAndTheLastOmitsItsLength) {
         expect += frame::encoded_size(c);
     }
     EXPECT_EQ(plain.size(), expect);
-    EXPECT_EQ(frame::kind_of(plain), frame::Kind::data);
+    EXPECT_EQ(frame::kind_of(plain), frame::Kind::Data);
     EXPECT_EQ(frame::heard_mask_of(plain), 2);
     EXPECT_EQ(frame::frame_number_of(plain), 0x123456U);
     const auto got = frame::decode_chunks(plain);
@@ -299,16 +299,16 @@ TEST(GroundlinkFrame, SealedFrameChecksCrcAndUnkeyedCrcBindsTheSession) {
 
 TEST(GroundlinkReplayWindow, RejectsDuplicatesAndTooOldAndReconstructsAcrossTheWrap) {
     ReplayWindow w;
-    EXPECT_EQ(w.check(0), ReplayWindow::Check::fresh);
+    EXPECT_EQ(w.check(0), ReplayWindow::Check::Fresh);
     w.accept(0);
-    EXPECT_EQ(w.check(0), ReplayWindow::Check::duplicate);
+    EXPECT_EQ(w.check(0), ReplayWindow::Check::Duplicate);
     w.accept(5);
-    EXPECT_EQ(w.check(3), ReplayWindow::Check::fresh);  // reordered, not yet seen
+    EXPECT_EQ(w.check(3), ReplayWindow::Check::Fresh);  // reordered, not yet seen
     w.accept(3);
-    EXPECT_EQ(w.check(3), ReplayWindow::Check::duplicate);
+    EXPECT_EQ(w.check(3), ReplayWindow::Check::Duplicate);
     w.accept(200);
-    EXPECT_EQ(w.check(100), ReplayWindow::Check::too_old);
-    EXPECT_EQ(w.check(199), ReplayWindow::Check::fresh);
+    EXPECT_EQ(w.check(100), ReplayWindow::Check::TooOld);
+    EXPECT_EQ(w.check(199), ReplayWindow::Check::Fresh);
 
     ReplayWindow wrap;
     const std::uint64_t base = (std::uint64_t{1} << 24) - 3;

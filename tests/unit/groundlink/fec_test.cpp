@@ -106,7 +106,7 @@ TEST(GroundlinkFec, AFrameSurvivesLostAndFlippedBytesThroughItsShards) {
         deframer.feed(
             damaged,
             [&](std::vector<std::uint8_t>&& plain) {
-                if (assembler.add(plain, TimePoint{}, out) == fec::ShardAssembler::Result::complete) {
+                if (assembler.add(plain, TimePoint{}, out) == fec::ShardAssembler::Result::Complete) {
                     ++complete;
                     EXPECT_EQ(out, frame);
                 }

@@ -19,7 +19,7 @@ struct Figures {
     Duration max_backlog{};
 };
 
-enum class FastFrom { none, sender, receiver };
+enum class FastFrom { None, Sender, Receiver };
 
 Figures measure(std::size_t paths, test::Impairments imp, FastFrom fast_from, Duration run,
                 std::uint64_t seed) {
@@ -27,7 +27,7 @@ Figures measure(std::size_t paths, test::Impairments imp, FastFrom fast_from, Du
     TransportConfig b = test::base_config(2);
     if (paths == 2) {
         a.paths = b.paths = 2;
-        a.path_mode = b.path_mode = PathMode::split;
+        a.path_mode = b.path_mode = PathMode::Split;
         b.split_tx_path = 1;
     }
     std::vector<test::PathModel> models(paths);
@@ -54,12 +54,12 @@ Figures measure(std::size_t paths, test::Impairments imp, FastFrom fast_from, Du
         }
     };
     while (link.now() < end) {
-        while (link.a().core->send_safe(3, test::pattern(1000, next), link.now()) == SendResult::accepted) {
+        while (link.a().core->send_safe(3, test::pattern(1000, next), link.now()) == SendResult::Accepted) {
             ++next;
         }
         link.run_until(link.now() + 100ms, [&] {
-            if (fast_from != FastFrom::none && link.now() >= next_fast) {
-                auto& from = fast_from == FastFrom::sender ? link.a() : link.b();
+            if (fast_from != FastFrom::None && link.now() >= next_fast) {
+                auto& from = fast_from == FastFrom::Sender ? link.a() : link.b();
                 for (std::uint16_t topic = 0; topic < 3; ++topic) {
                     const auto id = static_cast<std::uint32_t>(0x40000000U + fast_sent.size());
                     fast_sent[id] = link.now();
@@ -69,7 +69,7 @@ Figures measure(std::size_t paths, test::Impairments imp, FastFrom fast_from, Du
             }
             for (; seen_b < link.b().received.size(); ++seen_b) {
                 const auto& d = link.b().received[seen_b];
-                if (d.cls == MessageClass::safe) {
+                if (d.cls == MessageClass::Safe) {
                     bytes += d.bytes.size();
                     f.max_stall_s = std::max(
                         f.max_stall_s, std::chrono::duration<double>(link.now() - last_delivery).count());
@@ -98,7 +98,7 @@ Figures measure(std::size_t paths, test::Impairments imp, FastFrom fast_from, Du
 }
 
 TEST(GroundlinkLinkFigures, CleanLinkBulkGoodput) {
-    const auto f = measure(1, {}, FastFrom::none, 60s, 1);
+    const auto f = measure(1, {}, FastFrom::None, 60s, 1);
     EXPECT_GT(f.goodput, 0.94);       // target 0.95
     EXPECT_LT(f.max_backlog, 400ms);  // pacing keeps the radio queue to about a frame
 }
@@ -106,28 +106,28 @@ TEST(GroundlinkLinkFigures, CleanLinkBulkGoodput) {
 TEST(GroundlinkLinkFigures, BulkGoodputUnderByteCorruption) {
     test::Impairments light;
     light.byte_corrupt = 1e-4;
-    EXPECT_GT(measure(1, light, FastFrom::none, 90s, 2).goodput, 0.82);  // target 0.85
+    EXPECT_GT(measure(1, light, FastFrom::None, 90s, 2).goodput, 0.82);  // target 0.85
     test::Impairments heavy;
     heavy.byte_corrupt = 1e-3;
-    EXPECT_GT(measure(1, heavy, FastFrom::none, 90s, 3).goodput, 0.63);  // target 0.65
+    EXPECT_GT(measure(1, heavy, FastFrom::None, 90s, 3).goodput, 0.63);  // target 0.65
 }
 
 TEST(GroundlinkLinkFigures, ThirtyPercentFrameLossNeverStallsFiveSeconds) {
     test::Impairments lossy;
     lossy.loss = 0.3;
     for (std::uint64_t seed : {4U, 5U}) {
-        const auto f = measure(1, lossy, FastFrom::none, 90s, seed);
+        const auto f = measure(1, lossy, FastFrom::None, 90s, seed);
         EXPECT_GT(f.goodput, 0.4);
         EXPECT_LT(f.max_stall_s, 5.0) << "seed " << seed;
     }
 }
 
 TEST(GroundlinkLinkFigures, FastLatencyWhileBulkSaturates) {
-    const auto same = measure(1, {}, FastFrom::sender, 60s, 6);
+    const auto same = measure(1, {}, FastFrom::Sender, 60s, 6);
     EXPECT_GT(same.fast_received, 1700U);
     EXPECT_LT(same.fast_p99_ms, 150.0);
     EXPECT_GT(same.goodput, 0.4);
-    const auto reverse = measure(1, {}, FastFrom::receiver, 60s, 7);
+    const auto reverse = measure(1, {}, FastFrom::Receiver, 60s, 7);
     EXPECT_GT(reverse.fast_received, 1700U);
     EXPECT_LT(reverse.fast_p99_ms, 150.0);
     EXPECT_GT(reverse.goodput, 0.25);
@@ -135,8 +135,8 @@ TEST(GroundlinkLinkFigures, FastLatencyWhileBulkSaturates) {
 }
 
 TEST(GroundlinkLinkFigures, SplitCarriesNearlyTwiceSingle) {
-    const auto single = measure(1, {}, FastFrom::none, 60s, 8);
-    const auto split = measure(2, {}, FastFrom::none, 60s, 8);
+    const auto single = measure(1, {}, FastFrom::None, 60s, 8);
+    const auto split = measure(2, {}, FastFrom::None, 60s, 8);
     EXPECT_GT(split.goodput, 1.85 * single.goodput);  // target 1.9
 }
 
@@ -148,7 +148,7 @@ TEST(GroundlinkLinkFigures, BothEndsSaturatingShareTheAirWithoutAQueue) {
     for (int s = 0; s < 60; ++s) {
         for (int e = 0; e < 2; ++e) {
             while (link.end(e).core->send_safe(3, test::pattern(1000, next[static_cast<std::size_t>(e)]),
-                                               link.now()) == SendResult::accepted) {
+                                               link.now()) == SendResult::Accepted) {
                 ++next[static_cast<std::size_t>(e)];
             }
         }

@@ -27,7 +27,7 @@ void check_end(const test::Endpoint& rx, const Sent& sent, bool expect_all, std:
         const auto it = sent.all.find(id);
         ASSERT_NE(it, sent.all.end()) << "seed " << seed << ": delivered a message never sent";
         ASSERT_EQ(it->second, d.bytes) << "seed " << seed << ": delivered bytes differ from the sent message";
-        if (d.cls == MessageClass::safe) {
+        if (d.cls == MessageClass::Safe) {
             got[d.priority].push_back(id);
         } else {
             ASSERT_TRUE(fast_seen.insert(id).second) << "seed " << seed << ": Fast message delivered twice";
@@ -66,7 +66,7 @@ void run_seed(std::uint64_t seed) {
     std::vector<test::PathModel> models{pm};
     if (seed % 4 == 1) {
         a.paths = b.paths = 2;
-        a.path_mode = b.path_mode = seed % 8 == 1 ? PathMode::split : PathMode::redundant;
+        a.path_mode = b.path_mode = seed % 8 == 1 ? PathMode::Split : PathMode::Redundant;
         b.split_tx_path = 1;
         test::PathModel second = pm;
         second.imp.loss = uni(0.0, 0.3);
@@ -90,7 +90,7 @@ void run_seed(std::uint64_t seed) {
                 if (rng() % 3 == 0) {
                     link.end(from).core->send_fast(prio, static_cast<std::uint16_t>(rng() % 6), msg,
                                                    link.now());
-                } else if (link.end(from).core->send_safe(prio, msg, link.now()) == SendResult::accepted) {
+                } else if (link.end(from).core->send_safe(prio, msg, link.now()) == SendResult::Accepted) {
                     sent[static_cast<std::size_t>(from)].safe[prio].push_back(id);
                 }
             }

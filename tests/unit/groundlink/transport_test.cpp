@@ -27,7 +27,7 @@ bool has_event(const test::Endpoint& e, TransportEvent::Kind k) {
 std::size_t count_safe(const test::Endpoint& e, std::uint8_t prio) {
     return static_cast<std::size_t>(std::count_if(
         e.received.begin(), e.received.end(),
-        [prio](const Delivered& d) { return d.cls == MessageClass::safe && d.priority == prio; }));
+        [prio](const Delivered& d) { return d.cls == MessageClass::Safe && d.priority == prio; }));
 }
 
 /// Offers `a` 40 KB of bulk: 40 messages of 1000 bytes on the lowest priority.
@@ -48,7 +48,7 @@ TEST(GroundlinkTransportConfig, ValidateNamesEachProblem) {
     EXPECT_NE(e[0].find("paths"), std::string::npos);
     EXPECT_THROW(Transport(c, TimePoint{}), std::invalid_argument);
     TransportConfig split = base_config(1);
-    split.path_mode = PathMode::split;
+    split.path_mode = PathMode::Split;
     EXPECT_FALSE(split.validate().empty());
     split.paths = 2;
     EXPECT_TRUE(split.validate().empty());
@@ -58,8 +58,8 @@ TEST(GroundlinkTransport, HandshakeThenSafeBothWaysAuthenticated) {
     SimLink link(base_config(0x1111), base_config(0x2222), one_path(), 1);
     const auto m1 = pattern(300, 1);
     const auto m2 = pattern(3000, 2);
-    ASSERT_EQ(link.a().core->send_safe(0, m1, link.now()), SendResult::accepted);
-    ASSERT_EQ(link.b().core->send_safe(2, m2, link.now()), SendResult::accepted);
+    ASSERT_EQ(link.a().core->send_safe(0, m1, link.now()), SendResult::Accepted);
+    ASSERT_EQ(link.b().core->send_safe(2, m2, link.now()), SendResult::Accepted);
     link.run_for(5s);
     ASSERT_FALSE(link.livelocked());
     ASSERT_EQ(link.b().received.size(), 1U);
@@ -73,8 +73,8 @@ TEST(GroundlinkTransport, HandshakeThenSafeBothWaysAuthenticated) {
         EXPECT_TRUE(link.end(i).core->link_up());
         EXPECT_TRUE(link.end(i).core->session_established());
         EXPECT_EQ(s.mac_failures, 0U);
-        EXPECT_TRUE(has_event(link.end(i), TransportEvent::Kind::session_established));
-        EXPECT_TRUE(has_event(link.end(i), TransportEvent::Kind::link_up));
+        EXPECT_TRUE(has_event(link.end(i), TransportEvent::Kind::SessionEstablished));
+        EXPECT_TRUE(has_event(link.end(i), TransportEvent::Kind::LinkUp));
     }
     EXPECT_GT(link.a().core->stats().rtt_samples, 0U);
 }
@@ -197,7 +197,7 @@ TEST(GroundlinkTransport, FastFreshestWinsEndToEnd) {
     link.run_for(1s);
     std::vector<std::uint32_t> got;
     for (const auto& d : link.b().received) {
-        if (d.cls == MessageClass::fast) {
+        if (d.cls == MessageClass::Fast) {
             got.push_back(test::id_of(d.bytes));
             EXPECT_EQ(d.topic, 7);
         }
@@ -240,9 +240,9 @@ TEST(GroundlinkTransport, PeerRestartIsDetectedAndBothResynchronize) {
         link.b().core->send_safe(0, pattern(100, 100 + i), link.now());
     }
     link.run_for(5s);
-    EXPECT_TRUE(has_event(link.a(), TransportEvent::Kind::peer_restarted));
+    EXPECT_TRUE(has_event(link.a(), TransportEvent::Kind::PeerRestarted));
     EXPECT_EQ(link.a().core->stats().peer_restarts, 1U);
-    EXPECT_TRUE(has_event(link.b(), TransportEvent::Kind::session_established));
+    EXPECT_TRUE(has_event(link.b(), TransportEvent::Kind::SessionEstablished));
     ASSERT_EQ(count_safe(link.b(), 0), 5U);
     for (std::uint32_t i = 0; i < 5; ++i) {
         EXPECT_EQ(test::id_of(link.b().received[i].bytes), 5 + i);
@@ -264,7 +264,7 @@ TEST(GroundlinkTransport, RestartedPeerThatHeardTheOldSessionsHelloFirstIsStillA
     std::vector<std::uint8_t> session_hello;
     for (const auto& wire : link.recorded(1)) {
         const auto plain = cobs_decode(std::span(wire).first(wire.size() - 1));
-        if (plain && frame::kind_of(*plain) == frame::Kind::hello) {
+        if (plain && frame::kind_of(*plain) == frame::Kind::Hello) {
             session_hello = wire;
         }
     }
@@ -293,7 +293,7 @@ TEST(GroundlinkTransport, ReplayedHelloOfADeadIncarnationLeavesTheLiveSessionAlo
     std::vector<std::vector<std::uint8_t>> old_hellos;
     for (const auto& wire : link.recorded(0)) {
         const auto plain = cobs_decode(std::span(wire).first(wire.size() - 1));
-        if (plain && frame::kind_of(*plain) == frame::Kind::hello) {
+        if (plain && frame::kind_of(*plain) == frame::Kind::Hello) {
             old_hellos.push_back(wire);
         }
     }
@@ -328,7 +328,7 @@ TEST(GroundlinkTransport, FreshPeerMisledByAnOldRecordingStillGetsASession) {
     std::vector<std::uint8_t> first_session_hello;
     for (const auto& wire : link.recorded(1)) {
         const auto plain = cobs_decode(std::span(wire).first(wire.size() - 1));
-        if (plain && frame::kind_of(*plain) == frame::Kind::hello) {
+        if (plain && frame::kind_of(*plain) == frame::Kind::Hello) {
             first_session_hello = wire;
         }
     }
@@ -393,7 +393,7 @@ TEST(GroundlinkTransport, ForgedAndReplayedFramesAreNeverDelivered) {
     link.a().core->send_safe(0, pattern(10, 4242), link.now());
     link.run_for(3s);
     EXPECT_EQ(count_safe(link.b(), 0), 21U);
-    EXPECT_FALSE(has_event(link.b(), TransportEvent::Kind::peer_restarted));
+    EXPECT_FALSE(has_event(link.b(), TransportEvent::Kind::PeerRestarted));
 }
 
 test::PathModel clean_path() {
@@ -416,7 +416,7 @@ std::uint64_t bulk_bytes_delivered(PathMode mode, std::size_t paths, Duration ru
     std::uint32_t next = 0;
     const TimePoint end = link.now() + run;
     while (link.now() < end) {
-        while (link.a().core->send_safe(3, pattern(1000, next), link.now()) == SendResult::accepted) {
+        while (link.a().core->send_safe(3, pattern(1000, next), link.now()) == SendResult::Accepted) {
             ++next;
         }
         link.run_for(1s);
@@ -429,15 +429,15 @@ std::uint64_t bulk_bytes_delivered(PathMode mode, std::size_t paths, Duration ru
 }
 
 TEST(GroundlinkTransport, SplitModeNearlyDoublesThroughput) {
-    const auto single = bulk_bytes_delivered(PathMode::single, 1, 30s, 11);
-    const auto split = bulk_bytes_delivered(PathMode::split, 2, 30s, 11);
+    const auto single = bulk_bytes_delivered(PathMode::Single, 1, 30s, 11);
+    const auto split = bulk_bytes_delivered(PathMode::Split, 2, 30s, 11);
     EXPECT_GT(static_cast<double>(single), 0.9 * 5760.0 * 28.0);
     EXPECT_GT(static_cast<double>(split), 1.9 * static_cast<double>(single));
 }
 
 TEST(GroundlinkTransport, SplitFallsBackWhenAPairGoesSilentAndReturns) {
-    TransportConfig a = dual(1, PathMode::split, 0);
-    TransportConfig b = dual(2, PathMode::split, 1);
+    TransportConfig a = dual(1, PathMode::Split, 0);
+    TransportConfig b = dual(2, PathMode::Split, 1);
     a.split_borrow = b.split_borrow = false;  // so path 1 carries A's data only while falling back
     SimLink link(a, b, {clean_path(), clean_path()}, 12);
     link.run_for(3s);
@@ -447,7 +447,7 @@ TEST(GroundlinkTransport, SplitFallsBackWhenAPairGoesSilentAndReturns) {
     }
     link.run_for(15s);
     EXPECT_EQ(count_safe(link.b(), 1), 30U);
-    EXPECT_TRUE(has_event(link.b(), TransportEvent::Kind::path_down));
+    EXPECT_TRUE(has_event(link.b(), TransportEvent::Kind::PathDown));
     const auto via_fallback = link.written(0, 1);
     EXPECT_GT(via_fallback, 30U * 500U);
     link.path(0).a_to_b_up = true;  // recovers
@@ -463,7 +463,7 @@ TEST(GroundlinkTransport, SplitFallsBackWhenAPairGoesSilentAndReturns) {
 }
 
 TEST(GroundlinkTransport, RedundantModeDropsDuplicatesAndSurvivesOnePathDying) {
-    SimLink link(dual(1, PathMode::redundant, 0), dual(2, PathMode::redundant, 0),
+    SimLink link(dual(1, PathMode::Redundant, 0), dual(2, PathMode::Redundant, 0),
                  {clean_path(), clean_path()}, 13);
     for (std::uint32_t i = 0; i < 20; ++i) {
         link.a().core->send_safe(0, pattern(200, i), link.now());
@@ -562,7 +562,7 @@ TEST(GroundlinkTransport, AnEndThatHearsNoAcknowledgementsProbesInsteadOfFilling
     link.run_for(2s);
     ASSERT_TRUE(link.a().core->session_established());
     for (std::uint32_t i = 0; i < 40; ++i) {
-        ASSERT_EQ(link.a().core->send_safe(3, pattern(2000, i), link.now()), SendResult::accepted);
+        ASSERT_EQ(link.a().core->send_safe(3, pattern(2000, i), link.now()), SendResult::Accepted);
     }
     link.path(0).b_to_a_up = false;
     const std::uint64_t before = link.written(0, 0);
@@ -589,8 +589,8 @@ TEST(GroundlinkTransport, AnOversizedMessageIsDroppedCountedAndTheChannelGoesOn)
     SimLink link(big, small, one_path(), 17);
     link.run_for(2s);
     ASSERT_TRUE(link.b().core->session_established());
-    ASSERT_EQ(link.a().core->send_safe(3, pattern(4000, 1), link.now()), SendResult::accepted);
-    ASSERT_EQ(link.a().core->send_safe(3, pattern(100, 2), link.now()), SendResult::accepted);
+    ASSERT_EQ(link.a().core->send_safe(3, pattern(4000, 1), link.now()), SendResult::Accepted);
+    ASSERT_EQ(link.a().core->send_safe(3, pattern(100, 2), link.now()), SendResult::Accepted);
     link.a().core->send_fast(1, 7, pattern(3000, 3), link.now());
     link.run_until(link.now() + 30s,
                    [&] { return count_safe(link.b(), 3) == 1 && link.a().core->safe_pending(3) == 0; });
@@ -609,7 +609,7 @@ TEST(GroundlinkTransport, LinkGoesDownAfterSilenceAndComesBack) {
     link.path(0).b_to_a_up = false;
     link.run_for(5s);
     EXPECT_FALSE(link.a().core->link_up());
-    EXPECT_TRUE(has_event(link.a(), TransportEvent::Kind::link_down));
+    EXPECT_TRUE(has_event(link.a(), TransportEvent::Kind::LinkDown));
     link.path(0).a_to_b_up = true;
     link.path(0).b_to_a_up = true;
     link.run_for(3s);

@@ -32,14 +32,14 @@ TEST(EventText, AStateChangeUsesTheOperatorsStateNames) {
 
 TEST(EventText, BootCalibrationNoticesAreInfoAndRealFailuresStayErrors) {
     // ArduPilot sends these at MAV_SEVERITY_CRITICAL (2) or ALERT (1) on every power-up.
-    EXPECT_EQ(status_text_severity(2, "Beginning INS calibration; do not move vehicle"), Sev::info);
-    EXPECT_EQ(status_text_severity(1, "Initialising APM..."), Sev::info);
-    EXPECT_EQ(status_text_severity(2, "Warming up ADC..."), Sev::info);
-    EXPECT_EQ(status_text_severity(2, "Calibration FAILED"), Sev::error);
-    EXPECT_EQ(status_text_severity(2, "PreArm: Compass not calibrated"), Sev::error);
-    EXPECT_EQ(status_text_severity(3, "EKF variance"), Sev::error);
-    EXPECT_EQ(status_text_severity(4, "Low battery"), Sev::warning);
-    EXPECT_EQ(status_text_severity(6, "Ready to drive."), Sev::info);
+    EXPECT_EQ(status_text_severity(2, "Beginning INS calibration; do not move vehicle"), Sev::Info);
+    EXPECT_EQ(status_text_severity(1, "Initialising APM..."), Sev::Info);
+    EXPECT_EQ(status_text_severity(2, "Warming up ADC..."), Sev::Info);
+    EXPECT_EQ(status_text_severity(2, "Calibration FAILED"), Sev::Error);
+    EXPECT_EQ(status_text_severity(2, "PreArm: Compass not calibrated"), Sev::Error);
+    EXPECT_EQ(status_text_severity(3, "EKF variance"), Sev::Error);
+    EXPECT_EQ(status_text_severity(4, "Low battery"), Sev::Warning);
+    EXPECT_EQ(status_text_severity(6, "Ready to drive."), Sev::Info);
 }
 
 }  // namespace

@@ -50,9 +50,9 @@ const LinkQuality kWeak{true, 0.3, 0.0, k57600};
 TEST(TelemetryScheduler, SendsEachKindAtItsRequestedRateOnAGoodLink) {
     Sim sim;
     auto counts = sim.run(std::chrono::seconds(10), kGood);
-    EXPECT_NEAR(counts[TelemetryKind::vehicle], 20, 1);
-    EXPECT_NEAR(counts[TelemetryKind::link_stats], 10, 1);
-    EXPECT_DOUBLE_EQ(sim.scheduler.effective_hz(TelemetryKind::vehicle), 2.0);
+    EXPECT_NEAR(counts[TelemetryKind::Vehicle], 20, 1);
+    EXPECT_NEAR(counts[TelemetryKind::LinkStats], 10, 1);
+    EXPECT_DOUBLE_EQ(sim.scheduler.effective_hz(TelemetryKind::Vehicle), 2.0);
     EXPECT_DOUBLE_EQ(sim.scheduler.factor(), 1.0);
 }
 
@@ -63,11 +63,11 @@ TEST(TelemetryScheduler, KeepsPushedTelemetryWithinTheLinkBudget) {
     EXPECT_DOUBLE_EQ(sim.scheduler.budget_bytes_per_s(), 240.0);
     auto counts = sim.run(std::chrono::seconds(20), LinkQuality{true, 0, 0, 960.0});
     const double bytes_per_s =
-        (counts[TelemetryKind::vehicle] * 48.0 + counts[TelemetryKind::link_stats] * 37.0) / 20.0;
+        (counts[TelemetryKind::Vehicle] * 48.0 + counts[TelemetryKind::LinkStats] * 37.0) / 20.0;
     EXPECT_LE(bytes_per_s, 240.0 * 1.05);
     EXPECT_GT(bytes_per_s, 240.0 * 0.9);
-    EXPECT_LT(sim.scheduler.effective_hz(TelemetryKind::vehicle), 10.0);
-    EXPECT_GE(sim.scheduler.effective_hz(TelemetryKind::link_stats), c.min_hz);
+    EXPECT_LT(sim.scheduler.effective_hz(TelemetryKind::Vehicle), 10.0);
+    EXPECT_GE(sim.scheduler.effective_hz(TelemetryKind::LinkStats), c.min_hz);
 }
 
 TEST(TelemetryScheduler, LowersUnderAWeakLinkAndRestoresAfterRecovery) {
@@ -77,12 +77,12 @@ TEST(TelemetryScheduler, LowersUnderAWeakLinkAndRestoresAfterRecovery) {
     EXPECT_DOUBLE_EQ(sim.scheduler.factor(), 0.125);
     EXPECT_TRUE(sim.scheduler.weak());
     EXPECT_EQ(sim.scheduler.lowerings(), 3u);
-    EXPECT_DOUBLE_EQ(sim.scheduler.effective_hz(TelemetryKind::vehicle), 0.25);
-    EXPECT_DOUBLE_EQ(sim.scheduler.effective_hz(TelemetryKind::link_stats), 0.2);  // the floor
+    EXPECT_DOUBLE_EQ(sim.scheduler.effective_hz(TelemetryKind::Vehicle), 0.25);
+    EXPECT_DOUBLE_EQ(sim.scheduler.effective_hz(TelemetryKind::LinkStats), 0.2);  // the floor
     // Over the last 10 s the factor was already at its floor: about 2.5 samples, never none.
     auto floor = sim.run(std::chrono::seconds(10), kWeak);
-    EXPECT_NEAR(floor[TelemetryKind::vehicle], 2.5, 1);
-    EXPECT_LT(weak[TelemetryKind::vehicle], 40 / 2);
+    EXPECT_NEAR(floor[TelemetryKind::Vehicle], 2.5, 1);
+    EXPECT_LT(weak[TelemetryKind::Vehicle], 40 / 2);
 
     // Good again: one doubling per 10 s of good link, back to the requested rates.
     sim.run(std::chrono::seconds(9), kGood);
@@ -91,7 +91,7 @@ TEST(TelemetryScheduler, LowersUnderAWeakLinkAndRestoresAfterRecovery) {
     EXPECT_DOUBLE_EQ(sim.scheduler.factor(), 1.0);
     EXPECT_EQ(sim.scheduler.restorations(), 3u);
     auto restored = sim.run(std::chrono::seconds(10), kGood);
-    EXPECT_NEAR(restored[TelemetryKind::vehicle], 20, 1);
+    EXPECT_NEAR(restored[TelemetryKind::Vehicle], 20, 1);
 }
 
 TEST(TelemetryScheduler, ReplacedTelemetryCountsAsAWeakLink) {
@@ -120,18 +120,18 @@ TEST(TelemetryScheduler, ALinkDownChangesNothing) {
 
 TEST(TelemetryScheduler, RatesFromTheGroundAreCheckedAndTakeEffect) {
     Sim sim;
-    EXPECT_TRUE(sim.scheduler.set_rate(TelemetryKind::vehicle, 25.0, sim.now).has_value());
-    EXPECT_TRUE(sim.scheduler.set_rate(TelemetryKind::vehicle, -1.0, sim.now).has_value());
-    EXPECT_FALSE(sim.scheduler.set_rate(TelemetryKind::vehicle, 5.0, sim.now).has_value());
-    EXPECT_FALSE(sim.scheduler.set_rate(TelemetryKind::link_stats, 0.0, sim.now).has_value());
+    EXPECT_TRUE(sim.scheduler.set_rate(TelemetryKind::Vehicle, 25.0, sim.now).has_value());
+    EXPECT_TRUE(sim.scheduler.set_rate(TelemetryKind::Vehicle, -1.0, sim.now).has_value());
+    EXPECT_FALSE(sim.scheduler.set_rate(TelemetryKind::Vehicle, 5.0, sim.now).has_value());
+    EXPECT_FALSE(sim.scheduler.set_rate(TelemetryKind::LinkStats, 0.0, sim.now).has_value());
     auto counts = sim.run(std::chrono::seconds(10), kGood);
-    EXPECT_NEAR(counts[TelemetryKind::vehicle], 50, 1);
-    EXPECT_EQ(counts[TelemetryKind::link_stats], 0) << "rate 0 turns a kind off";
+    EXPECT_NEAR(counts[TelemetryKind::Vehicle], 50, 1);
+    EXPECT_EQ(counts[TelemetryKind::LinkStats], 0) << "rate 0 turns a kind off";
 
     // A reload (SIGHUP) puts the configured rates back.
     sim.scheduler.set_config(TelemetrySchedulerConfig{}, sim.now);
-    EXPECT_DOUBLE_EQ(sim.scheduler.requested_hz(TelemetryKind::vehicle), 2.0);
-    EXPECT_DOUBLE_EQ(sim.scheduler.effective_hz(TelemetryKind::link_stats), 1.0);
+    EXPECT_DOUBLE_EQ(sim.scheduler.requested_hz(TelemetryKind::Vehicle), 2.0);
+    EXPECT_DOUBLE_EQ(sim.scheduler.effective_hz(TelemetryKind::LinkStats), 1.0);
 }
 
 TEST(TelemetryScheduler, ALatePollDoesNotBurst) {

@@ -97,7 +97,7 @@ TEST(GroundProtocol, TelemetryClampsOutOfRangeValues) {
 TEST(GroundProtocol, OtherMessagesRoundTrip) {
     std::vector<Message> messages{
         LinkStatsReport{180, 52, 4800, 17, 2},
-        Event{Event::Severity::warning, "autopilot rebooted"},
+        Event{Event::Severity::Warning, "autopilot rebooted"},
         Command{42, {{"cmd", "param.set"}, {"name", "WP_RADIUS"}, {"value", 2.5}}},
         Result{42, {{"ok", true}, {"result", {{"value", 2.5}}}}},
     };
@@ -138,7 +138,7 @@ TEST(GroundProtocol, AStatusAnswerIsCompressedToAFewHundredBytesAndRoundTrips) {
     const Result answer{9, {{"ok", true}, {"result", status}}};
     const auto cbor = nlohmann::json::to_cbor(answer.answer);
     const auto wire = encode(answer);
-    EXPECT_EQ(wire[1], static_cast<std::uint8_t>(MessageType::result_deflated));
+    EXPECT_EQ(wire[1], static_cast<std::uint8_t>(MessageType::ResultDeflated));
     EXPECT_LT(wire.size(), cbor.size() / 2) << "cbor " << cbor.size() << " bytes";
     const auto back = decode(wire);
     ASSERT_TRUE(back.message) << back.error;
@@ -146,7 +146,7 @@ TEST(GroundProtocol, AStatusAnswerIsCompressedToAFewHundredBytesAndRoundTrips) {
 
     // A short command stays plain CBOR: compressing it would not pay.
     const auto status_cmd = encode(Command{1, {{"cmd", "status"}}});
-    EXPECT_EQ(status_cmd[1], static_cast<std::uint8_t>(MessageType::command));
+    EXPECT_EQ(status_cmd[1], static_cast<std::uint8_t>(MessageType::Command));
 }
 
 TEST(GroundProtocol, ADamagedCompressedPayloadIsNamedNotDecoded) {
@@ -155,7 +155,7 @@ TEST(GroundProtocol, ADamagedCompressedPayloadIsNamedNotDecoded) {
         big["key_" + std::to_string(i)] = "value " + std::to_string(i);
     }
     auto wire = encode(Command{3, {{"cmd", "plan.load"}, {"plan", big}}});
-    ASSERT_EQ(wire[1], static_cast<std::uint8_t>(MessageType::command_deflated));
+    ASSERT_EQ(wire[1], static_cast<std::uint8_t>(MessageType::CommandDeflated));
     auto truncated = wire;
     truncated.resize(truncated.size() / 2);
     const auto d = decode(truncated);
@@ -164,7 +164,7 @@ TEST(GroundProtocol, ADamagedCompressedPayloadIsNamedNotDecoded) {
     // A stream that would inflate beyond the limit is refused, not allocated.
     const std::vector<std::uint8_t> zeros(kMaxInflated + 1024, 0);
     auto bomb = std::vector<std::uint8_t>{
-        kVersion, static_cast<std::uint8_t>(MessageType::result_deflated), 1, 0, 0, 0};
+        kVersion, static_cast<std::uint8_t>(MessageType::ResultDeflated), 1, 0, 0, 0};
     const auto packed = deflate_payload(zeros);
     bomb.insert(bomb.end(), packed.begin(), packed.end());
     EXPECT_LT(packed.size(), 2048U);

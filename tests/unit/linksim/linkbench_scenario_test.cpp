@@ -17,7 +17,7 @@ Scenario short_scenario(LinkMode mode) {
 }
 
 TEST(LinkbenchScenario, SeedOnItsOwnPairRunsNearLineRate) {
-    const auto r = run_scenario(short_scenario(LinkMode::dual), make_seed_endpoint);
+    const auto r = run_scenario(short_scenario(LinkMode::Dual), make_seed_endpoint);
     ASSERT_TRUE(r.ran);
     // One-way pair: only framing (9 bytes per 300, DLE/ETX, DLE doubling) stands between it and line rate.
     EXPECT_GT(r.goodput_pct, 85.0);
@@ -28,7 +28,7 @@ TEST(LinkbenchScenario, SeedOnItsOwnPairRunsNearLineRate) {
 }
 
 TEST(LinkbenchScenario, SeedOverrunsAHalfDuplexRadioSharedWithItsAcks) {
-    const auto r = run_scenario(short_scenario(LinkMode::single), make_seed_endpoint);
+    const auto r = run_scenario(short_scenario(LinkMode::Single), make_seed_endpoint);
     ASSERT_TRUE(r.ran);
     // Unpaced writes at the serial rate into a radio whose air also carries the ACKs: the FIFO overflows.
     EXPECT_GT(r.radio_overflow, 1000u);
@@ -37,17 +37,17 @@ TEST(LinkbenchScenario, SeedOverrunsAHalfDuplexRadioSharedWithItsAcks) {
 }
 
 TEST(LinkbenchScenario, SameScenarioSameFigures) {
-    Scenario s = short_scenario(LinkMode::dual);
+    Scenario s = short_scenario(LinkMode::Dual);
     s.byte_corruption = 1e-3;
     const auto a = run_scenario(s, make_seed_endpoint);
     const auto b = run_scenario(s, make_seed_endpoint);
     EXPECT_EQ(a.goodput_pct, b.goodput_pct);
     EXPECT_EQ(a.safe_messages, b.safe_messages);
-    EXPECT_LT(a.goodput_pct, run_scenario(short_scenario(LinkMode::dual), make_seed_endpoint).goodput_pct);
+    EXPECT_LT(a.goodput_pct, run_scenario(short_scenario(LinkMode::Dual), make_seed_endpoint).goodput_pct);
 }
 
 TEST(LinkbenchReport, TargetsWithoutOursAreNotEvaluated) {
-    Row row{short_scenario(LinkMode::single), ScenarioResult{}, ScenarioResult{}};
+    Row row{short_scenario(LinkMode::Single), ScenarioResult{}, ScenarioResult{}};
     row.seed.ran = true;
     row.seed.goodput_pct = 96.0;
     const auto checks = check_targets({row});

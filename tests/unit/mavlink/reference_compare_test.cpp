@@ -24,7 +24,11 @@ namespace {
 using test::NoisyStream;
 using test::SentFrame;
 
-enum Decoded : std::uint8_t { kNo = 0, kVerified = 1, kUnverified = 2 };
+// How a sent frame came out of a decoder (an index into the per-kind counters below).
+using Decoded = std::uint8_t;
+constexpr Decoded kNo = 0;
+constexpr Decoded kVerified = 1;
+constexpr Decoded kUnverified = 2;
 
 // What one decoder made of a stream: for each sent frame, whether it was decoded with the bytes it was
 // sent with; and how many delivered frames were not such a frame.
