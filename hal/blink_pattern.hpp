@@ -4,7 +4,7 @@
 // pattern means belongs to its owner (the status LED's meanings are in services/autopilot/status_led.hpp).
 #include <span>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 
 namespace airseg::hal {
 

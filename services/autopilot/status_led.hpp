@@ -13,9 +13,9 @@
 // A pattern starts its cycle when it is chosen, so a person sees it from its beginning.
 #include <iosfwd>
 
+#include "base/time.hpp"
 #include "hal/blink_pattern.hpp"
 #include "services/autopilot/autopilot.hpp"
-#include "services/common/time.hpp"
 
 namespace airseg::autopilot {
 
