@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 
 namespace airseg::cli {
 

@@ -1,22 +1,12 @@
 #pragma once
-// Status LED patterns as pure functions of time (no timer, no GPIO): what level the LED shows at time t
-// after the pattern started, and when it next changes. The daemon's status LED driver (through
-// autopilot::StatusLed) drives a GpioLine from these.
-#include <iosfwd>
+// Blink patterns as pure functions of time (no timer, no GPIO): what level a line shows at time t after the
+// pattern started, and when it next changes. A pattern is one cycle of on/off steps that repeats; what a
+// pattern means belongs to its owner (the status LED's meanings are in services/autopilot/status_led.hpp).
 #include <span>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 
 namespace airseg::hal {
-
-/// What the status LED tells someone looking at the vehicle.
-enum class LedPattern {
-    Off,
-    Booting,  ///< fast even blink, 100 ms on / 100 ms off: the daemon is starting
-    Ready,    ///< slow even blink, 1 s on / 1 s off: autopilot connected, no ground link
-    LinkUp,   ///< on, with a 100 ms dark blip every 2 s: ground link up (the blip shows the daemon is alive)
-    Fault,    ///< double flash every second: a service reports a fault
-};
 
 /// One segment of a pattern's cycle.
 struct BlinkStep {
@@ -24,16 +14,14 @@ struct BlinkStep {
     Duration length;
 };
 
-/// One cycle of `pattern`; the cycle repeats. Off is a single dark step.
-std::span<const BlinkStep> blink_steps(LedPattern pattern) noexcept;
-/// Length of one cycle.
-Duration blink_period(LedPattern pattern) noexcept;
-/// LED level `elapsed` after the pattern started (negative elapsed counts as 0).
-bool led_level(LedPattern pattern, Duration elapsed) noexcept;
-/// Time since the pattern started at which the level next changes after `elapsed`; Duration::max() if never.
-Duration next_led_change(LedPattern pattern, Duration elapsed) noexcept;
+/// One cycle of steps, repeated forever. An empty cycle, or one of zero length, is dark and never changes.
+using BlinkPattern = std::span<const BlinkStep>;
 
-const char* to_string(LedPattern pattern) noexcept;
-std::ostream& operator<<(std::ostream& os, LedPattern pattern);
+/// Length of one cycle.
+Duration blink_period(BlinkPattern pattern) noexcept;
+/// Level `elapsed` after the pattern started (negative elapsed counts as 0).
+bool blink_level(BlinkPattern pattern, Duration elapsed) noexcept;
+/// Time since the pattern started at which the level next changes after `elapsed`; Duration::max() if never.
+Duration next_blink_change(BlinkPattern pattern, Duration elapsed) noexcept;
 
 }  // namespace airseg::hal

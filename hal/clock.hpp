@@ -2,7 +2,7 @@
 // The clock seam: code that needs "now" outside a sans-IO core takes a hal::Clock&, so tests can drive time.
 #include <atomic>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 
 namespace airseg::hal {
 

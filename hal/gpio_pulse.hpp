@@ -4,9 +4,9 @@
 #include <memory>
 #include <system_error>
 
+#include "base/time.hpp"
 #include "hal/asio.hpp"
 #include "hal/gpio.hpp"
-#include "services/common/time.hpp"
 
 namespace airseg::hal {
 

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "base/time.hpp"
 #include "hal/asio.hpp"
 #include "hal/error.hpp"
-#include "services/common/time.hpp"
 
 namespace airseg::hal {
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 
 namespace airseg::linkbench {
 

@@ -38,7 +38,7 @@
 #include <span>
 #include <vector>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 
 namespace airseg::linkbench::seed {
 

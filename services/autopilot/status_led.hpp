@@ -1,8 +1,8 @@
 #pragma once
 // StatusLed: what the vehicle's status LED shows, sans-IO. It takes the autopilot status and the ground link
 // state as they change, with the time, and answers which pattern is on, the LED level at any time and when
-// that level next changes (patterns from hal/blink_pattern.hpp). A thin adapter in the daemon drives a GPIO
-// line from it with one timer.
+// that level next changes (played by hal/blink_pattern.hpp). A thin adapter in the daemon drives a GPIO line
+// from it with one timer.
 //
 // Patterns, most important first:
 //   Fault    double flash: the autopilot link was up and is lost (heartbeats stopped, port unplugged), or
@@ -11,11 +11,28 @@
 //   LinkUp   on with a short dark blip: autopilot READY and the ground link up
 //   Ready    slow blink: autopilot READY, no ground link
 // A pattern starts its cycle when it is chosen, so a person sees it from its beginning.
+#include <iosfwd>
+
+#include "base/time.hpp"
 #include "hal/blink_pattern.hpp"
 #include "services/autopilot/autopilot.hpp"
-#include "services/common/time.hpp"
 
 namespace airseg::autopilot {
+
+/// What the status LED tells someone looking at the vehicle.
+enum class LedPattern {
+    Off,
+    Booting,  ///< fast even blink, 100 ms on / 100 ms off: the daemon is starting
+    Ready,    ///< slow even blink, 1 s on / 1 s off: autopilot connected, no ground link
+    LinkUp,   ///< on, with a 100 ms dark blip every 2 s: ground link up (the blip shows the daemon is alive)
+    Fault,    ///< double flash every second: a service reports a fault
+};
+
+/// How `pattern` blinks: one cycle, repeated. Off is a single dark step.
+hal::BlinkPattern blink_steps(LedPattern pattern) noexcept;
+
+const char* to_string(LedPattern pattern) noexcept;
+std::ostream& operator<<(std::ostream& os, LedPattern pattern);
 
 class StatusLed {
   public:
@@ -25,7 +42,7 @@ class StatusLed {
     void autopilot(const AutopilotStatus& status, TimePoint now);
     void ground_link(bool up, TimePoint now);
 
-    hal::LedPattern pattern() const { return pattern_; }
+    LedPattern pattern() const { return pattern_; }
     /// When the current pattern was chosen.
     TimePoint since() const { return since_; }
     /// LED level at `now` (not before since()).
@@ -36,7 +53,7 @@ class StatusLed {
   private:
     void choose(TimePoint now);
 
-    hal::LedPattern pattern_ = hal::LedPattern::Booting;
+    LedPattern pattern_ = LedPattern::Booting;
     TimePoint since_;
     bool ready_ = false;
     bool link_up_ = false;

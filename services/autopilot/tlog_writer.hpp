@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 
 namespace airseg::autopilot {
 

@@ -7,8 +7,8 @@
 #include <memory>
 #include <utility>
 
+#include "base/time.hpp"
 #include "services/common/asio.hpp"
-#include "services/common/time.hpp"
 
 namespace airseg {
 

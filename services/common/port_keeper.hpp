@@ -5,9 +5,9 @@
 #include <span>
 #include <string>
 
+#include "base/time.hpp"
 #include "hal/serial_port.hpp"
 #include "services/common/asio.hpp"
-#include "services/common/time.hpp"
 
 namespace airseg {
 

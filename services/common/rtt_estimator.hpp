@@ -6,7 +6,7 @@
 #include <chrono>
 #include <cstdint>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 
 namespace airseg {
 

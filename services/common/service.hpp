@@ -9,11 +9,11 @@
 #include <mutex>
 #include <string>
 
+#include "base/time.hpp"
 #include "services/common/asio.hpp"
 #include "services/common/bus.hpp"
 #include "services/common/command_dispatcher.hpp"
 #include "services/common/health.hpp"
-#include "services/common/time.hpp"
 
 namespace airseg {
 

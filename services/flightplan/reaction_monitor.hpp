@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 #include "services/flightplan/geo.hpp"
 #include "services/flightplan/plan.hpp"
 

@@ -30,7 +30,7 @@
 #include <string_view>
 #include <vector>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 #include "services/flightplan/feeder_types.hpp"
 #include "services/flightplan/waypoint.hpp"
 

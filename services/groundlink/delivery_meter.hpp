@@ -10,7 +10,7 @@
 #include <deque>
 #include <optional>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 
 namespace airseg::groundlink {
 

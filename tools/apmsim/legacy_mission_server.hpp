@@ -30,9 +30,9 @@
 #include <cstdint>
 #include <functional>
 
+#include "base/time.hpp"
 #include "services/autopilot/mavlink/frame.hpp"
 #include "services/autopilot/mavlink/messages.hpp"
-#include "services/common/time.hpp"
 #include "tools/apmsim/mission_server.hpp"
 #include "tools/apmsim/mission_store.hpp"
 #include "tools/apmsim/outbox.hpp"

@@ -21,8 +21,8 @@
 #include <functional>
 #include <optional>
 
+#include "base/time.hpp"
 #include "services/autopilot/mavlink/frame.hpp"
-#include "services/common/time.hpp"
 #include "tools/apmsim/mission_store.hpp"
 #include "tools/apmsim/outbox.hpp"
 

@@ -9,9 +9,9 @@
 #include <utility>
 #include <vector>
 
+#include "base/time.hpp"
 #include "services/autopilot/mavlink/encoder.hpp"
 #include "services/autopilot/mavlink/messages.hpp"
-#include "services/common/time.hpp"
 
 namespace airseg::apmsim {
 

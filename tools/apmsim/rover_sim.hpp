@@ -32,9 +32,9 @@
 #include <string>
 #include <vector>
 
+#include "base/time.hpp"
 #include "services/autopilot/mavlink/frame.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
-#include "services/common/time.hpp"
 #include "tools/apmsim/firmware_profile.hpp"
 #include "tools/apmsim/legacy_mission_server.hpp"
 #include "tools/apmsim/legacy_parser.hpp"

@@ -7,7 +7,7 @@
 #include <string_view>
 #include <vector>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 
 namespace airseg::apmsim {
 

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <optional>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 
 namespace airseg::apmsim {
 

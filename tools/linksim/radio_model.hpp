@@ -39,7 +39,7 @@
 #include <span>
 #include <vector>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 #include "tools/linksim/radio_config.hpp"
 
 namespace airseg::linksim {

@@ -40,6 +40,7 @@
 #include <variant>
 #include <vector>
 
+#include "base/time.hpp"
 #include "services/autopilot/ardupilot/auto_entry_check.hpp"
 #include "services/autopilot/ardupilot/link_watch.hpp"
 #include "services/autopilot/ardupilot/mission_client.hpp"
@@ -50,7 +51,6 @@
 #include "services/autopilot/autopilot.hpp"
 #include "services/autopilot/autopilot_config.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
-#include "services/common/time.hpp"
 
 namespace airseg::autopilot::ardupilot {
 

@@ -18,7 +18,7 @@
 #include <utility>
 #include <vector>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 
 namespace airseg::autopilot::ardupilot {
 

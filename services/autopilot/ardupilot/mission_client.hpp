@@ -38,12 +38,12 @@
 #include <string>
 #include <vector>
 
+#include "base/time.hpp"
 #include "services/autopilot/ardupilot/outbox.hpp"
 #include "services/autopilot/autopilot_config.hpp"
 #include "services/autopilot/mavlink/frame.hpp"
 #include "services/autopilot/mavlink/messages.hpp"
 #include "services/common/rtt_estimator.hpp"
-#include "services/common/time.hpp"
 
 namespace airseg::autopilot::ardupilot {
 

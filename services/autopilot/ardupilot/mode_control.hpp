@@ -14,8 +14,8 @@
 #include <string>
 #include <utility>
 
+#include "base/time.hpp"
 #include "services/autopilot/autopilot.hpp"
-#include "services/common/time.hpp"
 
 namespace airseg::autopilot::ardupilot {
 

@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
+#include "base/time.hpp"
 #include "services/autopilot/ardupilot/outbox.hpp"
 #include "services/autopilot/autopilot.hpp"
 #include "services/autopilot/mavlink/frame.hpp"
-#include "services/common/time.hpp"
 
 namespace airseg::autopilot::ardupilot {
 

@@ -11,9 +11,9 @@
 // sending what it returns.
 #include <optional>
 
+#include "base/time.hpp"
 #include "services/autopilot/autopilot_config.hpp"
 #include "services/autopilot/mavlink/messages.hpp"
-#include "services/common/time.hpp"
 
 namespace airseg::autopilot::ardupilot {
 

@@ -7,7 +7,7 @@
 #include <optional>
 #include <vector>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 #include "services/groundlink/transport/frame.hpp"
 
 namespace airseg::groundlink {

@@ -14,7 +14,7 @@
 #include <span>
 #include <vector>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 
 namespace airseg::groundlink::fec {
 

@@ -9,7 +9,7 @@
 #include <span>
 #include <vector>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 #include "services/groundlink/transport/frame.hpp"
 
 namespace airseg::groundlink {

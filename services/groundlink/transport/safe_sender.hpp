@@ -10,7 +10,7 @@
 #include <span>
 #include <vector>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 #include "services/groundlink/transport/frame.hpp"
 #include "services/groundlink/transport/transport.hpp"
 

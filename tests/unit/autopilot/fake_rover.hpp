@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
+#include "base/time.hpp"
 #include "services/autopilot/mavlink/encoder.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
-#include "services/common/time.hpp"
 
 namespace airseg::autopilot::testing {
 

@@ -12,7 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include "services/common/time.hpp"
+#include "base/time.hpp"
 
 namespace airseg::autopilot::testing {
 

@@ -1,5 +1,5 @@
-// The status LED core in simulated time: which pattern each situation shows, and the levels a person would
-// see on the line, sampled every 10 ms.
+// The status LED core in simulated time: how each pattern blinks, which pattern each situation shows, and the
+// levels a person would see on the line, sampled every 10 ms.
 #include "services/autopilot/status_led.hpp"
 
 #include <gtest/gtest.h>
@@ -8,8 +8,6 @@
 
 namespace airseg::autopilot {
 namespace {
-
-using hal::LedPattern;
 
 const TimePoint kStart = TimePoint{} + std::chrono::hours(2);
 
@@ -47,6 +45,79 @@ Seen watch(const StatusLed& led, TimePoint from, TimePoint to) {
     }
     s.on_fraction = static_cast<double>(on) / samples;
     return s;
+}
+
+bool lit(LedPattern p, Duration elapsed) {
+    return hal::blink_level(blink_steps(p), elapsed);
+}
+
+// The changes next_blink_change predicts from the start until `span`.
+std::vector<Duration> predicted_changes(LedPattern p, Duration span) {
+    std::vector<Duration> changes;
+    for (Duration t = hal::next_blink_change(blink_steps(p), Duration::zero()); t < span;
+         t = hal::next_blink_change(blink_steps(p), t)) {
+        changes.push_back(t);
+    }
+    return changes;
+}
+
+TEST(StatusLedPattern, BootingBlinksFastAndEvenly) {
+    EXPECT_TRUE(lit(LedPattern::Booting, milliseconds(0)));
+    EXPECT_TRUE(lit(LedPattern::Booting, milliseconds(99)));
+    EXPECT_FALSE(lit(LedPattern::Booting, milliseconds(100)));
+    EXPECT_TRUE(lit(LedPattern::Booting, milliseconds(200)));
+    EXPECT_EQ(hal::blink_period(blink_steps(LedPattern::Booting)), milliseconds(200));
+}
+
+TEST(StatusLedPattern, ReadyBlinksSlowly) {
+    EXPECT_TRUE(lit(LedPattern::Ready, milliseconds(999)));
+    EXPECT_FALSE(lit(LedPattern::Ready, milliseconds(1000)));
+    EXPECT_FALSE(lit(LedPattern::Ready, milliseconds(1999)));
+    EXPECT_TRUE(lit(LedPattern::Ready, milliseconds(2000)));
+}
+
+TEST(StatusLedPattern, LinkUpIsMostlyOnWithABlip) {
+    int on = 0;
+    for (int ms = 0; ms < 2000; ++ms) {
+        on += lit(LedPattern::LinkUp, milliseconds(ms)) ? 1 : 0;
+    }
+    EXPECT_EQ(on, 1900);
+    EXPECT_FALSE(lit(LedPattern::LinkUp, milliseconds(1950)));
+}
+
+TEST(StatusLedPattern, FaultFlashesTwicePerSecond) {
+    EXPECT_EQ(predicted_changes(LedPattern::Fault, milliseconds(1000)),
+              (std::vector<Duration>{milliseconds(100), milliseconds(200), milliseconds(300)}));
+    for (int ms : {0, 99, 200, 299}) {
+        EXPECT_TRUE(lit(LedPattern::Fault, milliseconds(ms))) << ms;
+    }
+    for (int ms : {100, 199, 300, 999}) {
+        EXPECT_FALSE(lit(LedPattern::Fault, milliseconds(ms))) << ms;
+    }
+}
+
+TEST(StatusLedPattern, OffNeverLightsOrChanges) {
+    for (int ms = 0; ms < 5000; ++ms) {
+        ASSERT_FALSE(lit(LedPattern::Off, milliseconds(ms))) << ms;
+    }
+    EXPECT_EQ(hal::next_blink_change(blink_steps(LedPattern::Off), milliseconds(0)), Duration::max());
+}
+
+// Every blinking pattern changes level exactly where next_blink_change says, millisecond by millisecond.
+TEST(StatusLedPattern, LevelChangesOnlyWherePredicted) {
+    for (auto p : {LedPattern::Booting, LedPattern::Ready, LedPattern::LinkUp, LedPattern::Fault}) {
+        const Duration span = 3 * hal::blink_period(blink_steps(p));
+        const auto predicted = predicted_changes(p, span);
+        ASSERT_GE(predicted.size(), 2U) << p;
+        auto next = predicted.begin();
+        for (Duration t = milliseconds(1); t < span; t += milliseconds(1)) {
+            const bool changed = lit(p, t) != lit(p, t - milliseconds(1));
+            const bool expected = next != predicted.end() && *next == t;
+            ASSERT_EQ(changed, expected) << p << " at " << t.count();
+            next += expected ? 1 : 0;
+        }
+        EXPECT_EQ(next, predicted.end()) << p;
+    }
 }
 
 TEST(StatusLed, ShowsBootingThenReadyThenGroundLinkThenFaultThenRecovers) {

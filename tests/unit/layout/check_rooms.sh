@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Each line of code knows its room: only hal/ touches termios and libgpiod, only daemon/ talks to systemd,
-# and nothing outside services/autopilot/ (and the tools that speak to an autopilot) knows MAVLink.
+# nothing outside services/autopilot/ (and the tools that speak to an autopilot) knows MAVLink, and the lower
+# rooms (base/ at the bottom, hal/ above it) know nothing of the rooms above them.
 set -euo pipefail
 root=${1:?source dir}
 cd "$root"
@@ -32,4 +33,11 @@ report "ArduPilot/MAVLink headers (included by groundlink or flightplan)" \
 report "the ArduPilot driver or MAVLink library (linked by groundlink or flightplan)" \
   "$(grep -lE 'airseg_mavlink|airseg_autopilot([^_[:alnum:]]|$)' services/groundlink/CMakeLists.txt \
        services/flightplan/CMakeLists.txt || true)"
+# hal/ sits below the services and the programs; it may use base/ and itself only.
+report "services/, daemon/ or client/ headers (included by hal)" \
+  "$(grep -rlE '#include "(services|daemon|client)/' --include='*.cpp' --include='*.hpp' --include='*.h' hal || true)"
+# base/ is the bottom room: every other room may include it, so it includes none of them.
+report "headers of other rooms (included by base)" \
+  "$(grep -rn '#include "' --include='*.cpp' --include='*.hpp' --include='*.h' base | grep -v '#include "base/' ||
+       true)"
 exit $fail
