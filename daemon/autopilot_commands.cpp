@@ -15,6 +15,29 @@ bool valid_param_name(const Json& name) {
            name.get_ref<const std::string&>().size() <= 16;
 }
 
+// What an ok reply carries: `result` completed from the autopilot's answer.
+Json completed_result(const autopilot::RequestDone& done, Json result) {
+    switch (done.kind) {
+        case autopilot::RequestKind::GetParam:
+        case autopilot::RequestKind::SetParam:
+            if (done.param_value) {
+                result["value"] = *done.param_value;
+            }
+            break;
+        case autopilot::RequestKind::ListParams: {
+            auto& params = result["params"] = Json::object();
+            for (const auto& [name, value] : done.params) {
+                params[name] = value;
+            }
+            result["count"] = done.params.size();
+            break;
+        }
+        default:
+            break;
+    }
+    return result;
+}
+
 }  // namespace
 
 CommandResult command_result(const autopilot::RequestDone& done, Json result) {
@@ -39,9 +62,6 @@ CommandResult command_result(const autopilot::RequestDone& done, Json result) {
 
 AutopilotCommands::AutopilotCommands(Bus& bus, CommandDispatcher& commands, Strand strand)
     : bus_(bus), strand_(strand) {
-    done_subscription_ = bus_.subscribe<autopilot::RequestDone>(
-        strand_, [this](const autopilot::RequestDone& done) { on_done(done); });
-
     commands.add("state", strand_, Role::Control, [this](const Json& req, CommandDispatcher::Reply reply) {
         const auto it = req.find("state");
         const auto state = it != req.end() && it->is_string()
@@ -53,8 +73,7 @@ AutopilotCommands::AutopilotCommands(Bus& bus, CommandDispatcher& commands, Stra
                                       "WAYPOINT_NAVIGATION"));
             return;
         }
-        request({0, autopilot::RequestStateChange{*state}}, {{"state", state_name(*state)}},
-                std::move(reply));
+        request(autopilot::RequestStateChange{*state}, {{"state", state_name(*state)}}, std::move(reply));
     });
     commands.add(
         "param.get", strand_, Role::Monitor, [this](const Json& req, CommandDispatcher::Reply reply) {
@@ -64,7 +83,7 @@ AutopilotCommands::AutopilotCommands(Bus& bus, CommandDispatcher& commands, Stra
                                           "\"name\" must be a parameter name (1..16)"));
                 return;
             }
-            request({0, autopilot::GetParam{name.get<std::string>()}}, {{"name", name}}, std::move(reply));
+            request(autopilot::GetParam{name.get<std::string>()}, {{"name", name}}, std::move(reply));
         });
     commands.add("param.set", strand_, Role::Control,
                  [this](const Json& req, CommandDispatcher::Reply reply) {
@@ -79,7 +98,7 @@ AutopilotCommands::AutopilotCommands(Bus& bus, CommandDispatcher& commands, Stra
                          reply(CommandResult::fail(CommandStatus::BadRequest, "\"value\" must be a number"));
                          return;
                      }
-                     request({0, autopilot::SetParam{name.get<std::string>(), value.get<double>()}},
+                     request(autopilot::SetParam{name.get<std::string>(), value.get<double>()},
                              {{"name", name}}, std::move(reply));
                  });
     add_param_list(commands);
@@ -87,44 +106,22 @@ AutopilotCommands::AutopilotCommands(Bus& bus, CommandDispatcher& commands, Stra
 
 void AutopilotCommands::add_param_list(CommandDispatcher& commands) {
     commands.add("param.list", strand_, Role::Monitor, [this](const Json&, CommandDispatcher::Reply reply) {
-        request({0, autopilot::ListParams{}}, Json::object(), std::move(reply));
+        request(autopilot::ListParams{}, Json::object(), std::move(reply));
     });
 }
 
-void AutopilotCommands::request(autopilot::AutopilotRequest r, Json result, CommandDispatcher::Reply reply) {
-    r.id = next_id_;
-    next_id_ = next_id_ == UINT32_MAX ? kFirstId : next_id_ + 1;
-    pending_[r.id] = Pending{std::move(result), std::move(reply)};
+void AutopilotCommands::request(Op op, Json result, CommandDispatcher::Reply reply) {
+    autopilot::AutopilotRequest r;
+    r.op = std::move(op);
+    autopilot::RequestDone not_answered;
+    not_answered.result = RequestResult::Cancelled;
+    not_answered.detail = "not answered: the autopilot service is not running";
+    r.reply = Reply<autopilot::RequestDone>(
+        strand_, guard_, std::move(not_answered),
+        [result = std::move(result), reply = std::move(reply)](const autopilot::RequestDone& done) mutable {
+            reply(command_result(done, completed_result(done, std::move(result))));
+        });
     bus_.publish(std::move(r));
-}
-
-void AutopilotCommands::on_done(const autopilot::RequestDone& done) {
-    const auto it = pending_.find(done.id);
-    if (it == pending_.end()) {
-        return;  // another requester's
-    }
-    auto reply = std::move(it->second.reply);
-    Json result = std::move(it->second.result);
-    pending_.erase(it);
-    switch (done.kind) {
-        case autopilot::RequestKind::GetParam:
-        case autopilot::RequestKind::SetParam:
-            if (done.param_value) {
-                result["value"] = *done.param_value;
-            }
-            break;
-        case autopilot::RequestKind::ListParams: {
-            auto& params = result["params"] = Json::object();
-            for (const auto& [name, value] : done.params) {
-                params[name] = value;
-            }
-            result["count"] = done.params.size();
-            break;
-        }
-        default:
-            break;
-    }
-    reply(command_result(done, std::move(result)));
 }
 
 }  // namespace airseg::daemon

@@ -10,6 +10,8 @@
 #include <variant>
 #include <vector>
 
+#include "services/common/reply.hpp"
+
 namespace airseg::autopilot {
 
 /// The vehicle states of the USAL virtual autopilot, as the rest of the system reasons about them.
@@ -148,7 +150,8 @@ struct RequestDone {
 using Event = std::variant<WaypointReached, MissionCurrentChanged, ModeChanged, LinkUp, LinkDown,
                            AutopilotRebooted, Ready, StatusText, RequestDone>;
 
-// --- bus requests to the autopilot service (answered by a RequestDone event with the same id) -------------
+// --- bus requests to the autopilot service (answered through their Reply)
+// -----------------------------------
 struct RequestStateChange {
     VehicleState state = VehicleState::Parking;
 };
@@ -174,10 +177,15 @@ struct SetParam {
 /// The parameter table as downloaded at connection (and kept current by every set and PARAM_VALUE).
 struct ListParams {};
 struct AutopilotRequest {
-    std::uint32_t id = 0;  // chosen by the requester, echoed in RequestDone::id
+    // Transitional, for the flight plan manager until it moves to `reply`: a request without a reply is
+    // answered by a RequestDone event carrying this id, chosen by the requester. Leave it 0 with a reply.
+    std::uint32_t id = 0;
     std::variant<RequestStateChange, UploadMission, WriteMissionItems, DownloadMission, SetMissionCurrent,
                  ClearMission, GetParam, SetParam, ListParams>
         op;
+    // Answered once, when the request is finished; its fallback should say the autopilot service did not
+    // answer (not running), which is what the requester gets when no service takes the request.
+    Reply<RequestDone> reply;
 };
 /// Ground joystick input, -1..1 each; it drives only in MANUAL_NAVIGATION and only while it keeps coming.
 struct JoystickInput {

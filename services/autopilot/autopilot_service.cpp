@@ -93,7 +93,6 @@ void AutopilotService::on_request(const AutopilotRequest& r) {
     if (std::holds_alternative<ListParams>(r.op)) {
         // Answered from the cached table: no traffic to the autopilot, so no driver request.
         RequestDone done;
-        done.id = r.id;
         done.kind = RequestKind::ListParams;
         for (const auto& [name, entry] : driver_.params().table()) {
             done.params.emplace_back(name, static_cast<double>(entry.value));
@@ -102,7 +101,7 @@ void AutopilotService::on_request(const AutopilotRequest& r) {
             done.result = RequestResult::Refused;
             done.detail = "the parameters have not been downloaded yet (autopilot not ready)";
         }
-        ctx_.bus.publish(std::move(done));
+        answer({r.reply, r.id}, std::move(done));
         return;
     }
     const std::uint32_t id = std::visit(
@@ -129,8 +128,18 @@ void AutopilotService::on_request(const AutopilotRequest& r) {
             }
         },
         r.op);
-    requester_ids_[id] = r.id;
+    requesters_[id] = Requester{r.reply, r.id};
     pump();
+}
+
+void AutopilotService::answer(const Requester& requester, RequestDone done) {
+    if (requester.reply) {
+        requester.reply(std::move(done));
+        return;
+    }
+    // Transitional: the flight plan manager still waits for a RequestDone event with its id.
+    done.id = requester.id;
+    ctx_.bus.publish(std::move(done));
 }
 
 // Everything the driver has for the outside world, then the timer for its next deadline.
@@ -170,14 +179,19 @@ void AutopilotService::publish(Event e) {
         [&](auto& ev) {
             using T = std::decay_t<decltype(ev)>;
             if constexpr (std::is_same_v<T, RequestDone>) {
-                if (auto it = requester_ids_.find(ev.id); it != requester_ids_.end()) {
-                    ev.id = it->second;
-                    requester_ids_.erase(it);
-                }
                 if (ev.result != RequestResult::Ok) {
                     spdlog::info("{}{} #{}: {} {}", prefix_, to_string(ev.kind), ev.id, to_string(ev.result),
                                  ev.detail);
                 }
+                Requester requester;
+                if (auto it = requesters_.find(ev.id); it != requesters_.end()) {
+                    requester = std::move(it->second);
+                    requesters_.erase(it);
+                } else {
+                    requester.id = ev.id;
+                }
+                answer(requester, std::move(ev));
+                return;
             } else if constexpr (std::is_same_v<T, LinkDown>) {
                 spdlog::warn("{}link down: {}", prefix_, ev.reason);
             } else if constexpr (std::is_same_v<T, AutopilotRebooted>) {

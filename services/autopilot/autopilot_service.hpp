@@ -5,9 +5,10 @@
 // pulses the reset line when the driver asks, reopens the port at the rate the driver's baud probing asks
 // for, and records every frame in the .tlog when enabled (its flush deadline shares the driver's timer).
 //
-// Bus: subscribes AutopilotRequest, JoystickInput, OperatorReset; publishes the autopilot::Event types
-// (RequestDone with the requester's id) as events, and AutopilotStatus and Telemetry as variables.
-// Log prefix: autopilot[<device>]: .
+// Bus: subscribes AutopilotRequest (answered through its Reply), JoystickInput, OperatorReset; publishes the
+// other autopilot::Event types as events, and AutopilotStatus and Telemetry as variables. A request without a
+// Reply is answered by a RequestDone event with the requester's id (transitional, for the flight plan
+// manager). Log prefix: autopilot[<device>]: .
 #include <map>
 #include <memory>
 #include <optional>
@@ -48,7 +49,13 @@ class AutopilotService : public Service {
     void on_stop() override;
 
   private:
+    struct Requester {
+        Reply<RequestDone> reply;
+        std::uint32_t id = 0;  // transitional: for a request without a reply, the RequestDone event's id
+    };
+
     void on_request(const AutopilotRequest& r);
+    void answer(const Requester& requester, RequestDone done);
     void pump();
     void arm_timer();
     void on_timer();
@@ -68,7 +75,7 @@ class AutopilotService : public Service {
     TlogWriter tlog_;
     DeadlineTimer timer_;
     TimePoint status_published_at_{};
-    std::map<std::uint32_t, std::uint32_t> requester_ids_;  // driver id -> requester id
+    std::map<std::uint32_t, Requester> requesters_;  // driver id -> who waits for the result
     std::vector<Subscription> subscriptions_;
     bool running_ = false;
     bool switching_baud_ = false;  // the next open is a baud probe's reopen of the same device

@@ -9,7 +9,9 @@
 //  - variables (publish_latest): the latest value wins; a subscriber that has not yet run its previous
 //  delivery
 //    sees only the newest value. The last value is also kept for late subscribers and for latest<T>().
-// Calls (request -> result) are events that carry a Reply<T> (see reply.hpp).
+// Calls (request -> result) are events that carry a Reply<T> (see reply.hpp): the message is copied to each
+// subscriber, the first copy answered completes the call on the requester's strand, and a call nobody answers
+// completes with the requester's fallback, so a request needs no id and no subscription to its result.
 #include <any>
 #include <atomic>
 #include <functional>

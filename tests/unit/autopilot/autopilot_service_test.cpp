@@ -111,7 +111,10 @@ TEST(AutopilotService, ReachesReadyOnAPtyAndAnswersBusRequests) {
     ASSERT_TRUE(run_until([&] { return !ready.empty(); }));
     EXPECT_LT(ready[0].seconds_from_open, 5.0);
 
-    bus.publish(AutopilotRequest{77, RequestStateChange{VehicleState::WaypointNavigation}});
+    AutopilotRequest by_id;  // the transitional id path: answered by a RequestDone event
+    by_id.id = 77;
+    by_id.op = RequestStateChange{VehicleState::WaypointNavigation};
+    bus.publish(std::move(by_id));
     ASSERT_TRUE(run_until([&] { return !done.empty(); }));
     EXPECT_EQ(done[0].id, 77u);
     EXPECT_EQ(done[0].result, RequestResult::Ok) << done[0].detail;
@@ -128,6 +131,23 @@ TEST(AutopilotService, ReachesReadyOnAPtyAndAnswersBusRequests) {
         }
         return false;
     }));
+
+    // A request with a Reply is answered through it, on the requester's strand, and not as an event.
+    ReplyGuard guard;
+    std::vector<RequestDone> replied;
+    bool on_test_strand = false;
+    AutopilotRequest park;
+    park.op = RequestStateChange{VehicleState::Parking};
+    park.reply = Reply<RequestDone>(test_strand, guard, RequestDone{}, [&](const RequestDone& d) {
+        on_test_strand = test_strand.running_in_this_thread();
+        replied.push_back(d);
+    });
+    bus.publish(std::move(park));
+    ASSERT_TRUE(run_until([&] { return !replied.empty(); }));
+    EXPECT_EQ(replied[0].kind, RequestKind::SetState);
+    EXPECT_EQ(replied[0].result, RequestResult::Ok) << replied[0].detail;
+    EXPECT_TRUE(on_test_strand);
+    EXPECT_EQ(done.size(), 1u);
 
     service->stop();
     rover.stop();
