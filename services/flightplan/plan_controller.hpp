@@ -19,8 +19,8 @@
 #include <variant>
 #include <vector>
 
+#include "base/time.hpp"
 #include "services/autopilot/autopilot.hpp"
-#include "services/common/time.hpp"
 #include "services/flightplan/expander.hpp"
 #include "services/flightplan/persistence.hpp"
 #include "services/flightplan/plan_loader.hpp"
