@@ -113,11 +113,8 @@ void AutopilotCommands::add_param_list(CommandDispatcher& commands) {
 void AutopilotCommands::request(Op op, Json result, CommandDispatcher::Reply reply) {
     autopilot::AutopilotRequest r;
     r.op = std::move(op);
-    autopilot::RequestDone not_answered;
-    not_answered.result = RequestResult::Cancelled;
-    not_answered.detail = "not answered: the autopilot service is not running";
     r.reply = Reply<autopilot::RequestDone>(
-        strand_, guard_, std::move(not_answered),
+        strand_, guard_, autopilot::not_answered(),
         [result = std::move(result), reply = std::move(reply)](const autopilot::RequestDone& done) mutable {
             reply(command_result(done, completed_result(done, std::move(result))));
         });

@@ -87,4 +87,11 @@ const char* to_string(RequestKind k) {
     return "?";
 }
 
+RequestDone not_answered() {
+    RequestDone done;
+    done.result = RequestResult::Cancelled;
+    done.detail = "not answered: the autopilot service is not running";
+    return done;
+}
+
 }  // namespace airseg::autopilot

@@ -177,16 +177,15 @@ struct SetParam {
 /// The parameter table as downloaded at connection (and kept current by every set and PARAM_VALUE).
 struct ListParams {};
 struct AutopilotRequest {
-    // Transitional, for the flight plan manager until it moves to `reply`: a request without a reply is
-    // answered by a RequestDone event carrying this id, chosen by the requester. Leave it 0 with a reply.
-    std::uint32_t id = 0;
     std::variant<RequestStateChange, UploadMission, WriteMissionItems, DownloadMission, SetMissionCurrent,
                  ClearMission, GetParam, SetParam, ListParams>
         op;
-    // Answered once, when the request is finished; its fallback should say the autopilot service did not
-    // answer (not running), which is what the requester gets when no service takes the request.
+    // Answered once, when the request is finished; its fallback should be not_answered(), which is what the
+    // requester gets when no service takes the request. RequestDone::id is then the driver's own number.
     Reply<RequestDone> reply;
 };
+/// The fallback of an AutopilotRequest's Reply: no autopilot service took the request.
+RequestDone not_answered();
 /// Ground joystick input, -1..1 each; it drives only in MANUAL_NAVIGATION and only while it keeps coming.
 struct JoystickInput {
     double steering = 0.0;

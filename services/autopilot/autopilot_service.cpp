@@ -101,7 +101,7 @@ void AutopilotService::on_request(const AutopilotRequest& r) {
             done.result = RequestResult::Refused;
             done.detail = "the parameters have not been downloaded yet (autopilot not ready)";
         }
-        answer({r.reply, r.id}, std::move(done));
+        r.reply(std::move(done));
         return;
     }
     const std::uint32_t id = std::visit(
@@ -128,18 +128,8 @@ void AutopilotService::on_request(const AutopilotRequest& r) {
             }
         },
         r.op);
-    requesters_[id] = Requester{r.reply, r.id};
+    requesters_[id] = r.reply;
     pump();
-}
-
-void AutopilotService::answer(const Requester& requester, RequestDone done) {
-    if (requester.reply) {
-        requester.reply(std::move(done));
-        return;
-    }
-    // Transitional: the flight plan manager still waits for a RequestDone event with its id.
-    done.id = requester.id;
-    ctx_.bus.publish(std::move(done));
 }
 
 // Everything the driver has for the outside world, then the timer for its next deadline.
@@ -183,14 +173,11 @@ void AutopilotService::publish(Event e) {
                     spdlog::info("{}{} #{}: {} {}", prefix_, to_string(ev.kind), ev.id, to_string(ev.result),
                                  ev.detail);
                 }
-                Requester requester;
                 if (auto it = requesters_.find(ev.id); it != requesters_.end()) {
-                    requester = std::move(it->second);
+                    const Reply<RequestDone> reply = std::move(it->second);
                     requesters_.erase(it);
-                } else {
-                    requester.id = ev.id;
+                    reply(std::move(ev));
                 }
-                answer(requester, std::move(ev));
                 return;
             } else if constexpr (std::is_same_v<T, LinkDown>) {
                 spdlog::warn("{}link down: {}", prefix_, ev.reason);

@@ -7,8 +7,7 @@
 //
 // Bus: subscribes AutopilotRequest (answered through its Reply), JoystickInput, OperatorReset; publishes the
 // other autopilot::Event types as events, and AutopilotStatus and Telemetry as variables. A request without a
-// Reply is answered by a RequestDone event with the requester's id (transitional, for the flight plan
-// manager). Log prefix: autopilot[<device>]: .
+// Reply runs unanswered. Log prefix: autopilot[<device>]: .
 #include <map>
 #include <memory>
 #include <optional>
@@ -49,13 +48,7 @@ class AutopilotService : public Service {
     void on_stop() override;
 
   private:
-    struct Requester {
-        Reply<RequestDone> reply;
-        std::uint32_t id = 0;  // transitional: for a request without a reply, the RequestDone event's id
-    };
-
     void on_request(const AutopilotRequest& r);
-    void answer(const Requester& requester, RequestDone done);
     void pump();
     void arm_timer();
     void on_timer();
@@ -75,7 +68,7 @@ class AutopilotService : public Service {
     TlogWriter tlog_;
     DeadlineTimer timer_;
     TimePoint status_published_at_{};
-    std::map<std::uint32_t, Requester> requesters_;  // driver id -> who waits for the result
+    std::map<std::uint32_t, Reply<RequestDone>> requesters_;  // driver id -> who waits for the result
     std::vector<Subscription> subscriptions_;
     bool running_ = false;
     bool switching_baud_ = false;  // the next open is a baud probe's reopen of the same device

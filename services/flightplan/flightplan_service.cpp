@@ -64,6 +64,7 @@ FlightplanService::FlightplanService(ServiceContext& ctx, FlightplanServiceConfi
 FlightplanService::~FlightplanService() = default;
 
 void FlightplanService::on_start() {
+    calls_.emplace();
     running_ = true;
     auto& bus = ctx_.bus;
     subscriptions_.push_back(
@@ -97,11 +98,6 @@ void FlightplanService::on_start() {
             flush();
         }));
     subscriptions_.push_back(
-        bus.subscribe<autopilot::RequestDone>(strand(), [this](const autopilot::RequestDone& d) {
-            controller_.on_request_done(d, SteadyClock::now());
-            flush();
-        }));
-    subscriptions_.push_back(
         bus.subscribe<groundlink::LinkState>(strand(), [this](const groundlink::LinkState& s) {
             controller_.on_link(s.up, SteadyClock::now());
             flush();
@@ -118,15 +114,37 @@ void FlightplanService::on_start() {
 void FlightplanService::on_stop() {
     running_ = false;
     subscriptions_.clear();
+    calls_.reset();
     timer_.cancel();
     status_timer_.cancel();
     controller_.stop("the daemon is stopping");
     flush();
 }
 
+void FlightplanService::call(AutopilotCall c) {
+    if (!calls_) {
+        return;  // stopped: nothing more goes to the autopilot
+    }
+    c.request.reply = Reply<autopilot::RequestDone>(
+        strand(), *calls_, autopilot::not_answered(), [this, id = c.id](const autopilot::RequestDone& d) {
+            controller_.on_request_done(id, d, SteadyClock::now());
+            flush();
+        });
+    ctx_.bus.publish(std::move(c.request));
+}
+
 void FlightplanService::flush() {
     while (auto out = controller_.poll_output()) {
-        std::visit([this](auto&& m) { ctx_.bus.publish(std::move(m)); }, std::move(*out));
+        std::visit(
+            [this](auto&& m) {
+                using T = std::decay_t<decltype(m)>;
+                if constexpr (std::is_same_v<T, AutopilotCall>) {
+                    call(std::move(m));
+                } else {
+                    ctx_.bus.publish(std::move(m));
+                }
+            },
+            std::move(*out));
     }
     while (auto save = controller_.poll_save()) {
         controller_.on_saved(*save, store_ ? store_->save_progress(save->progress) : std::nullopt);

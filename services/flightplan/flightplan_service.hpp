@@ -9,8 +9,9 @@
 // everything it required (the feeder has nothing left to ask), or with the failure.
 //
 // Bus: subscribes autopilot::AutopilotStatus, Telemetry, WaypointReached, MissionCurrentChanged, ModeChanged,
-// AutopilotRebooted, RequestDone, groundlink::LinkState (the ground link's up/down state, a typed variable);
-// publishes AutopilotRequest, FeederEvent and ReactionTrigger (events) and the "plan" status section.
+// AutopilotRebooted, groundlink::LinkState (the ground link's up/down state, a typed variable); publishes
+// AutopilotRequest (answered through its Reply), FeederEvent and ReactionTrigger (events) and the "plan"
+// status section.
 // Log prefix: flightplan: .
 #include <map>
 #include <optional>
@@ -35,9 +36,6 @@ struct FlightplanServiceConfig {
 
 class FlightplanService : public Service {
   public:
-    /// Bus request ids of this service start here (apart from other requesters').
-    static constexpr std::uint32_t kFirstRequestId = PlanController::kFirstRequestId;
-
     FlightplanService(ServiceContext& ctx, FlightplanServiceConfig config);
     ~FlightplanService() override;
 
@@ -58,6 +56,8 @@ class FlightplanService : public Service {
     /// Carries out what the controller decided after an input: bus, replies, state store, logs, timer.
     void flush();
     void publish_status(bool force);
+    /// Sends the request with a Reply that hands the answer to the controller.
+    void call(AutopilotCall c);
     void schedule_status();
 
     FlightplanServiceConfig config_;
@@ -69,6 +69,7 @@ class FlightplanService : public Service {
     DeadlineTimer timer_;
     asio::steady_timer status_timer_;
     std::vector<Subscription> subscriptions_;
+    std::optional<ReplyGuard> calls_;  // the autopilot's answers run only while started
     bool running_ = false;
 };
 

@@ -340,10 +340,10 @@ void PlanController::on_mode_changed(const autopilot::ModeChanged& m, TimePoint 
     pump(now);
 }
 
-void PlanController::on_request_done(const autopilot::RequestDone& done, TimePoint now) {
-    const auto it = in_flight_.find(done.id);
+void PlanController::on_request_done(std::uint32_t id, const autopilot::RequestDone& done, TimePoint now) {
+    const auto it = in_flight_.find(id);
     if (it == in_flight_.end()) {
-        return;  // another requester's, or forgotten after a reconnect
+        return;  // forgotten after a reconnect
     }
     const std::uint32_t feeder_id = it->second.feeder_id;
     log(Level::Debug,
@@ -383,8 +383,7 @@ void PlanController::on_link(bool up, TimePoint now) {
 
 void PlanController::send(const FeederRequest& request, TimePoint now) {
     autopilot::AutopilotRequest r;
-    r.id = next_bus_id_;
-    next_bus_id_ = next_bus_id_ >= 0x7FFFFFFFu ? kFirstRequestId : next_bus_id_ + 1;
+    const std::uint32_t id = next_call_id_++;
     std::visit(
         [&](const auto& op) {
             using T = std::decay_t<decltype(op)>;
@@ -404,8 +403,8 @@ void PlanController::send(const FeederRequest& request, TimePoint now) {
     std::ostringstream o;
     o << request;
     log(Level::Debug, o.str());
-    in_flight_[r.id] = InFlight{request.id, now};
-    outputs_.emplace_back(std::move(r));
+    in_flight_[id] = InFlight{request.id, now};
+    outputs_.emplace_back(AutopilotCall{id, std::move(r)});
 }
 
 void PlanController::pump(TimePoint now) {

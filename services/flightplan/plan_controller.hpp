@@ -75,8 +75,14 @@ struct LogLine {
     std::string text;  // without the service's prefix
 };
 
+/// A request for the autopilot; its answer comes back through on_request_done() with the same id.
+struct AutopilotCall {
+    std::uint32_t id = 0;
+    autopilot::AutopilotRequest request;
+};
+
 /// What goes out on the bus: a request for the autopilot, or an event.
-using PlanOutput = std::variant<autopilot::AutopilotRequest, FeederEvent, ReactionTrigger>;
+using PlanOutput = std::variant<AutopilotCall, FeederEvent, ReactionTrigger>;
 
 /// A plan.load / plan.append request, read but not yet checked against the running plan.
 struct LoadRequest {
@@ -87,9 +93,6 @@ struct LoadRequest {
 
 class PlanController {
   public:
-    /// Bus request ids of the flight plan service start here (apart from other requesters').
-    static constexpr std::uint32_t kFirstRequestId = 0x40000000u;
-
     explicit PlanController(PlanControllerConfig config);
 
     // ---- life cycle
@@ -106,7 +109,8 @@ class PlanController {
     void on_current(std::uint32_t seq, TimePoint now);
     void on_rebooted(TimePoint now);
     void on_mode_changed(const autopilot::ModeChanged& m, TimePoint now);
-    void on_request_done(const autopilot::RequestDone& done, TimePoint now);
+    /// The answer to the AutopilotCall with this id (its RequestDone::id is the autopilot's own).
+    void on_request_done(std::uint32_t id, const autopilot::RequestDone& done, TimePoint now);
 
     // ---- ground link
     void on_link(bool up, TimePoint now);
@@ -186,8 +190,8 @@ class PlanController {
     std::optional<autopilot::Position> autopilot_home_;
     bool groundlink_seen_up_ = false;
     bool groundlink_up_ = false;
-    std::map<std::uint32_t, InFlight> in_flight_;  // by bus request id
-    std::uint32_t next_bus_id_ = kFirstRequestId;
+    std::map<std::uint32_t, InFlight> in_flight_;  // by AutopilotCall id
+    std::uint32_t next_call_id_ = 1;
     std::optional<std::string> fault_;  // the last request failure, while the feeder is faulted
     std::string last_failure_;
     std::vector<Waiter> waiters_;

@@ -111,13 +111,21 @@ TEST(AutopilotService, ReachesReadyOnAPtyAndAnswersBusRequests) {
     ASSERT_TRUE(run_until([&] { return !ready.empty(); }));
     EXPECT_LT(ready[0].seconds_from_open, 5.0);
 
-    AutopilotRequest by_id;  // the transitional id path: answered by a RequestDone event
-    by_id.id = 77;
-    by_id.op = RequestStateChange{VehicleState::WaypointNavigation};
-    bus.publish(std::move(by_id));
-    ASSERT_TRUE(run_until([&] { return !done.empty(); }));
-    EXPECT_EQ(done[0].id, 77u);
-    EXPECT_EQ(done[0].result, RequestResult::Ok) << done[0].detail;
+    // Requests are answered through their Reply, on the requester's strand, never as a RequestDone event.
+    ReplyGuard guard;
+    std::vector<RequestDone> replied;
+    bool on_test_strand = false;
+    AutopilotRequest drive;
+    drive.op = RequestStateChange{VehicleState::WaypointNavigation};
+    drive.reply = Reply<RequestDone>(test_strand, guard, not_answered(), [&](const RequestDone& d) {
+        on_test_strand = test_strand.running_in_this_thread();
+        replied.push_back(d);
+    });
+    bus.publish(std::move(drive));
+    ASSERT_TRUE(run_until([&] { return !replied.empty(); }));
+    EXPECT_EQ(replied[0].kind, RequestKind::SetState);
+    EXPECT_EQ(replied[0].result, RequestResult::Ok) << replied[0].detail;
+    EXPECT_TRUE(on_test_strand);
 
     ASSERT_TRUE(run_until([&] {
         const auto s = bus.latest<AutopilotStatus>();
@@ -132,22 +140,16 @@ TEST(AutopilotService, ReachesReadyOnAPtyAndAnswersBusRequests) {
         return false;
     }));
 
-    // A request with a Reply is answered through it, on the requester's strand, and not as an event.
-    ReplyGuard guard;
-    std::vector<RequestDone> replied;
-    bool on_test_strand = false;
+    // A request nobody answers through (no Reply) still runs.
     AutopilotRequest park;
     park.op = RequestStateChange{VehicleState::Parking};
-    park.reply = Reply<RequestDone>(test_strand, guard, RequestDone{}, [&](const RequestDone& d) {
-        on_test_strand = test_strand.running_in_this_thread();
-        replied.push_back(d);
-    });
     bus.publish(std::move(park));
-    ASSERT_TRUE(run_until([&] { return !replied.empty(); }));
-    EXPECT_EQ(replied[0].kind, RequestKind::SetState);
-    EXPECT_EQ(replied[0].result, RequestResult::Ok) << replied[0].detail;
-    EXPECT_TRUE(on_test_strand);
-    EXPECT_EQ(done.size(), 1u);
+    EXPECT_TRUE(run_until([&] {
+        const auto s = bus.latest<AutopilotStatus>();
+        return s && s->state == VehicleState::Parking;
+    }));
+    EXPECT_EQ(replied.size(), 1u);
+    EXPECT_TRUE(done.empty()) << "answers go through the Reply, not the bus";
 
     service->stop();
     rover.stop();
