@@ -40,4 +40,19 @@ report "services/, daemon/ or client/ headers (included by hal)" \
 report "headers of other rooms (included by base)" \
   "$(grep -rn '#include "' --include='*.cpp' --include='*.hpp' --include='*.h' base | grep -v '#include "base/' ||
        true)"
+# A service sees another only through the top-level headers of its directory (its bus vocabulary and
+# interface); the subdirectories (groundlink's transport/, link/, protocol/, the autopilot's ardupilot/,
+# mavlink/) are that service's internals.
+internals=""
+for dir in services/*/; do
+  own=$(basename "$dir")
+  internals+=$(grep -rlE "#include \"services/[a-z_]+/[a-z_]+/" --include='*.cpp' --include='*.hpp' --include='*.h' \
+                 "$dir" | while read -r f; do
+                   grep -oE "#include \"services/[a-z_]+/[a-z_]+/" "$f" | grep -vq "services/$own/" && echo "$f"
+                 done || true)
+done
+report "another service's internals (a subdirectory of services/OTHER/)" "$internals"
+# The status LED's meanings belong to the daemon's services, the blinking to hal/ (it names no daemon state).
+report "daemon meanings in hal (Booting/Ready/LinkUp/Fault patterns)" \
+  "$(grep -rlE 'LedPattern|Booting|LinkUp' --include='*.cpp' --include='*.hpp' hal || true)"
 exit $fail
