@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <sstream>
 
 namespace airseg::cli {
 
@@ -10,6 +11,13 @@ namespace {
 [[noreturn]] void fail(std::string_view option, std::string_view text, std::string_view wanted) {
     throw UsageError(std::string(option) + ": expected " + std::string(wanted) + ", got '" +
                      std::string(text) + "'");
+}
+
+/// A bound as people write it: 100, 0.1, 1e+09 (not 100.000000).
+std::string bound(double v) {
+    std::ostringstream o;
+    o << v;
+    return o.str();
 }
 
 Duration from_seconds(double s) {
@@ -34,7 +42,7 @@ double parse_double(std::string_view option, std::string_view text, double min, 
     auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
     if (text.empty() || ec != std::errc{} || ptr != text.data() + text.size() || !std::isfinite(v) ||
         v < min || v > max) {
-        fail(option, text, "a number within [" + std::to_string(min) + ", " + std::to_string(max) + "]");
+        fail(option, text, "a number within [" + bound(min) + ", " + bound(max) + "]");
     }
     return v;
 }

@@ -87,7 +87,6 @@ struct Options {
 
 const std::vector<std::string> kCommandNames{"status", "watch",    "state",   "param", "rates",
                                              "log",    "joystick", "request", "plan"};
-const std::vector<std::string> kLiveOptionNames{"--duration", "--interval", "--device", "--rate", "--note"};
 
 /// A bad command line in one line and where the help is: the whole help would push the reason off the
 /// screen.
@@ -238,36 +237,26 @@ int live_command(const Options& o, Requester& client, airseg::client::RadioClien
     live.json = o.json;
     live.timeout = std::chrono::milliseconds(o.timeout_ms);
     airseg::client::JoystickOptions stick;
-    long interval_ms = 1000;
-    for (std::size_t i = 1; i < o.positional.size(); ++i) {
-        const auto& a = o.positional[i];
-        if (i + 1 >= o.positional.size()) {
-            return usage_error(cmd + ": " + a + " needs a value");
-        }
-        const std::string v = o.positional[++i];
-        char* end = nullptr;
-        const double n = std::strtod(v.c_str(), &end);
-        const bool numeric = !v.empty() && *end == '\0' && n > 0;
-        if (a == "--duration" && numeric) {
-            live.duration = std::chrono::milliseconds(static_cast<long>(n));
-        } else if (a == "--interval" && cmd == "watch" && numeric) {
-            interval_ms = static_cast<long>(n);
-        } else if (a == "--note" && cmd == "watch") {
-            live.notes.push_back(v);
-        } else if (a == "--device" && cmd == "joystick") {
-            stick.device = v;
-        } else if (a == "--rate" && cmd == "joystick" && numeric && n <= 50) {
-            stick.rate_hz = n;
-        } else if (std::find(kLiveOptionNames.begin(), kLiveOptionNames.end(), a) == kLiveOptionNames.end()) {
-            return usage_error(cmd + ": unknown option '" + a + "'" +
-                               airseg::did_you_mean(a, kLiveOptionNames));
-        } else {
-            return usage_error(cmd + ": bad option or value: " + a + " " + v);
-        }
+    double interval_ms = 1000;
+    double duration_ms = 0;
+    using namespace airseg::cli;
+    // Each command's own options, after its name; the same parser and messages as the global ones.
+    OptionTable table;
+    table.value("duration", "MS", "", number(duration_ms, 1, 1e9));
+    if (cmd == "watch") {
+        table.value("interval", "MS", "", number(interval_ms, 100, 1e9))
+            .value("note", "TEXT", "",
+                   [&live](std::string_view, std::string_view v) { live.notes.emplace_back(v); });
+    } else if (cmd == "joystick") {
+        table.value("device", "PATH", "", text(stick.device))
+            .value("rate", "HZ", "", number(stick.rate_hz, 0.1, 50));
     }
-    if (interval_ms < 100) {
-        return usage_error("watch --interval must be at least 100 ms");
+    try {
+        airseg::cli::parse({o.positional.begin() + 1, o.positional.end()}, table);
+    } catch (const UsageError& e) {
+        return usage_error(cmd + ": " + e.what());
     }
+    live.duration = std::chrono::milliseconds(static_cast<long>(duration_ms));
     airseg::client::install_stop_handlers();
     if (cmd == "watch") {
         if (radio != nullptr) {
@@ -275,7 +264,7 @@ int live_command(const Options& o, Requester& client, airseg::client::RadioClien
         }
         return watch(
             o, [&](const nlohmann::json& r) { return client.request(r); }, nullptr,
-            std::chrono::milliseconds(interval_ms), live);
+            std::chrono::milliseconds(static_cast<long>(interval_ms)), live);
     }
     if (radio == nullptr) {
         return usage_error(cmd + " needs the radio link (--link or --udp): the vehicle pushes it");

@@ -13,6 +13,7 @@
 #include <deque>
 
 #include "hal/io_errors.hpp"
+#include "hal/write_queue.hpp"
 
 namespace airseg::hal {
 namespace {
@@ -208,21 +209,17 @@ class Pty::Impl : public std::enable_shared_from_this<Impl> {
         if (!peer_) {
             return WriteResult::NoPeer;
         }
-        if (bytes.empty()) {
-            return WriteResult::Queued;
+        if (const auto r = writes_.push(std::move(bytes), config_.max_queued_bytes);
+            r != WriteResult::Queued) {
+            return r;
         }
-        if (bytes.size() > config_.max_queued_bytes - std::min(queued_bytes_, config_.max_queued_bytes)) {
-            return WriteResult::QueueFull;
-        }
-        queued_bytes_ += bytes.size();
-        write_queue_.push_back(std::move(bytes));
-        if (!writing_) {
+        if (!writing_ && writes_.has_waiting()) {
             do_write();
         }
         return WriteResult::Queued;
     }
 
-    std::size_t queued_bytes() const { return queued_bytes_; }
+    std::size_t queued_bytes() const { return writes_.bytes(); }
 
   private:
     void schedule_peer_check() {
@@ -274,8 +271,7 @@ class Pty::Impl : public std::enable_shared_from_this<Impl> {
     void reset_io_state() {
         reading_ = false;
         writing_ = false;
-        write_queue_.clear();
-        queued_bytes_ = 0;
+        writes_.clear();
     }
 
     void do_read() {
@@ -311,8 +307,7 @@ class Pty::Impl : public std::enable_shared_from_this<Impl> {
 
     void do_write() {
         writing_ = true;
-        auto buffer = std::make_shared<std::vector<std::uint8_t>>(std::move(write_queue_.front()));
-        write_queue_.pop_front();
+        auto buffer = std::make_shared<std::vector<std::uint8_t>>(writes_.take_one());
         boost::asio::async_write(
             stream_, boost::asio::buffer(*buffer),
             [self = shared_from_this(), gen = generation_, buffer](
@@ -324,18 +319,17 @@ class Pty::Impl : public std::enable_shared_from_this<Impl> {
             return;
         }
         writing_ = false;
-        queued_bytes_ -= size;
+        writes_.written(size);
         if (ec) {
             if (is_unplug_error(ec)) {
                 set_peer(false);
             } else {
                 spdlog::warn("{}write failed ({}); queued bytes dropped", prefix_, ec.message());
-                write_queue_.clear();
-                queued_bytes_ = 0;
+                writes_.clear();
             }
             return;
         }
-        if (!write_queue_.empty()) {
+        if (writes_.has_waiting()) {
             do_write();
         }
     }
@@ -354,8 +348,7 @@ class Pty::Impl : public std::enable_shared_from_this<Impl> {
     PeerHandler on_peer_open_;
     PeerHandler on_peer_close_;
     std::array<std::uint8_t, kReadChunk> read_buffer_{};
-    std::deque<std::vector<std::uint8_t>> write_queue_;
-    std::size_t queued_bytes_ = 0;
+    WriteQueue writes_;
 };
 
 Pty::Pty(Executor executor, PtyConfig config)

@@ -12,6 +12,7 @@
 
 #include "hal/io_errors.hpp"
 #include "hal/serial_termios.hpp"
+#include "hal/write_queue.hpp"
 
 namespace airseg::hal {
 
@@ -78,8 +79,7 @@ class SerialPort::Impl : public std::enable_shared_from_this<Impl> {
         ++generation_;  // handlers of the closed descriptor see a stale generation and do nothing
         reading_ = false;
         writing_ = false;
-        write_queue_.clear();
-        queued_bytes_ = 0;
+        writes_.clear();
     }
 
     bool is_open() const { return stream_.is_open(); }
@@ -99,15 +99,11 @@ class SerialPort::Impl : public std::enable_shared_from_this<Impl> {
         if (!is_open()) {
             return WriteResult::NotOpen;
         }
-        if (bytes.empty()) {
-            return WriteResult::Queued;
+        if (const auto r = writes_.push(std::move(bytes), config_.max_queued_bytes);
+            r != WriteResult::Queued) {
+            return r;
         }
-        if (bytes.size() > config_.max_queued_bytes - std::min(queued_bytes_, config_.max_queued_bytes)) {
-            return WriteResult::QueueFull;
-        }
-        queued_bytes_ += bytes.size();
-        write_queue_.push_back(std::move(bytes));
-        if (!writing_) {
+        if (!writing_ && writes_.has_waiting()) {
             // Deferred by one turn of the event loop, so everything queued in this turn leaves in one write,
             // back to back as a UART sends it: two frames meant together (a mode change and the mission slot
             // right behind it) are not split by whatever else the loop runs, which the board would see as a
@@ -122,7 +118,7 @@ class SerialPort::Impl : public std::enable_shared_from_this<Impl> {
         return WriteResult::Queued;
     }
 
-    std::size_t queued_bytes() const { return queued_bytes_; }
+    std::size_t queued_bytes() const { return writes_.bytes(); }
 
     std::error_code set_line(int bit, bool on) {
         if (!is_open()) {
@@ -172,9 +168,9 @@ class SerialPort::Impl : public std::enable_shared_from_this<Impl> {
     void do_write() {
         writing_ = true;
         auto batch = std::make_shared<Batch>();
-        batch->frames.assign(std::make_move_iterator(write_queue_.begin()),
-                             std::make_move_iterator(write_queue_.end()));
-        write_queue_.clear();
+        auto waiting = writes_.take_all();
+        batch->frames.assign(std::make_move_iterator(waiting.begin()),
+                             std::make_move_iterator(waiting.end()));
         for (const auto& f : batch->frames) {
             batch->buffers.emplace_back(f.data(), f.size());
             batch->size += f.size();
@@ -191,12 +187,12 @@ class SerialPort::Impl : public std::enable_shared_from_this<Impl> {
             return;
         }
         writing_ = false;
-        queued_bytes_ -= size;
+        writes_.written(size);
         if (ec) {
             fail(ec, HalError::WriteFailed);
             return;
         }
-        if (!write_queue_.empty()) {
+        if (writes_.has_waiting()) {
             do_write();
         }
     }
@@ -226,8 +222,7 @@ class SerialPort::Impl : public std::enable_shared_from_this<Impl> {
     bool reading_ = false;
     bool writing_ = false;
     std::array<std::uint8_t, kReadChunk> read_buffer_{};
-    std::deque<std::vector<std::uint8_t>> write_queue_;
-    std::size_t queued_bytes_ = 0;
+    WriteQueue writes_;
 };
 
 SerialPort::SerialPort(Executor executor) : impl_(std::make_shared<Impl>(std::move(executor))) {}

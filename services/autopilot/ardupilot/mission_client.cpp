@@ -687,16 +687,21 @@ void MissionClient::on_count(std::uint16_t count, TimePoint now) {
     w.items.reserve(count);
     w.next_seq = 0;
     if (count == 0) {
-        mav::MissionAck ack;
-        ack.target_system = target_sysid_;
-        ack.target_component = target_compid_;
-        ack.type = kAccepted;
-        out_.send(ack);
-        finish(MissionResult::Success, {}, now);
+        finish_download(now);
         return;
     }
     w.step = Step::WaitItem;
     transmit(w, now, false);
+}
+
+// The whole list is in: acknowledge it, as the protocol's downloader ends a transfer.
+void MissionClient::finish_download(TimePoint now) {
+    mav::MissionAck ack;
+    ack.target_system = target_sysid_;
+    ack.target_component = target_compid_;
+    ack.type = kAccepted;
+    out_.send(ack);
+    finish(MissionResult::Success, {}, now);
 }
 
 void MissionClient::on_item(const mav::MissionItemInt& item, TimePoint now) {
@@ -713,12 +718,7 @@ void MissionClient::on_item(const mav::MissionItemInt& item, TimePoint now) {
     w.items.push_back(item);
     ++w.next_seq;
     if (w.next_seq == w.count) {
-        mav::MissionAck ack;
-        ack.target_system = target_sysid_;
-        ack.target_component = target_compid_;
-        ack.type = kAccepted;
-        out_.send(ack);
-        finish(MissionResult::Success, {}, now);
+        finish_download(now);
         return;
     }
     transmit(w, now, false);

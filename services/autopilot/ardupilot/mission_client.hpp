@@ -159,6 +159,7 @@ class MissionClient {
     void send_item(WorkItem& w, std::uint16_t seq, bool as_int);
     void progress(WorkItem& w, TimePoint now);
     void finish(MissionResult result, std::string detail, TimePoint now);
+    void finish_download(TimePoint now);
     void restart(WorkItem& w, TimePoint now);
     void fall_back_to_float(WorkItem& w, const std::string& why, TimePoint now);
     void reject(MissionOperation op, std::uint32_t id, MissionResult r, std::string detail);

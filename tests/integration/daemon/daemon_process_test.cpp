@@ -251,6 +251,11 @@ TEST_F(DaemonProcess, ClientUsageErrorsAreOneLineWithTheNearMiss) {
         {{"watch", "--duratoin", "100"}, "did you mean '--duration'?"},
         {{"plan", "laod", "x.yaml"}, "did you mean 'load'?"},
         {{"plan", "load", "x.yaml", "--pasued"}, "did you mean '--paused'?"},
+        // A command's own options: its name, the option and the bad text.
+        {{"watch", "--interval", "50"}, "watch: --interval: expected a number within [100, 1e+09], got '50'"},
+        {{"joystick", "--rate", "60"}, "joystick: --rate: expected a number within [0.1, 50], got '60'"},
+        {{"log", "--note", "x"}, "log: unrecognised option '--note'"},
+        {{"watch", "--duration"}, "watch: --duration: missing value"},
     };
     for (const auto& [args, hint] : cases) {
         const auto r = ctl(args);
