@@ -229,7 +229,7 @@ void BM_FeederPerReachedWaypoint(benchmark::State& state) {
     feeder.replace_plan({std::make_unique<Expander>(plan), "million"}, now);
     auto settle = [&] {
         while (auto r = feeder.poll_request(now)) {
-            feeder.on_request_result(r->id, RequestResult::Ok, now);
+            feeder.on_request_result(r->id, autopilot::RequestResult::Ok, now);
         }
         while (feeder.poll_event()) {
         }

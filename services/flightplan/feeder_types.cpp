@@ -52,19 +52,17 @@ const char* to_string(FeederEvent::Kind kind) {
 
 std::ostream& operator<<(std::ostream& os, const FeederRequest& r) {
     os << "#" << r.id << " ";
-    if (const auto* up = std::get_if<UploadMission>(&r.op)) {
+    if (const auto* up = std::get_if<autopilot::UploadMission>(&r.op)) {
         return os << "upload(" << up->items.size() << " items)";
     }
-    if (const auto* w = std::get_if<WriteItems>(&r.op)) {
+    if (const auto* w = std::get_if<autopilot::WriteMissionItems>(&r.op)) {
         return os << "write(slot " << w->first_slot << " x" << w->items.size() << ")";
     }
-    if (const auto* s = std::get_if<SetCurrent>(&r.op)) {
+    if (const auto* s = std::get_if<autopilot::SetMissionCurrent>(&r.op)) {
         return os << "set-current(" << s->slot << ")";
     }
-    if (std::holds_alternative<HoldVehicle>(r.op)) {
-        return os << "hold";
-    }
-    return os << "resume";
+    const auto& change = std::get<autopilot::RequestStateChange>(r.op);
+    return os << (change.state == autopilot::VehicleState::Parking ? "hold" : "resume");
 }
 
 }  // namespace airseg::flightplan

@@ -1,6 +1,7 @@
 #pragma once
-// The WindowFeeder's vocabulary, in autopilot-neutral terms: the autopilot driver translates these into
-// its own protocol (for ArduPilot: MISSION_COUNT/ITEM_INT uploads, MISSION_WRITE_PARTIAL_LIST,
+// The WindowFeeder's own vocabulary: its requests, events and progress. What it asks of the autopilot is
+// the autopilot's neutral vocabulary (services/autopilot/autopilot.hpp), which the driver translates into its
+// own protocol (for ArduPilot: MISSION_COUNT/ITEM_INT uploads, MISSION_WRITE_PARTIAL_LIST,
 // MISSION_SET_CURRENT, DO_JUMP, NAV_LOITER_UNLIM, mode changes).
 #include <cstdint>
 #include <optional>
@@ -9,70 +10,21 @@
 #include <variant>
 #include <vector>
 
-#include "services/flightplan/geo.hpp"
+#include "services/autopilot/autopilot.hpp"
 #include "services/flightplan/waypoint.hpp"
 
 namespace airseg::flightplan {
 
-/// One slot of the autopilot's mission.
-struct MissionItem {
-    enum class Kind : std::uint8_t {
-        Waypoint,  // drive to position; the autopilot reports it reached and moves to the next slot
-        Stop,      // stay at position; the mission does not advance past it (ArduPilot: NAV_LOITER_UNLIM)
-        JumpTo,    // continue at jump_slot, forever (ArduPilot: DO_JUMP with repeat -1)
-    };
-    Kind kind = Kind::Waypoint;
-    LatLon position;
-    std::optional<double> alt;
-    double speed = 0.0;           // m/s on the leg to this item
-    double arrival_radius = 0.0;  // metres
-    std::uint16_t jump_slot = 0;
-    bool operator==(const MissionItem&) const = default;
-};
-
-/// Replace the whole mission with `items` at slots 1..n (slot 0, home, is the driver's business).
-struct UploadMission {
-    std::vector<MissionItem> items;
-};
-/// Overwrite existing slots first_slot..first_slot+n-1 (a partial write; the mission keeps its length).
-struct WriteItems {
-    std::uint16_t first_slot = 1;
-    std::vector<MissionItem> items;
-};
-/// Make `slot` the autopilot's current target.
-struct SetCurrent {
-    std::uint16_t slot = 1;
-};
-/// Stop automatic navigation where the vehicle is (ArduPilot Rover: HOLD mode).
-struct HoldVehicle {};
-/// Follow the mission from the current target (ArduPilot: AUTO mode).
-struct ResumeMission {};
-
+/// A request to the autopilot, in the autopilot's own neutral terms: a whole-mission upload (slots 1..n;
+/// slot 0, home, is the driver's), a partial write (the mission keeps its length), a new current target, or
+/// a state change (Parking to stop where the vehicle is, WaypointNavigation to follow the mission).
 struct FeederRequest {
-    std::uint32_t id = 0;
-    std::variant<UploadMission, WriteItems, SetCurrent, HoldVehicle, ResumeMission> op;
+    std::uint32_t id = 0;  // the feeder's own number, matched by on_request_result()
+    std::variant<autopilot::UploadMission, autopilot::WriteMissionItems, autopilot::SetMissionCurrent,
+                 autopilot::RequestStateChange>
+        op;
 };
 std::ostream& operator<<(std::ostream& os, const FeederRequest& request);
-
-enum class RequestResult : std::uint8_t {
-    Ok,
-    Failed,   // not confirmed (timeout, link down, busy): asked again
-    Refused,  // the autopilot said no to the content (a mission it does not take): asking again cannot help
-};
-
-/// The autopilot's navigation mode, as far as the feeder cares.
-enum class VehicleMode : std::uint8_t {
-    Unknown,  // link down, booting
-    Auto,     // following its mission (ArduPilot: AUTO)
-    Hold,     // stopped (HOLD)
-    Manual,   // someone drives by hand (the RC pilot, the ground joystick)
-};
-/// Who changed the mode.
-enum class ModeCause : std::uint8_t {
-    Ours,     // this daemon asked for it (the feeder, or an operator's state command)
-    Board,    // the autopilot itself (end of its mission, a failsafe, a mode switch it treats as its own)
-    RcPilot,  // the RC pilot took the vehicle (MANUAL)
-};
 
 enum class PlanState : std::uint8_t {
     None,

@@ -15,41 +15,6 @@ namespace {
 using Level = LogLine::Level;
 using Status = CommandReply::Status;
 
-autopilot::MissionItem to_autopilot(const MissionItem& m) {
-    autopilot::MissionItem out;
-    switch (m.kind) {
-        case MissionItem::Kind::Waypoint:
-            out.kind = autopilot::MissionItem::Kind::Waypoint;
-            break;
-        case MissionItem::Kind::Stop:
-            out.kind = autopilot::MissionItem::Kind::Stop;
-            break;
-        case MissionItem::Kind::JumpTo:
-            out.kind = autopilot::MissionItem::Kind::JumpTo;
-            break;
-    }
-    out.lat = m.position.lat;
-    out.lon = m.position.lon;
-    out.alt = m.alt.value_or(0.0);
-    if (m.speed > 0.0) {
-        out.speed = m.speed;
-    }
-    if (m.arrival_radius > 0.0) {
-        out.radius = m.arrival_radius;
-    }
-    out.jump_slot = m.jump_slot;
-    return out;
-}
-
-std::vector<autopilot::MissionItem> to_autopilot(const std::vector<MissionItem>& items) {
-    std::vector<autopilot::MissionItem> out;
-    out.reserve(items.size());
-    for (const auto& m : items) {
-        out.push_back(to_autopilot(m));
-    }
-    return out;
-}
-
 // The top-level element index from an element path such as "plan.elements[12].scan".
 std::uint32_t top_element_index(const std::string& path) {
     const auto open = path.find('[');
@@ -312,31 +277,7 @@ void PlanController::on_rebooted(TimePoint now) {
 }
 
 void PlanController::on_mode_changed(const autopilot::ModeChanged& m, TimePoint now) {
-    using S = autopilot::VehicleState;
-    VehicleMode mode = VehicleMode::Unknown;
-    switch (m.to) {
-        case S::WaypointNavigation:
-            mode = VehicleMode::Auto;
-            break;
-        case S::Parking:
-            mode = VehicleMode::Hold;
-            break;
-        case S::Directed:
-        case S::ManualNavigation:
-        case S::Manual:
-            mode = VehicleMode::Manual;
-            break;
-        case S::Unknown:
-        case S::ConfigureCheck:
-            break;
-    }
-    ModeCause cause = ModeCause::Board;
-    if (m.cause == autopilot::ModeChangeCause::Requested) {
-        cause = ModeCause::Ours;
-    } else if (m.to == S::Directed) {
-        cause = ModeCause::RcPilot;  // MANUAL that nobody here asked for: the RC transmitter's switch
-    }
-    feeder_.on_mode(mode, cause, now);
+    feeder_.on_mode(m.to, m.cause, now);
     pump(now);
 }
 
@@ -350,23 +291,14 @@ void PlanController::on_request_done(std::uint32_t id, const autopilot::RequestD
         fmt::format("#{} {} in {} ms", feeder_id, autopilot::to_string(done.result),
                     std::chrono::duration_cast<std::chrono::milliseconds>(now - it->second.sent).count()));
     in_flight_.erase(it);
-    const bool ok = done.result == autopilot::RequestResult::Ok;
-    // A mission the autopilot refused (its answer, after the driver's fallbacks) or one it cannot hold is
-    // final; anything else (timeouts, a busy or reconnecting autopilot) is asked again.
-    const bool refused =
-        done.result == autopilot::RequestResult::Refused || done.result == autopilot::RequestResult::Invalid;
-    if (ok) {
+    if (done.result == autopilot::RequestResult::Ok) {
         fault_.reset();
     } else {
         last_failure_ = std::string(autopilot::to_string(done.kind)) + ": " +
                         autopilot::to_string(done.result) +
                         (done.detail.empty() ? "" : " (" + done.detail + ")");
     }
-    feeder_.on_request_result(feeder_id,
-                              ok        ? RequestResult::Ok
-                              : refused ? RequestResult::Refused
-                                        : RequestResult::Failed,
-                              now, last_failure_);
+    feeder_.on_request_result(feeder_id, done.result, now, last_failure_);
     pump(now);
 }
 
@@ -384,22 +316,7 @@ void PlanController::on_link(bool up, TimePoint now) {
 void PlanController::send(const FeederRequest& request, TimePoint now) {
     autopilot::AutopilotRequest r;
     const std::uint32_t id = next_call_id_++;
-    std::visit(
-        [&](const auto& op) {
-            using T = std::decay_t<decltype(op)>;
-            if constexpr (std::is_same_v<T, UploadMission>) {
-                r.op = autopilot::UploadMission{to_autopilot(op.items)};
-            } else if constexpr (std::is_same_v<T, WriteItems>) {
-                r.op = autopilot::WriteMissionItems{op.first_slot, to_autopilot(op.items)};
-            } else if constexpr (std::is_same_v<T, SetCurrent>) {
-                r.op = autopilot::SetMissionCurrent{op.slot};
-            } else if constexpr (std::is_same_v<T, HoldVehicle>) {
-                r.op = autopilot::RequestStateChange{autopilot::VehicleState::Parking};
-            } else {
-                r.op = autopilot::RequestStateChange{autopilot::VehicleState::WaypointNavigation};
-            }
-        },
-        request.op);
+    std::visit([&](const auto& op) { r.op = op; }, request.op);
     std::ostringstream o;
     o << request;
     log(Level::Debug, o.str());

@@ -4,6 +4,36 @@
 
 namespace airseg::flightplan {
 
+namespace {
+
+using autopilot::MissionItem;
+using autopilot::VehicleState;
+
+/// What an autopilot answer means to the feeder; the one place its results are told apart.
+enum class Answer : std::uint8_t {
+    Done,
+    Retry,    // not confirmed (no answer, busy, not connected, cut short by the link): asked again
+    Refused,  // the autopilot said no to the content or cannot hold it: asking again cannot help
+};
+
+Answer answer(autopilot::RequestResult result) {
+    switch (result) {
+        case autopilot::RequestResult::Ok:
+            return Answer::Done;
+        case autopilot::RequestResult::Refused:
+        case autopilot::RequestResult::Invalid:
+            return Answer::Refused;
+        case autopilot::RequestResult::Timeout:
+        case autopilot::RequestResult::Busy:
+        case autopilot::RequestResult::NotReady:
+        case autopilot::RequestResult::Cancelled:
+            return Answer::Retry;
+    }
+    return Answer::Retry;
+}
+
+}  // namespace
+
 std::optional<std::string> FeederConfig::validate() const {
     if (window < 3) {
         return "flightplan.window must be >= 3";
@@ -39,10 +69,17 @@ std::vector<MissionItem> WindowFeeder::slot_items(std::uint16_t slot, const Miss
 MissionItem WindowFeeder::Entry::item() const {
     MissionItem m;
     m.kind = stop ? MissionItem::Kind::Stop : MissionItem::Kind::Waypoint;
-    m.position = wp.position;
-    m.alt = wp.alt;
-    m.speed = wp.speed;
-    m.arrival_radius = wp.arrival_radius;
+    m.lat = wp.position.lat;
+    m.lon = wp.position.lon;
+    // A waypoint's unset values (no altitude, speed or radius 0) leave the board its own: altitude relative
+    // to home, the leg speed and acceptance radius it has configured.
+    m.alt = wp.alt.value_or(0.0);
+    if (wp.speed > 0.0) {
+        m.speed = wp.speed;
+    }
+    if (wp.arrival_radius > 0.0) {
+        m.radius = wp.arrival_radius;
+    }
     return m;
 }
 
@@ -135,7 +172,7 @@ void WindowFeeder::restart(TimePoint now) {
     hold_wp_.reset();
     stream_ended_ = false;
     done_ = false;
-    // The new head goes in a slot the vehicle is not heading for; SetCurrent then points it there.
+    // The new head goes in a slot the vehicle is not heading for; a set-current then points it there.
     start_fresh(queue_.empty() ? kFirstRingSlot : ring_next(queue_[0].slot), now);
 }
 
@@ -359,7 +396,8 @@ void WindowFeeder::check_starvation() {
         return;
     }
     if (!confirmed(queue_[0])) {
-        const auto* in_flight = outstanding_ ? std::get_if<WriteItems>(&outstanding_->request.op) : nullptr;
+        const auto* in_flight =
+            outstanding_ ? std::get_if<autopilot::WriteMissionItems>(&outstanding_->request.op) : nullptr;
         if (in_flight && mode_ == Mode::Auto && in_flight->first_slot <= queue_[0].slot &&
             static_cast<std::size_t>(queue_[0].slot) < in_flight->first_slot + in_flight->items.size()) {
             // The vehicle reached its target while the write of the slot after it was on its way (a plan
@@ -462,15 +500,17 @@ void WindowFeeder::fail_plan(std::string why) {
     emit(FeederEvent::Kind::PlanFailed, nullptr, generation_, {}, std::move(why));
 }
 
-void WindowFeeder::on_mode(VehicleMode mode, ModeCause cause, TimePoint) {
+void WindowFeeder::on_mode(VehicleState state, autopilot::ModeChangeCause cause, TimePoint) {
     const Mode before = mode_;
-    switch (mode) {
-        case VehicleMode::Unknown:
+    const bool requested = cause == autopilot::ModeChangeCause::Requested;
+    switch (state) {
+        case VehicleState::Unknown:
+        case VehicleState::ConfigureCheck:
             mode_ = Mode::Unknown;
             return;
-        case VehicleMode::Auto:
+        case VehicleState::WaypointNavigation:
             mode_ = Mode::Auto;
-            if (interrupted_ && (!interrupted_by_hand_ || cause == ModeCause::Ours)) {
+            if (interrupted_ && (!interrupted_by_hand_ || requested)) {
                 // Back in AUTO: by the feeder after the board's own HOLD, or by an operator's state command.
                 interrupted_.reset();
                 interrupted_by_hand_ = false;
@@ -479,10 +519,12 @@ void WindowFeeder::on_mode(VehicleMode mode, ModeCause cause, TimePoint) {
                      queue_.empty() ? std::string{} : queue_[0].element_path, last_interruption_);
             }
             return;
-        case VehicleMode::Hold:
+        case VehicleState::Parking:
             mode_ = Mode::Hold;
             break;
-        case VehicleMode::Manual:
+        case VehicleState::Directed:
+        case VehicleState::ManualNavigation:
+        case VehicleState::Manual:
             mode_ = Mode::Manual;
             break;
     }
@@ -490,9 +532,9 @@ void WindowFeeder::on_mode(VehicleMode mode, ModeCause cause, TimePoint) {
     if (before != Mode::Auto || !plan_active() || desired_mode() != Mode::Auto || interrupted_) {
         return;
     }
-    const bool ours = outstanding_ && (std::holds_alternative<HoldVehicle>(outstanding_->request.op) ||
-                                       std::holds_alternative<ResumeMission>(outstanding_->request.op));
-    if (cause == ModeCause::Ours) {
+    const bool ours =
+        outstanding_ && std::holds_alternative<autopilot::RequestStateChange>(outstanding_->request.op);
+    if (requested) {
         if (ours) {
             return;
         }
@@ -503,7 +545,7 @@ void WindowFeeder::on_mode(VehicleMode mode, ModeCause cause, TimePoint) {
         interrupt("the operator took the vehicle (manual navigation); plan resume continues", true);
         return;
     }
-    if (cause == ModeCause::RcPilot || mode_ == Mode::Manual) {
+    if (mode_ == Mode::Manual) {  // the RC pilot's switch, or a manual state nobody here asked for
         interrupt("the RC pilot took the vehicle (MANUAL); plan resume continues", true);
         return;
     }
@@ -540,21 +582,22 @@ void WindowFeeder::on_autopilot_rebooted(TimePoint) {
     }
 }
 
-void WindowFeeder::on_request_result(std::uint32_t id, RequestResult result, TimePoint now,
+void WindowFeeder::on_request_result(std::uint32_t id, autopilot::RequestResult result, TimePoint now,
                                      std::string_view detail) {
     if (!outstanding_ || outstanding_->request.id != id) {
         return;  // stale: retried or reset since
     }
     const FeederRequest request = std::move(outstanding_->request);
     outstanding_.reset();
-    if (result == RequestResult::Ok) {
+    const Answer a = answer(result);
+    if (a == Answer::Done) {
         consecutive_failures_ = 0;
         request_succeeded(request);
         return;
     }
-    const bool writes_items =
-        std::holds_alternative<UploadMission>(request.op) || std::holds_alternative<WriteItems>(request.op);
-    if (result == RequestResult::Refused && writes_items) {
+    const bool writes_items = std::holds_alternative<autopilot::UploadMission>(request.op) ||
+                              std::holds_alternative<autopilot::WriteMissionItems>(request.op);
+    if (a == Answer::Refused && writes_items) {
         // The board does not take these items (the driver has already tried the forms it knows): asking
         // again every fault_backoff would never end. The vehicle is held and the plan ends here.
         consecutive_failures_ = 0;
@@ -588,7 +631,7 @@ void WindowFeeder::request_failed(TimePoint now) {
 }
 
 void WindowFeeder::request_succeeded(const FeederRequest& request) {
-    if (const auto* up = std::get_if<UploadMission>(&request.op)) {
+    if (const auto* up = std::get_if<autopilot::UploadMission>(&request.op)) {
         std::fill(confirmed_.begin(), confirmed_.end(), std::nullopt);
         for (std::size_t i = 0; i < up->items.size() && i + 1 < confirmed_.size(); ++i) {
             confirmed_[i + 1] = up->items[i];
@@ -597,24 +640,22 @@ void WindowFeeder::request_succeeded(const FeederRequest& request) {
         need_set_current_ = true;
         repoint_only_ = false;
         ap_target_.reset();
-    } else if (const auto* wr = std::get_if<WriteItems>(&request.op)) {
+    } else if (const auto* wr = std::get_if<autopilot::WriteMissionItems>(&request.op)) {
         for (std::size_t i = 0; i < wr->items.size(); ++i) {
             const std::size_t slot = wr->first_slot + i;
             if (slot < confirmed_.size()) {
                 confirmed_[slot] = wr->items[i];
             }
         }
-    } else if (const auto* sc = std::get_if<SetCurrent>(&request.op)) {
+    } else if (const auto* sc = std::get_if<autopilot::SetMissionCurrent>(&request.op)) {
         ap_target_ = sc->slot;
         if (!queue_.empty() && queue_[0].slot == sc->slot) {
             need_set_current_ = false;
             repoint_only_ = false;
         }
         current_mismatches_ = 0;
-    } else if (std::holds_alternative<HoldVehicle>(request.op)) {
-        mode_ = Mode::Hold;
-    } else if (std::holds_alternative<ResumeMission>(request.op)) {
-        mode_ = Mode::Auto;
+    } else if (const auto* change = std::get_if<autopilot::RequestStateChange>(&request.op)) {
+        mode_ = change->state == VehicleState::Parking ? Mode::Hold : Mode::Auto;
     }
 }
 
@@ -673,7 +714,7 @@ std::optional<FeederRequest> WindowFeeder::next_write(std::size_t from, std::siz
         if (!writable(i)) {
             continue;
         }
-        WriteItems w;
+        autopilot::WriteMissionItems w;
         w.first_slot = queue_[i].slot;
         w.items = slot_items(queue_[i].slot, queue_[i].item());
         for (std::size_t j = i + 1;
@@ -695,7 +736,7 @@ std::optional<FeederRequest> WindowFeeder::poll_request(TimePoint now) {
     // Holding is tried at once after a fault, then at the backoff pace like everything else.
     if (want == Mode::Hold && mode_ != Mode::Hold && (now >= retry_not_before_ || fault_hold_pending_)) {
         fault_hold_pending_ = false;
-        return issue(HoldVehicle{}, now);
+        return issue(autopilot::RequestStateChange{VehicleState::Parking}, now);
     }
     if (queue_.empty() || now < retry_not_before_ || failed_) {
         return std::nullopt;
@@ -709,7 +750,7 @@ std::optional<FeederRequest> WindowFeeder::poll_request(TimePoint now) {
         for (const auto& e : queue_) {
             at[e.slot] = e.item();
         }
-        UploadMission up;
+        autopilot::UploadMission up;
         for (std::uint16_t s = 1; s <= wrap_slot(); ++s) {
             for (const auto& m : slot_items(s, at[s])) {
                 up.items.push_back(m);
@@ -721,7 +762,7 @@ std::optional<FeederRequest> WindowFeeder::poll_request(TimePoint now) {
         return w;
     }
     if (need_set_current_ && confirmed(queue_[0]) && (queue_.size() < 2 || confirmed(queue_[1]))) {
-        return issue(SetCurrent{queue_[0].slot}, now);
+        return issue(autopilot::SetMissionCurrent{queue_[0].slot}, now);
     }
     if (auto w = next_write(2, queue_.size(), now)) {
         return w;
@@ -734,7 +775,7 @@ std::optional<FeederRequest> WindowFeeder::poll_request(TimePoint now) {
         }
     }
     if (desired_mode() == Mode::Auto && mode_ != Mode::Auto && ready_for_auto()) {
-        return issue(ResumeMission{}, now);
+        return issue(autopilot::RequestStateChange{VehicleState::WaypointNavigation}, now);
     }
     return next_stop_filler(now);
 }
@@ -767,7 +808,7 @@ std::optional<FeederRequest> WindowFeeder::next_stop_filler(TimePoint now) {
         if (!free_slot(slot) || holds(slot, stop)) {
             continue;
         }
-        WriteItems w;
+        autopilot::WriteMissionItems w;
         w.first_slot = slot;
         w.items = slot_items(slot, stop);
         for (std::uint16_t next = slot + 1; next <= wrap_slot() && free_slot(next) && !holds(next, stop);

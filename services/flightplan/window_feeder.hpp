@@ -16,7 +16,7 @@
 //
 // Contract (the driver, on the service's strand):
 //   inputs   replace_plan(), skip_to(), jump_to(), pause(), resume(), release_hold(),
-//            on_reached(slot), on_current(slot), on_mode(mode, cause), on_request_result(id, result),
+//            on_reached(slot), on_current(slot), on_mode(state, cause), on_request_result(id, result),
 //            on_autopilot_rebooted(),
 //            handle_timeout(now) when poll_timeout() is due;
 //   outputs  poll_request(now) after every input, until it returns nothing: at most one request is
@@ -80,14 +80,15 @@ class WindowFeeder {
 
     void on_reached(std::uint16_t slot, TimePoint now);
     void on_current(std::uint16_t slot, TimePoint now);
-    /// The autopilot's mode changed. Leaving AUTO while the plan runs, without the feeder asking, interrupts
-    /// it: the board's own HOLD (end of its mission, a quirk, a failsafe) is undone at once (the window is
-    /// made whole, the head set current, AUTO asked for); a vehicle taken by hand (the RC pilot, or an
-    /// operator's state command to a manual state) is left to whoever took it until resume(); an operator's
-    /// state command to HOLD pauses the plan.
-    void on_mode(VehicleMode mode, ModeCause cause, TimePoint now);
+    /// The vehicle's state changed (`cause` Requested: by this daemon, the feeder or an operator's state
+    /// command). Leaving AUTO while the plan runs, without the feeder asking, interrupts it: the board's own
+    /// HOLD (end of its mission, a quirk, a failsafe) is undone at once (the window is made whole, the head
+    /// set current, AUTO asked for); a vehicle taken by hand (the RC pilot, or an operator's state command to
+    /// a manual state) is left to whoever took it until resume(); an operator's state command to HOLD pauses
+    /// the plan.
+    void on_mode(autopilot::VehicleState state, autopilot::ModeChangeCause cause, TimePoint now);
     /// `detail` is the autopilot's answer, for a refusal: a refused mission write fails the plan.
-    void on_request_result(std::uint32_t id, RequestResult result, TimePoint now,
+    void on_request_result(std::uint32_t id, autopilot::RequestResult result, TimePoint now,
                            std::string_view detail = {});
     void on_autopilot_rebooted(TimePoint now);
     void handle_timeout(TimePoint now);
@@ -107,7 +108,7 @@ class WindowFeeder {
         std::uint32_t generation = 0;
         std::string element_path;
         bool announced = false;  // ElementStarted considered (once, when it became the head)
-        MissionItem item() const;
+        autopilot::MissionItem item() const;
     };
     struct Outstanding {
         FeederRequest request;
@@ -127,10 +128,11 @@ class WindowFeeder {
         return slot > wrap_slot() && slot < wrap_slot() + kWrapSlots ? wrap_slot() : slot;
     }
     /// What a ring position holds on board for `item`: the item, or at W the whole wrap.
-    std::vector<MissionItem> slot_items(std::uint16_t slot, const MissionItem& item) const;
+    std::vector<autopilot::MissionItem> slot_items(std::uint16_t slot,
+                                                   const autopilot::MissionItem& item) const;
     bool confirmed(const Entry& e) const;
     /// The autopilot is known to hold `item` at ring position `slot`.
-    bool holds(std::uint16_t slot, const MissionItem& item) const;
+    bool holds(std::uint16_t slot, const autopilot::MissionItem& item) const;
     void start_fresh(std::uint16_t first_slot, TimePoint now);
     void restart(TimePoint now);
     void refill(TimePoint now);
@@ -166,8 +168,8 @@ class WindowFeeder {
 
     // What the autopilot is known to hold.
     bool mission_ok_ = false;
-    std::vector<std::optional<MissionItem>> confirmed_;  // by slot, 0..K+1
-    std::optional<std::uint16_t> ap_target_;             // the slot the autopilot is believed to head for
+    std::vector<std::optional<autopilot::MissionItem>> confirmed_;  // by slot, 0..K+1
+    std::optional<std::uint16_t> ap_target_;  // the slot the autopilot is believed to head for
     bool need_set_current_ = false;
     bool repoint_only_ = false;  // set-current due after the board's own HOLD: its reports still count
     Mode mode_ = Mode::Unknown;

@@ -18,6 +18,11 @@
 
 namespace airseg::flightplan::test {
 
+using autopilot::MissionItem;
+using autopilot::ModeChangeCause;
+using autopilot::RequestResult;
+using autopilot::VehicleState;
+
 class SimAutopilot {
   public:
     SimAutopilot() { reboot(); }
@@ -26,7 +31,7 @@ class SimAutopilot {
     bool early_jumps = false;
 
     RequestResult apply(const FeederRequest& r) {
-        if (const auto* up = std::get_if<UploadMission>(&r.op)) {
+        if (const auto* up = std::get_if<autopilot::UploadMission>(&r.op)) {
             slots_.assign(1, home());
             for (const auto& item : up->items) {
                 slots_.push_back(item);
@@ -36,9 +41,9 @@ class SimAutopilot {
             }
             return RequestResult::Ok;
         }
-        if (const auto* w = std::get_if<WriteItems>(&r.op)) {
+        if (const auto* w = std::get_if<autopilot::WriteMissionItems>(&r.op)) {
             if (w->first_slot == 0 || w->first_slot + w->items.size() > slots_.size()) {
-                return RequestResult::Failed;
+                return RequestResult::Timeout;
             }
             for (std::size_t i = 0; i < w->items.size(); ++i) {
                 slots_[w->first_slot + i] = w->items[i];
@@ -46,26 +51,27 @@ class SimAutopilot {
             ++writes_;
             return RequestResult::Ok;
         }
-        if (const auto* s = std::get_if<SetCurrent>(&r.op)) {
+        if (const auto* s = std::get_if<autopilot::SetMissionCurrent>(&r.op)) {
             if (s->slot == 0 || s->slot >= slots_.size()) {
-                return RequestResult::Failed;
+                return RequestResult::Timeout;
             }
             current_ = s->slot;
             parked_ = false;
             return RequestResult::Ok;
         }
-        if (std::holds_alternative<HoldVehicle>(r.op)) {
-            set_mode(VehicleMode::Hold, ModeCause::Ours);
+        const auto& change = std::get<autopilot::RequestStateChange>(r.op);
+        if (change.state == VehicleState::Parking) {
+            set_mode(VehicleState::Parking, ModeChangeCause::Requested);
             ++hold_requests_;
             return RequestResult::Ok;
         }
-        set_mode(VehicleMode::Auto, ModeCause::Ours);
+        set_mode(VehicleState::WaypointNavigation, ModeChangeCause::Requested);
         return RequestResult::Ok;
     }
 
     struct ModeReport {
-        VehicleMode mode;
-        ModeCause cause;
+        VehicleState mode;
+        ModeChangeCause cause;
     };
     /// Mode changes since the last call, oldest first.
     std::vector<ModeReport> mode_changes() { return std::exchange(changes_, {}); }
@@ -80,7 +86,7 @@ class SimAutopilot {
             parked_ = true;
             return std::nullopt;
         }
-        visited_.push_back(item.position);
+        visited_.push_back({item.lat, item.lon});
         const std::uint16_t reached = current_;
         std::size_t next = current_ + 1u;
         if (early_jumps && next + 2u < slots_.size() && slots_[next + 1u].kind == MissionItem::Kind::JumpTo) {
@@ -90,15 +96,16 @@ class SimAutopilot {
         for (int guard = 0; !early_jumps && next < slots_.size() && guard < 8; ++guard) {
             if (slots_[next].kind == MissionItem::Kind::JumpTo) {
                 next = slots_[next].jump_slot;
-            } else if (slots_[next].kind == MissionItem::Kind::Waypoint &&
-                       slots_[next].position == item.position) {
+            } else if (slots_[next].kind == MissionItem::Kind::Waypoint && slots_[next].lat == item.lat &&
+                       slots_[next].lon == item.lon) {
                 ++next;  // a waypoint where the vehicle already is: passed at once (inside its radius)
             } else {
                 break;
             }
         }
         if (next >= slots_.size()) {
-            set_mode(VehicleMode::Hold, ModeCause::Board);  // mission complete: ArduPilot Rover goes HOLD
+            set_mode(VehicleState::Parking,
+                     ModeChangeCause::External);  // mission complete: ArduPilot Rover goes HOLD
             ++end_of_mission_holds_;
         } else {
             current_ = static_cast<std::uint16_t>(next);
@@ -110,16 +117,16 @@ class SimAutopilot {
         slots_.assign(1, home());
         current_ = 0;
         auto_ = false;
-        mode_ = VehicleMode::Unknown;
+        mode_ = VehicleState::Unknown;
         parked_ = false;
     }
 
     /// The RC pilot takes the vehicle out of AUTO (the transmitter's MANUAL switch).
-    void operator_takes_over() { set_mode(VehicleMode::Manual, ModeCause::RcPilot); }
+    void operator_takes_over() { set_mode(VehicleState::Directed, ModeChangeCause::External); }
     /// The autopilot falls into HOLD by itself (a failsafe, a quirk of its mission logic).
-    void board_holds() { set_mode(VehicleMode::Hold, ModeCause::Board); }
+    void board_holds() { set_mode(VehicleState::Parking, ModeChangeCause::External); }
     /// An operator's state command (through this daemon, not the feeder) parks the vehicle.
-    void operator_parks() { set_mode(VehicleMode::Hold, ModeCause::Ours); }
+    void operator_parks() { set_mode(VehicleState::Parking, ModeChangeCause::Requested); }
 
     std::uint16_t current() const { return current_; }
     bool in_auto() const { return auto_; }
@@ -133,22 +140,18 @@ class SimAutopilot {
     int early_jumps_taken() const { return early_jumps_taken_; }
 
   private:
-    void set_mode(VehicleMode mode, ModeCause cause) {
-        auto_ = mode == VehicleMode::Auto;
+    void set_mode(VehicleState mode, ModeChangeCause cause) {
+        auto_ = mode == VehicleState::WaypointNavigation;
         if (mode != mode_) {
             mode_ = mode;
             changes_.push_back({mode, cause});
         }
     }
-    static MissionItem home() {
-        MissionItem h;
-        h.position = {0.0, 0.0};
-        return h;
-    }
+    static MissionItem home() { return MissionItem{}; }
     std::vector<MissionItem> slots_;
     std::uint16_t current_ = 0;
     bool auto_ = false;
-    VehicleMode mode_ = VehicleMode::Unknown;
+    VehicleState mode_ = VehicleState::Unknown;
     std::vector<ModeReport> changes_;
     bool parked_ = false;
     std::vector<LatLon> visited_;
@@ -239,11 +242,13 @@ class Harness {
                 break;
             }
             const bool fail =
-                chance(imp_.fail_request) || (imp_.fail_writes && std::holds_alternative<WriteItems>(r->op));
-            const bool refuse = imp_.refuse_missions && (std::holds_alternative<WriteItems>(r->op) ||
-                                                         std::holds_alternative<UploadMission>(r->op));
+                chance(imp_.fail_request) ||
+                (imp_.fail_writes && std::holds_alternative<autopilot::WriteMissionItems>(r->op));
+            const bool refuse =
+                imp_.refuse_missions && (std::holds_alternative<autopilot::WriteMissionItems>(r->op) ||
+                                         std::holds_alternative<autopilot::UploadMission>(r->op));
             const RequestResult res = refuse ? RequestResult::Refused
-                                      : fail ? RequestResult::Failed
+                                      : fail ? RequestResult::Timeout
                                              : ap.apply(*r);
             // The driver reports a confirmed mode change before the request's result.
             report_modes();

@@ -392,7 +392,7 @@ TEST(FlightplanFeeder, AReplacementWhoseFirstWriteLandsJustAfterTheTargetIsReach
     h.feeder.replace_plan(test::synthetic(20, 42.0), h.now);
     auto write = h.feeder.poll_request(h.now);
     ASSERT_TRUE(write.has_value());
-    ASSERT_TRUE(std::holds_alternative<WriteItems>(write->op)) << *write;
+    ASSERT_TRUE(std::holds_alternative<autopilot::WriteMissionItems>(write->op)) << *write;
     // The vehicle reaches the kept target before the write of the slot after it has landed: it now heads
     // for that slot's old content (route A's next waypoint).
     const auto reached = h.ap.step();
@@ -482,14 +482,15 @@ TEST(FlightplanFeeder, AfterTheEndTheRingSlotsHoldTheStopSoDrivingOnGoesNowhere)
     const auto& slots = h.ap.slots();
     ASSERT_EQ(slots.size(), 15u);
     auto holds_stop = [&](std::size_t s) {
-        return slots[s].kind == MissionItem::Kind::Stop && slots[s].position == end;
+        return slots[s].kind == autopilot::MissionItem::Kind::Stop && slots[s].lat == end.lat &&
+               slots[s].lon == end.lon;
     };
     // The 24th entry, the Stop, went to ring position 2 + 23 % 10 = 5.
     EXPECT_TRUE(holds_stop(5));
     for (std::size_t s : {6, 7, 8, 9, 10, 11, 12, 14}) {
         EXPECT_TRUE(holds_stop(s)) << "slot " << s;
     }
-    EXPECT_EQ(slots[13].kind, MissionItem::Kind::JumpTo);
+    EXPECT_EQ(slots[13].kind, autopilot::MissionItem::Kind::JumpTo);
     // The slots left last keep their waypoints while the vehicle may still report reaching them.
     for (std::size_t s : {2, 3, 4}) {
         EXPECT_FALSE(holds_stop(s)) << "slot " << s;
@@ -540,7 +541,7 @@ TEST(FlightplanFeeder, RequestTimeoutCountsAsFailureAndIsRetried) {
     ASSERT_TRUE(again.has_value());
     EXPECT_NE(again->id, first->id);
     EXPECT_EQ(again->op.index(), first->op.index());
-    h.feeder.on_request_result(first->id, RequestResult::Ok, h.now);  // stale: ignored
+    h.feeder.on_request_result(first->id, autopilot::RequestResult::Ok, h.now);  // stale: ignored
     EXPECT_FALSE(h.feeder.poll_request(h.now).has_value());
     EXPECT_EQ(h.feeder.progress().retries, 1u);
 }
