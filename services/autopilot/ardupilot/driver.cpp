@@ -71,7 +71,6 @@ Driver::Driver(AutopilotConfig config)
 // --- port lifecycle ----------------------------------------------------------------------------------------
 
 void Driver::on_port_open(TimePoint now) {
-    opened_at_ = now;
     link_.on_port_open(now);
     parser_ = mav::Parser{};
     missions_.forget_board();  // another board may be behind the port now

@@ -198,7 +198,6 @@ class Driver {
     FrameTap tap_;
 
     Phase phase_ = Phase::Closed;
-    TimePoint opened_at_{};
     TimePoint sequence_start_{};
     TimePoint phase_deadline_ = kNever;  // boot timeout, or the pause before retrying a failed step
     bool retry_pending_ = false;
