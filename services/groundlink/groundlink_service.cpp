@@ -338,18 +338,25 @@ void GroundlinkService::arm_telemetry() {
 
 void GroundlinkService::on_telemetry_timer() {
     const TimePoint now = SteadyClock::now();
-    while (auto kind = scheduler_.poll_due(now)) {
-        if (!driver_ || !driver_->link_up()) {
-            continue;  // nobody listens: a sample queued now would only be stale when the link comes back
+    const auto send_due = [&] {
+        while (auto kind = scheduler_.poll_due(now)) {
+            if (!driver_ || !driver_->link_up()) {
+                continue;  // nobody listens: a sample queued now would only be stale when the link comes back
+            }
+            if (*kind == TelemetryKind::Vehicle && vehicle_) {
+                driver_->send_fast(protocol::kPriorityTelemetry, protocol::kTopicTelemetry,
+                                   protocol::encode(make_sample(*vehicle_, plan_)));
+                ++samples_sent_;
+                delivery_.on_pushed(now);
+            } else if (*kind == TelemetryKind::LinkStats) {
+                send_link_stats(now);
+            }
         }
-        if (*kind == TelemetryKind::Vehicle && vehicle_) {
-            driver_->send_fast(protocol::kPriorityTelemetry, protocol::kTopicTelemetry,
-                               protocol::encode(make_sample(*vehicle_, plan_)));
-            ++samples_sent_;
-            delivery_.on_pushed(now);
-        } else if (*kind == TelemetryKind::LinkStats) {
-            send_link_stats(now);
-        }
+    };
+    if (driver_) {
+        driver_->batch(send_due);  // the kinds due together go out in one frame
+    } else {
+        send_due();
     }
     arm_telemetry();
 }

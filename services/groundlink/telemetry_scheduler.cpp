@@ -141,7 +141,7 @@ void TelemetryScheduler::recompute(TimePoint now) {
         effective_[i] = std::max(floor, requested_[i] * scale * factor_);
         if (effective_[i] != before) {
             // A faster rate takes effect at once; a slower one from the next message on.
-            next_due_[i] = std::min(next_due_[i], now + period_of(effective_[i]));
+            next_due_[i] = std::min(next_due_[i], next_on_grid(now, period_of(effective_[i])));
         }
     }
 }
@@ -152,11 +152,10 @@ std::optional<TelemetryKind> TelemetryScheduler::poll_due(TimePoint now) {
         if (effective_[i] <= 0 || next_due_[i] > now) {
             continue;
         }
-        const auto period = period_of(effective_[i]);
-        next_due_[i] += period;
-        if (next_due_[i] <= now) {
-            next_due_[i] = now + period;  // late (a busy strand): no burst to catch up
-        }
+        // On the steady clock's grid of the period, as the daemon's other periodic work (time.hpp): kinds
+        // whose periods divide a second come due together and with the whole-second ticks, one wake-up for
+        // all. A late poll (a busy strand) skips to the next grid point: no burst to catch up.
+        next_due_[i] = next_on_grid(now, period_of(effective_[i]));
         return k;
     }
     return std::nullopt;

@@ -35,6 +35,26 @@ class LinkDriver {
     SendResult send_fast(std::uint8_t priority, std::uint16_t topic, std::span<const std::uint8_t> msg);
     void stop();
 
+    /// Runs `sends` (calls of send_safe/send_fast) and hands the core's frames to the paths once, after all
+    /// of them: messages queued at one instant share a frame instead of the second waiting a frame time
+    /// behind the first (a wake-up of its own on an idle link).
+    template <typename Sends>
+    void batch(Sends&& sends) {
+        if (pumping_) {
+            sends();  // already inside a pump (a handler sending): that pump goes round again
+            return;
+        }
+        pumping_ = true;
+        struct Release {
+            LinkDriver& driver;
+            ~Release() {
+                driver.pumping_ = false;
+                driver.pump();
+            }
+        } release{*this};
+        sends();
+    }
+
     const Transport& core() const { return core_; }
     const LinkStats& stats() const { return core_.stats(); }
     bool link_up() const { return core_.link_up(); }

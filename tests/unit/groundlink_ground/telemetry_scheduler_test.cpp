@@ -147,6 +147,37 @@ TEST(TelemetryScheduler, ALatePollDoesNotBurst) {
     EXPECT_GT(sim.scheduler.poll_timeout(), sim.now);
 }
 
+TEST(TelemetryScheduler, KindsDueTogetherShareTheWholeSecondGrid) {
+    // Started off the grid: after the first messages every deadline is a multiple of its period on the
+    // steady clock, so the 2 Hz and 1 Hz kinds come due at the same instant each whole second (one wake-up
+    // with the daemon's other 1 s ticks, not one per kind).
+    TelemetrySchedulerConfig c;
+    TelemetryScheduler scheduler(c, k57600,
+                                 TimePoint{} + std::chrono::hours(1) + std::chrono::milliseconds(137));
+    TimePoint now = TimePoint{} + std::chrono::hours(1) + std::chrono::milliseconds(137);
+    std::map<TimePoint, int> due_at;
+    for (int wake = 0; wake < 40; ++wake) {
+        while (scheduler.poll_due(now)) {
+            ++due_at[now];
+        }
+        now = scheduler.poll_timeout();
+    }
+    int together = 0;
+    for (const auto& [t, n] : due_at) {
+        if (t == due_at.begin()->first) {
+            continue;
+        }
+        EXPECT_EQ(t.time_since_epoch() % std::chrono::milliseconds(500), Duration::zero());
+        const bool whole_second = t.time_since_epoch() % std::chrono::seconds(1) == Duration::zero();
+        EXPECT_EQ(n, whole_second ? 2 : 1);
+        together += whole_second ? 1 : 0;
+    }
+    EXPECT_GE(together, 19);
+    // A later rate change keeps to the grid of the new period.
+    ASSERT_FALSE(scheduler.set_rate(TelemetryKind::Vehicle, 4.0, now + std::chrono::milliseconds(3)));
+    EXPECT_EQ(scheduler.poll_timeout().time_since_epoch() % std::chrono::milliseconds(250), Duration::zero());
+}
+
 TEST(TelemetryScheduler, ConfigValidationNamesTheKey) {
     TelemetrySchedulerConfig c;
     EXPECT_TRUE(c.validate().empty());
