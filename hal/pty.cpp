@@ -12,6 +12,7 @@
 #include <cerrno>
 #include <deque>
 
+#include "hal/current_read.hpp"
 #include "hal/io_errors.hpp"
 #include "hal/write_queue.hpp"
 
@@ -276,17 +277,12 @@ class Pty::Impl : public std::enable_shared_from_this<Impl> {
 
     void do_read() {
         reading_ = true;
-        stream_.async_read_some(
-            boost::asio::buffer(read_buffer_),
-            [self = shared_from_this(), gen = generation_](boost::system::error_code ec, std::size_t n) {
-                self->on_read(gen, ec, n);
-            });
+        async_read_current(stream_, boost::asio::buffer(read_buffer_), shared_from_this(), &Impl::generation_,
+                           &Impl::on_read);
     }
 
+    // Runs only for a current read (current_read.hpp).
     void on_read(std::uint64_t gen, boost::system::error_code ec, std::size_t n) {
-        if (gen != generation_ || ec == boost::asio::error::operation_aborted) {
-            return;
-        }
         reading_ = false;
         if (ec) {
             if (is_unplug_error(ec)) {

@@ -10,6 +10,7 @@
 #include <deque>
 #include <iterator>
 
+#include "hal/current_read.hpp"
 #include "hal/io_errors.hpp"
 #include "hal/serial_termios.hpp"
 #include "hal/write_queue.hpp"
@@ -141,17 +142,12 @@ class SerialPort::Impl : public std::enable_shared_from_this<Impl> {
     };
 
     void do_read() {
-        stream_.async_read_some(
-            boost::asio::buffer(read_buffer_),
-            [self = shared_from_this(), gen = generation_](boost::system::error_code ec, std::size_t n) {
-                self->on_read(gen, ec, n);
-            });
+        async_read_current(stream_, boost::asio::buffer(read_buffer_), shared_from_this(), &Impl::generation_,
+                           &Impl::on_read);
     }
 
+    // Runs only for a current read (current_read.hpp).
     void on_read(std::uint64_t gen, boost::system::error_code ec, std::size_t n) {
-        if (gen != generation_ || ec == boost::asio::error::operation_aborted) {
-            return;
-        }
         if (ec) {
             fail(ec, HalError::ReadFailed);
             return;
