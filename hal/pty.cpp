@@ -112,11 +112,7 @@ class Pty::Impl : public std::enable_shared_from_this<Impl> {
             return result;
         }
         if (auto errors = PtyConfig::validate(config_); !errors.empty()) {
-            result.error = make_error_code(HalError::InvalidConfig);
-            for (const auto& e : errors) {
-                result.message += result.message.empty() ? e : "; " + e;
-            }
-            return result;
+            return invalid_config(errors);
         }
         termios raw{};
         ::cfmakeraw(&raw);

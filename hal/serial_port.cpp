@@ -27,11 +27,7 @@ class SerialPort::Impl : public std::enable_shared_from_this<Impl> {
         prefix_ = "serial[" + config.path + "]: ";
         OpenResult result;
         if (auto errors = SerialConfig::validate(config); !errors.empty()) {
-            result.error = make_error_code(HalError::InvalidConfig);
-            for (const auto& e : errors) {
-                result.message += result.message.empty() ? e : "; " + e;
-            }
-            return result;
+            return invalid_config(errors);
         }
         const int fd = ::open(config.path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
         if (fd < 0) {
