@@ -38,6 +38,15 @@ std::error_code make_error_code(HalError e) noexcept {
     return {static_cast<int>(e), hal_category()};
 }
 
+OpenResult invalid_config(const std::vector<std::string>& errors) {
+    OpenResult result;
+    result.error = make_error_code(HalError::InvalidConfig);
+    for (const auto& e : errors) {
+        result.message += result.message.empty() ? e : "; " + e;
+    }
+    return result;
+}
+
 const char* to_string(WriteResult r) noexcept {
     switch (r) {
         case WriteResult::Queued:

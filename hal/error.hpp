@@ -31,6 +31,9 @@ struct OpenResult {
     explicit operator bool() const { return ok(); }
 };
 
+/// The failed open of a configuration that validate() rejected: InvalidConfig, with all of `errors`.
+OpenResult invalid_config(const std::vector<std::string>& errors);
+
 /// Outcome of handing bytes to a device's write queue.
 enum class WriteResult {
     Queued,     ///< accepted; will be written in order

@@ -12,6 +12,7 @@
 #include <cerrno>
 #include <deque>
 
+#include "hal/current_read.hpp"
 #include "hal/io_errors.hpp"
 #include "hal/write_queue.hpp"
 
@@ -111,11 +112,7 @@ class Pty::Impl : public std::enable_shared_from_this<Impl> {
             return result;
         }
         if (auto errors = PtyConfig::validate(config_); !errors.empty()) {
-            result.error = make_error_code(HalError::InvalidConfig);
-            for (const auto& e : errors) {
-                result.message += result.message.empty() ? e : "; " + e;
-            }
-            return result;
+            return invalid_config(errors);
         }
         termios raw{};
         ::cfmakeraw(&raw);
@@ -276,17 +273,12 @@ class Pty::Impl : public std::enable_shared_from_this<Impl> {
 
     void do_read() {
         reading_ = true;
-        stream_.async_read_some(
-            boost::asio::buffer(read_buffer_),
-            [self = shared_from_this(), gen = generation_](boost::system::error_code ec, std::size_t n) {
-                self->on_read(gen, ec, n);
-            });
+        async_read_current(stream_, boost::asio::buffer(read_buffer_), shared_from_this(), &Impl::generation_,
+                           &Impl::on_read);
     }
 
+    // Runs only for a current read (current_read.hpp).
     void on_read(std::uint64_t gen, boost::system::error_code ec, std::size_t n) {
-        if (gen != generation_ || ec == boost::asio::error::operation_aborted) {
-            return;
-        }
         reading_ = false;
         if (ec) {
             if (is_unplug_error(ec)) {

@@ -10,6 +10,7 @@
 #include <deque>
 #include <iterator>
 
+#include "hal/current_read.hpp"
 #include "hal/io_errors.hpp"
 #include "hal/serial_termios.hpp"
 #include "hal/write_queue.hpp"
@@ -26,11 +27,7 @@ class SerialPort::Impl : public std::enable_shared_from_this<Impl> {
         prefix_ = "serial[" + config.path + "]: ";
         OpenResult result;
         if (auto errors = SerialConfig::validate(config); !errors.empty()) {
-            result.error = make_error_code(HalError::InvalidConfig);
-            for (const auto& e : errors) {
-                result.message += result.message.empty() ? e : "; " + e;
-            }
-            return result;
+            return invalid_config(errors);
         }
         const int fd = ::open(config.path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
         if (fd < 0) {
@@ -141,17 +138,12 @@ class SerialPort::Impl : public std::enable_shared_from_this<Impl> {
     };
 
     void do_read() {
-        stream_.async_read_some(
-            boost::asio::buffer(read_buffer_),
-            [self = shared_from_this(), gen = generation_](boost::system::error_code ec, std::size_t n) {
-                self->on_read(gen, ec, n);
-            });
+        async_read_current(stream_, boost::asio::buffer(read_buffer_), shared_from_this(), &Impl::generation_,
+                           &Impl::on_read);
     }
 
+    // Runs only for a current read (current_read.hpp).
     void on_read(std::uint64_t gen, boost::system::error_code ec, std::size_t n) {
-        if (gen != generation_ || ec == boost::asio::error::operation_aborted) {
-            return;
-        }
         if (ec) {
             fail(ec, HalError::ReadFailed);
             return;

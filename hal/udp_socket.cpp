@@ -47,11 +47,7 @@ class UdpSocket::Impl : public std::enable_shared_from_this<Impl> {
         const std::string where =
             "udp[" + config.bind_address + ":" + std::to_string(config.bind_port) + "]: ";
         if (auto errors = UdpConfig::validate(config); !errors.empty()) {
-            result.error = make_error_code(HalError::InvalidConfig);
-            for (const auto& e : errors) {
-                result.message += result.message.empty() ? e : "; " + e;
-            }
-            return result;
+            return invalid_config(errors);
         }
         const Endpoint local(boost::asio::ip::make_address(config.bind_address), config.bind_port);
         boost::system::error_code ec;

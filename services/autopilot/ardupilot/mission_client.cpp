@@ -3,19 +3,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "services/autopilot/mavlink/enums.hpp"
+
 namespace airseg::autopilot::ardupilot {
 
 namespace mav = airseg::mavlink;
 
 namespace {
-// MAV_MISSION_RESULT values used here.
-constexpr std::uint8_t kAccepted = 0;
-constexpr std::uint8_t kNoSpace = 4;
-constexpr std::uint8_t kInvalidSequence = 13;
-constexpr std::uint8_t kOperationCancelled = 15;
-constexpr std::uint8_t kError = 1;
-constexpr std::uint8_t kMissionTypeMission = 0;
-
 const char* mission_result_name(std::uint8_t type) {
     static const char* const kNames[] = {"ACCEPTED",
                                          "ERROR",
@@ -222,7 +216,7 @@ std::uint32_t MissionClient::enqueue(WorkItem w, TimePoint now) {
             it.seq = static_cast<std::uint16_t>(w.first + i);
             it.target_system = target_sysid_;
             it.target_component = target_compid_;
-            it.mission_type = kMissionTypeMission;
+            it.mission_type = mav::kMissionTypeMission;
         }
     }
     if (work_.size() >= kMaxQueued) {
@@ -288,6 +282,14 @@ void MissionClient::send_item(WorkItem& w, std::uint16_t seq, bool as_int) {
     }
 }
 
+template <class M>
+void MissionClient::send_to_mission(M m) {
+    m.target_system = target_sysid_;
+    m.target_component = target_compid_;
+    m.mission_type = mav::kMissionTypeMission;
+    out_.send(m);
+}
+
 // Sends what the current step waits an answer for: first transmission, or a retry after a timeout.
 void MissionClient::transmit(WorkItem& w, TimePoint now, bool retry) {
     switch (w.step) {
@@ -296,61 +298,40 @@ void MissionClient::transmit(WorkItem& w, TimePoint now, bool retry) {
                 send_item(w, w.next_seq, w.answer_int);
             } else if (w.op == MissionOperation::Upload) {
                 mav::MissionCount m;
-                m.target_system = target_sysid_;
-                m.target_component = target_compid_;
                 m.count = static_cast<std::uint16_t>(w.items.size());
-                m.mission_type = kMissionTypeMission;
-                out_.send(m);
+                send_to_mission(m);
             } else {
                 mav::MissionWritePartialList m;
-                m.target_system = target_sysid_;
-                m.target_component = target_compid_;
                 m.start_index = static_cast<std::int16_t>(w.first);
                 m.end_index = static_cast<std::int16_t>(w.first + w.items.size() - 1);
-                m.mission_type = kMissionTypeMission;
-                out_.send(m);
+                send_to_mission(m);
             }
             break;
         case Step::WaitAck:
             if (w.op == MissionOperation::Clear) {
                 mav::MissionClearAll m;
-                m.target_system = target_sysid_;
-                m.target_component = target_compid_;
-                m.mission_type = kMissionTypeMission;
-                out_.send(m);
+                send_to_mission(m);
             } else if (w.items.empty()) {
                 mav::MissionCount m;  // an empty upload is acknowledged right after its count
-                m.target_system = target_sysid_;
-                m.target_component = target_compid_;
-                m.mission_type = kMissionTypeMission;
-                out_.send(m);
+                send_to_mission(m);
             } else {
                 send_item(w, w.next_seq, w.answer_int);
             }
             break;
         case Step::WaitCount: {
             mav::MissionRequestList m;
-            m.target_system = target_sysid_;
-            m.target_component = target_compid_;
-            m.mission_type = kMissionTypeMission;
-            out_.send(m);
+            send_to_mission(m);
             break;
         }
         case Step::WaitItem:
             if (use_int_) {
                 mav::MissionRequestInt m;
-                m.target_system = target_sysid_;
-                m.target_component = target_compid_;
                 m.seq = w.next_seq;
-                m.mission_type = kMissionTypeMission;
-                out_.send(m);
+                send_to_mission(m);
             } else {
                 mav::MissionRequest m;
-                m.target_system = target_sysid_;
-                m.target_component = target_compid_;
                 m.seq = w.next_seq;
-                m.mission_type = kMissionTypeMission;
-                out_.send(m);
+                send_to_mission(m);
             }
             break;
         case Step::WaitCurrent: {
@@ -484,42 +465,42 @@ bool MissionClient::handle_frame(const mav::Frame& f, TimePoint now) {
     switch (f.msgid) {
         case mav::MissionRequestInt::kId: {
             const auto m = mav::decode_payload<mav::MissionRequestInt>(f.payload_view());
-            if (addressed_to_us(m.target_system) && m.mission_type == kMissionTypeMission) {
+            if (addressed_to_us(m.target_system) && m.mission_type == mav::kMissionTypeMission) {
                 on_request(m.seq, true, now);
             }
             return true;
         }
         case mav::MissionRequest::kId: {
             const auto m = mav::decode_payload<mav::MissionRequest>(f.payload_view());
-            if (addressed_to_us(m.target_system) && m.mission_type == kMissionTypeMission) {
+            if (addressed_to_us(m.target_system) && m.mission_type == mav::kMissionTypeMission) {
                 on_request(m.seq, false, now);
             }
             return true;
         }
         case mav::MissionAck::kId: {
             const auto m = mav::decode_payload<mav::MissionAck>(f.payload_view());
-            if (addressed_to_us(m.target_system) && m.mission_type == kMissionTypeMission) {
+            if (addressed_to_us(m.target_system) && m.mission_type == mav::kMissionTypeMission) {
                 on_ack(m.type, now);
             }
             return true;
         }
         case mav::MissionCount::kId: {
             const auto m = mav::decode_payload<mav::MissionCount>(f.payload_view());
-            if (addressed_to_us(m.target_system) && m.mission_type == kMissionTypeMission) {
+            if (addressed_to_us(m.target_system) && m.mission_type == mav::kMissionTypeMission) {
                 on_count(m.count, now);
             }
             return true;
         }
         case mav::MissionItemInt::kId: {
             const auto m = mav::decode_payload<mav::MissionItemInt>(f.payload_view());
-            if (addressed_to_us(m.target_system) && m.mission_type == kMissionTypeMission) {
+            if (addressed_to_us(m.target_system) && m.mission_type == mav::kMissionTypeMission) {
                 on_item(m, now);
             }
             return true;
         }
         case mav::MissionItem::kId: {
             const auto m = mav::decode_payload<mav::MissionItem>(f.payload_view());
-            if (addressed_to_us(m.target_system) && m.mission_type == kMissionTypeMission) {
+            if (addressed_to_us(m.target_system) && m.mission_type == mav::kMissionTypeMission) {
                 on_item(to_int_item(m), now);
             }
             return true;
@@ -598,7 +579,7 @@ void MissionClient::on_ack(std::uint8_t type, TimePoint now) {
         ++stats_.ignored_frames;
         return;
     }
-    if (type == kAccepted) {
+    if (type == mav::kMissionAccepted) {
         if (w.step == Step::WaitAck) {
             progress(w, now);
             finish(MissionResult::Success, {}, now);
@@ -608,7 +589,7 @@ void MissionClient::on_ack(std::uint8_t type, TimePoint now) {
         }
         return;
     }
-    if (type == kInvalidSequence && uploading) {
+    if (type == mav::kMissionInvalidSequence && uploading) {
         ++stats_.invalid_sequence_acks;
         return;
     }
@@ -616,17 +597,18 @@ void MissionClient::on_ack(std::uint8_t type, TimePoint now) {
     // is no longer receiving when one of our items arrives (ERROR: its cancel, or its final acceptance, was
     // lost). Either way the mission on board is not known to be ours: start the transfer again. An error
     // before any item was asked for is the vehicle's verdict on the request itself and is final.
-    if (type == kError && !w.any_request && w.restarts > 0) {
+    if (type == mav::kMissionError && !w.any_request && w.restarts > 0) {
         ++stats_.ignored_frames;  // the answer to an item of the abandoned attempt, still on the link
         return;
     }
-    const bool vehicle_lost_track = type == kOperationCancelled || (type == kError && w.any_request);
+    const bool vehicle_lost_track =
+        type == mav::kMissionOperationCancelled || (type == mav::kMissionError && w.any_request);
     if (uploading && vehicle_lost_track && w.restarts < config_.retries) {
         restart(w, now);
         return;
     }
     const std::string answer = std::string("MAV_MISSION_") + mission_result_name(type);
-    if (uploading && w.sent_int && type != kNoSpace && use_int_) {
+    if (uploading && w.sent_int && type != mav::kMissionNoSpace && use_int_) {
         fall_back_to_float(w, answer, now);
         return;
     }
@@ -637,7 +619,7 @@ void MissionClient::on_ack(std::uint8_t type, TimePoint now) {
     const std::string after = uploading && !w.sent_int && !fallback_reason_.empty()
                                   ? " (MISSION_ITEM_INT was refused before: " + fallback_reason_ + ")"
                                   : "";
-    finish(type == kNoSpace ? MissionResult::NoSpace : MissionResult::Denied,
+    finish(type == mav::kMissionNoSpace ? MissionResult::NoSpace : MissionResult::Denied,
            "autopilot answered " + answer + form + after, now);
 }
 
@@ -699,7 +681,7 @@ void MissionClient::finish_download(TimePoint now) {
     mav::MissionAck ack;
     ack.target_system = target_sysid_;
     ack.target_component = target_compid_;
-    ack.type = kAccepted;
+    ack.type = mav::kMissionAccepted;
     out_.send(ack);
     finish(MissionResult::Success, {}, now);
 }

@@ -2,16 +2,11 @@
 
 #include <cmath>
 
+#include "services/autopilot/mavlink/enums.hpp"
+
 namespace airseg::autopilot::ardupilot {
 
 namespace {
-constexpr std::uint16_t kNavWaypoint = 16;
-constexpr std::uint16_t kNavLoiterUnlim = 17;
-constexpr std::uint16_t kDoJump = 177;
-constexpr std::uint8_t kFrameGlobal = 0;
-constexpr std::uint8_t kFrameMission = 2;
-constexpr std::uint8_t kFrameGlobalRelativeAltInt = 6;
-
 std::int32_t to_e7(double degrees) {
     return static_cast<std::int32_t>(std::llround(degrees * 1e7));
 }
@@ -23,9 +18,10 @@ mavlink::MissionItemInt encode_item(const MissionItem& item, bool stop_as_waypoi
     switch (item.kind) {
         case MissionItem::Kind::Waypoint:
         case MissionItem::Kind::Stop:
-            m.command =
-                item.kind == MissionItem::Kind::Waypoint || stop_as_waypoint ? kNavWaypoint : kNavLoiterUnlim;
-            m.frame = kFrameGlobalRelativeAltInt;
+            m.command = item.kind == MissionItem::Kind::Waypoint || stop_as_waypoint
+                            ? mavlink::kCmdNavWaypoint
+                            : mavlink::kCmdNavLoiterUnlim;
+            m.frame = mavlink::kFrameGlobalRelativeAltInt;
             m.x = to_e7(item.lat);
             m.y = to_e7(item.lon);
             m.z = static_cast<float>(item.alt);
@@ -35,8 +31,8 @@ mavlink::MissionItemInt encode_item(const MissionItem& item, bool stop_as_waypoi
             }
             break;
         case MissionItem::Kind::JumpTo:
-            m.command = kDoJump;
-            m.frame = kFrameMission;
+            m.command = mavlink::kCmdDoJump;
+            m.frame = mavlink::kFrameMission;
             m.param1 = static_cast<float>(item.jump_slot);
             m.param2 = -1.0f;
             break;
@@ -46,16 +42,17 @@ mavlink::MissionItemInt encode_item(const MissionItem& item, bool stop_as_waypoi
 
 MissionItem decode_item(const mavlink::MissionItemInt& m) {
     MissionItem item;
-    if (m.command == kDoJump) {
+    if (m.command == mavlink::kCmdDoJump) {
         item.kind = MissionItem::Kind::JumpTo;
         item.jump_slot = static_cast<std::uint16_t>(std::lround(m.param1));
         return item;
     }
-    item.kind = m.command == kNavLoiterUnlim ? MissionItem::Kind::Stop : MissionItem::Kind::Waypoint;
+    item.kind =
+        m.command == mavlink::kCmdNavLoiterUnlim ? MissionItem::Kind::Stop : MissionItem::Kind::Waypoint;
     item.lat = static_cast<double>(m.x) * 1e-7;
     item.lon = static_cast<double>(m.y) * 1e-7;
     item.alt = m.z;
-    if (m.command == kNavWaypoint) {
+    if (m.command == mavlink::kCmdNavWaypoint) {
         if (m.param1 > 0) {
             item.hold_s = m.param1;
         }
@@ -68,8 +65,8 @@ MissionItem decode_item(const mavlink::MissionItemInt& m) {
 
 mavlink::MissionItemInt home_item(const Position& home) {
     mavlink::MissionItemInt m;
-    m.command = kNavWaypoint;
-    m.frame = kFrameGlobal;
+    m.command = mavlink::kCmdNavWaypoint;
+    m.frame = mavlink::kFrameGlobal;
     m.autocontinue = 1;
     m.x = to_e7(home.lat);
     m.y = to_e7(home.lon);

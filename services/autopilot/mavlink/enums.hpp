@@ -7,7 +7,10 @@
 namespace airseg::mavlink {
 
 // MAV_CMD
+inline constexpr std::uint16_t kCmdNavWaypoint = 16;
+inline constexpr std::uint16_t kCmdNavLoiterUnlim = 17;
 inline constexpr std::uint16_t kCmdDoSetMode = 176;
+inline constexpr std::uint16_t kCmdDoJump = 177;
 inline constexpr std::uint16_t kCmdDoChangeSpeed = 178;
 inline constexpr std::uint16_t kCmdDoSetHome = 179;
 inline constexpr std::uint16_t kCmdDoSetParameter = 180;
@@ -38,12 +41,18 @@ inline constexpr std::uint8_t kMissionAccepted = 0;
 inline constexpr std::uint8_t kMissionError = 1;
 inline constexpr std::uint8_t kMissionUnsupportedFrame = 2;
 inline constexpr std::uint8_t kMissionUnsupported = 3;
+inline constexpr std::uint8_t kMissionNoSpace = 4;
 inline constexpr std::uint8_t kMissionInvalidSequence = 13;
+inline constexpr std::uint8_t kMissionOperationCancelled = 15;
+
+// MAV_MISSION_TYPE
+inline constexpr std::uint8_t kMissionTypeMission = 0;
 
 // MAV_FRAME
 inline constexpr std::uint8_t kFrameGlobal = 0;
 inline constexpr std::uint8_t kFrameMission = 2;
 inline constexpr std::uint8_t kFrameGlobalRelativeAlt = 3;
+inline constexpr std::uint8_t kFrameGlobalRelativeAltInt = 6;
 
 // MAV_TYPE, MAV_AUTOPILOT
 inline constexpr std::uint8_t kMavTypeGroundRover = 10;

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
+#include <type_traits>
 
 namespace airseg::mavlink {
 
@@ -74,56 +75,27 @@ constexpr std::string_view type_name(FieldType t) {
     return "";
 }
 
+/// FieldTypeOf<T>::value: the wire type of C++ type T (or of an array's elements).
 template <class T>
 struct FieldTypeOf;
-template <>
-struct FieldTypeOf<char> {
-    static constexpr FieldType value = FieldType::Char;
-};
-template <>
-struct FieldTypeOf<std::uint8_t> {
-    static constexpr FieldType value = FieldType::Uint8;
-};
-template <>
-struct FieldTypeOf<std::int8_t> {
-    static constexpr FieldType value = FieldType::Int8;
-};
-template <>
-struct FieldTypeOf<std::uint16_t> {
-    static constexpr FieldType value = FieldType::Uint16;
-};
-template <>
-struct FieldTypeOf<std::int16_t> {
-    static constexpr FieldType value = FieldType::Int16;
-};
-template <>
-struct FieldTypeOf<std::uint32_t> {
-    static constexpr FieldType value = FieldType::Uint32;
-};
-template <>
-struct FieldTypeOf<std::int32_t> {
-    static constexpr FieldType value = FieldType::Int32;
-};
-template <>
-struct FieldTypeOf<std::uint64_t> {
-    static constexpr FieldType value = FieldType::Uint64;
-};
-template <>
-struct FieldTypeOf<std::int64_t> {
-    static constexpr FieldType value = FieldType::Int64;
-};
-template <>
-struct FieldTypeOf<float> {
-    static constexpr FieldType value = FieldType::Float;
-};
-template <>
-struct FieldTypeOf<double> {
-    static constexpr FieldType value = FieldType::Double;
-};
+// One row a wire type, so the mapping reads as the table it is.
+#define AIRSEG_MAVLINK_FIELD_TYPE_OF(CppType_, FieldType_) \
+    template <>                                            \
+    struct FieldTypeOf<CppType_> : std::integral_constant<FieldType, FieldType::FieldType_> {};
+AIRSEG_MAVLINK_FIELD_TYPE_OF(char, Char)
+AIRSEG_MAVLINK_FIELD_TYPE_OF(std::uint8_t, Uint8)
+AIRSEG_MAVLINK_FIELD_TYPE_OF(std::int8_t, Int8)
+AIRSEG_MAVLINK_FIELD_TYPE_OF(std::uint16_t, Uint16)
+AIRSEG_MAVLINK_FIELD_TYPE_OF(std::int16_t, Int16)
+AIRSEG_MAVLINK_FIELD_TYPE_OF(std::uint32_t, Uint32)
+AIRSEG_MAVLINK_FIELD_TYPE_OF(std::int32_t, Int32)
+AIRSEG_MAVLINK_FIELD_TYPE_OF(std::uint64_t, Uint64)
+AIRSEG_MAVLINK_FIELD_TYPE_OF(std::int64_t, Int64)
+AIRSEG_MAVLINK_FIELD_TYPE_OF(float, Float)
+AIRSEG_MAVLINK_FIELD_TYPE_OF(double, Double)
+#undef AIRSEG_MAVLINK_FIELD_TYPE_OF
 template <class T, std::size_t N>
-struct FieldTypeOf<std::array<T, N>> {
-    static constexpr FieldType value = FieldTypeOf<T>::value;
-};
+struct FieldTypeOf<std::array<T, N>> : FieldTypeOf<T> {};
 
 template <class T>
 struct ArrayLengthOf {

@@ -24,12 +24,6 @@ constexpr auto kMessages = [] {
 #define AIRSEG_MAVLINK_EXTENSIONS()
 #define AIRSEG_MAVLINK_END()
 #include "services/autopilot/mavlink/messages.def"
-#undef AIRSEG_MAVLINK_MESSAGE
-#undef AIRSEG_MAVLINK_FIELD
-#undef AIRSEG_MAVLINK_ARRAY
-#undef AIRSEG_MAVLINK_VERSION_FIELD
-#undef AIRSEG_MAVLINK_EXTENSIONS
-#undef AIRSEG_MAVLINK_END
     };
     std::sort(table.begin(), table.end(),
               [](const MessageInfo& a, const MessageInfo& b) { return a.id < b.id; });

@@ -50,12 +50,6 @@ inline constexpr std::uint8_t kMavlinkDialectVersion = 3;
     }                                             \
     ;
 #include "services/autopilot/mavlink/messages.def"
-#undef AIRSEG_MAVLINK_MESSAGE
-#undef AIRSEG_MAVLINK_FIELD
-#undef AIRSEG_MAVLINK_ARRAY
-#undef AIRSEG_MAVLINK_VERSION_FIELD
-#undef AIRSEG_MAVLINK_EXTENSIONS
-#undef AIRSEG_MAVLINK_END
 
 // --- the declarations, as data -----------------------------------------------------------------------------
 namespace declarations {
@@ -69,12 +63,6 @@ namespace declarations {
     }                        \
     ;
 #include "services/autopilot/mavlink/messages.def"
-#undef AIRSEG_MAVLINK_MESSAGE
-#undef AIRSEG_MAVLINK_FIELD
-#undef AIRSEG_MAVLINK_ARRAY
-#undef AIRSEG_MAVLINK_VERSION_FIELD
-#undef AIRSEG_MAVLINK_EXTENSIONS
-#undef AIRSEG_MAVLINK_END
 }  // namespace declarations
 
 /// MessageTraits<M>::layout: wire order, offsets, lengths and CRC_EXTRA of message M;
@@ -98,12 +86,6 @@ struct MessageTraits;
     }                        \
     ;
 #include "services/autopilot/mavlink/messages.def"
-#undef AIRSEG_MAVLINK_MESSAGE
-#undef AIRSEG_MAVLINK_FIELD
-#undef AIRSEG_MAVLINK_ARRAY
-#undef AIRSEG_MAVLINK_VERSION_FIELD
-#undef AIRSEG_MAVLINK_EXTENSIONS
-#undef AIRSEG_MAVLINK_END
 
 template <class M>
 concept Message = requires {

@@ -6,17 +6,15 @@
 #include <array>
 #include <cmath>
 
+#include "base/little_endian.hpp"
+
 namespace airseg::groundlink::protocol {
 namespace {
 
 class Writer {
   public:
     void u8(std::uint64_t v) { out.push_back(static_cast<std::uint8_t>(v & 0xff)); }
-    void le(std::uint64_t v, int bytes) {
-        for (int i = 0; i < bytes; ++i) {
-            u8(v >> (8 * i));
-        }
-    }
+    void le(std::uint64_t v, int bytes) { append_le(out, v, static_cast<std::size_t>(bytes)); }
     void bytes(std::span<const std::uint8_t> b) { out.insert(out.end(), b.begin(), b.end()); }
     std::vector<std::uint8_t> out;
 };
@@ -26,10 +24,9 @@ class Reader {
     explicit Reader(std::span<const std::uint8_t> b) : b_(b) {}
     bool has(std::size_t n) const { return pos_ + n <= b_.size(); }
     std::uint64_t le(int bytes) {
-        std::uint64_t v = 0;
-        for (int i = 0; i < bytes; ++i) {
-            v |= static_cast<std::uint64_t>(b_[pos_++]) << (8 * i);
-        }
+        const auto n = static_cast<std::size_t>(bytes);
+        const std::uint64_t v = load_le(b_.data() + pos_, n);
+        pos_ += n;
         return v;
     }
     std::int64_t sle(int bytes) {

@@ -5,24 +5,21 @@
 #include <span>
 #include <vector>
 
+#include "base/little_endian.hpp"
+
 namespace airseg::groundlink::wire {
 
 inline void put_u8(std::vector<std::uint8_t>& out, std::uint8_t v) {
     out.push_back(v);
 }
 inline void put_u16(std::vector<std::uint8_t>& out, std::uint16_t v) {
-    out.push_back(static_cast<std::uint8_t>(v & 0xFFU));
-    out.push_back(static_cast<std::uint8_t>((v >> 8) & 0xFFU));
+    append_le(out, v, 2);
 }
 inline void put_u24(std::vector<std::uint8_t>& out, std::uint32_t v) {
-    for (int i = 0; i < 3; ++i) {
-        out.push_back(static_cast<std::uint8_t>((v >> (8 * i)) & 0xFFU));
-    }
+    append_le(out, v, 3);
 }
 inline void put_u32(std::vector<std::uint8_t>& out, std::uint32_t v) {
-    for (int i = 0; i < 4; ++i) {
-        out.push_back(static_cast<std::uint8_t>((v >> (8 * i)) & 0xFFU));
-    }
+    append_le(out, v, 4);
 }
 /// Writes `v` little-endian at `p` (8 bytes).
 inline void store_u64(std::uint8_t* p, std::uint64_t v) {
@@ -37,9 +34,7 @@ inline void store_u64(std::uint8_t* p, std::uint64_t v) {
     p[7] = static_cast<std::uint8_t>(v >> 56);
 }
 inline void put_u64(std::vector<std::uint8_t>& out, std::uint64_t v) {
-    for (int i = 0; i < 8; ++i) {
-        out.push_back(static_cast<std::uint8_t>((v >> (8 * i)) & 0xFFU));
-    }
+    append_le(out, v, 8);
 }
 
 /// Bounds-checked reader: every get_* returns false (and leaves the reader failed) instead of reading past
@@ -72,11 +67,7 @@ class Reader {
             ok_ = false;
             return false;
         }
-        T acc = 0;
-        for (std::size_t i = 0; i < n; ++i) {
-            acc = static_cast<T>(acc | (static_cast<T>(data_[pos_ + i]) << (8 * i)));
-        }
-        v = acc;
+        v = static_cast<T>(load_le(data_.data() + pos_, n));
         pos_ += n;
         return true;
     }
