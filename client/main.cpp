@@ -33,25 +33,15 @@ constexpr int kDone = 0;
 constexpr int kRefused = 1;
 constexpr int kNoLink = 3;
 
-const char* const kUsageText =
+/// The --help text around the options block (from the option table).
+const char* const kUsageHead =
     "Usage: airsegctl [CONNECTION] [--json] [--timeout MS] COMMAND [ARGS]\n"
     "\n"
     "Talks to airsegd, the on-board daemon, and shows what it says. Nothing is shown as done before\n"
     "the vehicle has acknowledged it.\n"
-    "\n"
-    "Connection (one of):\n"
-    "  --local            through airsegd's local socket on the board (the default)\n"
-    "  --socket PATH      local socket path (default /run/airseg/status.sock)\n"
-    "  --link PATH[,PATH2]  over the ground radio(s) on these serial devices; with two, list them in the\n"
-    "                     same radio-pair order as the vehicle's groundlink.ports\n"
-    "  --baud N           radio port baud rate (default 57600)\n"
-    "  --mode MODE        single (one device), split or redundant (two devices)\n"
-    "  --udp HOST:PORT    over UDP to the vehicle's ground-link socket\n"
-    "  --key FILE         pre-shared key file (mode 0600), the same as the vehicle's groundlink.key_file\n"
-    "  --timeout MS       how long to wait for an answer (default 5000)\n"
-    "\n"
-    "Output:\n"
-    "  --json             machine-readable JSON instead of text\n"
+    "\n";
+
+const char* const kUsageTail =
     "\n"
     "Commands:\n"
     "  status             health of every service and the vehicle's state\n"
@@ -98,11 +88,14 @@ int usage_error(const std::string& message) {
 /// command, and options the table does not know after it are the command's own (watch --duration MS).
 std::optional<int> parse(int argc, char** argv, Options& o) {
     using namespace airseg::cli;
-    OptionTable table;
+    OptionTable table("Options");
     table
-        .flag("local", "", [&o] { o.use_radio = false; })  // the default; named for scripts to be explicit
-        .value("socket", "PATH", "", text(o.socket))
-        .value("link", "PATH[,PATH2]", "",
+        .flag("local", "through airsegd's local socket on the board (the default)",
+              [&o] { o.use_radio = false; })  // named for scripts to be explicit
+        .value("socket", "PATH", "local socket path (default /run/airseg/status.sock)", text(o.socket))
+        .value("link", "PATH[,PATH2]",
+               "over the ground radio(s) on these serial devices; with two, list them in the same radio-pair "
+               "order as the vehicle's groundlink.ports",
                [&o](std::string_view option, std::string_view v) {
                    if (v.empty()) {
                        throw UsageError(std::string(option) + ": expected PATH[,PATH2], got ''");
@@ -119,15 +112,17 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
                    }
                    o.use_radio = true;
                })
-        .value("udp", "HOST:PORT", "",
+        .value("udp", "HOST:PORT", "over UDP to the vehicle's ground-link socket",
                [&o](std::string_view, std::string_view v) {
                    o.radio.udp = v;
                    o.use_radio = true;
                })
-        .value("baud", "N", "", number(o.radio.baud, 0, UINT32_MAX))
-        .value("mode", "MODE", "", text(o.radio.mode))
-        .value("key", "FILE", "", text(o.radio.key_file))
-        .value("timeout", "MS", "",
+        .value("baud", "N", "radio port baud rate (default 57600)", number(o.radio.baud, 0, UINT32_MAX))
+        .value("mode", "MODE", "single (one device), split or redundant (two devices)", text(o.radio.mode))
+        .value("key", "FILE",
+               "pre-shared key file (mode 0600), the same as the vehicle's groundlink.key_file",
+               text(o.radio.key_file))
+        .value("timeout", "MS", "how long to wait for an answer, in milliseconds (default 5000)",
                [&o](std::string_view option, std::string_view v) {
                    try {
                        o.timeout_ms = static_cast<long>(parse_unsigned(option, v, 1, LONG_MAX));
@@ -137,9 +132,9 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
                                         std::string(v) + "'");
                    }
                })
-        .flag("json", "", [&o] { o.json = true; })
+        .flag("json", "machine-readable JSON instead of text", [&o] { o.json = true; })
         .help_and_version();
-    const Program program{"airsegctl", [] { return std::string(kUsageText); }};
+    const Program program{"airsegctl", [&table] { return kUsageHead + describe(table) + kUsageTail; }};
     auto line = run(program, std::vector<std::string>(argv + std::min(argc, 1), argv + argc), table,
                     std::cout, std::cerr, {.max = SIZE_MAX, .take_unknown_options = true});
     if (line.exit_code) {

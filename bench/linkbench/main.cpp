@@ -1,14 +1,15 @@
 // linkbench: the ground-link transport against the seed's MAREA serial transport over the same simulated
 // radios, in simulated time. Deterministic: the same build prints the same figures.
-#include <charconv>
-#include <cstring>
+#include <cstdint>
 #include <iostream>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "bench/linkbench/report.hpp"
 #include "bench/linkbench/scenario.hpp"
+#include "cli/command_line.hpp"
 
 namespace {
 
@@ -35,15 +36,6 @@ Scenarios, for 57600 and 115200 baud, single pair and dual pair (split: each end
   outage=30s       the same with a 30 s outage of both directions starting at 20 s (90 s run)
   bidir            bulk Safe both ways (dual/single ratio of this row is a target)
 
-  --json            one JSON object per scenario instead of the table
-  --verbose         also print where the bytes went (wire use, air busy, FIFO overflow)
-  --duration S      seconds of simulated time per scenario (default 40; the outage runs 30 s longer)
-  --turnaround-ms X  radio turnaround (default 1)
-  --pacing F        the transport's link_rate as a fraction of baud/10 (default 1.0)
-  --only TEXT       only the scenarios whose "baud mode impairment" contains TEXT (e.g. "57600 single loss")
-  --seed N          seed of the radios' impairments (default 1000): the figures of one run are one draw of
-                    the radios' randomness; other seeds show how much a figure (a longest stall) varies
-  --strict          exit status 1 when a target fails
 )";
 
 struct Knobs {
@@ -112,59 +104,39 @@ int main(int argc, char** argv) {
     bool json = false;
     bool strict = false;
     bool verbose = false;
-    long seconds = 40;
+    std::uint32_t seconds = 40;
     Knobs knobs;
     std::string only;
-    for (int i = 1; i < argc; ++i) {
-        const std::string_view arg = argv[i];
-        if (arg == "--json") {
-            json = true;
-        } else if (arg == "--verbose") {
-            verbose = true;
-        } else if (arg == "--strict") {
-            strict = true;
-        } else if (arg == "--only" && i + 1 < argc) {
-            only = argv[++i];
-        } else if (arg == "--duration" && i + 1 < argc) {
-            const std::string_view v = argv[++i];
-            auto [ptr, ec] = std::from_chars(v.data(), v.data() + v.size(), seconds);
-            if (ec != std::errc{} || ptr != v.data() + v.size() || seconds < 5 || seconds > 3600) {
-                std::cerr << "linkbench: --duration wants whole seconds within [5, 3600], got '" << v
-                          << "'\n";
-                return 2;
-            }
-        } else if (arg == "--seed" && i + 1 < argc) {
-            const std::string_view v = argv[++i];
-            auto [ptr, ec] = std::from_chars(v.data(), v.data() + v.size(), knobs.seed);
-            if (ec != std::errc{} || ptr != v.data() + v.size()) {
-                std::cerr << "linkbench: --seed wants a whole number, got '" << v << "'\n";
-                return 2;
-            }
-        } else if ((arg == "--turnaround-ms" || arg == "--pacing") && i + 1 < argc) {
-            const std::string_view v = argv[++i];
-            double x = 0;
-            auto [ptr, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
-            const bool pacing = arg == "--pacing";
-            if (ec != std::errc{} || ptr != v.data() + v.size() || x < 0 ||
-                (pacing && (x < 0.1 || x > 2.0)) || x > 1000) {
-                std::cerr << "linkbench: " << arg << " wants "
-                          << (pacing ? "a factor within [0.1, 2]" : "milliseconds within [0, 1000]")
-                          << ", got '" << v << "'\n";
-                return 2;
-            }
-            if (pacing) {
-                knobs.pacing_factor = x;
-            } else {
-                knobs.turnaround =
-                    std::chrono::duration_cast<Duration>(std::chrono::duration<double, std::milli>(x));
-            }
-        } else if (arg == "--help" || arg == "-h") {
-            std::cout << kUsage;
-            return 0;
-        } else {
-            std::cerr << "linkbench: unknown argument '" << arg << "'\n" << kUsage;
-            return 2;
-        }
+    cli::OptionTable table("Options");
+    table.flag("json", "one JSON object per scenario instead of the table", [&] { json = true; })
+        .flag("verbose", "also print where the bytes went (wire use, air busy, FIFO overflow)",
+              [&] { verbose = true; })
+        .value("duration", "S",
+               "seconds of simulated time per scenario, whole seconds within [5, 3600] (default 40; the "
+               "outage runs 30 s longer)",
+               cli::number(seconds, 5, 3600))
+        .value("turnaround-ms", "X", "radio turnaround in milliseconds within [0, 1000] (default 1)",
+               [&](std::string_view option, std::string_view text) {
+                   knobs.turnaround = std::chrono::duration_cast<Duration>(
+                       std::chrono::duration<double, std::milli>(cli::parse_double(option, text, 0, 1000)));
+               })
+        .value("pacing", "F",
+               "the transport's link_rate as a fraction of baud/10, within [0.1, 2] (default 1.0)",
+               cli::number(knobs.pacing_factor, 0.1, 2.0))
+        .value("only", "TEXT",
+               "only the scenarios whose \"baud mode impairment\" contains TEXT (e.g. \"57600 single loss\")",
+               cli::text(only))
+        .value("seed", "N",
+               "seed of the radios' impairments (default 1000): the figures of one run are one draw of the "
+               "radios' randomness; other seeds show how much a figure (a longest stall) varies",
+               cli::number(knobs.seed, 0, std::numeric_limits<std::uint64_t>::max()))
+        .flag("strict", "exit status 1 when a target fails", [&] { strict = true; })
+        .help_and_version(false);
+    const cli::Program program{"linkbench", [&] { return std::string(kUsage) + cli::describe(table); }};
+    const auto line =
+        cli::run(program, std::vector<std::string>(argv + 1, argv + argc), table, std::cout, std::cerr);
+    if (line.exit_code) {
+        return *line.exit_code;
     }
 
     std::vector<Row> rows;

@@ -15,14 +15,16 @@
 #include <valgrind/callgrind.h>
 
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
+#include <iostream>
+#include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "bench/mavlink/telemetry_stream.hpp"
+#include "cli/command_line.hpp"
 #include "services/autopilot/mavlink/message_table.hpp"
 #include "services/autopilot/mavlink/messages.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
@@ -165,51 +167,86 @@ std::string crc_table() {
     return out;
 }
 
-int usage() {
-    std::fprintf(stderr,
-                 "usage: bench_mavlink_callgrind parse|parse-decode|reference READ_SIZE\n"
-                 "       bench_mavlink_callgrind decode\n"
-                 "       bench_mavlink_callgrind write-stream|write-crcs FILE\n");
-    return 2;
+constexpr const char* kProgram = "bench_mavlink_callgrind";
+
+std::string help(const airseg::cli::OptionTable& table) {
+    return std::string("Usage: ") + kProgram + " parse|parse-decode|reference READ_SIZE\n       " + kProgram +
+           " decode\n       " + kProgram +
+           " write-stream|write-crcs FILE\n\n"
+           "Instruction counts of the MAVLink receive path on one minute of ArduPilot telemetry, for "
+           "callgrind\n(bench/mavlink/callgrind.sh).\n\n" +
+           airseg::cli::describe(table);
+}
+
+/// How many operands follow each mode word.
+std::optional<std::size_t> operands_of(std::string_view mode) {
+    if (mode == "parse" || mode == "parse-decode" || mode == "reference" || mode == "write-stream" ||
+        mode == "write-crcs") {
+        return 1;
+    }
+    if (mode == "decode") {
+        return 0;
+    }
+    return std::nullopt;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-    if (argc < 2) {
-        return usage();
+    airseg::cli::OptionTable table("Options");
+    table.help_and_version(false);
+    const airseg::cli::Program program{kProgram, [&table] { return help(table); }};
+    const auto line = airseg::cli::run(program, std::vector<std::string>(argv + 1, argv + argc), table,
+                                       std::cout, std::cerr, {.max = 2});
+    if (line.exit_code) {
+        return *line.exit_code;
     }
-    const std::string_view mode = argv[1];
+    const auto& words = line.operands;
+    if (words.empty()) {
+        return airseg::cli::usage_error(std::cerr, kProgram, "missing the mode word");
+    }
+    const std::string_view mode = words[0];
+    const auto wanted = operands_of(mode);
+    if (!wanted) {
+        return airseg::cli::usage_error(std::cerr, kProgram, "unknown mode '" + words[0] + "'");
+    }
+    if (words.size() != *wanted + 1) {
+        return airseg::cli::usage_error(
+            std::cerr, kProgram,
+            words.size() > *wanted + 1
+                ? "unexpected argument '" + words.back() + "'"
+                : std::string(mode.starts_with("write") ? "FILE" : "READ_SIZE") + ": missing value");
+    }
+    std::size_t read_size = 0;
+    if (mode == "parse" || mode == "parse-decode" || mode == "reference") {
+        try {
+            read_size = static_cast<std::size_t>(airseg::cli::parse_unsigned(
+                "READ_SIZE", words[1], 1, std::numeric_limits<std::uint32_t>::max()));
+        } catch (const airseg::cli::UsageError& e) {
+            return airseg::cli::usage_error(std::cerr, kProgram, e.what());
+        }
+    }
     const bench::TelemetryStream stream = bench::make_telemetry_stream(60.0);
     const std::span<const std::uint8_t> bytes(stream.bytes);
-    if (mode == "write-stream" && argc == 3) {
-        return write_file(argv[2],
+    if (mode == "write-stream") {
+        return write_file(words[1].c_str(),
                           std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()))
                    ? 0
                    : 1;
     }
-    if (mode == "write-crcs" && argc == 3) {
-        return write_file(argv[2], crc_table()) ? 0 : 1;
+    if (mode == "write-crcs") {
+        return write_file(words[1].c_str(), crc_table()) ? 0 : 1;
     }
     Result r;
-    if (mode == "decode" && argc == 2) {
+    if (mode == "decode") {
         r = run_decode(bytes);
         std::printf("messages %zu sink %g\n", r.frames, r.sink);
         return r.frames == stream.frames ? 0 : 1;
     }
-    if (argc != 3) {
-        return usage();
-    }
-    const auto read_size = static_cast<std::size_t>(std::strtoul(argv[2], nullptr, 10));
-    if (read_size == 0) {
-        return usage();
-    }
-    if (mode == "parse" || mode == "parse-decode") {
-        r = run_airseg(bytes, read_size, mode == "parse-decode");
-    } else if (mode == "reference") {
+    if (mode == "reference") {
         r = run_reference(bytes, read_size);
     } else {
-        return usage();
+        r = run_airseg(bytes, read_size, mode == "parse-decode");
     }
     std::printf("bytes %zu frames %zu sink %g\n", bytes.size(), r.frames, r.sink);
     return r.frames == stream.frames ? 0 : 1;

@@ -6,13 +6,17 @@
 //   bench_transport [--scenario=upload|telemetry] [--seconds=N] [--read=BYTES] [--unkeyed]
 //                   [--measure=none|a|b|both|poll_transmit]
 #include <cstdio>
-#include <cstdlib>
+#include <functional>
+#include <iostream>
 #include <map>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "bench/transport/driven_link.hpp"
+#include "cli/command_line.hpp"
 
 namespace {
 
@@ -44,43 +48,52 @@ struct Options {
     Selection measure = Selection::None;
 };
 
-Options parse(int argc, char** argv) {
-    Options o;
-    for (int i = 1; i < argc; ++i) {
-        const std::string_view a = argv[i];
-        const auto value = [&](std::string_view key) -> std::optional<std::string> {
-            if (a.substr(0, key.size()) == key) {
-                return std::string(a.substr(key.size()));
-            }
-            return std::nullopt;
-        };
-        if (auto v = value("--scenario=")) {
-            o.scenario = *v;
-        } else if (auto s = value("--seconds=")) {
-            o.seconds = std::stod(*s);
-        } else if (auto r = value("--read=")) {
-            o.read_bytes = std::stoul(*r);
-        } else if (a == "--unkeyed") {
-            o.keyed = false;
-        } else if (auto m = value("--measure=")) {
-            static const std::map<std::string, Selection> names{{"none", Selection::None},
-                                                                {"a", Selection::EndA},
-                                                                {"b", Selection::EndB},
-                                                                {"both", Selection::Both},
-                                                                {"poll_transmit", Selection::PollTransmit}};
-            const auto it = names.find(*m);
-            if (it == names.end()) {
-                throw std::invalid_argument("unknown --measure " + *m);
-            }
-            o.measure = it->second;
-        } else {
-            throw std::invalid_argument("unknown argument " + std::string(a));
+/// One of names' keys, or a UsageError that lists them.
+template <class T>
+cli::Apply one_of(T& target, std::map<std::string, T, std::less<>> names, std::string wanted) {
+    return [&target, names = std::move(names), wanted = std::move(wanted)](std::string_view option,
+                                                                           std::string_view text) {
+        const auto it = names.find(text);
+        if (it == names.end()) {
+            throw cli::UsageError(std::string(option) + ": expected " + wanted + ", got '" +
+                                  std::string(text) + "'");
         }
-    }
-    if (o.scenario != "upload" && o.scenario != "telemetry") {
-        throw std::invalid_argument("unknown --scenario " + o.scenario);
-    }
-    return o;
+        target = it->second;
+    };
+}
+
+/// The options, or the exit code after --help or a bad command line.
+std::optional<int> parse(int argc, char** argv, Options& o) {
+    cli::OptionTable table("Options");
+    table
+        .value("scenario", "NAME",
+               "upload (the full exchange with a flight plan upload) or telemetry (default upload)",
+               one_of<std::string>(o.scenario, {{"upload", "upload"}, {"telemetry", "telemetry"}},
+                                   "upload or telemetry"))
+        .value("seconds", "N", "simulated seconds measured, after 5 s to set the session up (default 60)",
+               cli::number(o.seconds, 0, 1e6))
+        .value("read", "BYTES", "bytes per read from the simulated serial port (default 16)",
+               cli::number(o.read_bytes, 1, 1 << 20))
+        .flag("unkeyed", "run the transport without a key (default keyed)", [&o] { o.keyed = false; })
+        .value("measure", "WHICH",
+               "the calls callgrind collects: none, a (airsegd's end), b (airsegctl's end), both or "
+               "poll_transmit (default none)",
+               one_of(o.measure,
+                      {{"none", Selection::None},
+                       {"a", Selection::EndA},
+                       {"b", Selection::EndB},
+                       {"both", Selection::Both},
+                       {"poll_transmit", Selection::PollTransmit}},
+                      "none, a, b, both or poll_transmit"))
+        .help_and_version(false);
+    const cli::Program program{"bench_transport", [&table] {
+                                   return "Usage: bench_transport [OPTION]...\n\n"
+                                          "The ground-link transport's calls on a simulated 57600-baud radio "
+                                          "pair,\nfor callgrind (bench/transport/callgrind.sh).\n\n" +
+                                          cli::describe(table);
+                               }};
+    return cli::run(program, std::vector<std::string>(argv + 1, argv + argc), table, std::cout, std::cerr)
+        .exit_code;
 }
 
 gl::TransportConfig config(std::uint64_t nonce, bool keyed) {
@@ -249,8 +262,11 @@ void print_end(const char* name, const EndTally& t) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    Options o;
+    if (const auto exit_code = parse(argc, argv, o)) {
+        return *exit_code;
+    }
     try {
-        const Options o = parse(argc, argv);
         DrivenLink link(config(0xA11CE, o.keyed), config(0xB0B, o.keyed), kAirRate, o.read_bytes, o.measure);
         Scenario s(o, link);
         s.run();

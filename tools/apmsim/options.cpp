@@ -8,8 +8,9 @@ namespace airseg::apmsim {
 
 using cli::UsageError;
 
-const char* usage() {
-    return R"(usage: airseg-apmsim --link PATH [options]
+namespace {
+
+constexpr const char* kUsageHead = R"(usage: airseg-apmsim --link PATH [options]
 
 Simulates an ArduPilot APM:Rover board on a pseudo-terminal. PATH becomes a symlink to the pty slave; open
 it as you would open /dev/ttyACM0. The board speaks MAVLink as system 1, component 1
@@ -19,48 +20,9 @@ Like an APM on USB, the board reboots when a program opens the port (DTR): it go
 delay, then sends "Initialising APM..." and heartbeats in MAV_STATE_BOOT/CALIBRATING (mode INITIALISING)
 for the calibration time, then "Ready to drive." in STANDBY/ACTIVE and mode INITIAL_MODE (MANUAL).
 
-Board:
-  --link PATH              symlink to the pty slave (required)
-  --firmware PROFILE       what the board runs (docs/simulators.md, "Firmware profiles"):
-                           modern: ArduPilot Rover as today (MAVLink 2, MISSION_ITEM_INT,
-                             COMMAND_LONG modes, AUTO resumes, MISSION_ITEM_REACHED);
-                           rover2: APMrover2 2.4x on an APM 2.5 (MAVLink 1 only, float
-                             mission items, SET_MODE without acknowledgement, AUTO
-                             restarts at item 1, text-only reached reports, 500 ms
-                             re-request and 1 s patience in uploads)      [modern]
-  --boot-delay S           silence after a reset                                  [2]
-  --calib-time S           calibration time after the silence                     [3]
-  --no-reset-on-open       do not reboot when the port is opened (Pixhawk-style boards)
-  --baud N                 the board's UART rate. A pty moves bytes at any rate, so
-                           the simulator reads the rate the peer set on its end;
-                           while it differs, both sides receive noise, as two UARTs
-                           at different rates do                           [any rate]
-  --home LAT,LON           start and home position, degrees                       [41.2756,1.9866]
-  --home-alt M             home altitude above mean sea level                     [5]
-  --mission-capacity N     mission items the board holds, home included           [150]
-  --reached-style STYLE    both: MISSION_ITEM_REACHED and the STATUSTEXT
-                           "Reached waypoint #N dist Mm"; text: the text only,
-                           as APM:Rover 2.x firmware does                          [both]
-  --mavlink1               speak MAVLink 1 (default MAVLink 2; rover2 always does)
-  --param NAME=VALUE       set a parameter before boot (repeatable), e.g. WP_RADIUS=3
-  --seed N                 seed of the fault generators (deterministic)          [1]
-  --speedup N              simulated time runs N times faster than real time      [1]
-Faults (times are simulated seconds after start):
-  --loss P                 fraction of the bytes lost, each direction
-  --loss-burst N           lose bytes in bursts of N bytes on average (geometric
-                           lengths: frames cut short, tails, whole frames)
-                           instead of one by one                                  [1]
-  --corrupt P              probability each byte (either direction) gets a bit flipped
-  --hb-stall START:DUR     no heartbeats from START for DUR seconds (repeatable)
-  --reboot-at S            reboot at S
-  --unplug START:DUR       remove the pty at START, plug a new one in after DUR (repeatable)
-  --ignore-mission         ignore every mission protocol message
-  --slow MS                answer every request MS milliseconds late
-Control and output:
-  --control PATH           Unix datagram socket taking run-time commands (below)
-  --quiet                  no event lines on standard error
-  --help
+)";
 
+constexpr const char* kUsageTail = R"(
 On exit (SIGINT, SIGTERM) the mode history is printed on standard output as one JSON object. SIGUSR1
 reboots the board.
 
@@ -85,7 +47,8 @@ Control commands (one per datagram; the reply goes to the sender's bound address
   param NAME [VALUE]       read or set a parameter
   help
 )";
-}
+
+}  // namespace
 
 namespace {
 
@@ -98,14 +61,11 @@ GeoPoint parse_lat_lon(std::string_view option, std::string_view text) {
                     cli::parse_double(option, text.substr(comma + 1), -180, 180)};
 }
 
-}  // namespace
-
-std::optional<ApmSimOptions> parse_options(const std::vector<std::string>& args) {
+// The firmware sets defaults (MAVLink version, reached style, mission timers) that the other options
+// may then change, wherever --firmware stands on the line: they act after the whole line is read.
+void fill_table(cli::OptionTable& table, ApmSimOptions& o,
+                std::vector<std::function<void()>>& after_firmware) {
     using namespace cli;
-    ApmSimOptions o;
-    // The firmware sets defaults (MAVLink version, reached style, mission timers) that the other options
-    // may then change, wherever --firmware stands on the line: they act after the whole line is read.
-    std::vector<std::function<void()>> after_firmware;
     auto later = [&after_firmware](Apply apply) -> Apply {
         return [&after_firmware, apply = std::move(apply)](std::string_view option, std::string_view text) {
             after_firmware.push_back(
@@ -115,9 +75,13 @@ std::optional<ApmSimOptions> parse_options(const std::vector<std::string>& args)
     auto later_flag = [&after_firmware](std::function<void()> apply) {
         return [&after_firmware, apply = std::move(apply)] { after_firmware.push_back(apply); };
     };
-    OptionTable table;
-    table.value("link", "PATH", "", text(o.link_path))
-        .value("firmware", "PROFILE", "",
+    table.value("link", "PATH", "symlink to the pty slave (required)", text(o.link_path))
+        .value("firmware", "PROFILE",
+               "what the board runs (docs/simulators.md, \"Firmware profiles\"): modern: ArduPilot Rover as "
+               "today (MAVLink 2, MISSION_ITEM_INT, COMMAND_LONG modes, AUTO resumes, MISSION_ITEM_REACHED); "
+               "rover2: APMrover2 2.4x on an APM 2.5 (MAVLink 1 only, float mission items, SET_MODE without "
+               "acknowledgement, AUTO restarts at item 1, text-only reached reports, 500 ms re-request and 1 "
+               "s patience in uploads) [modern]",
                [&o](std::string_view option, std::string_view v) {
                    const auto f = parse_firmware(v);
                    if (!f) {
@@ -126,17 +90,28 @@ std::optional<ApmSimOptions> parse_options(const std::vector<std::string>& args)
                    }
                    o.sim = RoverSimConfig::for_firmware(*f);
                })
-        .value("control", "PATH", "", text(o.control_path))
-        .value("boot-delay", "S", "", later(in_seconds(o.sim.boot_delay)))
-        .value("calib-time", "S", "", later(in_seconds(o.sim.calib_time)))
-        .flag("no-reset-on-open", "", later_flag([&o] { o.sim.reset_on_open = false; }))
-        .value("baud", "N", "", number(o.baud, 9600, 1500000))
-        .value("home", "LAT,LON", "", later([&o](std::string_view option, std::string_view v) {
+        .value("boot-delay", "S", "silence after a reset, seconds [2]", later(in_seconds(o.sim.boot_delay)))
+        .value("calib-time", "S", "calibration time after the silence, seconds [3]",
+               later(in_seconds(o.sim.calib_time)))
+        .flag("no-reset-on-open", "do not reboot when the port is opened (Pixhawk-style boards)",
+              later_flag([&o] { o.sim.reset_on_open = false; }))
+        .value("baud", "N",
+               "the board's UART rate. A pty moves bytes at any rate, so the simulator reads the rate the "
+               "peer set on its end; while it differs, both sides receive noise, as two UARTs at different "
+               "rates do [any rate]",
+               number(o.baud, 9600, 1500000))
+        .value("home", "LAT,LON", "start and home position, degrees [41.2756,1.9866]",
+               later([&o](std::string_view option, std::string_view v) {
                    o.sim.home = parse_lat_lon(option, v);
                }))
-        .value("home-alt", "M", "", later(number(o.sim.home_alt, -1000, 10000)))
-        .value("mission-capacity", "N", "", later(number(o.sim.mission_capacity, 1, 65535)))
-        .value("reached-style", "STYLE", "", later([&o](std::string_view option, std::string_view v) {
+        .value("home-alt", "M", "home altitude above mean sea level, metres [5]",
+               later(number(o.sim.home_alt, -1000, 10000)))
+        .value("mission-capacity", "N", "mission items the board holds, home included [150]",
+               later(number(o.sim.mission_capacity, 1, 65535)))
+        .value("reached-style", "STYLE",
+               "both: MISSION_ITEM_REACHED and the STATUSTEXT \"Reached waypoint #N dist Mm\"; text: the "
+               "text only, as APM:Rover 2.x firmware does [both]",
+               later([&o](std::string_view option, std::string_view v) {
                    if (v == "both") {
                        o.sim.reached_style = ReachedStyle::MessageAndText;
                    } else if (v == "text") {
@@ -146,8 +121,9 @@ std::optional<ApmSimOptions> parse_options(const std::vector<std::string>& args)
                                         std::string(v) + "'");
                    }
                }))
-        .flag("mavlink1", "", later_flag([&o] { o.sim.version = mavlink::Version::V1; }))
-        .value("param", "NAME=VALUE", "",
+        .flag("mavlink1", "speak MAVLink 1 (default MAVLink 2; rover2 always does)",
+              later_flag([&o] { o.sim.version = mavlink::Version::V1; }))
+        .value("param", "NAME=VALUE", "set a parameter before boot (repeatable), e.g. WP_RADIUS=3",
                [&o](std::string_view option, std::string_view text) {
                    const std::string v(text);
                    const auto eq = v.find('=');
@@ -161,19 +137,48 @@ std::optional<ApmSimOptions> parse_options(const std::vector<std::string>& args)
                    o.params.emplace_back(
                        name, static_cast<float>(parse_double(option, v.substr(eq + 1), -1e9, 1e9)));
                })
-        .value("seed", "N", "", later(number(o.sim.seed, 0, UINT64_MAX)))
-        .value("speedup", "N", "", number(o.speedup, 0.01, 10000))
-        .value("loss", "P", "", probability(o.faults.loss))
-        .value("loss-burst", "N", "", number(o.faults.loss_burst, 1, 10000))
-        .value("corrupt", "P", "", probability(o.faults.corrupt))
-        .value("hb-stall", "START:DUR", "", windows(o.hb_stalls))
-        .value("reboot-at", "S", "", in_seconds(o.reboot_at))
-        .value("unplug", "START:DUR", "", windows(o.unplugs))
-        .flag("ignore-mission", "", [&o] { o.faults.ignore_mission = true; })
-        .value("slow", "MS", "", in_milliseconds(o.faults.slow))
-        .flag("quiet", "", [&o] { o.quiet = true; })
+        .value("seed", "N", "seed of the fault generators (deterministic) [1]",
+               later(number(o.sim.seed, 0, UINT64_MAX)))
+        .value("speedup", "N", "simulated time runs N times faster than real time [1]",
+               number(o.speedup, 0.01, 10000))
+        // Faults (times are simulated seconds after start):
+        .value("loss", "P", "fraction of the bytes lost, each direction", probability(o.faults.loss))
+        .value("loss-burst", "N",
+               "lose bytes in bursts of N bytes on average (geometric lengths: frames cut short, tails, "
+               "whole frames) instead of one by one [1]",
+               number(o.faults.loss_burst, 1, 10000))
+        .value("corrupt", "P", "probability each byte (either direction) gets a bit flipped",
+               probability(o.faults.corrupt))
+        .value("hb-stall", "START:DUR", "no heartbeats from START for DUR seconds (repeatable)",
+               windows(o.hb_stalls))
+        .value("reboot-at", "S", "reboot at S", in_seconds(o.reboot_at))
+        .value("unplug", "START:DUR", "remove the pty at START, plug a new one in after DUR (repeatable)",
+               windows(o.unplugs))
+        .flag("ignore-mission", "ignore every mission protocol message",
+              [&o] { o.faults.ignore_mission = true; })
+        .value("slow", "MS", "answer every request MS milliseconds late", in_milliseconds(o.faults.slow))
+        .value("control", "PATH", "Unix datagram socket taking run-time commands (below)",
+               text(o.control_path))
+        .flag("quiet", "no event lines on standard error", [&o] { o.quiet = true; })
         .help_and_version(false);
-    parse(args, table);
+}
+
+}  // namespace
+
+std::string usage() {
+    ApmSimOptions unused;
+    std::vector<std::function<void()>> after_firmware;
+    cli::OptionTable table("Options");
+    fill_table(table, unused, after_firmware);
+    return std::string(kUsageHead) + cli::describe(table) + kUsageTail;
+}
+
+std::optional<ApmSimOptions> parse_options(const std::vector<std::string>& args) {
+    ApmSimOptions o;
+    std::vector<std::function<void()>> after_firmware;
+    cli::OptionTable table;
+    fill_table(table, o, after_firmware);
+    cli::parse(args, table);
     if (table.help_requested()) {
         return std::nullopt;
     }

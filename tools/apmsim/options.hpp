@@ -24,7 +24,7 @@ struct ApmSimOptions {
     bool quiet = false;                                 // --quiet
 };
 
-const char* usage();
+std::string usage();
 /// Parses the arguments (without argv[0]). nullopt for --help; throws cli::UsageError.
 std::optional<ApmSimOptions> parse_options(const std::vector<std::string>& args);
 

@@ -8,38 +8,18 @@ namespace airseg::linksim {
 
 using cli::UsageError;
 
-const char* usage() {
-    return R"(usage: airseg-linksim --a PATH --b PATH [options]
+namespace {
+
+constexpr const char* kUsageHead = R"(usage: airseg-linksim --a PATH --b PATH [options]
 
 Emulates a pair of transparent serial radios between two pseudo-terminals. PATH A and PATH B become symlinks
 to the pty slaves; a program opens each as it would open /dev/ttyUSB0 (and should put it in raw mode). Bytes
 written at A come out at B and back, at the serial rate, sharing one air channel the way SiK/3DR, XBee and
 XTend radios do, with the impairments below. For two radio pairs (dual serial) run two instances.
 
-Link:
-  --baud N              serial rate at both ends, 8N1 (baud/10 bytes/s)        [57600]
-  --air-rate BPS        raw air bit rate (bytes/s = BPS/8)                     [serial byte rate]
-  --half-duplex         one air channel shared by both directions              [default]
-  --full-duplex         one air channel per direction
-  --turnaround MS       half duplex: dead air when the sending side changes    [1]
-  --packet BYTES        largest air packet                                     [252]
-  --packet-overhead B   bytes sent on air with every packet                    [0]
-  --buffer BYTES        each radio's serial-side FIFO; overflow is dropped     [2048]
-  --latency MS          added delay per air packet
-Impairments (each also as -ab / -ba for one direction, e.g. --loss-ab 0.01):
-  --loss P              probability a byte is lost
-  --ber P               probability a bit is flipped
-  --corrupt P           probability a byte arrives with one bit flipped
-  --frame-loss P        probability an air packet is lost
-  --outage START:DUR    seconds after start, for DUR seconds nothing gets through (repeatable)
-  --seed N              seed of the impairment generators (deterministic)      [1]
-Control and output:
-  --control PATH        Unix datagram socket taking run-time commands (below)
-  --stats-interval S    print statistics every S seconds
-  --json                statistics as JSON (one object per line)
-  --host-backlog BYTES  bytes read from a pty that may wait for the serial line [65536]
-  --help
+)";
 
+constexpr const char* kUsageTail = R"(
 Statistics are printed on exit (SIGINT, SIGTERM): per direction bytes in/out, dropped on overflow, lost,
 corrupted, air packets sent/lost, and air utilisation.
 
@@ -54,66 +34,93 @@ Control commands (one per datagram; the reply goes to the sender's bound address
   stats                             statistics as JSON
   help
 )";
-}
-
-namespace {
 
 using Setter = std::function<void(DirectionImpairment&, std::string_view option, std::string_view value)>;
 
 /// An impairment as --NAME (both directions) and --NAME-ab / --NAME-ba (one).
-void add_impairment(cli::OptionTable& table, RadioConfig& radio, const std::string& name, const Setter& set) {
+void add_impairment(cli::OptionTable& table, RadioConfig& radio, const std::string& name,
+                    const char* value_name, const std::string& help, const Setter& set) {
     for (const std::string suffix : {"", "-ab", "-ba"}) {
         const auto option = name + suffix;
-        table.value(option.c_str(), "V", "", [&radio, suffix, set](std::string_view opt, std::string_view v) {
-            if (suffix != "-ba") {
-                set(radio.impairment[index(Side::A)], opt, v);
-            }
-            if (suffix != "-ab") {
-                set(radio.impairment[index(Side::B)], opt, v);
-            }
-        });
+        const auto text = suffix.empty()
+                              ? help
+                              : "the same, from " + suffix.substr(1, 1) + " to " + suffix.substr(2) + " only";
+        table.value(option.c_str(), value_name, text.c_str(),
+                    [&radio, suffix, set](std::string_view opt, std::string_view v) {
+                        if (suffix != "-ba") {
+                            set(radio.impairment[index(Side::A)], opt, v);
+                        }
+                        if (suffix != "-ab") {
+                            set(radio.impairment[index(Side::B)], opt, v);
+                        }
+                    });
     }
+}
+
+/// The options in the order --help lists them; they act in command-line order.
+void fill_table(cli::OptionTable& table, LinkSimOptions& o) {
+    using namespace cli;
+    table.value("a", "PATH", "symlink to create to radio A's pty slave (required)", text(o.a_path))
+        .value("b", "PATH", "symlink to create to radio B's pty slave (required)", text(o.b_path))
+        .value("baud", "N", "serial rate at both ends, 8N1 (baud/10 bytes/s) [57600]",
+               number(o.radio.baud, 300, 4'000'000))
+        .value("air-rate", "BPS", "raw air bit rate (bytes/s = BPS/8) [serial byte rate]",
+               number(o.radio.air_rate_bps, 300, 100'000'000))
+        .flag("half-duplex", "one air channel shared by both directions [default]",
+              [&] { o.radio.duplex = Duplex::Half; })
+        .flag("full-duplex", "one air channel per direction", [&] { o.radio.duplex = Duplex::Full; })
+        .value("turnaround", "MS", "half duplex: dead air when the sending side changes [1]",
+               in_milliseconds(o.radio.turnaround))
+        .value("packet", "BYTES", "largest air packet [252]", number(o.radio.max_air_packet, 1, 65536))
+        .value("packet-overhead", "B", "bytes sent on air with every packet [0]",
+               number(o.radio.air_packet_overhead, 0, 65536))
+        .value("buffer", "BYTES", "each radio's serial-side FIFO; overflow is dropped [2048]",
+               number(o.radio.radio_buffer, 1, 1U << 24));
+    // Each impairment also as --NAME-ab / --NAME-ba for one direction, e.g. --loss-ab 0.01.
+    add_impairment(table, o.radio, "latency", "MS", "added delay per air packet",
+                   [](DirectionImpairment& d, auto opt, auto v) { d.latency = parse_milliseconds(opt, v); });
+    add_impairment(table, o.radio, "loss", "P", "probability a byte is lost",
+                   [](DirectionImpairment& d, auto opt, auto v) { d.byte_loss = parse_probability(opt, v); });
+    add_impairment(
+        table, o.radio, "ber", "P", "probability a bit is flipped",
+        [](DirectionImpairment& d, auto opt, auto v) { d.bit_error_rate = parse_probability(opt, v); });
+    add_impairment(
+        table, o.radio, "corrupt", "P", "probability a byte arrives with one bit flipped",
+        [](DirectionImpairment& d, auto opt, auto v) { d.byte_corruption = parse_probability(opt, v); });
+    add_impairment(
+        table, o.radio, "frame-loss", "P", "probability an air packet is lost",
+        [](DirectionImpairment& d, auto opt, auto v) { d.frame_loss = parse_probability(opt, v); });
+    add_impairment(table, o.radio, "outage", "START:DUR",
+                   "seconds after start, for DUR seconds nothing gets through (repeatable)",
+                   [](DirectionImpairment& d, auto opt, auto v) {
+                       const auto w = parse_window(opt, v);
+                       d.outages.push_back({w.start, w.length});
+                   });
+    table
+        .value("seed", "N", "seed of the impairment generators (deterministic) [1]",
+               number(o.radio.seed, 0, UINT64_MAX))
+        .value("control", "PATH", "Unix datagram socket taking run-time commands (below)",
+               text(o.control_path))
+        .value("stats-interval", "S", "print statistics every S seconds", in_seconds(o.stats_interval))
+        .flag("json", "statistics as JSON (one object per line)", [&] { o.json = true; })
+        .value("host-backlog", "BYTES", "bytes read from a pty that may wait for the serial line [65536]",
+               number(o.host_backlog, 1, 1U << 26))
+        .help_and_version(false);
 }
 
 }  // namespace
 
+std::string usage() {
+    LinkSimOptions unused;
+    cli::OptionTable table("Options");
+    fill_table(table, unused);
+    return std::string(kUsageHead) + cli::describe(table) + kUsageTail;
+}
+
 std::optional<LinkSimOptions> parse_options(const std::vector<std::string>& args) {
-    using namespace cli;
     LinkSimOptions o;
-    OptionTable table;
-    table.value("a", "PATH", "", text(o.a_path))
-        .value("b", "PATH", "", text(o.b_path))
-        .value("baud", "N", "", number(o.radio.baud, 300, 4'000'000))
-        .value("air-rate", "BPS", "", number(o.radio.air_rate_bps, 300, 100'000'000))
-        .flag("half-duplex", "", [&] { o.radio.duplex = Duplex::Half; })
-        .flag("full-duplex", "", [&] { o.radio.duplex = Duplex::Full; })
-        .value("turnaround", "MS", "", in_milliseconds(o.radio.turnaround))
-        .value("packet", "BYTES", "", number(o.radio.max_air_packet, 1, 65536))
-        .value("packet-overhead", "B", "", number(o.radio.air_packet_overhead, 0, 65536))
-        .value("buffer", "BYTES", "", number(o.radio.radio_buffer, 1, 1U << 24))
-        .value("seed", "N", "", number(o.radio.seed, 0, UINT64_MAX))
-        .value("control", "PATH", "", text(o.control_path))
-        .value("stats-interval", "S", "", in_seconds(o.stats_interval))
-        .flag("json", "", [&] { o.json = true; })
-        .value("host-backlog", "BYTES", "", number(o.host_backlog, 1, 1U << 26))
-        .help_and_version(false);
-    add_impairment(table, o.radio, "loss",
-                   [](DirectionImpairment& d, auto opt, auto v) { d.byte_loss = parse_probability(opt, v); });
-    add_impairment(table, o.radio, "ber", [](DirectionImpairment& d, auto opt, auto v) {
-        d.bit_error_rate = parse_probability(opt, v);
-    });
-    add_impairment(table, o.radio, "corrupt", [](DirectionImpairment& d, auto opt, auto v) {
-        d.byte_corruption = parse_probability(opt, v);
-    });
-    add_impairment(table, o.radio, "frame-loss", [](DirectionImpairment& d, auto opt, auto v) {
-        d.frame_loss = parse_probability(opt, v);
-    });
-    add_impairment(table, o.radio, "latency",
-                   [](DirectionImpairment& d, auto opt, auto v) { d.latency = parse_milliseconds(opt, v); });
-    add_impairment(table, o.radio, "outage", [](DirectionImpairment& d, auto opt, auto v) {
-        const auto w = parse_window(opt, v);
-        d.outages.push_back({w.start, w.length});
-    });
+    cli::OptionTable table;
+    fill_table(table, o);
     parse(args, table);
     if (table.help_requested()) {
         return std::nullopt;

@@ -19,7 +19,7 @@ struct LinkSimOptions {
 };
 
 /// The full --help text.
-const char* usage();
+std::string usage();
 
 /// Parses argv. Throws cli::UsageError naming the option on bad input. Returns nullopt for --help.
 std::optional<LinkSimOptions> parse_options(const std::vector<std::string>& args);

@@ -32,16 +32,6 @@ FILE is read instead of standard input when given ("-" is standard input). A FIL
 as a telemetry log (8-byte big-endian microsecond timestamp before each frame) and each line then starts
 with "timestamp_us".
 
-Options:
-  --tlog       read the input as a telemetry log whatever its name
-  --raw        read the input as a plain byte stream whatever its name
-  --encode     the reverse: JSON lines in (the format above; "v" 1 or 2 selects the framing, default 2;
-               "sysid" default 255, "compid" default 190, "seq" default counts up per sysid/compid;
-               missing fields are 0, HEARTBEAT.mavlink_version 3), MAVLink frames out. Lines that cannot be
-               encoded are reported on standard error with their line number and skipped; the exit
-               status is then 1.
-  -o OUTPUT    write to OUTPUT instead of standard output
-  -h, --help   show this help
 )";
 
 struct Options {
@@ -137,13 +127,23 @@ int encode(const Options& opt, std::istream& in, std::FILE* out) {
 
 int main(int argc, char** argv) {
     Options opt;
-    airseg::cli::OptionTable table;
-    table.flag("encode", "", [&] { opt.encode = true; })
-        .flag("tlog", "", [&] { opt.format = Options::Format::Tlog; })
-        .flag("raw", "", [&] { opt.format = Options::Format::Raw; })
-        .value(",o", "OUTPUT", "", airseg::cli::text(opt.output))
+    airseg::cli::OptionTable table("Options");
+    table
+        .flag("tlog", "read the input as a telemetry log whatever its name",
+              [&] { opt.format = Options::Format::Tlog; })
+        .flag("raw", "read the input as a plain byte stream whatever its name",
+              [&] { opt.format = Options::Format::Raw; })
+        .flag("encode",
+              "the reverse: JSON lines in (the format above; \"v\" 1 or 2 selects the framing, default 2; "
+              "\"sysid\" default 255, \"compid\" default 190, \"seq\" default counts up per sysid/compid; "
+              "missing fields are 0, HEARTBEAT.mavlink_version 3), MAVLink frames out. Lines that cannot be "
+              "encoded are reported on standard error with their line number and skipped; the exit status "
+              "is then 1.",
+              [&] { opt.encode = true; })
+        .value(",o", "OUTPUT", "write to OUTPUT instead of standard output", airseg::cli::text(opt.output))
         .help_and_version(false);
-    const airseg::cli::Program program{"airseg-mavdump", [] { return std::string(kUsage); }};
+    const airseg::cli::Program program{
+        "airseg-mavdump", [&table] { return std::string(kUsage) + airseg::cli::describe(table); }};
     const auto line = airseg::cli::run(program, std::vector<std::string>(argv + 1, argv + argc), table,
                                        std::cout, std::cerr, {.max = 1});
     if (line.exit_code) {

@@ -615,7 +615,10 @@ std::uint32_t Driver::request_state(VehicleState target, TimePoint now) {
         done(id, RequestKind::SetState, RequestResult::Ok);
         return id;
     }
-    modes_.start(id, target, mode, now);
+    // Nothing is running after the cancel above (which words why); an outcome here still gets reported.
+    if (auto o = modes_.start(id, target, mode, now)) {
+        finish_mode(std::move(*o), now);
+    }
     if (target == VehicleState::WaypointNavigation) {
         auto_check_.arm(board_slot(), now);
     }

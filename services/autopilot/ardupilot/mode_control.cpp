@@ -17,9 +17,12 @@ const char* mav_result_name(std::uint8_t r) {
 }
 }  // namespace
 
-void ModeControl::start(std::uint32_t id, VehicleState target, std::uint32_t mode, TimePoint now) {
+std::optional<ModeOutcome> ModeControl::start(std::uint32_t id, VehicleState target, std::uint32_t mode,
+                                              TimePoint now) {
+    auto superseded = cancel("superseded by request " + std::to_string(id));
     request_ = Request{id, target, mode, 0, now + timeout_};
     send_ = mode;
+    return superseded;
 }
 
 std::optional<ModeOutcome> ModeControl::on_heartbeat(std::uint32_t custom_mode) {

@@ -4,8 +4,8 @@
 // start() asks for the mode (poll_send() says to send it); without confirmation within timeout it is sent
 // again, `retries` times, then the request ends Timeout. A heartbeat in the mode ends it Ok; a COMMAND_ACK
 // refusing MAV_CMD_DO_SET_MODE ends it Refused (ACCEPTED and IN_PROGRESS wait for the heartbeat); cancel()
-// ends it Cancelled (superseded by another request, link lost, reboot). One request at a time: the owner
-// ends the running one (cancel) before starting the next, so none is ever dropped.
+// ends it Cancelled (superseded by another request, link lost, reboot). One request at a time: start() while
+// one is running ends that one Cancelled and returns its outcome, so none is ever dropped.
 //
 // The frames (SET_MODE or COMMAND_LONG) are the Driver's: it drains poll_send() after start() and
 // handle_timeout() and encodes them; it reacts to every returned ModeOutcome.
@@ -32,8 +32,10 @@ class ModeControl {
     /// Each attempt waits `timeout` for the heartbeat; `retries` attempts follow the first.
     ModeControl(Duration timeout, unsigned retries) : timeout_(timeout), retries_(retries) {}
 
-    /// Starts request `id` for autopilot mode `mode` (the vehicle state `target`). Nothing may be running.
-    void start(std::uint32_t id, VehicleState target, std::uint32_t mode, TimePoint now);
+    /// Starts request `id` for autopilot mode `mode` (the vehicle state `target`). A request still running
+    /// ends Cancelled first and that outcome is returned, so that it is not dropped without one.
+    [[nodiscard]] std::optional<ModeOutcome> start(std::uint32_t id, VehicleState target, std::uint32_t mode,
+                                                   TimePoint now);
     /// The autopilot reported `custom_mode` in a heartbeat: Ok when it is the mode asked for.
     std::optional<ModeOutcome> on_heartbeat(std::uint32_t custom_mode);
     /// The autopilot answered MAV_CMD_DO_SET_MODE with MAV_RESULT `result`: Refused unless it accepted.

@@ -15,7 +15,7 @@ constexpr auto kManual = static_cast<std::uint32_t>(RoverMode::Manual);
 
 TEST(ModeControl, RetriedThenTimedOut) {
     ModeControl m(milliseconds(1500), 3);
-    m.start(7, VehicleState::Parking, kHold, kAsked);
+    EXPECT_FALSE(m.start(7, VehicleState::Parking, kHold, kAsked));
     EXPECT_TRUE(m.pending());
     EXPECT_EQ(m.poll_send(), kHold);
     EXPECT_FALSE(m.poll_send());
@@ -48,7 +48,7 @@ TEST(ModeControl, RetriedThenTimedOut) {
 
 TEST(ModeControl, NoRetriesMeansOneAttempt) {
     ModeControl m(seconds(1), 0);
-    m.start(1, VehicleState::Parking, kHold, kAsked);
+    EXPECT_FALSE(m.start(1, VehicleState::Parking, kHold, kAsked));
     EXPECT_EQ(m.poll_send(), kHold);
     const auto o = m.handle_timeout(kAsked + seconds(1));
     ASSERT_TRUE(o);
@@ -58,7 +58,7 @@ TEST(ModeControl, NoRetriesMeansOneAttempt) {
 
 TEST(ModeControl, ConfirmedByTheHeartbeatsMode) {
     ModeControl m(milliseconds(1500), 3);
-    m.start(3, VehicleState::WaypointNavigation, kAuto, kAsked);
+    EXPECT_FALSE(m.start(3, VehicleState::WaypointNavigation, kAuto, kAsked));
     (void)m.poll_send();
     EXPECT_FALSE(m.on_heartbeat(kHold));  // not yet there
     EXPECT_TRUE(m.pending());
@@ -80,7 +80,7 @@ TEST(ModeControl, ConfirmedByTheHeartbeatsMode) {
 
 TEST(ModeControl, RefusedByTheAck) {
     ModeControl m(milliseconds(1500), 3);
-    m.start(4, VehicleState::WaypointNavigation, kAuto, kAsked);
+    EXPECT_FALSE(m.start(4, VehicleState::WaypointNavigation, kAuto, kAsked));
     EXPECT_FALSE(m.on_ack(0));  // ACCEPTED: the heartbeat confirms
     EXPECT_FALSE(m.on_ack(5));  // IN_PROGRESS
     EXPECT_TRUE(m.pending());
@@ -96,7 +96,7 @@ TEST(ModeControl, RefusedByTheAck) {
 TEST(ModeControl, ASecondRequestEndsTheFirstCancelled) {
     // The Driver cancels the running request before it starts the next.
     ModeControl m(milliseconds(1500), 3);
-    m.start(1, VehicleState::WaypointNavigation, kAuto, kAsked);
+    EXPECT_FALSE(m.start(1, VehicleState::WaypointNavigation, kAuto, kAsked));
     (void)m.poll_send();
     const auto first = m.cancel("superseded by a request for MANUAL");
     ASSERT_TRUE(first);
@@ -105,7 +105,7 @@ TEST(ModeControl, ASecondRequestEndsTheFirstCancelled) {
     EXPECT_EQ(first->detail, "superseded by a request for MANUAL");
     EXPECT_FALSE(m.cancel("again"));
 
-    m.start(2, VehicleState::Manual, kManual, kAsked + milliseconds(200));
+    EXPECT_FALSE(m.start(2, VehicleState::Manual, kManual, kAsked + milliseconds(200)));
     EXPECT_EQ(m.poll_send(), kManual);
     EXPECT_EQ(m.poll_timeout(), kAsked + milliseconds(1700));
     EXPECT_FALSE(m.on_heartbeat(kAuto));  // the first request's mode confirms nothing now
@@ -113,6 +113,28 @@ TEST(ModeControl, ASecondRequestEndsTheFirstCancelled) {
     ASSERT_TRUE(second);
     EXPECT_EQ(second->id, 2u);
     EXPECT_EQ(second->result, RequestResult::Ok);
+}
+
+TEST(ModeControl, StartWhileOneIsRunningEndsItCancelled) {
+    ModeControl m(milliseconds(1500), 3);
+    EXPECT_FALSE(m.start(1, VehicleState::WaypointNavigation, kAuto, kAsked));
+    (void)m.poll_send();
+    const auto first = m.start(2, VehicleState::Manual, kManual, kAsked + milliseconds(200));
+    ASSERT_TRUE(first);
+    EXPECT_EQ(first->id, 1u);
+    EXPECT_EQ(first->target, VehicleState::WaypointNavigation);
+    EXPECT_EQ(first->mode, kAuto);
+    EXPECT_EQ(first->result, RequestResult::Cancelled);
+    EXPECT_EQ(first->detail, "superseded by request 2");
+
+    EXPECT_EQ(m.poll_send(), kManual);
+    EXPECT_EQ(m.poll_timeout(), kAsked + milliseconds(1700));
+    EXPECT_FALSE(m.on_heartbeat(kAuto));
+    const auto second = m.on_heartbeat(kManual);
+    ASSERT_TRUE(second);
+    EXPECT_EQ(second->id, 2u);
+    EXPECT_EQ(second->result, RequestResult::Ok);
+    EXPECT_FALSE(m.cancel("again"));  // the first ended once, at start()
 }
 
 }  // namespace
