@@ -112,6 +112,7 @@ void PlanController::start_plan(ActivePlan plan, bool append, TimePoint now) {
     returning_home_ = false;
     problem_.clear();
     last_saved_.reset();
+    last_written_.reset();
     save_progress();
 }
 
@@ -144,14 +145,14 @@ void PlanController::save_progress() {
 
 void PlanController::on_saved(const ProgressSave& save, const std::optional<std::string>& error) {
     if (!error) {
-        last_saved_ = save.progress;
+        last_saved_ = last_written_ = save.progress;
         return;
     }
     if (!save.report_failure) {
         return;
     }
     if (last_saved_ && *last_saved_ == save.progress) {
-        last_saved_.reset();
+        last_saved_ = last_written_;  // not kept: the next input tries this point again
     }
     if (problem_ != *error) {
         log(Level::Error, "cannot save progress: " + *error);
@@ -172,8 +173,8 @@ bool PlanController::return_home(TimePoint now) {
     }
     const auto& v = active_->plan->vehicle;
     // The plan's progress stays saved where it was interrupted (paused), so a restart does not drive on.
-    if (config_.keeps_progress && last_saved_) {
-        SavedProgress paused = *last_saved_;
+    if (config_.keeps_progress && last_written_) {
+        SavedProgress paused = *last_written_;
         paused.state = PlanState::Paused;
         saves_.push_back(ProgressSave{std::move(paused), false});
     }

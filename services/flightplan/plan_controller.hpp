@@ -196,7 +196,10 @@ class PlanController {
     std::string last_failure_;
     std::vector<Waiter> waiters_;
 
+    // last_saved_: the point last handed out to be saved (not handed out again); last_written_: the last one
+    // the store confirmed, which a way home keeps as paused even when later saves failed.
     std::optional<SavedProgress> last_saved_;
+    std::optional<SavedProgress> last_written_;
     std::string problem_;        // plan.error: the last problem found (corrupt state, failed save, ...)
     std::string last_reaction_;  // plan.reaction
     Json last_status_;

@@ -381,6 +381,34 @@ TEST(FlightplanController, AProgressTheStoreCannotKeepIsThePlansError) {
     EXPECT_EQ(rig.c.progress_json()["error"], "disk full");
 }
 
+TEST(FlightplanController, AfterAFailedSaveAWayHomeStillLeavesTheLastSavedPointPaused) {
+    PlanControllerConfig config;
+    config.keeps_progress = true;
+    Rig rig(config);
+    rig.run_plan("return_home", true);
+    ASSERT_FALSE(rig.saves.empty());
+    const SavedProgress written = rig.saves.back().progress;
+    ASSERT_EQ(written.state, PlanState::Running);
+    rig.save_error = "disk full";  // the store refuses from now on
+    rig.c.pause(rig.next_id++, rig.now);
+    rig.drain();
+    rig.confirm_all();
+    ASSERT_EQ(rig.saves.back().progress.state, PlanState::Paused)
+        << "the paused point was tried, and refused";
+    rig.c.resume_plan(rig.next_id++, rig.now);
+    rig.drain();
+    rig.confirm_all();
+    const auto before = rig.saves.size();
+    rig.c.on_link(false, rig.now);
+    rig.drain();
+    rig.advance(seconds(21));
+    rig.confirm_all();
+    ASSERT_GT(rig.saves.size(), before) << "a way home keeps the restart point";
+    const auto& paused = rig.saves.back().progress;
+    EXPECT_EQ(paused.state, PlanState::Paused);
+    EXPECT_EQ(paused.next_index, written.next_index) << "the point the store last kept";
+}
+
 TEST(FlightplanController, StopFailsTheWaitingCommands) {
     Rig rig;
     rig.ready();
