@@ -39,6 +39,12 @@ bool is_upload(const autopilot::AutopilotRequest& r) {
     return std::holds_alternative<autopilot::UploadMission>(r.op);
 }
 
+PlanControllerConfig with_a_state_store() {
+    PlanControllerConfig config;
+    config.keeps_progress = true;
+    return config;
+}
+
 // The controller, an autopilot that confirms what it is asked (or not, when told so) and the outputs seen.
 struct Rig {
     explicit Rig(PlanControllerConfig config = {}) : c(std::move(config)) {
@@ -353,9 +359,7 @@ TEST(FlightplanController, PauseThenResumeLeavesTheRunningPlanInAuto) {
 }
 
 TEST(FlightplanController, ProgressIsKeptOnceAndAWayHomeLeavesThePlanSavedAsPaused) {
-    PlanControllerConfig config;
-    config.keeps_progress = true;
-    Rig rig(config);
+    Rig rig(with_a_state_store());
     rig.run_plan("return_home", true);
     ASSERT_FALSE(rig.saves.empty());
     EXPECT_EQ(rig.saves.back().progress.state, PlanState::Running);
@@ -373,18 +377,14 @@ TEST(FlightplanController, ProgressIsKeptOnceAndAWayHomeLeavesThePlanSavedAsPaus
 }
 
 TEST(FlightplanController, AProgressTheStoreCannotKeepIsThePlansError) {
-    PlanControllerConfig config;
-    config.keeps_progress = true;
-    Rig rig(config);
+    Rig rig(with_a_state_store());
     rig.save_error = "disk full";
     rig.run_plan("hold", true);
     EXPECT_EQ(rig.c.progress_json()["error"], "disk full");
 }
 
 TEST(FlightplanController, AfterAFailedSaveAWayHomeStillLeavesTheLastSavedPointPaused) {
-    PlanControllerConfig config;
-    config.keeps_progress = true;
-    Rig rig(config);
+    Rig rig(with_a_state_store());
     rig.run_plan("return_home", true);
     ASSERT_FALSE(rig.saves.empty());
     const SavedProgress written = rig.saves.back().progress;
