@@ -12,7 +12,7 @@
 #include <cerrno>
 #include <deque>
 
-#include "hal/current_read.hpp"
+#include "hal/current_io.hpp"
 #include "hal/io_errors.hpp"
 #include "hal/write_queue.hpp"
 
@@ -277,7 +277,7 @@ class Pty::Impl : public std::enable_shared_from_this<Impl> {
                            &Impl::on_read);
     }
 
-    // Runs only for a current read (current_read.hpp).
+    // Runs only for a current read (current_io.hpp).
     void on_read(std::uint64_t gen, boost::system::error_code ec, std::size_t n) {
         reading_ = false;
         if (ec) {
@@ -300,16 +300,12 @@ class Pty::Impl : public std::enable_shared_from_this<Impl> {
     void do_write() {
         writing_ = true;
         auto buffer = std::make_shared<std::vector<std::uint8_t>>(writes_.take_one());
-        boost::asio::async_write(
-            stream_, boost::asio::buffer(*buffer),
-            [self = shared_from_this(), gen = generation_, buffer](
-                boost::system::error_code ec, std::size_t) { self->on_write(gen, ec, buffer->size()); });
+        async_write_current(stream_, boost::asio::buffer(*buffer), buffer, buffer->size(), shared_from_this(),
+                            &Impl::generation_, &Impl::on_write);
     }
 
-    void on_write(std::uint64_t gen, boost::system::error_code ec, std::size_t size) {
-        if (gen != generation_ || ec == boost::asio::error::operation_aborted) {
-            return;
-        }
+    // Runs only for a current write (current_io.hpp).
+    void on_write(boost::system::error_code ec, std::size_t size) {
         writing_ = false;
         writes_.written(size);
         if (ec) {

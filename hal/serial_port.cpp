@@ -10,7 +10,7 @@
 #include <deque>
 #include <iterator>
 
-#include "hal/current_read.hpp"
+#include "hal/current_io.hpp"
 #include "hal/io_errors.hpp"
 #include "hal/serial_termios.hpp"
 #include "hal/write_queue.hpp"
@@ -142,7 +142,7 @@ class SerialPort::Impl : public std::enable_shared_from_this<Impl> {
                            &Impl::on_read);
     }
 
-    // Runs only for a current read (current_read.hpp).
+    // Runs only for a current read (current_io.hpp).
     void on_read(std::uint64_t gen, boost::system::error_code ec, std::size_t n) {
         if (ec) {
             fail(ec, HalError::ReadFailed);
@@ -167,17 +167,12 @@ class SerialPort::Impl : public std::enable_shared_from_this<Impl> {
             batch->buffers.emplace_back(f.data(), f.size());
             batch->size += f.size();
         }
-        boost::asio::async_write(
-            stream_, batch->buffers,
-            [self = shared_from_this(), gen = generation_, batch](boost::system::error_code ec, std::size_t) {
-                self->on_write(gen, ec, batch->size);
-            });
+        async_write_current(stream_, batch->buffers, batch, batch->size, shared_from_this(),
+                            &Impl::generation_, &Impl::on_write);
     }
 
-    void on_write(std::uint64_t gen, boost::system::error_code ec, std::size_t size) {
-        if (gen != generation_ || ec == boost::asio::error::operation_aborted) {
-            return;
-        }
+    // Runs only for a current write (current_io.hpp).
+    void on_write(boost::system::error_code ec, std::size_t size) {
         writing_ = false;
         writes_.written(size);
         if (ec) {
