@@ -27,7 +27,7 @@ bool expired(const LiveOptions& o, Clock::time_point started) {
 }
 
 /// Waits until the link is up (the vehicle pushes nothing before); false after the timeout.
-bool wait_for_link(RadioClient& radio, const LiveOptions& o,
+bool wait_for_link(VehicleLink& radio, const LiveOptions& o,
                    const std::function<void(const proto::Message&)>& on_message) {
     const auto deadline = Clock::now() + o.timeout;
     while (!radio.link_up() && g_stop == 0) {
@@ -59,7 +59,7 @@ bool stop_requested() {
     return g_stop != 0;
 }
 
-int run_radio_watch(RadioClient& radio, const LiveOptions& o) {
+int run_radio_watch(VehicleLink& radio, const LiveOptions& o) {
     WatchState state;
     auto take = [&state](const proto::Message& m) { state.take(m, Clock::now()); };
     if (!wait_for_link(radio, o, take)) {
@@ -97,7 +97,7 @@ int run_radio_watch(RadioClient& radio, const LiveOptions& o) {
     return kDone;
 }
 
-int run_log(RadioClient& radio, const LiveOptions& o) {
+int run_log(VehicleLink& radio, const LiveOptions& o) {
     auto print = [&o](const proto::Message& m) {
         const auto* e = std::get_if<proto::Event>(&m);
         if (e == nullptr) {
@@ -122,7 +122,7 @@ int run_log(RadioClient& radio, const LiveOptions& o) {
     return kDone;
 }
 
-int run_joystick(RadioClient& radio, const LiveOptions& o, const JoystickOptions& j) {
+int run_joystick(VehicleLink& radio, const LiveOptions& o, const JoystickOptions& j) {
     std::string error;
     // The first input is a command: the vehicle acknowledges that this station may drive (a monitor key is
     // refused here, before any stick input is streamed).

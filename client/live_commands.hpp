@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "client/radio_client.hpp"
+#include "client/vehicle_link.hpp"
 
 namespace airseg::client {
 
@@ -20,14 +20,14 @@ struct LiveOptions {
 };
 
 /// Exit codes as everywhere in airsegctl: 0 done, 1 refused, 2 usage, 3 no link.
-int run_radio_watch(RadioClient& radio, const LiveOptions& options);
-int run_log(RadioClient& radio, const LiveOptions& options);
+int run_radio_watch(VehicleLink& radio, const LiveOptions& options);
+int run_log(VehicleLink& radio, const LiveOptions& options);
 
 struct JoystickOptions {
     std::string device;  // /dev/input/jsN; empty = keyboard
     double rate_hz = 10;
 };
-int run_joystick(RadioClient& radio, const LiveOptions& options, const JoystickOptions& joystick);
+int run_joystick(VehicleLink& radio, const LiveOptions& options, const JoystickOptions& joystick);
 
 /// The --note lines as shown under a live view (empty without notes).
 std::string notes_text(const LiveOptions& options);

@@ -18,10 +18,12 @@
 #include <vector>
 
 #include "cli/command_line.hpp"
+#include "client/hub_client.hpp"
 #include "client/live_commands.hpp"
 #include "client/local_client.hpp"
 #include "client/plan_command.hpp"
 #include "client/radio_client.hpp"
+#include "client/radio_options.hpp"
 #include "client/status_view.hpp"
 #include "client/vehicle_commands.hpp"
 #include "services/common/nearest_word.hpp"
@@ -69,7 +71,10 @@ const char* const kUsageTail =
 struct Options {
     std::string socket = "/run/airseg/status.sock";
     airseg::client::RadioOptions radio;
+    airseg::client::HubOptions hub;
     bool use_radio = false;
+    bool use_hub = false;
+    bool local_chosen = false;  // --local or --socket: never look for a ground hub instead
     bool json = false;
     long timeout_ms = 5000;
     std::vector<std::string> positional;
@@ -77,6 +82,10 @@ struct Options {
 
 const std::vector<std::string> kCommandNames{"status", "watch",    "state",   "param", "rates",
                                              "log",    "joystick", "request", "plan"};
+
+bool exists(const std::string& path) {
+    return ::access(path.c_str(), F_OK) == 0;
+}
 
 /// A bad command line in one line and where the help is: the whole help would push the reason off the
 /// screen.
@@ -91,37 +100,31 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
     OptionTable table("Options");
     table
         .flag("local", "through airsegd's local socket on the board (the default)",
-              [&o] { o.use_radio = false; })  // named for scripts to be explicit
-        .value("socket", "PATH", "local socket path (default /run/airseg/status.sock)", text(o.socket))
-        .value("link", "PATH[,PATH2]",
-               "over the ground radio(s) on these serial devices; with two, list them in the same radio-pair "
-               "order as the vehicle's groundlink.ports",
-               [&o](std::string_view option, std::string_view v) {
-                   if (v.empty()) {
-                       throw UsageError(std::string(option) + ": expected PATH[,PATH2], got ''");
-                   }
-                   o.radio.ports.clear();
-                   std::size_t start = 0;
-                   for (std::size_t comma; (comma = v.find(',', start)) != std::string_view::npos;
-                        start = comma + 1) {
-                       o.radio.ports.emplace_back(v.substr(start, comma - start));
-                   }
-                   o.radio.ports.emplace_back(v.substr(start));
-                   if (o.radio.ports.size() == 2 && o.radio.mode == "single") {
-                       o.radio.mode = "split";
-                   }
-                   o.use_radio = true;
-               })
-        .value("udp", "HOST:PORT", "over UDP to the vehicle's ground-link socket",
+              [&o] {
+                  o.use_radio = o.use_hub = false;
+                  o.local_chosen = true;
+              })  // named for scripts to be explicit
+        .value("socket", "PATH", "local socket path (default /run/airseg/status.sock)",
                [&o](std::string_view, std::string_view v) {
-                   o.radio.udp = v;
-                   o.use_radio = true;
+                   o.socket = v;
+                   o.local_chosen = true;
                })
-        .value("baud", "N", "radio port baud rate (default 57600)", number(o.radio.baud, 0, UINT32_MAX))
-        .value("mode", "MODE", "single (one device), split or redundant (two devices)", text(o.radio.mode))
-        .value("key", "FILE",
-               "pre-shared key file (mode 0600), the same as the vehicle's groundlink.key_file",
-               text(o.radio.key_file))
+        .flag("ground",
+              "through the ground hub airseg-ground on its default socket (/run/airseg/ground.sock); chosen "
+              "by itself when that socket exists and airsegd's does not",
+              [&o] { o.use_hub = true; })
+        .value("ground-socket", "PATH", "through the ground hub on this Unix socket",
+               [&o](std::string_view, std::string_view v) {
+                   o.hub.socket = v;
+                   o.use_hub = true;
+               })
+        .value("ground-tcp", "HOST:PORT", "through the ground hub's TCP listener",
+               [&o](std::string_view, std::string_view v) {
+                   o.hub.tcp = v;
+                   o.use_hub = true;
+               });
+    airseg::client::add_radio_options(table, o.radio, [&o] { o.use_radio = true; });
+    table
         .value("timeout", "MS", "how long to wait for an answer, in milliseconds (default 5000)",
                [&o](std::string_view option, std::string_view v) {
                    try {
@@ -144,10 +147,19 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
     if (o.positional.empty()) {
         return usage_error("no command given");
     }
+    if (o.use_radio && o.use_hub) {
+        return usage_error(
+            "--ground and the radio options (--link, --udp) exclude each other: the hub owns the "
+            "radio");
+    }
     if (o.use_radio) {
         if (auto problem = airseg::client::validate(o.radio); !problem.empty()) {
             return usage_error(problem);
         }
+    }
+    if (!o.use_radio && !o.use_hub && !o.local_chosen && !exists(o.socket) &&
+        exists(std::string(airseg::client::hub::kDefaultSocket))) {
+        o.use_hub = true;  // a ground laptop: no airsegd here, but a hub
     }
     return std::nullopt;
 }
@@ -177,7 +189,7 @@ int show_answer(const Options& o, const airseg::client::LocalAnswer& a,
 
 /// The local live view: the status document redrawn in place on a terminal, appended otherwise (for logs).
 int watch(const Options& o, const std::function<airseg::client::LocalAnswer(const nlohmann::json&)>& request,
-          airseg::client::RadioClient* radio, std::chrono::milliseconds interval,
+          airseg::client::VehicleLink* radio, std::chrono::milliseconds interval,
           const airseg::client::LiveOptions& live) {
     const bool tty = ::isatty(STDOUT_FILENO) == 1;
     const auto began = std::chrono::steady_clock::now();
@@ -218,7 +230,7 @@ int watch(const Options& o, const std::function<airseg::client::LocalAnswer(cons
 
 struct Requester {
     airseg::client::LocalClient& local;
-    airseg::client::RadioClient* radio;
+    airseg::client::VehicleLink* radio;
     std::chrono::milliseconds timeout;
     airseg::client::LocalAnswer request(const nlohmann::json& r) {
         return radio ? radio->request(r, timeout) : local.request(r);
@@ -226,7 +238,7 @@ struct Requester {
 };
 
 /// watch, log and joystick: their own options follow the command name.
-int live_command(const Options& o, Requester& client, airseg::client::RadioClient* radio) {
+int live_command(const Options& o, Requester& client, airseg::client::VehicleLink* radio) {
     const auto& cmd = o.positional[0];
     airseg::client::LiveOptions live;
     live.json = o.json;
@@ -262,7 +274,7 @@ int live_command(const Options& o, Requester& client, airseg::client::RadioClien
             std::chrono::milliseconds(static_cast<long>(interval_ms)), live);
     }
     if (radio == nullptr) {
-        return usage_error(cmd + " needs the radio link (--link or --udp): the vehicle pushes it");
+        return usage_error(cmd + " needs the radio link (--link, --udp or --ground): the vehicle pushes it");
     }
     if (cmd == "log") {
         return airseg::client::run_log(*radio, live);
@@ -282,16 +294,33 @@ int main(int argc, char** argv) {
     }
     const auto timeout = std::chrono::milliseconds(o.timeout_ms);
     airseg::client::LocalClient local(o.socket, timeout);
-    std::unique_ptr<airseg::client::RadioClient> radio;
+    const auto& cmd = o.positional[0];
+    std::unique_ptr<airseg::client::VehicleLink> radio;
     if (o.use_radio) {
-        radio = std::make_unique<airseg::client::RadioClient>(o.radio);
-        if (auto error = radio->open(); !error.empty()) {
+        auto direct = std::make_unique<airseg::client::RadioClient>(o.radio);
+        if (auto error = direct->open(); !error.empty()) {
             std::cerr << "airsegctl: " << error << "\n";
             return kNoLink;
         }
+        radio = std::move(direct);
+    } else if (o.use_hub) {
+        auto options = o.hub;
+        options.key_file = o.radio.key_file;
+        // Watching needs no control, so watchers never keep an operator from taking it.
+        options.want_control = cmd != "status" && cmd != "watch" && cmd != "log";
+        options.name = "airsegctl " + cmd;
+        auto hub = std::make_unique<airseg::client::HubClient>(options);
+        if (auto error = hub->open(timeout); !error.empty()) {
+            std::cerr << "airsegctl: " << error << "\n";
+            return kNoLink;
+        }
+        if (options.want_control && hub->role() != "control") {
+            std::cerr << "airsegctl: the ground hub made this client a monitor: " << hub->role_reason()
+                      << "\n";
+        }
+        radio = std::move(hub);
     }
     Requester client{local, radio.get(), timeout};
-    const auto& cmd = o.positional[0];
     if (cmd == "status") {
         if (o.positional.size() != 1) {
             return usage_error("status takes no arguments");
@@ -320,7 +349,7 @@ int main(int argc, char** argv) {
     }
     if (cmd == "plan") {
         auto plan =
-            airseg::client::plan_command({o.positional.begin() + 1, o.positional.end()}, !o.use_radio);
+            airseg::client::plan_command({o.positional.begin() + 1, o.positional.end()}, radio == nullptr);
         if (!plan.request) {
             return usage_error(plan.error);
         }

@@ -208,7 +208,17 @@ void GroundlinkService::on_message(Delivered message) {
 void GroundlinkService::on_command(const protocol::Command& command) {
     ++commands_;
     const std::uint32_t id = command.request_id;
-    const Role role = ground_role();
+    // A ground hub relays its monitor clients' commands with "role": "monitor": the vehicle runs them with
+    // the lesser of the two rights, never more than the link's key grants.
+    auto request = command.request;
+    bool lowered = false;
+    if (request.is_object()) {
+        if (auto asked = request.find("role"); asked != request.end()) {
+            lowered = *asked == "monitor";
+            request.erase(asked);
+        }
+    }
+    const Role role = lowered ? Role::Monitor : ground_role();
     // The journal keeps what the ground asked of the vehicle; a plan upload is cut to its first characters.
     constexpr std::size_t kShown = 160;
     auto shown = command.request.dump(-1, ' ', true, nlohmann::json::error_handler_t::replace);
@@ -216,11 +226,14 @@ void GroundlinkService::on_command(const protocol::Command& command) {
         shown = shown.substr(0, kShown) + fmt::format("… ({} bytes)", shown.size());
     }
     spdlog::info("groundlink: request {} from the ground ({}): {}", id, to_string(role), shown);
-    ctx_.commands.dispatch(command.request, role, [this, id](CommandResult result) {
-        asio::dispatch(strand(), [this, id, result = std::move(result)]() mutable {
+    ctx_.commands.dispatch(request, role, [this, id, lowered](CommandResult result) {
+        asio::dispatch(strand(), [this, id, lowered, result = std::move(result)]() mutable {
             if (result.status == CommandStatus::Forbidden) {
                 ++commands_refused_;
-                result.error += " (this ground station uses the monitor key; commands need the control key)";
+                result.error += lowered
+                                    ? " (a monitor client of the ground hub; commands need its control role)"
+                                    : " (this ground station uses the monitor key; commands need the control "
+                                      "key)";
                 spdlog::warn("groundlink: refused a command from a monitor: {}", result.error);
             }
             if (!driver_) {

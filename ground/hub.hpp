@@ -1,0 +1,99 @@
+#pragma once
+// airseg-ground's hub: owns the radio link (one ground-link session to the vehicle) and serves many local
+// clients on a Unix socket and, optionally, TCP. Every client sees what the vehicle pushes; commands are
+// relayed one by one, each answered end to end by the vehicle. Roles per client: one control client at a time
+// (it proved the control key, or came over the Unix socket of a hub without a key) and any number of
+// monitors, whose commands the vehicle runs with monitor rights only.
+#include <boost/asio/local/stream_protocol.hpp>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "client/ground_end.hpp"
+#include "client/hub_wire.hpp"
+#include "ground/client_connection.hpp"
+#include "services/common/asio.hpp"
+
+namespace airseg::ground {
+
+struct HubConfig {
+    client::RadioOptions radio;
+    std::string socket{client::hub::kDefaultSocket};  // empty = no Unix socket
+    std::string tcp;                                  // HOST:PORT; empty = no TCP listener
+};
+
+class Hub {
+  public:
+    /// The vehicle's answer to a command the hub itself sent (the map's buttons, the plan shape).
+    using Done = std::function<void(nlohmann::json answer)>;
+    /// Everything the vehicle pushes, for the hub's own consumers (the map, the MAVLink endpoint).
+    using Listener = std::function<void(const groundlink::protocol::Message&)>;
+
+    Hub(asio::any_io_executor strand, HubConfig config);
+    ~Hub();
+    Hub(const Hub&) = delete;
+    Hub& operator=(const Hub&) = delete;
+
+    /// Opens the radio and the listeners; an error for people, empty on success.
+    std::string start();
+    void stop();
+
+    // On the strand:
+    /// Sends a command with control rights on behalf of the hub itself.
+    void command(nlohmann::json request, Done done);
+    void add_listener(Listener listener) { listeners_.push_back(std::move(listener)); }
+    /// Sends a message to the vehicle reliably (MAVLink from ground stations).
+    groundlink::SendResult send_to_vehicle(const groundlink::protocol::Message& message);
+    nlohmann::json link_stats() const;
+    std::size_t clients() const { return clients_.size(); }
+
+  private:
+    struct ClientState {
+        std::shared_ptr<ClientConnection> connection;
+        std::array<std::uint8_t, client::hub::kChallengeBytes> challenge{};
+        bool local = false;  // came over the Unix socket
+        bool welcomed = false;
+        bool control = false;
+        bool joystick_warned = false;
+        std::string name;
+    };
+    struct Pending {
+        std::uint32_t client = 0;  // 0: the hub's own command
+        std::uint32_t client_request = 0;
+        Done done;
+        std::chrono::steady_clock::time_point sent;
+    };
+
+    std::string listen_unix();
+    std::string listen_tcp();
+    void accept_unix();
+    void accept_tcp();
+    void add_client(ClientConnection::Socket socket, std::string peer, bool local);
+    void on_frame(ClientConnection& connection, client::hub::Frame frame);
+    void on_hello(ClientState& client, const nlohmann::json& hello);
+    void on_client_message(ClientState& client, const groundlink::protocol::Message& message);
+    void on_closed(ClientConnection& connection, const std::string& why);
+    void on_vehicle(groundlink::protocol::Message message);
+    std::uint32_t relay(nlohmann::json request, Pending pending);
+    void broadcast(const std::vector<std::uint8_t>& frame);
+    void tick();
+
+    asio::any_io_executor strand_;
+    HubConfig config_;
+    client::GroundEnd end_;
+    std::optional<std::array<std::uint8_t, 32>> key_;
+    std::unique_ptr<asio::local::stream_protocol::acceptor> unix_acceptor_;
+    std::unique_ptr<asio::ip::tcp::acceptor> tcp_acceptor_;
+    asio::steady_timer tick_timer_;
+    std::map<std::uint32_t, ClientState> clients_;
+    std::map<std::uint32_t, Pending> pending_;
+    std::vector<Listener> listeners_;
+    std::uint32_t next_client_ = 1;
+    std::uint32_t next_request_ = 1;
+    std::uint32_t control_holder_ = 0;
+    bool stopped_ = false;
+};
+
+}  // namespace airseg::ground

@@ -1,0 +1,94 @@
+// airseg-ground: the ground station hub. Owns the radio link to the vehicle and serves airsegctl clients
+// (watchers and one commanding operator at a time) on a Unix socket and optionally TCP.
+// docs/ground-station.md.
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <csignal>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "cli/command_line.hpp"
+#include "client/radio_options.hpp"
+#include "ground/hub.hpp"
+
+namespace {
+
+const char* const kUsageHead =
+    "Usage: airseg-ground (--link PATH[,PATH2] | --udp HOST:PORT) [OPTIONS]\n"
+    "\n"
+    "The ground station hub: keeps the one radio session to the vehicle and serves local clients.\n"
+    "airsegctl --ground talks through it: any number of watchers and one commanding operator at a time,\n"
+    "each command acknowledged by the vehicle.\n"
+    "\n";
+
+const char* const kUsageTail =
+    "\n"
+    "Roles: a client that proves the control key (airsegctl --key, the hub's own --key) may take control;\n"
+    "one client holds it at a time. Every other client is a monitor: it sees everything, and the vehicle\n"
+    "runs its commands with monitor rights only. A hub without --key grants control to Unix-socket\n"
+    "clients (the socket is mode 0660), never to TCP ones.\n"
+    "\n"
+    "Exit codes: 0 stopped by SIGINT/SIGTERM, 1 could not start, 2 usage.\n";
+
+struct Options {
+    airseg::ground::HubConfig hub;
+    bool radio_given = false;
+    std::string log_level = "info";
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    using namespace airseg::cli;
+    Options o;
+    OptionTable table("Options");
+    airseg::client::add_radio_options(table, o.hub.radio, [&o] { o.radio_given = true; });
+    table
+        .value(
+            "socket", "PATH", "Unix socket for clients (default /run/airseg/ground.sock; 'off' for none)",
+            [&o](std::string_view, std::string_view v) { o.hub.socket = v == "off" ? "" : std::string(v); })
+        .value("tcp", "HOST:PORT", "also serve clients over TCP (off by default)", text(o.hub.tcp))
+        .value("log-level", "LEVEL", "trace, debug, info, warn or error (default info)", text(o.log_level))
+        .help_and_version();
+    const Program program{"airseg-ground", [&table] { return kUsageHead + describe(table) + kUsageTail; }};
+    auto line = run(program, std::vector<std::string>(argv + std::min(argc, 1), argv + argc), table,
+                    std::cout, std::cerr, {.max = 0});
+    if (line.exit_code) {
+        return *line.exit_code;
+    }
+    if (!o.radio_given) {
+        return usage_error(std::cerr, "airseg-ground", "no radio given (--link PATH or --udp HOST:PORT)");
+    }
+    if (auto problem = airseg::client::validate(o.hub.radio); !problem.empty()) {
+        return usage_error(std::cerr, "airseg-ground", problem);
+    }
+    const auto level = spdlog::level::from_str(o.log_level);
+    if (level == spdlog::level::off && o.log_level != "off") {
+        return usage_error(std::cerr, "airseg-ground", "--log-level: unknown level '" + o.log_level + "'");
+    }
+    spdlog::set_default_logger(spdlog::stderr_color_mt("airseg-ground"));
+    spdlog::set_level(level);
+
+    boost::asio::io_context io;
+    auto strand = boost::asio::make_strand(io);
+    airseg::ground::Hub hub(strand, o.hub);
+    if (auto error = hub.start(); !error.empty()) {
+        std::cerr << "airseg-ground: " << error << '\n';
+        return 1;
+    }
+    boost::asio::signal_set signals(io, SIGINT, SIGTERM);
+    signals.async_wait([&](const boost::system::error_code& ec, int) {
+        if (!ec) {
+            spdlog::info("ground hub: stopping");
+            boost::asio::dispatch(strand, [&] {
+                hub.stop();
+                io.stop();
+            });
+        }
+    });
+    io.run();
+    return 0;
+}

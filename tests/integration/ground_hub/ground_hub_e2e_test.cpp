@@ -1,0 +1,226 @@
+// The ground station hub end to end on real ptys: airseg-apmsim ⇄ airsegd ⇄ airseg-linksim (57600 baud) ⇄
+// airseg-ground ⇄ several airsegctl at once. Watchers and one operator share the one radio session; the
+// operator's plan reaches every watcher; a monitor's command is refused by the vehicle; control is held by
+// one client at a time.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/stat.h>
+
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "client/hub_client.hpp"
+#include "tests/support/control_client.hpp"
+#include "tests/support/process.hpp"
+
+namespace airseg::test {
+namespace {
+
+using Json = nlohmann::json;
+constexpr auto kGenerous = 60s;
+constexpr double kHomeLat = 41.2756;
+constexpr double kHomeLon = 1.9866;
+
+bool exists(const std::string& path) {
+    struct stat st {};
+    return ::stat(path.c_str(), &st) == 0;
+}
+
+std::vector<Json> json_lines(const std::string& text) {
+    std::vector<Json> out;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) {
+        auto j = Json::parse(line, nullptr, false);
+        if (!j.is_discarded()) {
+            out.push_back(std::move(j));
+        }
+    }
+    return out;
+}
+
+class GroundHubE2e : public ::testing::Test {
+  protected:
+    void TearDown() override {
+        for (auto* p : {hub.get(), daemon.get()}) {
+            if (p != nullptr && p->running()) {
+                p->signal(SIGTERM);
+                p->wait_exit(10s);
+            }
+        }
+    }
+
+    void start_chain() {
+        key = dir.file("control.key");
+        write_file(key, std::string(64, 'c') + "\n");
+        ::chmod(key.c_str(), 0600);
+        linksim = std::make_unique<Subprocess>(
+            std::vector<std::string>{binary("tools/linksim/airseg-linksim"), "--a", dir.file("air"), "--b",
+                                     dir.file("ground"), "--baud", "57600", "--seed", "7"},
+            std::map<std::string, std::string>{}, dir.path());
+        ASSERT_TRUE(wait_until([&] { return exists(dir.file("air")) && exists(dir.file("ground")); }))
+            << linksim->err();
+        sim = std::make_unique<Subprocess>(
+            std::vector<std::string>{binary("tools/apmsim/airseg-apmsim"), "--link", dir.file("ttyACM0"),
+                                     "--home", std::to_string(kHomeLat) + "," + std::to_string(kHomeLon),
+                                     "--boot-delay", "0.5", "--calib-time", "0.5", "--speedup", "4",
+                                     "--quiet"},
+            std::map<std::string, std::string>{}, dir.path());
+        ASSERT_TRUE(wait_until([&] { return exists(dir.file("ttyACM0")); })) << sim->err();
+        daemon = std::make_unique<Subprocess>(
+            std::vector<std::string>{
+                binary("daemon/airsegd"), "--config", source_path("config/airseg.yaml"), "--set",
+                "status.socket=" + dir.file("status.sock"), "--set", "state_dir=" + dir.file("state"),
+                "--set", "autopilot.port=" + dir.file("ttyACM0"), "--set",
+                "groundlink.ports=[" + dir.file("air") + "]", "--set", "groundlink.key_file=" + key},
+            std::map<std::string, std::string>{}, dir.path());
+        hub = std::make_unique<Subprocess>(
+            std::vector<std::string>{binary("ground/airseg-ground"), "--link", dir.file("ground"), "--key",
+                                     key, "--socket", socket()},
+            std::map<std::string, std::string>{}, dir.path());
+        ASSERT_TRUE(wait_until([&] { return exists(socket()); })) << hub->err();
+        Json doc;
+        ASSERT_TRUE(wait_until(
+            [&] {
+                auto r = ctl({"status"});
+                doc = Json::parse(r.out, nullptr, false);
+                return r.exit_code == 0 && doc.is_object() &&
+                       doc.value("autopilot", Json::object()).value("ready", false);
+            },
+            kGenerous, 500ms))
+            << doc.dump() << "\nhub:\n"
+            << hub->err() << "\ndaemon:\n"
+            << daemon->err();
+    }
+
+    std::vector<std::string> ctl_argv(std::vector<std::string> args, bool with_key) const {
+        std::vector<std::string> argv{
+            binary("client/airsegctl"), "--ground-socket", socket(), "--timeout", "30000", "--json"};
+        if (with_key) {
+            argv.insert(argv.end(), {"--key", key});
+        }
+        argv.insert(argv.end(), args.begin(), args.end());
+        return argv;
+    }
+
+    RunResult ctl(std::vector<std::string> args, bool with_key = false) {
+        return run(ctl_argv(std::move(args), with_key), {}, 90s);
+    }
+
+    std::string plan_file() {
+        const std::string path = dir.file("line.yaml");
+        std::string elements;
+        for (int i = 1; i <= 10; ++i) {
+            elements += "    - waypoint: {lat: " + std::to_string(kHomeLat + 0.00008 * (i % 2)) +
+                        ", lon: " + std::to_string(kHomeLon + 0.0001 * i) + "}\n";
+        }
+        write_file(path,
+                   "plan:\n  name: through-the-hub\n  vehicle: {type: rover}\n  elements:\n" + elements);
+        return path;
+    }
+
+    std::string socket() const { return dir.file("ground.sock"); }
+
+    client::HubOptions operator_options(const std::string& name, const std::string& key_file) const {
+        client::HubOptions o;
+        o.socket = socket();
+        o.key_file = key_file;
+        o.want_control = true;
+        o.name = name;
+        return o;
+    }
+
+    TempDir dir;
+    std::string key;
+    std::unique_ptr<Subprocess> linksim, sim, daemon, hub;
+};
+
+TEST_F(GroundHubE2e, ThreeWatchersAndOneOperatorShareTheRadio) {
+    start_chain();
+    std::vector<std::unique_ptr<Subprocess>> watchers;
+    for (int i = 0; i < 3; ++i) {
+        watchers.push_back(std::make_unique<Subprocess>(ctl_argv({"watch", "--duration", "25000"}, false),
+                                                        std::map<std::string, std::string>{}, dir.path()));
+    }
+    // Every watcher is connected and has seen a sample before the plan goes in.
+    ASSERT_TRUE(wait_until(
+        [&] {
+            for (auto& w : watchers) {
+                if (json_lines(w->out()).empty()) {
+                    return false;
+                }
+            }
+            return true;
+        },
+        kGenerous, 200ms));
+
+    // A monitor (no key) may look but not command: the vehicle refuses, and says why.
+    auto refused = ctl({"plan", "load", plan_file()});
+    EXPECT_EQ(refused.exit_code, 1) << refused.out << refused.err;
+    EXPECT_NE(refused.err.find("monitor"), std::string::npos) << refused.err;
+    EXPECT_EQ(ctl({"plan", "show"}).exit_code, 0) << "monitor commands still work";
+
+    auto loaded = ctl({"plan", "load", plan_file()}, true);
+    ASSERT_EQ(loaded.exit_code, 0) << loaded.out << loaded.err << "\nhub:\n" << hub->err();
+    EXPECT_EQ(Json::parse(loaded.out)["name"], "through-the-hub") << loaded.out;
+
+    for (auto& w : watchers) {
+        ASSERT_TRUE(w->wait_exit(kGenerous)) << w->err();
+        const auto lines = json_lines(w->out());
+        bool saw_plan = false;
+        for (const auto& line : lines) {
+            const auto& plan = line.value("vehicle", Json::object()).value("plan", Json::object());
+            saw_plan = saw_plan || plan.value("state", "") == "running";
+        }
+        EXPECT_TRUE(saw_plan) << "every watcher sees the plan the operator loaded: " << lines.back().dump();
+        EXPECT_GE(lines.back()["samples"].get<int>(), 20) << lines.back().dump();
+        EXPECT_EQ(lines.back()["ground_link"]["link"], "up") << lines.back().dump();
+    }
+}
+
+TEST_F(GroundHubE2e, ControlIsHeldByOneClientAtATime) {
+    start_chain();
+    client::HubClient holder(operator_options("holder", key));
+    ASSERT_EQ(holder.open(10s), "");
+    EXPECT_EQ(holder.role(), "control");
+
+    auto second = ctl({"plan", "pause"}, true);
+    EXPECT_EQ(second.exit_code, 1) << second.out << second.err;
+    EXPECT_NE(second.err.find("control is held by holder"), std::string::npos) << second.err;
+
+    // The holder's commands go through and are answered end to end.
+    auto answer = holder.request({{"cmd", "plan.show"}}, 30s);
+    ASSERT_TRUE(answer.answer) << answer.error;
+    EXPECT_TRUE(answer.answer->value("ok", false)) << answer.answer->dump();
+
+    // A key that is not the hub's gives no control.
+    const auto wrong = dir.file("wrong.key");
+    write_file(wrong, std::string(64, 'd') + "\n");
+    ::chmod(wrong.c_str(), 0600);
+    client::HubClient impostor(operator_options("x", wrong));
+    ASSERT_EQ(impostor.open(10s), "");
+    EXPECT_EQ(impostor.role(), "monitor");
+    EXPECT_NE(impostor.role_reason().find("does not match"), std::string::npos) << impostor.role_reason();
+}
+
+TEST_F(GroundHubE2e, ControlPassesOnWhenTheHolderLeaves) {
+    start_chain();
+    {
+        client::HubClient holder(operator_options("first", key));
+        ASSERT_EQ(holder.open(10s), "");
+        ASSERT_EQ(holder.role(), "control");
+    }
+    // The hub notices the close asynchronously; the next operator gets control once it has.
+    RunResult next;
+    ASSERT_TRUE(wait_until(
+        [&] {
+            next = ctl({"plan", "pause"}, true);
+            return next.err.find("control is held") == std::string::npos;
+        },
+        kGenerous, 200ms))
+        << next.err;
+    // No plan runs, so the vehicle answers the pause itself (refused or done), never "forbidden".
+    EXPECT_EQ(next.err.find("monitor"), std::string::npos) << next.err;
+}
+
+}  // namespace
+}  // namespace airseg::test
