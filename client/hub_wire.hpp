@@ -24,7 +24,7 @@ inline constexpr std::size_t kMaxFrame = 1 << 20;
 inline constexpr std::size_t kChallengeBytes = 32;
 inline constexpr std::size_t kProofBytes = 32;
 /// Where airseg-ground listens by default and airsegctl looks for it.
-inline constexpr std::string_view kDefaultSocket = "/run/airseg/ground.sock";
+inline constexpr std::string_view kDefaultSocket = "/run/airseg-ground/ground.sock";
 
 struct Frame {
     FrameType type = FrameType::Json;

@@ -110,7 +110,7 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
                    o.local_chosen = true;
                })
         .flag("ground",
-              "through the ground hub airseg-ground on its default socket (/run/airseg/ground.sock); chosen "
+              "through the ground hub airseg-ground on its default socket (/run/airseg-ground/ground.sock); chosen "
               "by itself when that socket exists and airsegd's does not",
               [&o] { o.use_hub = true; })
         .value("ground-socket", "PATH", "through the ground hub on this Unix socket",

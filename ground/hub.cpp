@@ -1,11 +1,14 @@
 #include "ground/hub.hpp"
 
 #include <fmt/format.h>
+#include <grp.h>
 #include <sodium.h>
 #include <spdlog/spdlog.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 
 #include "services/groundlink/link/key_file.hpp"
@@ -124,6 +127,16 @@ std::string Hub::listen_unix() {
     }
     // Owner and group: the Unix socket of a hub without a key grants control, so others may not connect.
     ::chmod(path.c_str(), 0660);
+    if (!config_.socket_group.empty()) {
+        const ::group* g = ::getgrnam(config_.socket_group.c_str());
+        if (g == nullptr) {
+            return "--socket-group: no group '" + config_.socket_group + "'";
+        }
+        if (::chown(path.c_str(), static_cast<uid_t>(-1), g->gr_gid) != 0) {
+            return "cannot give group " + config_.socket_group + " the socket " + path + ": " +
+                   std::strerror(errno);
+        }
+    }
     spdlog::info("ground hub: clients on {}", path);
     accept_unix();
     return {};

@@ -22,6 +22,7 @@ struct HubConfig {
     client::RadioOptions radio;
     std::string socket{client::hub::kDefaultSocket};  // empty = no Unix socket
     std::string tcp;                                  // HOST:PORT; empty = no TCP listener
+    std::string socket_group;  // group given access to the Unix socket; empty = the hub's own
 };
 
 class Hub {

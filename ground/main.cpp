@@ -29,7 +29,7 @@ const char* const kUsageTail =
     "Roles: a client that proves the control key (airsegctl --key, the hub's own --key) may take control;\n"
     "one client holds it at a time. Every other client is a monitor: it sees everything, and the vehicle\n"
     "runs its commands with monitor rights only. A hub without --key grants control to Unix-socket\n"
-    "clients (the socket is mode 0660), never to TCP ones.\n"
+    "clients (the socket is mode 0660: owner and --socket-group), never to TCP ones.\n"
     "\n"
     "Exit codes: 0 stopped by SIGINT/SIGTERM, 1 could not start, 2 usage.\n";
 
@@ -48,8 +48,12 @@ int main(int argc, char** argv) {
     airseg::client::add_radio_options(table, o.hub.radio, [&o] { o.radio_given = true; });
     table
         .value(
-            "socket", "PATH", "Unix socket for clients (default /run/airseg/ground.sock; 'off' for none)",
+            "socket", "PATH",
+            "Unix socket for clients (default /run/airseg-ground/ground.sock; 'off' for none)",
             [&o](std::string_view, std::string_view v) { o.hub.socket = v == "off" ? "" : std::string(v); })
+        .value("socket-group", "NAME",
+               "group allowed to connect to the socket (mode 0660; default the hub's)",
+               text(o.hub.socket_group))
         .value("tcp", "HOST:PORT", "also serve clients over TCP (off by default)", text(o.hub.tcp))
         .value("log-level", "LEVEL", "trace, debug, info, warn or error (default info)", text(o.log_level))
         .help_and_version();

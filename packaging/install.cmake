@@ -47,6 +47,7 @@ set(_airseg_man_dir ${CMAKE_CURRENT_LIST_DIR}/man)
 set(_airseg_programs
     "airsegd|${CMAKE_INSTALL_SBINDIR}|airsegd.8"
     "airsegctl|${CMAKE_INSTALL_BINDIR}|airsegctl.1"
+    "airseg-ground|${CMAKE_INSTALL_BINDIR}|airseg-ground.1"
     "airseg-apmsim|${CMAKE_INSTALL_BINDIR}|airseg-apmsim.1"
     "airseg-linksim|${CMAKE_INSTALL_BINDIR}|airseg-linksim.1"
     "airseg-mavdump|${CMAKE_INSTALL_BINDIR}|airseg-mavdump.1")
@@ -71,7 +72,8 @@ if(_airseg_not_installed)
   message(STATUS "Not in this build, so not installed: ${_airseg_not_installed}")
 endif()
 
-install(FILES ${PROJECT_SOURCE_DIR}/systemd/airsegd.service DESTINATION ${AIRSEG_SYSTEMD_UNIT_DIR})
+install(FILES ${PROJECT_SOURCE_DIR}/systemd/airsegd.service ${PROJECT_SOURCE_DIR}/systemd/airseg-ground.service
+        DESTINATION ${AIRSEG_SYSTEMD_UNIT_DIR})
 
 if(EXISTS ${PROJECT_SOURCE_DIR}/config/airseg.yaml)
   install(FILES ${PROJECT_SOURCE_DIR}/config/airseg.yaml DESTINATION ${CMAKE_INSTALL_FULL_SYSCONFDIR}/airseg)

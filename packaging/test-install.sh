@@ -12,7 +12,8 @@
 # systemd does not run in a chroot, so the chroot pretends it does (/run/systemd/system) and
 # deb-systemd-invoke is diverted to a log: the checks read which unit actions the maintainer scripts ask
 # systemd for (no start at install, try-restart on upgrade, stop on removal). Checked:
-# - airseg-client alone: airsegctl and its manual page, no daemon, no unit, no user airseg;
+# - airseg-client alone: airsegctl, airseg-ground and their manual pages, the hub's unit (not enabled), no
+#   daemon, no airsegd unit, no user airseg;
 # - all packages: user airseg (in dialout and gpio), the conffile, /etc/airseg/conf.d, the unit enabled and
 #   not started, `systemd-analyze verify` clean, `airsegd --check-config` accepts the shipped file with a
 #   drop-in, manual pages, the licence and the docs under /usr/share/doc;
@@ -94,6 +95,10 @@ dpkg -i airseg-client.deb </dev/null >/dev/null || bad "dpkg -i airseg-client fa
 check "airsegctl installed" test -x /usr/bin/airsegctl
 check "airsegctl(1) installed" test -f /usr/share/man/man1/airsegctl.1.gz
 check "airsegctl runs" /usr/bin/airsegctl --version
+check "airseg-ground runs" /usr/bin/airseg-ground --version
+check "hub unit installed" test -f /lib/systemd/system/airseg-ground.service
+check "hub not enabled: it needs its radio set first" \
+  test ! -e /etc/systemd/system/multi-user.target.wants/airseg-ground.service
 check "no daemon" test ! -e /usr/sbin/airsegd
 check "no unit" test ! -e /lib/systemd/system/airsegd.service
 check "no user airseg" sh -c '! getent passwd airseg'
