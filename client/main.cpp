@@ -56,7 +56,7 @@ const char* const kUsageTail =
     "  param get NAME | param set NAME VALUE | param list\n"
     "                     the autopilot's parameters\n"
     "  rates [KIND=HZ ...]  show, or set, the pushed telemetry rates (kinds: vehicle, link_stats)\n"
-    "  log [--duration MS]  follow the vehicle's events and autopilot texts (radio only)\n"
+    "  log [--duration MS]  follow the vehicle's events and autopilot texts (radio or hub)\n"
     "  joystick [--device /dev/input/jsN] [--rate HZ] [--duration MS]\n"
     "                     drive in MANUAL_NAVIGATION from a joystick, or the keyboard without --device\n"
     "                     (w/s/a/d or arrows, space centres, q quits); inputs go at --rate (default 10 Hz)\n"
