@@ -294,7 +294,7 @@ class Session : public std::enable_shared_from_this<Session> {
         answered_ = true;
         close_after_ = close_after_ || close_after;
         queued_ += bytes.size();
-        if (queued_ > kMaxQueuedBytes) {
+        if (streaming_ && queued_ > kMaxQueuedBytes) {
             close();
             return;
         }
