@@ -64,9 +64,11 @@
     planName = plan && plan.name ? plan.name : null;
     document.getElementById('plan-name').textContent = planName ? planName : 'no plan';
     const bounds = L.latLngBounds([]);
-    const route = [];
+    const mainRoute = [];
     ((plan && plan.elements) || []).forEach((e, i) => {
       const pts = latlngs(e.points);
+      // Detached blocks run only when jumped to: they are drawn, but not joined to the main route.
+      const route = String(e.path || '').startsWith('plan.blocks') ? [] : mainRoute;
       const title = (e.name ? e.name + ' — ' : '') + e.kind + ' ' + e.path;
       counts.elements += 1;
       pts.forEach(p => bounds.extend(p));
@@ -100,8 +102,8 @@
         pts.forEach(p => route.push(p));
       }
     });
-    if (route.length >= 2) {
-      L.polyline(route, { className: 'airseg-plan-route', color: '#1f6feb', weight: 1, dashArray: '4 4' })
+    if (mainRoute.length >= 2) {
+      L.polyline(mainRoute, { className: 'airseg-plan-route', color: '#1f6feb', weight: 1, dashArray: '4 4' })
         .addTo(planLayer);
     }
     ((plan && plan.no_fly) || []).forEach(z => {
