@@ -82,7 +82,9 @@ for deb in "$@"; do
     airseg-client)
       has "$dir" /usr/bin/airsegctl /usr/share/man/man1/airsegctl.1.gz \
         /usr/bin/airseg-ground /usr/share/man/man1/airseg-ground.1.gz /lib/systemd/system/airseg-ground.service \
-        /usr/share/doc/airseg-client/examples/plans/rover-survey.yaml
+        /usr/share/doc/airseg-client/examples/plans/rover-survey.yaml /usr/share/airseg/map/index.html \
+        /usr/share/airseg/map/map.js /usr/share/airseg/map/map.css
+      has_dep libjs-leaflet || bad "airseg-client: Depends lacks libjs-leaflet (the map page)"
       lacks "$dir" /usr/sbin /lib/systemd/system/airsegd.service /etc /usr/bin/airseg-apmsim
       [ ! -e "$dir/DEBIAN/postinst" ] || ! grep -q adduser "$dir/DEBIAN/postinst" \
         || bad "airseg-client: postinst creates a user"

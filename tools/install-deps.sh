@@ -7,6 +7,8 @@ packages=(
   libgpiod-dev libsodium-dev nlohmann-json3-dev zlib1g-dev
   libgtest-dev libgmock-dev libbenchmark-dev valgrind
   clang libclang-rt-14-dev clang-tidy
+  # The ground map's page (Leaflet) and its browser test (headless chromium).
+  libjs-leaflet chromium
 )
 sudo=""
 if [ "$(id -u)" -ne 0 ]; then

@@ -89,6 +89,8 @@ void FlightplanService::register_commands() {
     c.add("plan.show", strand(), Role::Monitor, [this](const Json&, CommandDispatcher::Reply reply) {
         reply(CommandResult::ok(controller_.show()));
     });
+    c.add("plan.geometry", strand(), Role::Monitor,
+          [this](const Json& req, CommandDispatcher::Reply reply) { cmd_geometry(req, std::move(reply)); });
     c.add("plan.skip", strand(), Role::Control,
           [this](const Json& req, CommandDispatcher::Reply reply) { cmd_skip(req, std::move(reply)); });
     c.add("plan.pause", strand(), Role::Control, [this](const Json&, CommandDispatcher::Reply reply) {
@@ -141,6 +143,24 @@ void FlightplanService::cmd_load(const Json& req, CommandDispatcher::Reply reply
     const bool start_paused = paused != req.end() && paused->get<bool>();
     controller_.load(id, std::move(*plan), append, start_paused, source, SteadyClock::now());
     flush();
+}
+
+void FlightplanService::cmd_geometry(const Json& req, CommandDispatcher::Reply reply) {
+    // A map needs the shape, not every waypoint of an endless or huge plan: the answer stays one message.
+    constexpr std::uint64_t kDefaultPoints = 2000;
+    constexpr std::uint64_t kMostPoints = 20000;
+    std::uint64_t max_points = kDefaultPoints;
+    if (const auto given = req.find("max_points"); given != req.end()) {
+        if (!given->is_number_unsigned() || given->get<std::uint64_t>() < 1 ||
+            given->get<std::uint64_t>() > kMostPoints) {
+            reply(CommandResult::fail(
+                CommandStatus::BadRequest,
+                "\"max_points\" must be a whole number from 1 to " + std::to_string(kMostPoints)));
+            return;
+        }
+        max_points = given->get<std::uint64_t>();
+    }
+    reply(CommandResult::ok(controller_.geometry(static_cast<std::size_t>(max_points))));
 }
 
 void FlightplanService::cmd_skip(const Json& req, CommandDispatcher::Reply reply) {

@@ -4,8 +4,8 @@
 // the bus messages and commands, carries its requests, events and status to the bus, answers the commands,
 // keeps plan and progress in the state directory (StateStore) and resumes them at start.
 //
-// Commands (command dispatcher; see docs/flight-plan.md): plan.load, plan.append, plan.show, plan.skip,
-// plan.pause, plan.resume. A command that changes the vehicle is answered once the autopilot has confirmed
+// Commands (command dispatcher; see docs/flight-plan.md): plan.load, plan.append, plan.show, plan.geometry,
+// plan.skip, plan.pause, plan.resume. A command that changes the vehicle is answered once the autopilot has confirmed
 // everything it required (the feeder has nothing left to ask), or with the failure.
 //
 // Bus: subscribes autopilot::AutopilotStatus, Telemetry, WaypointReached, MissionCurrentChanged, ModeChanged,
@@ -51,6 +51,7 @@ class FlightplanService : public Service {
     void register_commands();
     void cmd_load(const Json& req, CommandDispatcher::Reply reply, bool append);
     void cmd_skip(const Json& req, CommandDispatcher::Reply reply);
+    void cmd_geometry(const Json& req, CommandDispatcher::Reply reply);
     CommandId keep_reply(CommandDispatcher::Reply reply);
 
     /// Carries out what the controller decided after an input: bus, replies, state store, logs, timer.

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "services/flightplan/home_stream.hpp"
@@ -581,6 +582,148 @@ Json PlanController::show() const {
                                 {"waypoints", optional_json(plan.count(id))}});
         }
     }
+    return j;
+}
+
+namespace {
+
+Json lat_lon_json(LatLon p) {
+    // 1e-7 degrees is about 1 cm: enough for a map, and the numbers print short.
+    return Json::array({std::round(p.lat * 1e7) / 1e7, std::round(p.lon * 1e7) / 1e7});
+}
+
+/// Walks a plan's element tree for plan.geometry, spending a budget of points.
+class GeometryWalk {
+  public:
+    GeometryWalk(std::shared_ptr<const Plan> plan, std::size_t max_points)
+        : plan_(*plan), stream_(std::move(plan), false), left_(max_points) {}
+
+    void walk(std::uint32_t container, Json& out) {
+        for (auto id : plan_.children(container)) {
+            const Node& n = plan_.nodes[id];
+            switch (n.kind) {
+                case NodeKind::Repeat:
+                case NodeKind::Block:
+                case NodeKind::ElementList:
+                    walk(id, out);
+                    break;
+                case NodeKind::Waypoint:
+                case NodeKind::Hold:
+                case NodeKind::Scan:
+                case NodeKind::Orbit:
+                    out.push_back(element(id));
+                    break;
+                case NodeKind::Speed:
+                case NodeKind::Goto:
+                    break;
+            }
+        }
+    }
+
+    Json zones() {
+        Json out = Json::array();
+        for (const auto& zone : plan_.no_fly) {
+            Json points = Json::array();
+            for (const auto& p : zone.polygon) {
+                add(points, p);
+            }
+            out.push_back({{"name", zone.name}, {"points", std::move(points)}});
+        }
+        return out;
+    }
+
+    bool truncated() const { return truncated_; }
+
+  private:
+    Json element(std::uint32_t id) {
+        const Node& n = plan_.nodes[id];
+        const NodeExtra& extra = plan_.extra(id);
+        Json e = {{"path", plan_.element_path(id)},
+                  {"kind", to_string(n.kind)},
+                  {"name", extra.name.empty() ? Json(nullptr) : Json(extra.name)},
+                  {"closed", false}};
+        Json points = Json::array();
+        if (n.kind == NodeKind::Scan && extra.scan) {
+            // The area itself; the lines driven across it follow in "lines".
+            e["closed"] = true;
+            for (const auto& p : extra.scan->polygon()) {
+                add(points, plan_.frame.to_geo(p));
+            }
+            e["lines"] = waypoints_of(id);
+        } else if (n.kind == NodeKind::Hold && !n.has_position) {
+            if (last_) {
+                add(points, *last_);  // it holds where the previous waypoint ends
+            }
+        } else {
+            points = waypoints_of(id);
+        }
+        if (n.kind == NodeKind::Hold) {
+            e["hold_s"] = extra.hold_seconds ? Json(*extra.hold_seconds) : Json(nullptr);
+        }
+        e["points"] = std::move(points);
+        return e;
+    }
+
+    /// The element's waypoints as the expander produces them (scan lines, orbit points).
+    Json waypoints_of(std::uint32_t id) {
+        Json points = Json::array();
+        if (left_ == 0 || !stream_.jump_to_node(id)) {
+            truncated_ = truncated_ || left_ == 0;
+            return points;
+        }
+        while (auto w = stream_.next()) {
+            if (w->element != id) {
+                break;
+            }
+            if (w->has_position) {
+                if (!add(points, w->position)) {
+                    break;
+                }
+                last_ = w->position;
+            }
+            if (w->last_of_element) {
+                break;
+            }
+        }
+        return points;
+    }
+
+    bool add(Json& points, LatLon p) {
+        if (left_ == 0) {
+            truncated_ = true;
+            return false;
+        }
+        --left_;
+        points.push_back(lat_lon_json(p));
+        return true;
+    }
+
+    const Plan& plan_;
+    Expander stream_;
+    std::size_t left_;
+    bool truncated_ = false;
+    std::optional<LatLon> last_;
+};
+
+}  // namespace
+
+Json PlanController::geometry(std::size_t max_points) const {
+    Json j = {
+        {"name", nullptr}, {"elements", Json::array()}, {"no_fly", Json::array()}, {"truncated", false}};
+    if (!active_ || !active_->plan) {
+        return j;
+    }
+    const auto& plan = active_->plan;
+    GeometryWalk walk(plan, max_points);
+    j["name"] = plan->name;
+    j["generation"] = feeder_.progress().generation;
+    j["no_fly"] = walk.zones();
+    for (auto list : {plan->main_list, plan->blocks_list}) {
+        if (list != kNoNode) {
+            walk.walk(list, j["elements"]);
+        }
+    }
+    j["truncated"] = walk.truncated();
     return j;
 }
 

@@ -128,6 +128,10 @@ class PlanController {
     void pause(CommandId id, TimePoint now);
     void resume_plan(CommandId id, TimePoint now);
     Json show() const;
+    /// The running plan's shape for a map (plan.geometry): every positioned element once, in plan order
+    /// (a repeat's body once, detached blocks after the main list), and the no-fly zones. At most
+    /// `max_points` points in all; "truncated" says when some were left out.
+    Json geometry(std::size_t max_points) const;
 
     // ---- persistence
     void on_saved(const ProgressSave& save, const std::optional<std::string>& error);

@@ -409,6 +409,85 @@ TEST(FlightplanController, AfterAFailedSaveAWayHomeStillLeavesTheLastSavedPointP
     EXPECT_EQ(paused.next_index, written.next_index) << "the point the store last kept";
 }
 
+constexpr const char* kShapePlan = R"(plan:
+  name: shape
+  no_fly:
+    - name: pond
+      polygon: [[41.0100, 2.0100], [41.0100, 2.0110], [41.0090, 2.0110]]
+  elements:
+    - waypoint: {name: start, lat: 41.0001, lon: 2.0001}
+    - hold: {seconds: 5}
+    - speed: 1.0
+    - repeat:
+        count: forever
+        elements:
+          - scan: {rectangle: {sw: [41.0002, 2.0002], ne: [41.0006, 2.0008]}, spacing: 6}
+          - hold: {lat: 41.0001, lon: 2.0001, until_released: true}
+  blocks:
+    - name: lost-link
+      elements:
+        - waypoint: {lat: 41.0, lon: 2.0}
+)";
+
+std::size_t points_in(const Json& geometry) {
+    std::size_t n = 0;
+    for (const auto& e : geometry["elements"]) {
+        n += e["points"].size() + (e.contains("lines") ? e["lines"].size() : 0);
+    }
+    for (const auto& z : geometry["no_fly"]) {
+        n += z["points"].size();
+    }
+    return n;
+}
+
+TEST(FlightplanController, GeometryWithoutAPlanIsEmpty) {
+    Rig rig;
+    const auto g = rig.c.geometry(2000);
+    EXPECT_TRUE(g["name"].is_null());
+    EXPECT_TRUE(g["elements"].empty());
+    EXPECT_TRUE(g["no_fly"].empty());
+}
+
+TEST(FlightplanController, GeometryDrawsEveryPositionedElementOnceEvenInAnEndlessLoop) {
+    Rig rig;
+    rig.ready();
+    rig.load(kShapePlan);
+    rig.confirm_all();
+    const auto g = rig.c.geometry(2000);
+    EXPECT_EQ(g["name"], "shape");
+    EXPECT_FALSE(g["truncated"].get<bool>());
+    EXPECT_TRUE(g["generation"].is_number());
+    ASSERT_EQ(g["elements"].size(), 5u) << g.dump(1);
+    const auto& e = g["elements"];
+    EXPECT_EQ(e[0]["kind"], "waypoint");
+    EXPECT_EQ(e[0]["name"], "start");
+    EXPECT_EQ(e[0]["points"], Json::parse("[[41.0001, 2.0001]]"));
+    EXPECT_EQ(e[1]["kind"], "hold");
+    EXPECT_EQ(e[1]["hold_s"], 5.0);
+    EXPECT_EQ(e[1]["points"], e[0]["points"]) << "a hold without a position holds where the last one ends";
+    EXPECT_EQ(e[2]["kind"], "scan");
+    EXPECT_TRUE(e[2]["closed"].get<bool>());
+    EXPECT_EQ(e[2]["points"].size(), 4u) << "the rectangle's outline";
+    EXPECT_GE(e[2]["lines"].size(), 4u) << "the lines across it, two ends each";
+    EXPECT_EQ(e[2]["lines"].size() % 2, 0u);
+    EXPECT_TRUE(e[3]["hold_s"].is_null()) << "until released";
+    EXPECT_NE(e[4]["path"].get<std::string>().find("blocks"), std::string::npos) << e[4]["path"];
+    ASSERT_EQ(g["no_fly"].size(), 1u);
+    EXPECT_EQ(g["no_fly"][0]["name"], "pond");
+    EXPECT_EQ(g["no_fly"][0]["points"].size(), 3u);
+}
+
+TEST(FlightplanController, GeometrySaysWhenItLeftPointsOut) {
+    Rig rig;
+    rig.ready();
+    rig.load(kShapePlan);
+    rig.confirm_all();
+    const auto g = rig.c.geometry(6);
+    EXPECT_TRUE(g["truncated"].get<bool>());
+    EXPECT_EQ(points_in(g), 6u);
+    EXPECT_FALSE(rig.c.geometry(1000)["truncated"].get<bool>());
+}
+
 TEST(FlightplanController, StopFailsTheWaitingCommands) {
     Rig rig;
     rig.ready();

@@ -1,0 +1,148 @@
+// Test-only: the map serving a fixed plan while a vehicle drives along it, for the browser test
+// (tests/integration/ground_map). Prints "listening on http://127.0.0.1:PORT/" once it serves.
+//
+//   airseg-map-fixture [--control] [--seconds N] [--web-dir DIR] [--leaflet-dir DIR]
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "ground/map/map_server.hpp"
+
+using airseg::ground::MapConfig;
+using airseg::ground::MapServer;
+using Json = nlohmann::json;
+
+namespace {
+
+Json fixture_plan() {
+    return Json::parse(R"({
+      "name": "fixture <survey> & co",
+      "generation": 1,
+      "truncated": false,
+      "elements": [
+        {"path": "plan.elements[0]", "kind": "waypoint", "name": "start", "closed": false,
+         "points": [[41.2752, 1.9868]]},
+        {"path": "plan.elements[1]", "kind": "waypoint", "name": null, "closed": false,
+         "points": [[41.2757, 1.9868]]},
+        {"path": "plan.elements[2]", "kind": "scan", "name": "field", "closed": true,
+         "points": [[41.2757, 1.9870], [41.2763, 1.9870], [41.2763, 1.9882], [41.2757, 1.9882]],
+         "lines": [[41.2757, 1.9871], [41.2763, 1.9871], [41.2763, 1.9878], [41.2757, 1.9878],
+                   [41.2757, 1.9881], [41.2763, 1.9881]]},
+        {"path": "plan.elements[3]", "kind": "hold", "name": "wait", "closed": false, "hold_s": 20,
+         "points": [[41.2760, 1.9875]]},
+        {"path": "plan.elements[4]", "kind": "orbit", "name": null, "closed": false,
+         "points": [[41.2761, 1.9887], [41.2760, 1.9888], [41.2759, 1.9887], [41.2760, 1.9886], [41.2761, 1.9887]]}
+      ],
+      "no_fly": [{"name": "pond", "points": [[41.2770, 1.9890], [41.2770, 1.9896], [41.2766, 1.9896], [41.2766, 1.9890]]}]
+    })");
+}
+
+/// The route the simulated vehicle drives: every point of the plan in order, round and round.
+std::vector<std::pair<double, double>> route_of(const Json& plan) {
+    std::vector<std::pair<double, double>> route;
+    for (const auto& e : plan["elements"]) {
+        const auto& pts = e.contains("lines") ? e["lines"] : e["points"];
+        for (const auto& p : pts) {
+            route.emplace_back(p[0].get<double>(), p[1].get<double>());
+        }
+    }
+    return route;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    MapConfig config;
+    config.listen = "127.0.0.1:0";
+    double seconds = 60;
+    for (int i = 1; i < argc; ++i) {
+        const std::string arg = argv[i];
+        const bool has_value = i + 1 < argc;
+        if (arg == "--control") {
+            config.control = true;
+        } else if (arg == "--seconds" && has_value) {
+            seconds = std::stod(argv[++i]);
+        } else if (arg == "--web-dir" && has_value) {
+            config.web_dir = argv[++i];
+        } else if (arg == "--leaflet-dir" && has_value) {
+            config.leaflet_dir = argv[++i];
+        } else if (arg == "--listen" && has_value) {
+            config.listen = argv[++i];
+        } else {
+            std::fprintf(stderr, "airseg-map-fixture: unknown argument %s\n", arg.c_str());
+            return 2;
+        }
+    }
+
+    airseg::asio::io_context io;
+    auto strand = airseg::asio::make_strand(io);
+    MapServer* map_ptr = nullptr;
+    MapServer map(strand, config, [&map_ptr](Json request, std::function<void(Json)> done) {
+        map_ptr->add_event("command " + request.value("cmd", std::string()));
+        done({{"ok", true}, {"result", {{"state", "running"}}}});
+    });
+    map_ptr = &map;
+    if (const auto error = map.start(); !error.empty()) {
+        std::fprintf(stderr, "airseg-map-fixture: %s\n", error.c_str());
+        return 1;
+    }
+    const Json plan = fixture_plan();
+    map.set_plan(plan);
+    map.set_link({{"link", "up"}, {"rtt_ms", 84}, {"loss", 0.02}, {"goodput_bps", 2400}});
+    map.add_event("plan fixture <survey> loaded & running");
+    std::printf("listening on http://127.0.0.1:%u/\n", static_cast<unsigned>(map.port()));
+    std::fflush(stdout);
+
+    const auto route = route_of(plan);
+    std::size_t leg = 0;
+    double along = 0.0;
+    airseg::asio::steady_timer step(strand);
+    airseg::asio::steady_timer end(strand);
+    std::function<void()> drive = [&] {
+        const auto [lat0, lon0] = route[leg % route.size()];
+        const auto [lat1, lon1] = route[(leg + 1) % route.size()];
+        airseg::groundlink::protocol::Telemetry t;
+        t.lat_deg = lat0 + (lat1 - lat0) * along;
+        t.lon_deg = lon0 + (lon1 - lon0) * along;
+        t.alt_m = 10;
+        t.ground_speed_mps = 1.5;
+        t.heading_deg = std::fmod(
+            std::atan2((lon1 - lon0) * std::cos(lat0 * M_PI / 180.0), lat1 - lat0) * 180.0 / M_PI + 360.0,
+            360.0);
+        t.battery_v = 12.4;
+        t.battery_pct = 80;
+        t.plan_state = 1;
+        map.add_position(t, std::chrono::system_clock::now());
+        along += 0.25;
+        if (along >= 1.0) {
+            along = 0.0;
+            ++leg;
+        }
+        step.expires_after(std::chrono::milliseconds(100));
+        step.async_wait([&](boost::system::error_code ec) {
+            if (!ec) {
+                drive();
+            }
+        });
+    };
+    airseg::asio::signal_set signals(io, SIGINT, SIGTERM);
+    airseg::asio::post(strand, drive);
+    end.expires_after(std::chrono::milliseconds(static_cast<long>(seconds * 1000)));
+    end.async_wait([&](boost::system::error_code) {
+        step.cancel();
+        map.stop();
+        signals.cancel();
+    });
+    signals.async_wait([&](boost::system::error_code, int) {
+        airseg::asio::post(strand, [&] {
+            end.cancel();
+            step.cancel();
+            map.stop();
+        });
+    });
+    io.run();
+    return 0;
+}

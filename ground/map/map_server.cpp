@@ -1,0 +1,586 @@
+#include "ground/map/map_server.hpp"
+
+#include <array>
+#include <charconv>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <utility>
+#include <variant>
+
+#include "ground/map/http.hpp"
+#include "ground/map/plan_export.hpp"
+
+namespace airseg::ground {
+
+using Json = nlohmann::json;
+using asio::ip::tcp;
+
+namespace {
+
+constexpr auto kRequestDeadline = std::chrono::seconds(15);
+constexpr auto kKeepAlive = std::chrono::seconds(15);
+constexpr std::size_t kEventsKept = 200;
+constexpr std::size_t kMaxFileBytes = 8u << 20;
+// A browser that stops reading (a sleeping laptop) is dropped rather than buffered for without end.
+constexpr std::size_t kMaxQueuedBytes = 4u << 20;
+// The largest plan airsegd takes (kMaxPlanTextBytes) plus room for its JSON escaping.
+constexpr std::size_t kMaxBodyBytes = 20u << 20;
+
+std::string dump(const Json& j) {
+    return j.dump(-1, ' ', false, Json::error_handler_t::replace);
+}
+
+Json empty_plan() {
+    return {{"name", nullptr}, {"elements", Json::array()}, {"no_fly", Json::array()}};
+}
+
+/// A path below a served directory: plain names only, so that no request reaches outside it.
+bool safe_relative_path(std::string_view rest) {
+    if (rest.empty() || rest.size() > 256) {
+        return false;
+    }
+    std::size_t start = 0;
+    while (start <= rest.size()) {
+        const auto slash = rest.find('/', start);
+        const auto seg =
+            rest.substr(start, slash == std::string_view::npos ? std::string_view::npos : slash - start);
+        if (seg.empty() || seg == "." || seg == "..") {
+            return false;
+        }
+        for (char c : seg) {
+            const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                            c == '.' || c == '-' || c == '_';
+            if (!ok) {
+                return false;
+            }
+        }
+        if (slash == std::string_view::npos) {
+            break;
+        }
+        start = slash + 1;
+    }
+    return true;
+}
+
+std::optional<std::string> read_file(const std::filesystem::path& path) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) {
+        return std::nullopt;
+    }
+    const auto size = std::filesystem::file_size(path, ec);
+    if (ec || size > kMaxFileBytes) {
+        return std::nullopt;
+    }
+    std::ifstream in(path, std::ios::binary);
+    std::string out(size, '\0');
+    if (!in.read(out.data(), static_cast<std::streamsize>(size))) {
+        return std::nullopt;
+    }
+    return out;
+}
+
+std::string error_response(int status, const std::string& why, const std::vector<std::string>& extra = {}) {
+    return http::response(status, "text/plain; charset=utf-8",
+                          std::to_string(status) + " " + http::reason(status) + ": " + why + "\n", extra);
+}
+
+std::string json_response(int status, const Json& body) {
+    return http::response(status, "application/json", dump(body));
+}
+
+/// The command a map button may send, checked and reduced to the fields it may carry; or why not.
+std::variant<Json, std::string> map_command(const std::string& body) {
+    const Json req = Json::parse(body, nullptr, false);
+    if (req.is_discarded() || !req.is_object()) {
+        return std::string("the body must be a JSON object such as {\"cmd\":\"plan.pause\"}");
+    }
+    const auto cmd = req.find("cmd");
+    if (cmd == req.end() || !cmd->is_string()) {
+        return std::string("\"cmd\" is missing");
+    }
+    const auto& name = cmd->get_ref<const std::string&>();
+    Json out = {{"cmd", name}};
+    if (name == "plan.pause" || name == "plan.resume") {
+        return out;
+    }
+    if (name == "plan.skip") {
+        if (const auto i = req.find("index"); i != req.end() && i->is_number_unsigned()) {
+            out["index"] = *i;
+        } else if (const auto e = req.find("element"); e != req.end() && e->is_string()) {
+            out["element"] = *e;
+        } else {
+            return std::string("plan.skip needs \"index\" (a waypoint number) or \"element\" (a name)");
+        }
+        return out;
+    }
+    if (name == "plan.load") {
+        const auto text = req.find("text");
+        if (text == req.end() || !text->is_string() || text->get_ref<const std::string&>().empty()) {
+            return std::string("plan.load needs \"text\": the plan itself (the map sends no file names)");
+        }
+        out["text"] = *text;
+        const auto source = req.find("source");
+        out["source"] = source != req.end() && source->is_string() ? *source : Json("map");
+        if (const auto paused = req.find("paused"); paused != req.end()) {
+            if (!paused->is_boolean()) {
+                return std::string("\"paused\" must be true or false");
+            }
+            out["paused"] = *paused;
+        }
+        return out;
+    }
+    return "\"" + name + "\" is not a map command (plan.load, plan.pause, plan.resume, plan.skip)";
+}
+
+struct Listen {
+    asio::ip::address address;
+    std::uint16_t port = 0;
+    std::string error;
+};
+
+Listen parse_listen(const std::string& listen) {
+    Listen out;
+    const auto colon = listen.rfind(':');
+    if (colon == std::string::npos) {
+        out.error = "give HOST:PORT";
+        return out;
+    }
+    std::string host = listen.substr(0, colon);
+    if (host.size() >= 2 && host.front() == '[' && host.back() == ']') {
+        host = host.substr(1, host.size() - 2);
+    }
+    if (host == "localhost") {
+        host = "127.0.0.1";
+    }
+    boost::system::error_code ec;
+    out.address = asio::ip::make_address(host, ec);
+    if (ec) {
+        out.error = "\"" + host + "\" is not an IP address";
+        return out;
+    }
+    const std::string port = listen.substr(colon + 1);
+    unsigned value = 0;
+    const auto [ptr, perr] = std::from_chars(port.data(), port.data() + port.size(), value);
+    if (port.empty() || perr != std::errc() || ptr != port.data() + port.size() || value > 65535) {
+        out.error = "\"" + port + "\" is not a port number";
+        return out;
+    }
+    out.port = static_cast<std::uint16_t>(value);
+    return out;
+}
+
+}  // namespace
+
+std::string map_web_dir(const std::string& configured) {
+    if (!configured.empty()) {
+        return configured;
+    }
+    std::error_code ec;
+    if (std::filesystem::exists(std::filesystem::path(AIRSEG_MAP_WEB_INSTALLED) / "index.html", ec)) {
+        return AIRSEG_MAP_WEB_INSTALLED;
+    }
+    return AIRSEG_MAP_WEB_SOURCE;
+}
+
+class Session;
+
+struct MapServer::Impl : std::enable_shared_from_this<MapServer::Impl> {
+    Impl(asio::any_io_executor ex, MapConfig cfg, CommandSink s)
+        : strand(std::move(ex)),
+          config(std::move(cfg)),
+          web_dir(map_web_dir(config.web_dir)),
+          sink(std::move(s)),
+          acceptor(strand),
+          keepalive(strand) {}
+
+    void accept();
+    void tick();
+    void broadcast(const std::string& event, const Json& data);
+    Json state() const;
+    Json position_json(const TrackPoint& p) const;
+
+    asio::any_io_executor strand;
+    MapConfig config;
+    std::string web_dir;
+    CommandSink sink;
+    tcp::acceptor acceptor;
+    asio::steady_timer keepalive;
+    bool running = false;
+    std::set<std::shared_ptr<Session>> sessions;
+
+    Json plan = empty_plan();
+    std::deque<TrackPoint> track;
+    Json last_position;  // with the fields the track leaves out (battery, plan state)
+    Json link;
+    std::deque<Json> events;
+};
+
+class Session : public std::enable_shared_from_this<Session> {
+  public:
+    Session(std::shared_ptr<MapServer::Impl> server, tcp::socket socket)
+        : server_(std::move(server)),
+          socket_(std::move(socket)),
+          deadline_(server_->strand),
+          parser_(http::Limits{16 * 1024, 64, kMaxBodyBytes}) {}
+
+    void start() {
+        deadline_.expires_after(kRequestDeadline);
+        deadline_.async_wait([self = shared_from_this()](boost::system::error_code ec) {
+            if (!ec && !self->answered_) {
+                self->send(error_response(408, "the request did not arrive in time"), true);
+            }
+        });
+        read();
+    }
+
+    void refuse_busy() { send(error_response(503, "too many connections to the map"), true); }
+
+    /// One server-sent event, if this is an event stream.
+    void event(const std::string& text) {
+        if (streaming_) {
+            send(text, false);
+        }
+    }
+
+    bool streaming() const { return streaming_; }
+
+    void close() {
+        if (closed_) {
+            return;
+        }
+        closed_ = true;
+        deadline_.cancel();
+        boost::system::error_code ignored;
+        socket_.shutdown(tcp::socket::shutdown_both, ignored);
+        socket_.close(ignored);
+        server_->sessions.erase(shared_from_this());
+    }
+
+  private:
+    void read() {
+        socket_.async_read_some(
+            asio::buffer(buf_), [self = shared_from_this()](boost::system::error_code ec, std::size_t n) {
+                if (ec || self->closed_) {
+                    self->close();
+                    return;
+                }
+                if (self->answered_) {
+                    // An event stream or a sent answer: the browser has nothing more to say; reading on only
+                    // notices when it goes.
+                    self->read();
+                    return;
+                }
+                switch (self->parser_.feed(std::string_view(self->buf_.data(), n))) {
+                    case http::RequestParser::State::Incomplete:
+                        self->read();
+                        break;
+                    case http::RequestParser::State::Failed:
+                        self->send(error_response(self->parser_.error_status(), self->parser_.error()), true);
+                        break;
+                    case http::RequestParser::State::Done:
+                        self->handle(self->parser_.request());
+                        self->read();
+                        break;
+                }
+            });
+    }
+
+    void send(std::string bytes, bool close_after) {
+        if (closed_) {
+            return;
+        }
+        answered_ = true;
+        close_after_ = close_after_ || close_after;
+        queued_ += bytes.size();
+        if (streaming_ && queued_ > kMaxQueuedBytes) {
+            close();
+            return;
+        }
+        out_.push_back(std::move(bytes));
+        if (out_.size() == 1) {
+            write();
+        }
+    }
+
+    void write() {
+        asio::async_write(socket_, asio::buffer(out_.front()),
+                          [self = shared_from_this()](boost::system::error_code ec, std::size_t) {
+                              if (ec || self->closed_) {
+                                  self->close();
+                                  return;
+                              }
+                              self->queued_ -= self->out_.front().size();
+                              self->out_.pop_front();
+                              if (!self->out_.empty()) {
+                                  self->write();
+                              } else if (self->close_after_) {
+                                  self->close();
+                              }
+                          });
+    }
+
+    void handle(const http::Request& req);
+    void serve_file(const http::Request& req, const std::string& dir, std::string_view rest);
+    void command(const http::Request& req);
+
+    std::shared_ptr<MapServer::Impl> server_;
+    tcp::socket socket_;
+    asio::steady_timer deadline_;
+    http::RequestParser parser_;
+    std::array<char, 8192> buf_{};
+    std::deque<std::string> out_;
+    std::size_t queued_ = 0;
+    bool answered_ = false;  // the request has its answer (or is an event stream)
+    bool close_after_ = false;
+    bool streaming_ = false;
+    bool closed_ = false;
+};
+
+void Session::handle(const http::Request& req) {
+    deadline_.cancel();
+    const std::string& path = req.path;
+    const bool head = req.method == "HEAD";
+    auto& s = *server_;
+    if (path == "/api/command") {
+        if (req.method != "POST") {
+            send(error_response(405, "use POST", {"Allow: POST"}), true);
+            return;
+        }
+        command(req);
+        return;
+    }
+    if (req.method != "GET" && !head) {
+        send(error_response(405, "only GET and HEAD here", {"Allow: GET, HEAD"}), true);
+        return;
+    }
+    if (path == "/" || path == "/index.html") {
+        serve_file(req, s.web_dir, "index.html");
+    } else if (path.starts_with("/static/")) {
+        serve_file(req, s.web_dir, std::string_view(path).substr(8));
+    } else if (path.starts_with("/leaflet/")) {
+        serve_file(req, s.config.leaflet_dir, std::string_view(path).substr(9));
+    } else if (path == "/events") {
+        answered_ = true;
+        streaming_ = true;
+        send(
+            "HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-cache\r\n"
+            "X-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n",
+            false);
+        if (!head) {
+            send("retry: 2000\nevent: state\ndata: " + dump(s.state()) + "\n\n", false);
+        } else {
+            close_after_ = true;
+        }
+    } else if (path == "/plan.geojson") {
+        send(http::response(200, "application/geo+json", dump(plan_geojson(s.plan)), {}, head), true);
+    } else if (path == "/track.geojson") {
+        send(http::response(200, "application/geo+json", dump(track_geojson(s.track)), {}, head), true);
+    } else if (path == "/plan.kml") {
+        send(http::response(200, "application/vnd.google-earth.kml+xml", plan_kml(s.plan),
+                            {"Content-Disposition: attachment; filename=\"plan.kml\""}, head),
+             true);
+    } else if (path == "/track.kml") {
+        send(http::response(200, "application/vnd.google-earth.kml+xml", track_kml(s.track),
+                            {"Content-Disposition: attachment; filename=\"track.kml\""}, head),
+             true);
+    } else {
+        send(error_response(404, "no such page: " + path), true);
+    }
+}
+
+void Session::serve_file(const http::Request& req, const std::string& dir, std::string_view rest) {
+    if (!safe_relative_path(rest)) {
+        send(error_response(404, "no such file"), true);
+        return;
+    }
+    const auto content = read_file(std::filesystem::path(dir) / std::string(rest));
+    if (!content) {
+        send(error_response(404, "no such file: " + std::string(rest)), true);
+        return;
+    }
+    send(http::response(200, http::content_type_for(rest), *content, {}, req.method == "HEAD"), true);
+}
+
+void Session::command(const http::Request& req) {
+    auto& s = *server_;
+    if (!s.config.control) {
+        send(json_response(
+                 403, {{"ok", false},
+                       {"error", "this map only watches: it was started without control of the vehicle"}}),
+             true);
+        return;
+    }
+    auto checked = map_command(req.body);
+    if (auto* why = std::get_if<std::string>(&checked)) {
+        send(json_response(400, {{"ok", false}, {"error", *why}}), true);
+        return;
+    }
+    if (!s.sink) {
+        send(json_response(503, {{"ok", false}, {"error", "no vehicle link to send the command on"}}), true);
+        return;
+    }
+    answered_ = true;
+    auto once = std::make_shared<bool>(false);
+    s.sink(std::move(std::get<Json>(checked)), [self = shared_from_this(), once](Json answer) {
+        if (std::exchange(*once, true)) {
+            return;
+        }
+        self->send(json_response(200, answer), true);
+    });
+}
+
+void MapServer::Impl::accept() {
+    acceptor.async_accept([self = shared_from_this()](boost::system::error_code ec, tcp::socket socket) {
+        if (!self->running) {
+            return;
+        }
+        if (!ec) {
+            auto session = std::make_shared<Session>(self, std::move(socket));
+            if (self->sessions.size() >= kMaxConnections) {
+                session->refuse_busy();  // kept alive by its write until the answer is out
+            } else {
+                self->sessions.insert(session);
+                session->start();
+            }
+        }
+        self->accept();
+    });
+}
+
+void MapServer::Impl::tick() {
+    keepalive.expires_after(kKeepAlive);
+    keepalive.async_wait([self = shared_from_this()](boost::system::error_code ec) {
+        if (ec || !self->running) {
+            return;
+        }
+        // A comment line: keeps idle proxies and the browser's stream open, and finds gone browsers.
+        for (const auto& session : std::vector(self->sessions.begin(), self->sessions.end())) {
+            session->event(": keepalive\n\n");
+        }
+        self->tick();
+    });
+}
+
+void MapServer::Impl::broadcast(const std::string& event, const Json& data) {
+    if (!running) {
+        return;
+    }
+    const std::string text = "event: " + event + "\ndata: " + dump(data) + "\n\n";
+    for (const auto& session : std::vector(sessions.begin(), sessions.end())) {
+        session->event(text);
+    }
+}
+
+Json MapServer::Impl::position_json(const TrackPoint& p) const {
+    return {{"lat", p.lat},         {"lon", p.lon},     {"alt", p.alt},
+            {"heading", p.heading}, {"speed", p.speed}, {"t", utc_time(p.at)}};
+}
+
+Json MapServer::Impl::state() const {
+    Json points = Json::array();
+    for (const auto& p : track) {
+        points.push_back(Json::array({p.lat, p.lon}));
+    }
+    return {
+        {"plan", plan},           {"track", std::move(points)}, {"position", last_position},  {"link", link},
+        {"events", Json(events)}, {"control", config.control},  {"tile_url", config.tile_url}};
+}
+
+MapServer::MapServer(asio::any_io_executor strand, MapConfig config, CommandSink sink)
+    : impl_(std::make_shared<Impl>(std::move(strand), std::move(config), std::move(sink))) {}
+
+MapServer::~MapServer() {
+    stop();
+}
+
+std::string MapServer::start() {
+    auto& s = *impl_;
+    const auto listen = parse_listen(s.config.listen);
+    if (!listen.error.empty()) {
+        return "cannot listen on " + s.config.listen + ": " + listen.error;
+    }
+    boost::system::error_code ec;
+    const tcp::endpoint endpoint(listen.address, listen.port);
+    s.acceptor.open(endpoint.protocol(), ec);
+    if (!ec) {
+        s.acceptor.set_option(tcp::acceptor::reuse_address(true), ec);
+    }
+    if (!ec) {
+        s.acceptor.bind(endpoint, ec);
+    }
+    if (!ec) {
+        s.acceptor.listen(asio::socket_base::max_listen_connections, ec);
+    }
+    if (ec) {
+        boost::system::error_code ignored;
+        s.acceptor.close(ignored);
+        return "cannot listen on " + s.config.listen + ": " + ec.message();
+    }
+    s.running = true;
+    s.accept();
+    s.tick();
+    return {};
+}
+
+void MapServer::stop() {
+    auto& s = *impl_;
+    if (!s.running) {
+        return;
+    }
+    s.running = false;
+    boost::system::error_code ignored;
+    s.acceptor.close(ignored);
+    s.keepalive.cancel();
+    for (const auto& session : std::vector(s.sessions.begin(), s.sessions.end())) {
+        session->close();
+    }
+}
+
+std::uint16_t MapServer::port() const {
+    boost::system::error_code ec;
+    const auto endpoint = impl_->acceptor.local_endpoint(ec);
+    return ec ? 0 : endpoint.port();
+}
+
+void MapServer::set_plan(const Json& geometry) {
+    impl_->plan = geometry.is_object() ? geometry : empty_plan();
+    impl_->broadcast("plan", impl_->plan);
+}
+
+void MapServer::add_position(const groundlink::protocol::Telemetry& t,
+                             std::chrono::system_clock::time_point at) {
+    auto& s = *impl_;
+    const TrackPoint p{t.lat_deg, t.lon_deg, t.alt_m, t.heading_deg, t.ground_speed_mps, at};
+    s.track.push_back(p);
+    if (s.track.size() > kTrackPoints) {
+        s.track.pop_front();
+    }
+    Json j = s.position_json(p);
+    j["battery_v"] = t.battery_v;
+    j["battery_pct"] = t.battery_pct ? Json(*t.battery_pct) : Json(nullptr);
+    j["gps_fix"] = t.gps_fix;
+    j["satellites"] = t.satellites;
+    j["plan_state"] = t.plan_state;
+    j["next_waypoint"] = t.next_waypoint;
+    s.last_position = j;
+    s.broadcast("position", j);
+}
+
+void MapServer::set_link(const Json& link) {
+    impl_->link = link;
+    impl_->broadcast("link", link);
+}
+
+void MapServer::add_event(const std::string& text) {
+    auto& s = *impl_;
+    Json e = {{"t", utc_time(std::chrono::system_clock::now())}, {"text", text}};
+    s.events.push_back(e);
+    if (s.events.size() > kEventsKept) {
+        s.events.pop_front();
+    }
+    s.broadcast("event", e);
+}
+
+}  // namespace airseg::ground

@@ -1,0 +1,64 @@
+#pragma once
+// The live map of airseg-ground: a small local web server (HTTP/1.1 on asio) serving the map page, the
+// plan and the vehicle's track as they change (server-sent events), exports as GeoJSON and KML, and, when
+// allowed, the plan commands (load, pause, resume, skip) passed to the vehicle through the hub.
+//
+// Everything runs on the strand given; the hub feeds it from that strand.
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "services/common/asio.hpp"
+#include "services/groundlink/protocol/ground_protocol.hpp"
+
+namespace airseg::ground {
+
+struct MapConfig {
+    std::string listen = "127.0.0.1:8080";  // HOST:PORT; port 0 = any (tests)
+    std::string leaflet_dir = "/usr/share/javascript/leaflet";
+    std::string web_dir;   // the page's own files; default: installed share dir, or the source dir (tests)
+    std::string tile_url;  // empty: offline grid
+    bool control = false;  // buttons command the vehicle; otherwise they are shown disabled
+};
+
+/// The page's files: `configured` when given, else the installed ones, else the source tree's.
+std::string map_web_dir(const std::string& configured);
+
+class MapServer {
+  public:
+    /// Sends one vehicle command ({"cmd":"plan.pause"} ...) and calls done once with the vehicle's answer
+    /// ({"ok":true,"result":...} or {"ok":false,"error":...}); runs on the same strand.
+    using CommandSink = std::function<void(nlohmann::json request, std::function<void(nlohmann::json)> done)>;
+
+    /// Points of the track kept (the oldest go first).
+    static constexpr std::size_t kTrackPoints = 10000;
+    /// Browser connections served at once; more are answered 503.
+    static constexpr std::size_t kMaxConnections = 64;
+
+    MapServer(asio::any_io_executor strand, MapConfig config, CommandSink sink);
+    ~MapServer();
+    MapServer(const MapServer&) = delete;
+    MapServer& operator=(const MapServer&) = delete;
+
+    /// Binds; returns an error for people ("cannot listen on ...: ...") or empty.
+    std::string start();
+    void stop();
+    /// The bound port.
+    std::uint16_t port() const;
+
+    // Fed by the hub, on the strand:
+    void set_plan(const nlohmann::json& geometry);  // the answer of plan.geometry
+    void add_position(const groundlink::protocol::Telemetry& t, std::chrono::system_clock::time_point at);
+    void set_link(const nlohmann::json& link);  // {"link":"up","rtt_ms":..,"loss":..,...}
+    void add_event(const std::string& text);
+
+    struct Impl;
+
+  private:
+    std::shared_ptr<Impl> impl_;
+};
+
+}  // namespace airseg::ground

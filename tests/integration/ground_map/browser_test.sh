@@ -1,0 +1,106 @@
+#!/usr/bin/env bash
+# Loads the map page from airseg-map-fixture (a plan, a vehicle driving it) in headless chromium and checks
+# what the page drew: the plan's lines, areas, holds and no-fly zone, the vehicle marker and a moving track
+# (from the DOM the browser dumps), and that a screenshot is a PNG with content.
+#
+#   browser_test.sh PATH/TO/airseg-map-fixture
+set -euo pipefail
+fixture=${1:?airseg-map-fixture}
+browser=${CHROMIUM:-$(command -v chromium || command -v chromium-browser || true)}
+if [ -z "$browser" ]; then
+  echo "FAIL: chromium is not installed; install it with: sudo apt-get install chromium libjs-leaflet" >&2
+  exit 1
+fi
+if [ ! -f /usr/share/javascript/leaflet/leaflet.js ]; then
+  echo "FAIL: Leaflet is not installed; install it with: sudo apt-get install libjs-leaflet" >&2
+  exit 1
+fi
+
+work=$(mktemp -d)
+pids=()
+cleanup() {
+  for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+  rm -rf "$work"
+}
+trap cleanup EXIT
+
+# Starts the fixture for $1 seconds; sets $url.
+start_fixture() {
+  local out=$work/fixture.$RANDOM
+  "$fixture" --seconds "$1" >"$out" 2>&1 &
+  pids+=($!)
+  for _ in $(seq 100); do
+    url=$(sed -n 's/^listening on \(http:[^ ]*\)$/\1/p' "$out")
+    [ -n "$url" ] && return 0
+    sleep 0.1
+  done
+  echo "FAIL: airseg-map-fixture did not start:" >&2
+  cat "$out" >&2
+  exit 1
+}
+
+# The page's event stream holds the browser's virtual time until the fixture ends it, so the fixture
+# runs a few seconds (the vehicle moves 10 times a second) and the browser then dumps what it drew.
+run_browser() {
+  timeout 120 "$browser" --headless --no-sandbox --disable-gpu --disable-dev-shm-usage --no-first-run \
+    --user-data-dir="$work/profile.$RANDOM" --window-size=1200,800 --virtual-time-budget=15000 "$@" \
+    2>>"$work/browser.log"
+}
+
+start_fixture 4
+run_browser --dump-dom "$url" >"$work/dom.html" || {
+  echo "FAIL: chromium failed:" >&2
+  tail -20 "$work/browser.log" >&2
+  exit 1
+}
+
+fail=0
+check() {  # description, condition result
+  if [ "$2" = yes ]; then echo "ok: $1"; else echo "FAIL: $1" >&2; fail=1; fi
+}
+count() { grep -o "$1" "$work/dom.html" | wc -l; }
+state=$(sed -n 's/.*<pre id="airseg-state"[^>]*>\([^<]*\)<\/pre>.*/\1/p' "$work/dom.html" | sed 's/&quot;/"/g; s/&lt;/</g; s/&gt;/>/g; s/&amp;/\&/g')
+echo "page state: $state"
+python3 - "$state" <<'PY' || fail=1
+import json, sys
+s = json.loads(sys.argv[1])
+checks = [
+    ("the plan's name", s["plan"] == "fixture <survey> & co"),
+    ("5 plan elements drawn", s["plan_elements"] == 5),
+    ("2 plan polylines (scan lines, orbit)", s["plan_lines"] == 2),
+    ("1 scan area", s["plan_polygons"] == 1),
+    ("1 hold", s["holds"] == 1),
+    ("1 no-fly zone", s["no_fly"] == 1),
+    ("the vehicle has a position", s["vehicle"] is not None),
+    ("the track moved (more than one point)", s["track_points"] > 1),
+    ("an event listed", s["events"] >= 1),
+    ("the buttons are read-only", s["control"] is False),
+]
+bad = [name for name, ok in checks if not ok]
+for name, ok in checks:
+    print(("ok: " if ok else "FAIL: ") + name)
+sys.exit(1 if bad else 0)
+PY
+# The same seen in the drawn SVG, not only in the page's own counts.
+check "plan polylines in the SVG" "$([ "$(count 'class="airseg-plan-line')" -eq 2 ] && echo yes || echo no)"
+check "no-fly polygon in the SVG" "$([ "$(count 'class="airseg-no-fly')" -eq 1 ] && echo yes || echo no)"
+check "track polyline in the SVG" "$([ "$(count 'class="airseg-track')" -eq 1 ] && echo yes || echo no)"
+check "vehicle marker" "$([ "$(count 'airseg-vehicle ')$(count 'airseg-vehicle"')" != 00 ] && echo yes || echo no)"
+check "buttons disabled" "$(grep -q '<button id="btn-pause" type="button" disabled' "$work/dom.html" && echo yes || echo no)"
+
+start_fixture 4
+run_browser --screenshot="$work/map.png" "$url" >/dev/null || true
+if [ ! -s "$work/map.png" ]; then
+  echo "FAIL: no screenshot written" >&2
+  tail -20 "$work/browser.log" >&2
+  fail=1
+else
+  magic=$(head -c 8 "$work/map.png" | od -An -tx1 | tr -d ' \n')
+  size=$(stat -c %s "$work/map.png")
+  check "screenshot is a PNG ($size bytes)" "$([ "$magic" = 89504e470d0a1a0a ] && [ "$size" -gt 5000 ] && echo yes || echo no)"
+fi
+if [ -n "${AIRSEG_MAP_SCREENSHOT:-}" ] && [ -s "$work/map.png" ]; then
+  cp "$work/map.png" "$AIRSEG_MAP_SCREENSHOT"
+fi
+exit $fail

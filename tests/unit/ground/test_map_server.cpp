@@ -1,0 +1,284 @@
+// MapServer on real sockets (an ephemeral port): routes, refusals, the event stream, commands.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <future>
+#include <optional>
+#include <thread>
+
+#include "ground/map/map_server.hpp"
+
+namespace airseg::ground {
+namespace {
+
+using Json = nlohmann::json;
+using asio::ip::tcp;
+
+/// A MapServer on its own io_context thread; calls into it go through its strand.
+struct Rig {
+    explicit Rig(MapConfig config = {}, bool start_it = true) {
+        leaflet = std::filesystem::temp_directory_path() /
+                  ("airseg-map-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+        std::filesystem::create_directories(leaflet);
+        std::ofstream(leaflet / "leaflet.css") << "/* leaflet */";
+        config.listen = config.listen == MapConfig{}.listen ? "127.0.0.1:0" : config.listen;
+        config.leaflet_dir = leaflet.string();
+        map =
+            std::make_unique<MapServer>(strand, config, [this](Json request, std::function<void(Json)> done) {
+                commands.push_back(request);
+                done({{"ok", true}, {"result", {{"state", "paused"}}}});
+            });
+        if (start_it) {
+            EXPECT_EQ(map->start(), "");
+        }
+        thread = std::thread([this] { io.run(); });
+    }
+    ~Rig() {
+        on_strand([this] { map->stop(); });
+        work = asio::any_io_executor();
+        thread.join();
+        map.reset();
+        std::filesystem::remove_all(leaflet);
+    }
+
+    template <typename F>
+    void on_strand(F f) {
+        std::promise<void> done;
+        asio::post(strand, [&] {
+            f();
+            done.set_value();
+        });
+        done.get_future().wait();
+    }
+
+    /// Sends `raw` on a new connection and reads the answer until the server closes it.
+    std::string exchange(const std::string& raw) const {
+        asio::io_context client;
+        tcp::socket s(client);
+        s.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), map->port()));
+        asio::write(s, asio::buffer(raw));
+        std::string out;
+        boost::system::error_code ec;
+        asio::read(s, asio::dynamic_buffer(out), ec);
+        return out;
+    }
+
+    std::string get(const std::string& path) const {
+        return exchange("GET " + path + " HTTP/1.1\r\nHost: localhost\r\n\r\n");
+    }
+
+    std::string post_command(const std::string& body) const {
+        return exchange(
+            "POST /api/command HTTP/1.1\r\nHost: localhost\r\nContent-Type: application/json\r\n"
+            "Content-Length: " +
+            std::to_string(body.size()) + "\r\n\r\n" + body);
+    }
+
+    static inline int counter = 0;
+    asio::io_context io;
+    asio::strand<asio::io_context::executor_type> strand = asio::make_strand(io);
+    // Keeps run() going while no socket waits (until the destructor lets it end).
+    asio::any_io_executor work = asio::prefer(io.get_executor(), asio::execution::outstanding_work.tracked);
+    std::filesystem::path leaflet;
+    std::unique_ptr<MapServer> map;
+    std::vector<Json> commands;  // touched on the strand only
+    std::thread thread;
+};
+
+std::string status_line(const std::string& response) {
+    return response.substr(0, response.find("\r\n"));
+}
+
+std::string body_of(const std::string& response) {
+    const auto at = response.find("\r\n\r\n");
+    return at == std::string::npos ? std::string() : response.substr(at + 4);
+}
+
+TEST(MapServer, ServesThePageLeafletAndTheExports) {
+    Rig rig;
+    const auto page = rig.get("/");
+    EXPECT_EQ(status_line(page), "HTTP/1.1 200 OK");
+    EXPECT_NE(page.find("Content-Type: text/html"), std::string::npos);
+    EXPECT_NE(page.find("/static/map.js"), std::string::npos);
+    EXPECT_EQ(status_line(rig.get("/static/map.js")), "HTTP/1.1 200 OK");
+    const auto css = rig.get("/leaflet/leaflet.css");
+    EXPECT_EQ(status_line(css), "HTTP/1.1 200 OK");
+    EXPECT_EQ(body_of(css), "/* leaflet */");
+    EXPECT_NE(css.find("Content-Type: text/css"), std::string::npos);
+
+    rig.on_strand([&] {
+        rig.map->set_plan(Json::parse(R"({"name":"p","elements":[
+        {"path":"plan.elements[0]","kind":"waypoint","name":null,"closed":false,"points":[[41,2],[41.1,2]]}],
+        "no_fly":[]})"));
+    });
+    const auto geojson = rig.get("/plan.geojson");
+    EXPECT_NE(geojson.find("Content-Type: application/geo+json"), std::string::npos);
+    EXPECT_EQ(Json::parse(body_of(geojson))["features"].size(), 1u);
+    EXPECT_NE(rig.get("/plan.kml").find("Content-Type: application/vnd.google-earth.kml+xml"),
+              std::string::npos);
+    EXPECT_EQ(Json::parse(body_of(rig.get("/track.geojson")))["type"], "FeatureCollection");
+    EXPECT_NE(body_of(rig.get("/track.kml")).find("<kml"), std::string::npos);
+    const auto head = rig.exchange("HEAD / HTTP/1.1\r\nHost: x\r\n\r\n");
+    EXPECT_EQ(status_line(head), "HTTP/1.1 200 OK");
+    EXPECT_EQ(body_of(head), "");
+}
+
+TEST(MapServer, UnknownPathsEscapesAndBadRequestsAreRefused) {
+    Rig rig;
+    EXPECT_EQ(status_line(rig.get("/nothing")), "HTTP/1.1 404 Not Found");
+    EXPECT_EQ(status_line(rig.get("/leaflet/../../etc/passwd")), "HTTP/1.1 404 Not Found");
+    EXPECT_EQ(status_line(rig.get("/leaflet/%2e%2e/%2e%2e/etc/passwd")), "HTTP/1.1 404 Not Found");
+    EXPECT_EQ(status_line(rig.get("/static/")), "HTTP/1.1 404 Not Found");
+    const auto bad = rig.exchange("NONSENSE\r\n\r\n");
+    EXPECT_EQ(status_line(bad), "HTTP/1.1 400 Bad Request");
+    EXPECT_NE(body_of(bad).find("request line"), std::string::npos) << "the reason is given";
+    EXPECT_EQ(status_line(rig.exchange("GET / HTTP/1.1\r\n\r\n")), "HTTP/1.1 400 Bad Request");
+    const auto huge =
+        rig.exchange("POST /api/command HTTP/1.1\r\nHost: x\r\nContent-Length: 999999999\r\n\r\n");
+    EXPECT_EQ(status_line(huge), "HTTP/1.1 413 Content Too Large");
+    const auto wrong = rig.exchange("DELETE / HTTP/1.1\r\nHost: x\r\n\r\n");
+    EXPECT_EQ(status_line(wrong), "HTTP/1.1 405 Method Not Allowed");
+    EXPECT_EQ(status_line(rig.get("/api/command")), "HTTP/1.1 405 Method Not Allowed");
+}
+
+TEST(MapServer, CommandsAreRefusedWithoutControl) {
+    Rig rig;
+    const auto r = rig.post_command(R"({"cmd":"plan.pause"})");
+    EXPECT_EQ(status_line(r), "HTTP/1.1 403 Forbidden");
+    EXPECT_NE(Json::parse(body_of(r))["error"].get<std::string>().find("without control"), std::string::npos);
+    rig.on_strand([&] { EXPECT_TRUE(rig.commands.empty()); });
+}
+
+TEST(MapServer, WithControlOnlyPlanCommandsReachTheVehicle) {
+    MapConfig config;
+    config.control = true;
+    Rig rig(config);
+    const auto r = rig.post_command(R"({"cmd":"plan.pause","extra":1})");
+    EXPECT_EQ(status_line(r), "HTTP/1.1 200 OK");
+    EXPECT_EQ(Json::parse(body_of(r))["result"]["state"], "paused");
+    EXPECT_EQ(status_line(rig.post_command(R"({"cmd":"plan.skip","element":"gate"})")), "HTTP/1.1 200 OK");
+    EXPECT_EQ(status_line(rig.post_command(R"({"cmd":"plan.load","text":"plan: {}","source":"f.yaml"})")),
+              "HTTP/1.1 200 OK");
+    const auto refused = rig.post_command(R"({"cmd":"param.set","name":"X"})");
+    EXPECT_EQ(status_line(refused), "HTTP/1.1 400 Bad Request");
+    EXPECT_NE(body_of(refused).find("not a map command"), std::string::npos);
+    EXPECT_EQ(status_line(rig.post_command(R"({"cmd":"plan.load","path":"/etc/passwd"})")),
+              "HTTP/1.1 400 Bad Request");
+    EXPECT_EQ(status_line(rig.post_command("not json")), "HTTP/1.1 400 Bad Request");
+    EXPECT_EQ(status_line(rig.post_command(R"({"cmd":"plan.skip"})")), "HTTP/1.1 400 Bad Request");
+    rig.on_strand([&] {
+        ASSERT_EQ(rig.commands.size(), 3u);
+        EXPECT_EQ(rig.commands[0], Json::parse(R"({"cmd":"plan.pause"})")) << "only the command's own fields";
+        EXPECT_EQ(rig.commands[1], Json::parse(R"({"cmd":"plan.skip","element":"gate"})"));
+        EXPECT_EQ(rig.commands[2], Json::parse(R"({"cmd":"plan.load","text":"plan: {}","source":"f.yaml"})"));
+    });
+}
+
+/// Reads server-sent events until `count` have arrived (after the response head).
+std::vector<std::pair<std::string, Json>> read_events(tcp::socket& s, std::string& buffer,
+                                                      std::size_t count) {
+    std::vector<std::pair<std::string, Json>> out;
+    while (out.size() < count) {
+        const auto end = buffer.find("\n\n");
+        if (end == std::string::npos) {
+            std::array<char, 4096> chunk{};
+            const auto n = s.read_some(asio::buffer(chunk));
+            buffer.append(chunk.data(), n);
+            continue;
+        }
+        const std::string block = buffer.substr(0, end);
+        buffer.erase(0, end + 2);
+        std::string event;
+        std::string data;
+        std::size_t at = 0;
+        while (at < block.size()) {
+            auto eol = block.find('\n', at);
+            const std::string line =
+                block.substr(at, eol == std::string::npos ? std::string::npos : eol - at);
+            at = eol == std::string::npos ? block.size() : eol + 1;
+            if (line.starts_with("event: ")) {
+                event = line.substr(7);
+            } else if (line.starts_with("data: ")) {
+                data = line.substr(6);
+            }
+        }
+        if (!event.empty()) {
+            out.emplace_back(event, Json::parse(data));
+        }
+    }
+    return out;
+}
+
+TEST(MapServer, TheEventStreamStartsWithTheWholeStateThenFollowsUpdates) {
+    Rig rig;
+    groundlink::protocol::Telemetry t;
+    t.lat_deg = 41.5;
+    t.lon_deg = 2.5;
+    t.heading_deg = 90;
+    rig.on_strand([&] {
+        rig.map->set_plan(Json::parse(R"({"name":"p","elements":[],"no_fly":[]})"));
+        rig.map->add_position(t, std::chrono::system_clock::now());
+        rig.map->set_link({{"link", "up"}, {"rtt_ms", 50}});
+        rig.map->add_event("hello");
+    });
+    asio::io_context client;
+    tcp::socket s(client);
+    s.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), rig.map->port()));
+    asio::write(
+        s, asio::buffer(std::string("GET /events HTTP/1.1\r\nHost: x\r\nAccept: text/event-stream\r\n\r\n")));
+    std::string buffer;
+    asio::read_until(s, asio::dynamic_buffer(buffer), "\r\n\r\n");
+    ASSERT_TRUE(buffer.starts_with("HTTP/1.1 200 OK\r\n"));
+    ASSERT_NE(buffer.find("Content-Type: text/event-stream"), std::string::npos);
+    buffer.erase(0, buffer.find("\r\n\r\n") + 4);
+
+    auto first = read_events(s, buffer, 1);
+    ASSERT_EQ(first[0].first, "state");
+    const Json& state = first[0].second;
+    EXPECT_EQ(state["plan"]["name"], "p");
+    EXPECT_EQ(state["track"], Json::parse("[[41.5, 2.5]]"));
+    EXPECT_EQ(state["position"]["heading"], 90.0);
+    EXPECT_EQ(state["link"]["rtt_ms"], 50);
+    EXPECT_EQ(state["events"][0]["text"], "hello");
+    EXPECT_EQ(state["control"], false);
+
+    t.lat_deg = 41.6;
+    rig.on_strand([&] {
+        rig.map->add_position(t, std::chrono::system_clock::now());
+        rig.map->add_event("bad \xff utf-8 <b>");
+    });
+    const auto next = read_events(s, buffer, 2);
+    EXPECT_EQ(next[0].first, "position");
+    EXPECT_EQ(next[0].second["lat"], 41.6);
+    EXPECT_EQ(next[1].first, "event");
+    EXPECT_NE(next[1].second["text"].get<std::string>().find("<b>"), std::string::npos);
+}
+
+TEST(MapServer, ManyBrowsersAtOnceAreServed) {
+    Rig rig;
+    std::vector<std::future<std::string>> answers;
+    for (int i = 0; i < 20; ++i) {
+        answers.push_back(std::async(std::launch::async, [&] { return rig.get("/static/map.css"); }));
+    }
+    for (auto& a : answers) {
+        EXPECT_EQ(status_line(a.get()), "HTTP/1.1 200 OK");
+    }
+}
+
+TEST(MapServer, ABusyPortIsReportedForPeople) {
+    Rig first;
+    MapConfig config;
+    config.listen = "127.0.0.1:" + std::to_string(first.map->port());
+    asio::io_context io;
+    MapServer second(io.get_executor(), config, {});
+    const auto error = second.start();
+    EXPECT_NE(error.find("cannot listen on 127.0.0.1:"), std::string::npos) << error;
+    MapConfig bad;
+    bad.listen = "nowhere";
+    MapServer third(io.get_executor(), bad, {});
+    EXPECT_EQ(third.start(), "cannot listen on nowhere: give HOST:PORT");
+}
+
+}  // namespace
+}  // namespace airseg::ground
