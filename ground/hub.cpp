@@ -23,6 +23,8 @@ namespace {
 /// How long the hub remembers a relayed command the vehicle has not answered (the client gave up long
 /// before).
 constexpr auto kForgetUnanswered = std::chrono::minutes(10);
+/// How long the hub waits for the answer to a command of its own (the map's) before calling it unanswered.
+constexpr auto kOwnCommandPatience = std::chrono::seconds(60);
 
 std::pair<std::string, std::string> split_host_port(const std::string& text) {
     const auto colon = text.rfind(':');
@@ -311,7 +313,7 @@ void Hub::on_client_message(ClientState& client, const proto::Message& message) 
             // The vehicle stays the one judge of what a monitor may do; the hub only lowers the rights.
             request["role"] = "monitor";
         }
-        relay(std::move(request), Pending{client.connection->id(), command->request_id, {}, {}});
+        relay(std::move(request), Pending{client.connection->id(), command->request_id, {}, {}, {}});
     } else if (const auto* stick = std::get_if<proto::Joystick>(&message)) {
         if (!client.control) {
             if (!client.joystick_warned) {
@@ -348,12 +350,13 @@ std::uint32_t Hub::relay(Json request, Pending pending) {
         return id;
     }
     pending.sent = std::chrono::steady_clock::now();
+    pending.cmd = request.is_object() ? request.value("cmd", std::string{}) : std::string{};
     pending_.emplace(id, std::move(pending));
     return id;
 }
 
 void Hub::command(Json request, Done done) {
-    relay(std::move(request), Pending{0, 0, std::move(done), {}});
+    relay(std::move(request), Pending{0, 0, std::move(done), {}, {}});
 }
 
 groundlink::SendResult Hub::send_to_vehicle(const proto::Message& message) {
@@ -380,6 +383,9 @@ void Hub::on_vehicle(proto::Message message) {
         }
         Pending pending = std::move(it->second);
         pending_.erase(it);
+        for (const auto& listener : result_listeners_) {
+            listener(pending.cmd, result->answer);
+        }
         if (pending.done) {
             pending.done(result->answer);
         } else if (auto client = clients_.find(pending.client); client != clients_.end()) {
@@ -425,7 +431,18 @@ void Hub::tick() {
     }
     broadcast(hub::encode_json({{"link", link_stats()}}));
     const auto now = std::chrono::steady_clock::now();
-    std::erase_if(pending_, [now](const auto& entry) { return now - entry.second.sent > kForgetUnanswered; });
+    for (auto it = pending_.begin(); it != pending_.end();) {
+        auto& p = it->second;
+        if (now - p.sent <= (p.done ? kOwnCommandPatience : kForgetUnanswered)) {
+            ++it;
+            continue;
+        }
+        auto done = std::move(p.done);
+        it = pending_.erase(it);
+        if (done) {
+            done(Json{{"ok", false}, {"status", "no_link"}, {"error", "no answer from the vehicle"}});
+        }
+    }
     tick_timer_.expires_after(std::chrono::seconds(1));
     tick_timer_.async_wait([this](boost::system::error_code ec) {
         if (!ec) {

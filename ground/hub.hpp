@@ -31,6 +31,8 @@ class Hub {
     using Done = std::function<void(nlohmann::json answer)>;
     /// Everything the vehicle pushes, for the hub's own consumers (the map, the MAVLink endpoint).
     using Listener = std::function<void(const groundlink::protocol::Message&)>;
+    /// The name of each relayed command ("plan.load") and the vehicle's answer to it.
+    using ResultListener = std::function<void(const std::string& cmd, const nlohmann::json& answer)>;
 
     Hub(asio::any_io_executor strand, HubConfig config);
     ~Hub();
@@ -45,6 +47,7 @@ class Hub {
     /// Sends a command with control rights on behalf of the hub itself.
     void command(nlohmann::json request, Done done);
     void add_listener(Listener listener) { listeners_.push_back(std::move(listener)); }
+    void add_result_listener(ResultListener listener) { result_listeners_.push_back(std::move(listener)); }
     /// Sends a message to the vehicle reliably (MAVLink from ground stations).
     groundlink::SendResult send_to_vehicle(const groundlink::protocol::Message& message);
     nlohmann::json link_stats() const;
@@ -65,6 +68,7 @@ class Hub {
         std::uint32_t client_request = 0;
         Done done;
         std::chrono::steady_clock::time_point sent;
+        std::string cmd;
     };
 
     std::string listen_unix();
@@ -91,6 +95,7 @@ class Hub {
     std::map<std::uint32_t, ClientState> clients_;
     std::map<std::uint32_t, Pending> pending_;
     std::vector<Listener> listeners_;
+    std::vector<ResultListener> result_listeners_;
     std::uint32_t next_client_ = 1;
     std::uint32_t next_request_ = 1;
     std::uint32_t control_holder_ = 0;

@@ -7,12 +7,14 @@
 #include <algorithm>
 #include <csignal>
 #include <iostream>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "cli/command_line.hpp"
 #include "client/radio_options.hpp"
 #include "ground/hub.hpp"
+#include "ground/map_feed.hpp"
 
 namespace {
 
@@ -35,6 +37,7 @@ const char* const kUsageTail =
 
 struct Options {
     airseg::ground::HubConfig hub;
+    airseg::ground::MapConfig map;
     bool radio_given = false;
     std::string log_level = "info";
 };
@@ -55,6 +58,17 @@ int main(int argc, char** argv) {
                "group allowed to connect to the socket (mode 0660; default the hub's)",
                text(o.hub.socket_group))
         .value("tcp", "HOST:PORT", "also serve clients over TCP (off by default)", text(o.hub.tcp))
+        .value(
+            "map", "HOST:PORT",
+            "serve the live map here (default 127.0.0.1:8080; 'off' for none; port 0 picks one)",
+            [&o](std::string_view, std::string_view v) { o.map.listen = v == "off" ? "" : std::string(v); })
+        .flag("map-control",
+              "let the map's buttons load, pause, resume and skip the plan (default: view only)",
+              [&o] { o.map.control = true; })
+        .value("map-tiles", "URL",
+               "tile server for the map, e.g. https://tile.openstreetmap.org/{z}/{x}/{y}.png (default: an "
+               "offline grid)",
+               text(o.map.tile_url))
         .value("log-level", "LEVEL", "trace, debug, info, warn or error (default info)", text(o.log_level))
         .help_and_version();
     const Program program{"airseg-ground", [&table] { return kUsageHead + describe(table) + kUsageTail; }};
@@ -83,11 +97,25 @@ int main(int argc, char** argv) {
         std::cerr << "airseg-ground: " << error << '\n';
         return 1;
     }
+    std::unique_ptr<airseg::ground::MapFeed> map;
+    if (!o.map.listen.empty()) {
+        map = std::make_unique<airseg::ground::MapFeed>(strand, hub, o.map);
+        if (auto error = map->start(); !error.empty()) {
+            std::cerr << "airseg-ground: " << error << '\n';
+            return 1;
+        }
+        const auto host = o.map.listen.substr(0, o.map.listen.rfind(':'));
+        spdlog::info("ground hub: the map on http://{}:{}/{}", host, map->port(),
+                     o.map.control ? " (its buttons command the vehicle)" : "");
+    }
     boost::asio::signal_set signals(io, SIGINT, SIGTERM);
     signals.async_wait([&](const boost::system::error_code& ec, int) {
         if (!ec) {
             spdlog::info("ground hub: stopping");
             boost::asio::dispatch(strand, [&] {
+                if (map) {
+                    map->stop();
+                }
                 hub.stop();
                 io.stop();
             });

@@ -287,6 +287,26 @@ class Session : public std::enable_shared_from_this<Session> {
             });
     }
 
+    /// "/events?for=S" ends the stream after S seconds: a snapshot of the live map (a headless browser only
+    /// renders once the page's requests are over) without a stream that never ends.
+    void end_stream_after(const std::string& query) {
+        if (!query.starts_with("for=")) {
+            return;
+        }
+        const auto text = query.substr(4);
+        int seconds = 0;
+        const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), seconds);
+        if (ec != std::errc() || end != text.data() + text.size() || seconds < 1 || seconds > 3600) {
+            return;
+        }
+        deadline_.expires_after(std::chrono::seconds(seconds));
+        deadline_.async_wait([self = shared_from_this()](boost::system::error_code e) {
+            if (!e) {
+                self->send(": end of the snapshot\n\n", true);
+            }
+        });
+    }
+
     void send(std::string bytes, bool close_after) {
         if (closed_) {
             return;
@@ -370,6 +390,7 @@ void Session::handle(const http::Request& req) {
             false);
         if (!head) {
             send("retry: 2000\nevent: state\ndata: " + dump(s.state()) + "\n\n", false);
+            end_stream_after(req.query);
         } else {
             close_after_ = true;
         }

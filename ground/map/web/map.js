@@ -33,6 +33,14 @@
   let linkState = null;
   let eventCount = 0;
 
+  function trackLength() {
+    const pts = trackLine.getLatLngs();
+    let metres = 0;
+    for (let i = 1; i < pts.length; i += 1) {
+      metres += map.distance(pts[i - 1], pts[i]);
+    }
+    return metres;
+  }
   function state() {
     return {
       plan: planName,
@@ -42,6 +50,7 @@
       holds: counts.holds,
       no_fly: counts.no_fly,
       track_points: trackLine.getLatLngs().length,
+      track_m: Math.round(trackLength()),
       vehicle: lastPosition ? { lat: lastPosition.lat, lon: lastPosition.lon, heading: lastPosition.heading } : null,
       link: linkState,
       events: eventCount,
@@ -237,7 +246,9 @@
   setControl(false);
   publish();
 
-  const events = new EventSource('/events');
+  // ?for=S: follow the vehicle for S seconds, then keep the picture (a snapshot; no reconnecting).
+  const follow = new URLSearchParams(location.search).get('for');
+  const events = new EventSource('/events' + (follow ? '?for=' + encodeURIComponent(follow) : ''));
   events.addEventListener('state', ev => {
     const s = JSON.parse(ev.data);
     setControl(!!s.control);
@@ -256,5 +267,11 @@
   events.addEventListener('position', ev => setPosition(JSON.parse(ev.data), true));
   events.addEventListener('link', ev => setLink(JSON.parse(ev.data)));
   events.addEventListener('event', ev => addEvent(JSON.parse(ev.data)));
-  events.onerror = () => setLink({ link: 'down', note: 'no connection to the hub' });
+  events.onerror = () => {
+    if (follow) {
+      events.close();
+      return;
+    }
+    setLink({ link: 'down', note: 'no connection to the hub' });
+  };
 })();

@@ -75,7 +75,7 @@ class GroundHubE2e : public ::testing::Test {
             std::map<std::string, std::string>{}, dir.path());
         hub = std::make_unique<Subprocess>(
             std::vector<std::string>{binary("ground/airseg-ground"), "--link", dir.file("ground"), "--key",
-                                     key, "--socket", socket()},
+                                     key, "--socket", socket(), "--map", "127.0.0.1:0"},
             std::map<std::string, std::string>{}, dir.path());
         ASSERT_TRUE(wait_until([&] { return exists(socket()); })) << hub->err();
         Json doc;
@@ -119,6 +119,51 @@ class GroundHubE2e : public ::testing::Test {
     }
 
     std::string socket() const { return dir.file("ground.sock"); }
+
+    /// The map's address, from the hub's log line.
+    std::string map_url() const {
+        const auto log = hub->err();
+        const auto at = log.find("the map on http://");
+        if (at == std::string::npos) {
+            return {};
+        }
+        const auto begin = at + std::string("the map on ").size();
+        return log.substr(begin, log.find_first_of(" \n", begin) - begin);
+    }
+
+    /// What the page drew, as its own counts (window.airsegMap.state(), mirrored into the DOM), from a real
+    /// headless browser that follows the vehicle for `seconds`.
+    Json map_snapshot(int seconds, std::string& dom) {
+        const auto browser = run({"/bin/sh", "-c", "command -v chromium || command -v chromium-browser"});
+        EXPECT_EQ(browser.exit_code, 0)
+            << "chromium is not installed: sudo apt-get install chromium libjs-leaflet";
+        if (browser.exit_code != 0) {
+            return {};
+        }
+        auto r =
+            run({browser.out.substr(0, browser.out.find('\n')), "--headless", "--no-sandbox", "--disable-gpu",
+                 "--disable-dev-shm-usage", "--no-first-run", "--user-data-dir=" + dir.file("browser"),
+                 "--window-size=1200,800", "--virtual-time-budget=30000", "--dump-dom",
+                 map_url() + "?for=" + std::to_string(seconds)},
+                {}, 120s);
+        dom = r.out;
+        const auto open = dom.find("<pre id=\"airseg-state\"");
+        const auto start = dom.find('>', open);
+        const auto end = dom.find("</pre>", start);
+        if (open == std::string::npos || end == std::string::npos) {
+            ADD_FAILURE() << "no page state in what chromium drew:\n" << dom.substr(0, 2000) << r.err;
+            return {};
+        }
+        auto text = dom.substr(start + 1, end - start - 1);
+        for (const auto& [entity, ch] : std::vector<std::pair<std::string, std::string>>{
+                 {"&quot;", "\""}, {"&lt;", "<"}, {"&gt;", ">"}, {"&amp;", "&"}}) {
+            for (auto at = text.find(entity); at != std::string::npos;
+                 at = text.find(entity, at + ch.size())) {
+                text.replace(at, entity.size(), ch);
+            }
+        }
+        return Json::parse(text, nullptr, false);
+    }
 
     client::HubOptions operator_options(const std::string& name, const std::string& key_file) const {
         client::HubOptions o;
@@ -220,6 +265,27 @@ TEST_F(GroundHubE2e, ControlPassesOnWhenTheHolderLeaves) {
         << next.err;
     // No plan runs, so the vehicle answers the pause itself (refused or done), never "forbidden".
     EXPECT_EQ(next.err.find("monitor"), std::string::npos) << next.err;
+}
+
+TEST_F(GroundHubE2e, TheMapShowsThePlanAndTheVehicleDrivingIt) {
+    start_chain();
+    ASSERT_FALSE(map_url().empty()) << hub->err();
+    auto loaded = ctl({"plan", "load", plan_file()}, true);
+    ASSERT_EQ(loaded.exit_code, 0) << loaded.out << loaded.err;
+    std::string dom;
+    const auto state = map_snapshot(8, dom);
+    ASSERT_TRUE(state.is_object()) << dom.substr(0, 2000);
+    EXPECT_EQ(state["plan"], "through-the-hub") << state.dump();
+    EXPECT_EQ(state["plan_elements"], 10) << state.dump();
+    ASSERT_TRUE(state["vehicle"].is_object()) << state.dump();
+    EXPECT_GT(state["vehicle"]["lon"].get<double>(), kHomeLon)
+        << "driving east along the plan: " << state.dump();
+    EXPECT_GT(state["track_points"].get<int>(), 5) << state.dump();
+    EXPECT_GT(state["track_m"].get<int>(), 5) << "the vehicle moved: " << state.dump();
+    EXPECT_FALSE(state["control"].get<bool>()) << "view only without --map-control";
+    // Drawn, not only counted: the track and the vehicle marker are in the page's SVG and markers.
+    EXPECT_NE(dom.find("airseg-track"), std::string::npos);
+    EXPECT_NE(dom.find("airseg-vehicle"), std::string::npos);
 }
 
 }  // namespace
