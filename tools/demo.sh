@@ -2,8 +2,9 @@
 # tools/demo.sh [--resume] [--duration MS]
 #
 # The bench on one machine: airseg-linksim (a 57600-baud radio pair with a little loss) between airsegd and
-# the ground, the simulated autopilot when it is built (airseg-apmsim), airsegd on config/airseg.yaml, and
-# airsegctl's live view over the radio in the foreground. Ctrl-C stops everything.
+# the ground, the simulated autopilot when it is built (airseg-apmsim), airsegd on config/airseg.yaml, the
+# ground station hub airseg-ground on the radio's ground end (with its live map in a browser), and airsegctl's
+# live view through the hub in the foreground. Ctrl-C stops everything.
 # Everything runs under build/demo/ (ptys, sockets, state, logs; AIRSEG_DEMO_DIR to put it elsewhere); no
 # root is needed. Each run starts clean: a flight plan left by an earlier run is dropped unless --resume is
 # given (airsegd would otherwise drive it again at once). --duration MS ends the demo by itself (for tests).
@@ -56,9 +57,22 @@ fi
   > "$run_dir/airsegd.log" 2>&1 &
 pids+=($!)
 
-ctl="$build/client/airsegctl --local --socket $run_dir/status.sock"
+# The map on a free port (named in the hub's log): a fixed one may be taken on a developer's machine.
+"$build/ground/airseg-ground" --link "$run_dir/radio-ground" --baud 57600 --socket "$run_dir/ground.sock" \
+  --map "127.0.0.1:${AIRSEG_DEMO_MAP_PORT:-0}" --map-control > "$run_dir/airseg-ground.log" 2>&1 &
+pids+=($!)
+wait_for "$run_dir/ground.sock"
+map_url=""
+for _ in $(seq 50); do
+  map_url=$(sed -n 's/.*the map on \(http:[^ ]*\).*/\1/p' "$run_dir/airseg-ground.log")
+  [ -n "$map_url" ] && break
+  sleep 0.1
+done
+
+ctl="$build/client/airsegctl --ground-socket $run_dir/ground.sock"
 # The hints stay under the live view (printed before it, the view's first refresh would clear them).
-"$build/client/airsegctl" --link "$run_dir/radio-ground" --baud 57600 --timeout 5000 watch "${watch_args[@]}" \
+"$build/client/airsegctl" --ground-socket "$run_dir/ground.sock" --timeout 5000 watch "${watch_args[@]}" \
   --note "demo: logs in $run_dir; Ctrl-C stops it all" \
+  --note "demo: the live map in a browser: ${map_url:-see $run_dir/airseg-ground.log}" \
   --note "demo: from another terminal: $ctl status" \
   --note "demo: a flight plan:        $ctl plan load config/plans/rover-survey.yaml"

@@ -35,4 +35,9 @@ if grep -q "demo: a flight plan: .*plan load config/plans/rover-survey.yaml" "$d
 else
   echo "FAIL: no hint lines in the demo's output:"; cat "$dir/out"; fail=1
 fi
+if grep -q "demo: the live map in a browser: http://127.0.0.1:[0-9]*/" "$dir/out"; then
+  echo "ok: the live view names the map's address"
+else
+  echo "FAIL: no map address in the demo's output:"; cat "$dir/out"; fail=1
+fi
 exit $fail
