@@ -168,7 +168,8 @@ std::string Hub::listen_tcp() {
     if (ec) {
         return "cannot listen on " + config_.tcp + ": " + ec.message();
     }
-    spdlog::info("ground hub: clients on tcp {}", config_.tcp);
+    const auto bound = tcp_acceptor_->local_endpoint(ec);
+    spdlog::info("ground hub: clients on tcp {}:{}", bound.address().to_string(), bound.port());
     accept_tcp();
     return {};
 }

@@ -75,7 +75,8 @@ class GroundHubE2e : public ::testing::Test {
             std::map<std::string, std::string>{}, dir.path());
         hub = std::make_unique<Subprocess>(
             std::vector<std::string>{binary("ground/airseg-ground"), "--link", dir.file("ground"), "--key",
-                                     key, "--socket", socket(), "--map", "127.0.0.1:0"},
+                                     key, "--socket", socket(), "--map", "127.0.0.1:0", "--tcp",
+                                     "127.0.0.1:0"},
             std::map<std::string, std::string>{}, dir.path());
         ASSERT_TRUE(wait_until([&] { return exists(socket()); })) << hub->err();
         Json doc;
@@ -119,6 +120,17 @@ class GroundHubE2e : public ::testing::Test {
     }
 
     std::string socket() const { return dir.file("ground.sock"); }
+
+    /// HOST:PORT of the hub's TCP listener, from its log line.
+    std::string tcp_address() const {
+        const auto log = hub->err();
+        const auto at = log.find("clients on tcp ");
+        if (at == std::string::npos) {
+            return {};
+        }
+        const auto begin = at + std::string("clients on tcp ").size();
+        return log.substr(begin, log.find_first_of(" \n", begin) - begin);
+    }
 
     /// The map's address, from the hub's log line.
     std::string map_url() const {
@@ -245,6 +257,26 @@ TEST_F(GroundHubE2e, ControlIsHeldByOneClientAtATime) {
     ASSERT_EQ(impostor.open(10s), "");
     EXPECT_EQ(impostor.role(), "monitor");
     EXPECT_NE(impostor.role_reason().find("does not match"), std::string::npos) << impostor.role_reason();
+}
+
+TEST_F(GroundHubE2e, OverTcpTheKeyDecidesTheRole) {
+    start_chain();
+    ASSERT_FALSE(tcp_address().empty()) << hub->err();
+    auto options = operator_options("tcp operator", key);
+    options.tcp = tcp_address();
+    client::HubClient keyed(options);
+    ASSERT_EQ(keyed.open(10s), "");
+    EXPECT_EQ(keyed.role(), "control");
+    auto answer = keyed.request({{"cmd", "status"}}, 30s);
+    ASSERT_TRUE(answer.answer) << answer.error;
+    EXPECT_TRUE(answer.answer->value("ok", false)) << answer.answer->dump();
+
+    // airsegctl over TCP without a key: a monitor, whose plan command the vehicle refuses.
+    auto refused =
+        run({binary("client/airsegctl"), "--ground-tcp", tcp_address(), "--json", "plan", "pause"}, {}, 60s);
+    EXPECT_EQ(refused.exit_code, 1) << refused.out << refused.err;
+    EXPECT_NE(refused.err.find("no key given"), std::string::npos) << refused.err;
+    EXPECT_NE(refused.out.find("a monitor client of the ground hub"), std::string::npos) << refused.out;
 }
 
 TEST_F(GroundHubE2e, ControlPassesOnWhenTheHolderLeaves) {
