@@ -42,11 +42,17 @@ AutopilotService::AutopilotService(ServiceContext& ctx, AutopilotServiceConfig c
                                        pump();
                                    }}),
       tlog_(config_.tlog),
+      gate_(config_.autopilot.target_sysid, config_.autopilot.target_compid),
       timer_(strand()),
       prefix_("autopilot[" + config_.port.serial.path + "]: ") {
-    if (config_.tlog.enabled) {
-        driver_.set_frame_tap([this](bool, std::span<const std::uint8_t> frame) {
-            tlog_.record(frame, std::chrono::system_clock::now(), SteadyClock::now());
+    if (config_.tlog.enabled || config_.forward_frames) {
+        driver_.set_frame_tap([this](bool outgoing, std::span<const std::uint8_t> frame) {
+            if (config_.tlog.enabled) {
+                tlog_.record(frame, std::chrono::system_clock::now(), SteadyClock::now());
+            }
+            if (!outgoing && running_) {
+                to_ground_stations(forwarded(frame));
+            }
         });
     }
 }
@@ -75,6 +81,8 @@ void AutopilotService::on_start() {
         driver_.operator_reset(SteadyClock::now());
         pump();
     }));
+    subscriptions_.push_back(bus.subscribe<GroundStationFrames>(
+        strand(), [this](const GroundStationFrames& g) { from_ground_station(g.bytes); }));
     keeper_.start();
     publish_status();
     update_health();
@@ -86,6 +94,37 @@ void AutopilotService::on_stop() {
     timer_.cancel();
     keeper_.stop();
     tlog_.flush();
+}
+
+// Frames a ground station sent the autopilot: mission writes are answered by the gate, the rest written.
+void AutopilotService::from_ground_station(std::span<const std::uint8_t> frames) {
+    if (!running_) {
+        return;
+    }
+    const auto refused_before = gate_.stats().missions_refused;
+    auto out = gate_.from_ground(frames);
+    if (gate_.stats().missions_refused != refused_before) {
+        spdlog::info("{}refused a mission write from a ground station ({} so far): missions are flight plans",
+                     prefix_, gate_.stats().missions_refused);
+    }
+    for (const auto& answer : out.to_ground) {
+        to_ground_stations(answer);
+    }
+    if (!keeper_.is_open()) {
+        return;
+    }
+    for (auto& frame : out.to_autopilot) {
+        if (config_.tlog.enabled) {
+            tlog_.record(frame, std::chrono::system_clock::now(), SteadyClock::now());
+        }
+        keeper_.write(std::move(frame));
+    }
+}
+
+void AutopilotService::to_ground_stations(const ForwardedFrame& frame) {
+    if (config_.forward_frames) {
+        ctx_.bus.publish(frame);
+    }
 }
 
 void AutopilotService::on_request(const AutopilotRequest& r) {
