@@ -94,6 +94,12 @@ AutopilotSetup autopilot_setup(const Config& config) {
     s.tlog.max_bytes = static_cast<std::uint64_t>(a.tlog_max_bytes);
     s.tlog.keep = static_cast<unsigned>(a.tlog_keep);
     s.forward_frames = config.groundlink.mavlink_forward_enabled;
+    if (!a.gcs_endpoint_udp.empty() || !a.gcs_endpoint_tcp.empty()) {
+        s.gcs_endpoint = autopilot::GcsEndpointConfig{a.gcs_endpoint_udp, a.gcs_endpoint_tcp, ""};
+        for (const auto& p : s.gcs_endpoint->validate()) {
+            out.problems.push_back("autopilot.gcs_endpoint." + p);  // "udp: ..." names the key's last part
+        }
+    }
 
     out.problems = autopilot::AutopilotConfig::validate(ap);
     out.problems.insert(out.problems.end(), unknown_messages.begin(), unknown_messages.end());

@@ -39,7 +39,9 @@ struct AutopilotConfig {
     std::string tlog_path = "/var/log/airseg/autopilot.tlog";  // autopilot.tlog.path
     long long tlog_max_bytes = 64ll << 20;                     // autopilot.tlog.max_bytes
     int tlog_keep = 4;                                         // autopilot.tlog.keep
-    std::string reset_line;                           // autopilot.reset.line: name or chip:offset; "" = none
+    std::string gcs_endpoint_udp;  // autopilot.gcs_endpoint.udp: ADDRESS:PORT for ground stations; "" = off
+    std::string gcs_endpoint_tcp;  // autopilot.gcs_endpoint.tcp: ADDRESS:PORT for ground stations; "" = off
+    std::string reset_line;        // autopilot.reset.line: name or chip:offset; "" = none
     milliseconds reset_unresponsive_timeout{20'000};  // autopilot.reset.unresponsive_timeout
     int reset_max_pulses = 3;                         // autopilot.reset.max_pulses
 };

@@ -410,6 +410,18 @@ std::vector<KeySpec> build_schema() {
         "autopilot.tlog.keep", [](Config& c) -> int& { return c.autopilot.tlog_keep; }, 0, 100,
         "rotated .tlog files kept"));
     s.push_back(string(
+        "autopilot.gcs_endpoint.udp", [](Config& c) -> std::string& { return c.autopilot.gcs_endpoint_udp; },
+        "ADDRESS:PORT where ground stations reach the autopilot through airsegd over UDP (e.g. "
+        "0.0.0.0:14550); "
+        "empty = off",
+        true));
+    s.push_back(string(
+        "autopilot.gcs_endpoint.tcp", [](Config& c) -> std::string& { return c.autopilot.gcs_endpoint_tcp; },
+        "ADDRESS:PORT where ground stations reach the autopilot through airsegd over TCP (e.g. "
+        "0.0.0.0:5760); "
+        "empty = off",
+        true));
+    s.push_back(string(
         "autopilot.reset.line", [](Config& c) -> std::string& { return c.autopilot.reset_line; },
         "GPIO line pulsed to reset an unresponsive autopilot: a line name or CHIP:OFFSET; empty = none",
         true));

@@ -45,7 +45,12 @@ AutopilotService::AutopilotService(ServiceContext& ctx, AutopilotServiceConfig c
       gate_(config_.autopilot.target_sysid, config_.autopilot.target_compid),
       timer_(strand()),
       prefix_("autopilot[" + config_.port.serial.path + "]: ") {
-    if (config_.tlog.enabled || config_.forward_frames) {
+    if (config_.gcs_endpoint) {
+        endpoint_ = std::make_unique<GcsEndpoint>(
+            strand(), *config_.gcs_endpoint,
+            [this](std::vector<std::uint8_t> frames) { from_ground_station(frames); });
+    }
+    if (config_.tlog.enabled || config_.forward_frames || endpoint_) {
         driver_.set_frame_tap([this](bool outgoing, std::span<const std::uint8_t> frame) {
             if (config_.tlog.enabled) {
                 tlog_.record(frame, std::chrono::system_clock::now(), SteadyClock::now());
@@ -83,6 +88,11 @@ void AutopilotService::on_start() {
     }));
     subscriptions_.push_back(bus.subscribe<GroundStationFrames>(
         strand(), [this](const GroundStationFrames& g) { from_ground_station(g.bytes); }));
+    if (endpoint_) {
+        if (auto error = endpoint_->start(); !error.empty()) {
+            spdlog::error("{}{}; no ground station endpoint", prefix_, error);
+        }
+    }
     keeper_.start();
     publish_status();
     update_health();
@@ -92,6 +102,9 @@ void AutopilotService::on_stop() {
     running_ = false;
     subscriptions_.clear();
     timer_.cancel();
+    if (endpoint_) {
+        endpoint_->stop();
+    }
     keeper_.stop();
     tlog_.flush();
 }
@@ -121,7 +134,11 @@ void AutopilotService::from_ground_station(std::span<const std::uint8_t> frames)
     }
 }
 
+// The endpoint's ground stations are on the board's network: they get every frame, unthrottled.
 void AutopilotService::to_ground_stations(const ForwardedFrame& frame) {
+    if (endpoint_) {
+        endpoint_->from_vehicle(frame.bytes);
+    }
     if (config_.forward_frames) {
         ctx_.bus.publish(frame);
     }

@@ -18,6 +18,7 @@
 #include "services/autopilot/ardupilot/driver.hpp"
 #include "services/autopilot/autopilot.hpp"
 #include "services/autopilot/autopilot_config.hpp"
+#include "services/autopilot/gcs_endpoint.hpp"
 #include "services/autopilot/gcs_gate.hpp"
 #include "services/autopilot/tlog_writer.hpp"
 #include "services/common/deadline_timer.hpp"
@@ -38,6 +39,9 @@ struct AutopilotServiceConfig {
     /// Publish every frame from the autopilot as a ForwardedFrame (groundlink.mavlink_forward.enabled), for
     /// standard ground stations through the ground link.
     bool forward_frames = false;
+    /// autopilot.gcs_endpoint: ground stations on the board's network, straight to the autopilot (through
+    /// the same gate), every frame from the autopilot to them; none = off.
+    std::optional<GcsEndpointConfig> gcs_endpoint;
 };
 
 class AutopilotService : public Service {
@@ -48,6 +52,8 @@ class AutopilotService : public Service {
 
     /// The driver, for tests and the status service; touch only on strand().
     const ardupilot::Driver& driver() const { return driver_; }
+    /// The ground station endpoint (autopilot.gcs_endpoint), or null; touch only on strand().
+    const GcsEndpoint* gcs_endpoint() const { return endpoint_.get(); }
 
   protected:
     void on_start() override;
@@ -75,6 +81,7 @@ class AutopilotService : public Service {
     PortKeeper keeper_;
     TlogWriter tlog_;
     GcsGate gate_;
+    std::unique_ptr<GcsEndpoint> endpoint_;
     DeadlineTimer timer_;
     TimePoint status_published_at_{};
     std::map<std::uint32_t, Reply<RequestDone>> requesters_;  // driver id -> who waits for the result
