@@ -14,7 +14,7 @@
 namespace airseg::autopilot {
 
 namespace mav = airseg::mavlink;
-using tcp = asio::ip::tcp;
+using Tcp = asio::ip::tcp;
 
 namespace {
 
@@ -123,11 +123,11 @@ class GcsEndpoint::Impl : public std::enable_shared_from_this<Impl> {
         }
         if (!config_.tcp.empty()) {
             const auto listen = *host_port(config_.tcp);
-            const tcp::endpoint at(asio::ip::make_address(listen.host), listen.port);
+            const Tcp::endpoint at(asio::ip::make_address(listen.host), listen.port);
             boost::system::error_code ec;
             acceptor_.open(at.protocol(), ec);
             if (!ec) {
-                acceptor_.set_option(tcp::acceptor::reuse_address(true), ec);
+                acceptor_.set_option(Tcp::acceptor::reuse_address(true), ec);
                 acceptor_.bind(at, ec);
             }
             if (!ec) {
@@ -208,7 +208,7 @@ class GcsEndpoint::Impl : public std::enable_shared_from_this<Impl> {
     };
     struct Client {
         explicit Client(asio::any_io_executor ex) : socket(ex) {}
-        tcp::socket socket;
+        Tcp::socket socket;
         mav::Parser parser;
         std::array<std::uint8_t, 2048> buffer{};
         std::deque<std::vector<std::uint8_t>> queue;
@@ -300,7 +300,7 @@ class GcsEndpoint::Impl : public std::enable_shared_from_this<Impl> {
     GcsEndpointConfig config_;
     ToVehicle to_vehicle_;
     hal::UdpSocket udp_;
-    tcp::acceptor acceptor_;
+    Tcp::acceptor acceptor_;
     std::map<hal::UdpSocket::Endpoint, Peer> peers_;
     std::map<std::uint64_t, std::shared_ptr<Client>> clients_;
     std::uint64_t next_client_ = 0;
