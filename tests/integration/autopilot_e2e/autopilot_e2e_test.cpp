@@ -16,10 +16,9 @@
 #include <cstring>
 #include <nlohmann/json.hpp>
 
-#include "services/autopilot/mavlink/encoder.hpp"
-#include "services/autopilot/mavlink/enums.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
 #include "tests/support/control_client.hpp"
+#include "tests/support/ground_station.hpp"
 #include "tests/support/process.hpp"
 
 namespace airseg::test {
@@ -267,48 +266,20 @@ class GcsEndpointE2e : public AutopilotE2e {
     int port_;
     int fd_ = ::socket(AF_INET, SOCK_DGRAM, 0);
     mavlink::Parser parser_;
-    mavlink::Encoder gcs_{254, 190};
+    GroundStation gcs_;
 };
 
 TEST_F(GcsEndpointE2e, AGroundStationHearsTheBoardReadsAParameterAndCannotUploadAMission) {
     ASSERT_TRUE(wait_until([&] { return ready(); }, kGenerous, kPoll)) << daemon_->err();
-    mavlink::Heartbeat hb;
-    hb.type = 6;  // MAV_TYPE_GCS
-    send(gcs_.encode(hb));
+    send(gcs_.heartbeat());
+    EXPECT_TRUE(hear(GroundStation::board_heartbeat, 10s)) << daemon_->err();
+    send(gcs_.read_param("CRUISE_SPEED"));
     EXPECT_TRUE(
-        hear([](const mavlink::Frame& f) { return f.msgid == mavlink::Heartbeat::kId && f.sysid == 1; }, 10s))
-        << daemon_->err();
-
-    mavlink::ParamRequestRead read;
-    read.target_system = 1;
-    read.target_component = 1;
-    read.param_index = -1;
-    mavlink::set_text(read.param_id, "CRUISE_SPEED");
-    send(gcs_.encode(read));
-    EXPECT_TRUE(hear(
-        [](const mavlink::Frame& f) {
-            return f.msgid == mavlink::ParamValue::kId &&
-                   mavlink::text_of(
-                       mavlink::decode_payload<mavlink::ParamValue>(f.payload_view()).param_id) ==
-                       "CRUISE_SPEED";
-        },
-        10s));
+        hear([](const mavlink::Frame& f) { return GroundStation::param_value(f, "CRUISE_SPEED"); }, 10s));
 
     const auto mission_before = control_->json("state")["mission_count"];
-    mavlink::MissionCount count;
-    count.target_system = 1;
-    count.target_component = 1;
-    count.count = 2;
-    send(gcs_.encode(count));
-    EXPECT_TRUE(hear(
-        [](const mavlink::Frame& f) {
-            if (f.msgid != mavlink::MissionAck::kId) {
-                return false;
-            }
-            const auto ack = mavlink::decode_payload<mavlink::MissionAck>(f.payload_view());
-            return ack.target_system == 254 && ack.type == mavlink::kMissionDenied;
-        },
-        10s));
+    send(gcs_.mission_upload(2));
+    EXPECT_TRUE(hear(GroundStation::mission_denied, 10s));
     EXPECT_EQ(control_->json("state")["mission_count"], mission_before) << "the board's mission is untouched";
     EXPECT_EQ(control_->json("stats")["mission_items_received"], 0);
     EXPECT_NE(daemon_->err().find("refused a mission write from a ground station"), std::string::npos)

@@ -18,12 +18,11 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "services/autopilot/mavlink/encoder.hpp"
-#include "services/autopilot/mavlink/enums.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
 #include "services/groundlink/protocol/ground_protocol.hpp"
 #include "services/groundlink/transport/transport.hpp"
 #include "tests/support/control_client.hpp"
+#include "tests/support/ground_station.hpp"
 #include "tests/support/process.hpp"
 
 namespace airseg::test {
@@ -507,38 +506,15 @@ TEST_F(GroundControlE2e, MavlinkForwardCarriesAGroundStationsTrafficAndRefusesMi
         << daemon->err();
 
     GroundEnd ground_end(port);
-    namespace mav = airseg::mavlink;
+    GroundStation gcs;
+    EXPECT_TRUE(ground_end.hear(GroundStation::board_heartbeat, 20s)) << daemon->err();
+    ground_end.send(gcs.read_param("CRUISE_SPEED"));
     EXPECT_TRUE(ground_end.hear(
-        [](const mav::Frame& f) { return f.msgid == mav::Heartbeat::kId && f.sysid == 1; }, 20s))
-        << daemon->err();
-
-    mav::Encoder gcs(254, 190);
-    mav::ParamRequestRead read;
-    read.target_system = 1;
-    read.target_component = 1;
-    read.param_index = -1;
-    mav::set_text(read.param_id, "CRUISE_SPEED");
-    ground_end.send(gcs.encode(read));
-    EXPECT_TRUE(ground_end.hear(
-        [](const mav::Frame& f) {
-            return f.msgid == mav::ParamValue::kId &&
-                   mav::text_of(mav::decode_payload<mav::ParamValue>(f.payload_view()).param_id) ==
-                       "CRUISE_SPEED";
-        },
-        20s));
+        [](const airseg::mavlink::Frame& f) { return GroundStation::param_value(f, "CRUISE_SPEED"); }, 20s));
 
     const auto mission_before = sim_control->json("state")["mission_count"];
-    mav::MissionCount count;
-    count.target_system = 1;
-    count.target_component = 1;
-    count.count = 2;
-    ground_end.send(gcs.encode(count));
-    EXPECT_TRUE(ground_end.hear(
-        [](const mav::Frame& f) {
-            return f.msgid == mav::MissionAck::kId &&
-                   mav::decode_payload<mav::MissionAck>(f.payload_view()).type == mav::kMissionDenied;
-        },
-        20s));
+    ground_end.send(gcs.mission_upload(2));
+    EXPECT_TRUE(ground_end.hear(GroundStation::mission_denied, 20s));
     EXPECT_EQ(sim_control->json("state")["mission_count"], mission_before);
 
     // The section is refreshed once a second.
