@@ -117,18 +117,35 @@ GcsGate::Output GcsGate::from_ground(std::span<const std::uint8_t> frames) {
 }
 
 bool GcsGate::refuse(const mav::Frame& f, Output& out) {
-    const auto target = mission_write(f);
-    if (!target || (target->system != sysid_ && target->system != 0) ||
-        target->mission_type != mav::kMissionTypeMission) {
-        return false;
+    if (f.msgid == mav::CommandLong::kId) {
+        // The command form of MISSION_SET_CURRENT moves the mission as much as the message does.
+        const auto cmd = mav::decode_payload<mav::CommandLong>(f.payload_view());
+        if (cmd.command != mav::kCmdDoSetMissionCurrent ||
+            (cmd.target_system != sysid_ && cmd.target_system != 0)) {
+            return false;
+        }
+        mav::CommandAck ack;
+        ack.command = cmd.command;
+        ack.result = mav::kResultDenied;
+        ack.target_system = f.sysid;
+        ack.target_component = f.compid;
+        out.to_ground.push_back(
+            {mav::CommandAck::kId, ForwardedFrame::Delivery::Reliable, answers_.encode(ack)});
+    } else {
+        const auto target = mission_write(f);
+        if (!target || (target->system != sysid_ && target->system != 0) ||
+            target->mission_type != mav::kMissionTypeMission) {
+            return false;
+        }
+        mav::MissionAck ack;
+        ack.target_system = f.sysid;
+        ack.target_component = f.compid;
+        ack.type = mav::kMissionDenied;
+        ack.mission_type = target->mission_type;
+        out.to_ground.push_back(
+            {mav::MissionAck::kId, ForwardedFrame::Delivery::Reliable, answers_.encode(ack)});
     }
     ++stats_.missions_refused;
-    mav::MissionAck ack;
-    ack.target_system = f.sysid;
-    ack.target_component = f.compid;
-    ack.type = mav::kMissionDenied;
-    ack.mission_type = target->mission_type;
-    out.to_ground.push_back({mav::MissionAck::kId, ForwardedFrame::Delivery::Reliable, answers_.encode(ack)});
     for (const char* line : kRefusal) {
         mav::Statustext text;
         text.severity = mav::kSeverityWarning;

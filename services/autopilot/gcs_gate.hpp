@@ -6,9 +6,10 @@
 // The flight plan manager owns the autopilot's mission: it feeds it a window at a time and must know every
 // slot. A ground station writing the mission behind its back would break the plan, so mission writes
 // (MISSION_COUNT, MISSION_ITEM(_INT), MISSION_CLEAR_ALL, MISSION_SET_CURRENT, MISSION_WRITE_PARTIAL_LIST for
-// the mission itself; fences and rally points pass) never reach the autopilot: the gate answers the ground
-// station itself, as the autopilot, with MISSION_ACK (MAV_MISSION_DENIED) and STATUSTEXTs saying why and
-// what to do. Reading the mission, parameters, commands and everything else pass unchanged.
+// the mission itself; fences and rally points pass; and COMMAND_LONG MAV_CMD_DO_SET_MISSION_CURRENT) never
+// reach the autopilot: the gate answers the ground station itself, as the autopilot, with MISSION_ACK
+// MAV_MISSION_DENIED (COMMAND_ACK MAV_RESULT_DENIED for the command) and STATUSTEXTs saying why and what to
+// do. Reading the mission, parameters, commands and everything else pass unchanged.
 #include <cstdint>
 #include <span>
 #include <vector>

@@ -81,6 +81,30 @@ TEST(GcsGate, EveryMissionWriteIsRefused) {
     EXPECT_EQ(rig.gate.stats().missions_refused, 5u);
 }
 
+TEST(GcsGate, TheSetCurrentCommandIsRefusedOtherCommandsPass) {
+    Rig rig;
+    mav::CommandLong set_current;
+    set_current.target_system = 1;
+    set_current.command = mav::kCmdDoSetMissionCurrent;
+    set_current.param1 = 3;
+    const auto out = rig.gate.from_ground(rig.gcs.encode(set_current));
+    EXPECT_TRUE(out.to_autopilot.empty());
+    ASSERT_FALSE(out.to_ground.empty());
+    const auto frames = parse(out.to_ground[0].bytes);
+    ASSERT_EQ(frames.size(), 1u);
+    ASSERT_EQ(frames[0].msgid, mav::CommandAck::kId);
+    const auto ack = mav::decode_payload<mav::CommandAck>(frames[0].payload_view());
+    EXPECT_EQ(ack.command, mav::kCmdDoSetMissionCurrent);
+    EXPECT_EQ(ack.result, mav::kResultDenied);
+    EXPECT_EQ(ack.target_system, 254);
+
+    mav::CommandLong arm;
+    arm.target_system = 1;
+    arm.command = 400;  // MAV_CMD_COMPONENT_ARM_DISARM
+    EXPECT_EQ(rig.gate.from_ground(rig.gcs.encode(arm)).to_autopilot.size(), 1u);
+    EXPECT_EQ(rig.gate.stats().missions_refused, 1u);
+}
+
 TEST(GcsGate, ReadsCommandsFencesAndOtherSystemsPassUnchanged) {
     Rig rig;
     mav::MissionRequestList list;  // a mission download
