@@ -141,6 +141,7 @@ class App::Impl {
         g.udp.remote_port = static_cast<std::uint16_t>(gl.udp_remote_port);
         g.monitor_key_file = gl.monitor_key_file;
         g.telemetry = telemetry_config(config_);
+        g.mavlink_forward = mavlink_forward_setup(config_).config;
         services_.push_back(std::make_unique<groundlink::GroundlinkService>(context_, std::move(g)));
         services_.push_back(
             std::make_unique<flightplan::FlightplanService>(context_, flightplan_setup(config_)));

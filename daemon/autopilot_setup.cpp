@@ -52,8 +52,8 @@ AutopilotSetup autopilot_setup(const Config& config) {
         ap.reset_on_open = a.reset_on_open == "true";
     }
     ap.gcs_heartbeat = a.gcs_heartbeat != "off";
-    ap.gcs_heartbeat_type = a.gcs_heartbeat == "onboard" ? autopilot::kMavTypeOnboardController
-                                                          : autopilot::kMavTypeGcs;
+    ap.gcs_heartbeat_type =
+        a.gcs_heartbeat == "onboard" ? autopilot::kMavTypeOnboardController : autopilot::kMavTypeGcs;
     ap.boot_timeout = a.boot_timeout;
     ap.heartbeat_timeout = a.heartbeat_timeout;
     ap.mode_timeout = a.mode_timeout;
@@ -93,6 +93,13 @@ AutopilotSetup autopilot_setup(const Config& config) {
     s.tlog.path = a.tlog_path;
     s.tlog.max_bytes = static_cast<std::uint64_t>(a.tlog_max_bytes);
     s.tlog.keep = static_cast<unsigned>(a.tlog_keep);
+    s.forward_frames = config.groundlink.mavlink_forward_enabled;
+    if (!a.gcs_endpoint_udp.empty() || !a.gcs_endpoint_tcp.empty()) {
+        s.gcs_endpoint = autopilot::GcsEndpointConfig{a.gcs_endpoint_udp, a.gcs_endpoint_tcp, ""};
+        for (const auto& p : s.gcs_endpoint->validate()) {
+            out.problems.push_back("autopilot.gcs_endpoint." + p);  // "udp: ..." names the key's last part
+        }
+    }
 
     out.problems = autopilot::AutopilotConfig::validate(ap);
     out.problems.insert(out.problems.end(), unknown_messages.begin(), unknown_messages.end());
@@ -112,6 +119,37 @@ AutopilotSetup autopilot_setup(const Config& config) {
         for (auto& p : hal::GpioLineRequest::validate(*out.status_led)) {
             out.problems.push_back("status_led.line: " + p);
         }
+    }
+    return out;
+}
+
+ForwardSetup mavlink_forward_setup(const Config& config) {
+    const auto& g = config.groundlink;
+    ForwardSetup out;
+    out.config.enabled = g.mavlink_forward_enabled;
+    out.config.budget_bytes_per_s = g.mavlink_forward_budget;
+    constexpr std::uint32_t kMaxId = 0xFFFFFF;
+    for (const auto& [key, hz] : g.mavlink_forward_rates) {
+        if (key == "default") {
+            out.config.default_hz = hz;
+            continue;
+        }
+        std::optional<std::uint32_t> id = autopilot::message_id(key);
+        if (!id && !key.empty() && key.size() <= 8 &&
+            std::all_of(key.begin(), key.end(), [](char ch) { return ch >= '0' && ch <= '9'; })) {
+            if (const auto n = std::stoul(key); n <= kMaxId) {
+                id = static_cast<std::uint32_t>(n);
+            }
+        }
+        if (!id) {
+            out.problems.push_back("groundlink.mavlink_forward.rates: " + key +
+                                   " is neither a MAVLink message this daemon knows nor a message id");
+            continue;
+        }
+        out.config.rate_hz[*id] = hz;
+    }
+    for (auto& p : out.config.validate()) {
+        out.problems.push_back(std::move(p));
     }
     return out;
 }

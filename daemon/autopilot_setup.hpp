@@ -8,6 +8,7 @@
 
 #include "daemon/config.hpp"
 #include "services/autopilot/autopilot_service.hpp"
+#include "services/groundlink/frame_forwarder.hpp"
 
 namespace airseg::daemon {
 
@@ -18,6 +19,15 @@ struct AutopilotSetup {
 };
 
 AutopilotSetup autopilot_setup(const Config& config);
+
+/// groundlink.mavlink_forward as the ground-link service takes it: rates by message id (a key is a MAVLink
+/// message name this daemon knows, or a message id; "default" sets the rate of the others). Each problem
+/// starts with its key.
+struct ForwardSetup {
+    groundlink::FrameForwarderConfig config;
+    std::vector<std::string> problems;
+};
+ForwardSetup mavlink_forward_setup(const Config& config);
 
 /// "autopilot.boot_timeout" (or "status_led.line") from "autopilot.boot_timeout: 200 s is outside ..."; empty
 /// when the message does not start with a key.

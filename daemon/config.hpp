@@ -22,7 +22,7 @@ struct AutopilotConfig {
     int baud = 115200;                      // autopilot.baud
     std::vector<int> bauds;                 // autopilot.bauds: tried in turn when non-empty
     milliseconds baud_probe{3'000};         // autopilot.baud_probe: time for a valid frame at one rate
-    std::string gcs_heartbeat = "gcs";       // autopilot.gcs_heartbeat: gcs | onboard | off
+    std::string gcs_heartbeat = "gcs";      // autopilot.gcs_heartbeat: gcs | onboard | off
     std::string reset_on_open = "auto";     // autopilot.reset_on_open: auto (= board is apm2) | true | false
     milliseconds reconnect_min{500};        // autopilot.reconnect_min
     milliseconds reconnect_max{10'000};     // autopilot.reconnect_max
@@ -39,7 +39,9 @@ struct AutopilotConfig {
     std::string tlog_path = "/var/log/airseg/autopilot.tlog";  // autopilot.tlog.path
     long long tlog_max_bytes = 64ll << 20;                     // autopilot.tlog.max_bytes
     int tlog_keep = 4;                                         // autopilot.tlog.keep
-    std::string reset_line;                           // autopilot.reset.line: name or chip:offset; "" = none
+    std::string gcs_endpoint_udp;  // autopilot.gcs_endpoint.udp: ADDRESS:PORT for ground stations; "" = off
+    std::string gcs_endpoint_tcp;  // autopilot.gcs_endpoint.tcp: ADDRESS:PORT for ground stations; "" = off
+    std::string reset_line;        // autopilot.reset.line: name or chip:offset; "" = none
     milliseconds reset_unresponsive_timeout{20'000};  // autopilot.reset.unresponsive_timeout
     int reset_max_pulses = 3;                         // autopilot.reset.max_pulses
 };
@@ -59,6 +61,10 @@ struct GroundlinkConfig {
     std::map<std::string, double> telemetry_rates{{"vehicle", 2.0}, {"link_stats", 1.0}};  // .telemetry.rates
     double telemetry_budget_share = 0.25;  // groundlink.telemetry.budget_share
     double telemetry_min_hz = 0.2;         // groundlink.telemetry.min_hz
+    bool mavlink_forward_enabled = false;  // groundlink.mavlink_forward.enabled
+    double mavlink_forward_budget = 0;  // groundlink.mavlink_forward.budget_bytes_per_s: 0 = 30 % of the link
+    std::map<std::string, double>
+        mavlink_forward_rates;  // groundlink.mavlink_forward.rates: name or id -> Hz
 };
 
 struct StatusLedConfig {

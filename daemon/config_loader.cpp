@@ -158,6 +158,14 @@ void check_consistency(const Config& c, const std::string& source,
                               fmt::format("{}: {} Hz is out of range 0..20", kind, hz)});
         }
     }
+    for (const auto& problem : mavlink_forward_setup(c).problems) {
+        const std::string key = problem.substr(0, problem.find(": "));
+        const bool named =
+            key.starts_with("groundlink.mavlink_forward.") && key.find(' ') == std::string::npos;
+        errors.push_back({at(named ? key : "groundlink.mavlink_forward.rates"),
+                          named ? key : "groundlink.mavlink_forward.rates",
+                          named ? problem.substr(key.size() + 2) : problem});
+    }
     if (!g.monitor_key_file.empty() && g.key_file.empty()) {
         errors.push_back({at("groundlink.monitor_key_file"), "groundlink.monitor_key_file",
                           "needs groundlink.key_file (the control key)"});

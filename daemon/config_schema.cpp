@@ -358,7 +358,8 @@ std::vector<KeySpec> build_schema() {
     s.push_back(choice(
         "autopilot.gcs_heartbeat", [](Config& c) -> std::string& { return c.autopilot.gcs_heartbeat; },
         {"gcs", "onboard", "off"},
-        "our 1 Hz HEARTBEAT to the autopilot, as MAV_TYPE_GCS or MAV_TYPE_ONBOARD_CONTROLLER (ArduPilot's GCS "
+        "our 1 Hz HEARTBEAT to the autopilot, as MAV_TYPE_GCS or MAV_TYPE_ONBOARD_CONTROLLER (ArduPilot's "
+        "GCS "
         "failsafe counts heartbeats from SYSID_MYGCS, 255, our system id), or none"));
     s.push_back(duration(
         "autopilot.reconnect_min", [](Config& c) -> milliseconds& { return c.autopilot.reconnect_min; },
@@ -408,6 +409,18 @@ std::vector<KeySpec> build_schema() {
     s.push_back(integer(
         "autopilot.tlog.keep", [](Config& c) -> int& { return c.autopilot.tlog_keep; }, 0, 100,
         "rotated .tlog files kept"));
+    s.push_back(string(
+        "autopilot.gcs_endpoint.udp", [](Config& c) -> std::string& { return c.autopilot.gcs_endpoint_udp; },
+        "ADDRESS:PORT where ground stations reach the autopilot through airsegd over UDP (e.g. "
+        "0.0.0.0:14550); "
+        "empty = off",
+        true));
+    s.push_back(string(
+        "autopilot.gcs_endpoint.tcp", [](Config& c) -> std::string& { return c.autopilot.gcs_endpoint_tcp; },
+        "ADDRESS:PORT where ground stations reach the autopilot through airsegd over TCP (e.g. "
+        "0.0.0.0:5760); "
+        "empty = off",
+        true));
     s.push_back(string(
         "autopilot.reset.line", [](Config& c) -> std::string& { return c.autopilot.reset_line; },
         "GPIO line pulsed to reset an unresponsive autopilot: a line name or CHIP:OFFSET; empty = none",
@@ -476,6 +489,21 @@ std::vector<KeySpec> build_schema() {
     s.push_back(number(
         "groundlink.telemetry.min_hz", [](Config& c) -> double& { return c.groundlink.telemetry_min_hz; },
         0.01, 20.0, "lowest rate of a telemetry kind that is on, however weak the link", true));
+    s.push_back(boolean(
+        "groundlink.mavlink_forward.enabled",
+        [](Config& c) -> bool& { return c.groundlink.mavlink_forward_enabled; },
+        "forward the autopilot's MAVLink over the ground link for standard ground stations (and theirs back, "
+        "control key only)"));
+    s.push_back(number(
+        "groundlink.mavlink_forward.budget_bytes_per_s",
+        [](Config& c) -> double& { return c.groundlink.mavlink_forward_budget; }, 0, 1e6,
+        "bytes per second forwarded MAVLink may use; 0 = 30 % of the radio link rate"));
+    s.push_back(number_map(
+        "groundlink.mavlink_forward.rates",
+        [](Config& c) -> std::map<std::string, double>& { return c.groundlink.mavlink_forward_rates; }, {},
+        false,
+        "Hz 0..50 per telemetry message forwarded (MAVLink name or id; 'default' for the others, 1 Hz); 0 = "
+        "not forwarded"));
     // Flight plans
     s.push_back(integer(
         "flightplan.window", [](Config& c) -> int& { return c.flightplan.window; }, 3, 250,

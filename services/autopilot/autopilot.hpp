@@ -194,6 +194,23 @@ struct JoystickInput {
 /// The operator's explicit reset out of failsafe MANUAL.
 struct OperatorReset {};
 
+/// One frame from the autopilot for standard ground stations (QGroundControl, Mission Planner), published as
+/// an event for each frame while forwarding is on. The bytes are opaque outside this room; the autopilot
+/// room says how it must travel: the freshest value of a telemetry message is all a ground station needs,
+/// while an answer it waits for (a parameter value, an acknowledgement, a mission item, a text) must arrive.
+struct ForwardedFrame {
+    enum class Delivery : std::uint8_t { Freshest, Reliable };
+    std::uint32_t id = 0;  // the message id, to rate-limit each kind on its own
+    Delivery delivery = Delivery::Freshest;
+    std::vector<std::uint8_t> bytes;  // one whole frame
+};
+/// Whole frames from a standard ground station for the autopilot, unchecked: the autopilot service parses
+/// them, keeps mission writes from the autopilot (the flight plan manager owns the mission) and writes the
+/// rest to the autopilot.
+struct GroundStationFrames {
+    std::vector<std::uint8_t> bytes;
+};
+
 /// What status shows as autopilot.* keys.
 struct AutopilotStatus {
     bool link_up = false;                        // autopilot.link

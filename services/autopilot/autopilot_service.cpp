@@ -42,11 +42,22 @@ AutopilotService::AutopilotService(ServiceContext& ctx, AutopilotServiceConfig c
                                        pump();
                                    }}),
       tlog_(config_.tlog),
+      gate_(config_.autopilot.target_sysid, config_.autopilot.target_compid),
       timer_(strand()),
       prefix_("autopilot[" + config_.port.serial.path + "]: ") {
-    if (config_.tlog.enabled) {
-        driver_.set_frame_tap([this](bool, std::span<const std::uint8_t> frame) {
-            tlog_.record(frame, std::chrono::system_clock::now(), SteadyClock::now());
+    if (config_.gcs_endpoint) {
+        endpoint_ = std::make_unique<GcsEndpoint>(
+            strand(), *config_.gcs_endpoint,
+            [this](std::vector<std::uint8_t> frames) { from_ground_station(frames); });
+    }
+    if (config_.tlog.enabled || config_.forward_frames || endpoint_) {
+        driver_.set_frame_tap([this](bool outgoing, std::span<const std::uint8_t> frame) {
+            if (config_.tlog.enabled) {
+                tlog_.record(frame, std::chrono::system_clock::now(), SteadyClock::now());
+            }
+            if (!outgoing && running_) {
+                to_ground_stations(forwarded(frame));
+            }
         });
     }
 }
@@ -75,6 +86,13 @@ void AutopilotService::on_start() {
         driver_.operator_reset(SteadyClock::now());
         pump();
     }));
+    subscriptions_.push_back(bus.subscribe<GroundStationFrames>(
+        strand(), [this](const GroundStationFrames& g) { from_ground_station(g.bytes); }));
+    if (endpoint_) {
+        if (auto error = endpoint_->start(); !error.empty()) {
+            spdlog::error("{}{}; no ground station endpoint", prefix_, error);
+        }
+    }
     keeper_.start();
     publish_status();
     update_health();
@@ -84,8 +102,46 @@ void AutopilotService::on_stop() {
     running_ = false;
     subscriptions_.clear();
     timer_.cancel();
+    if (endpoint_) {
+        endpoint_->stop();
+    }
     keeper_.stop();
     tlog_.flush();
+}
+
+// Frames a ground station sent the autopilot: mission writes are answered by the gate, the rest written.
+void AutopilotService::from_ground_station(std::span<const std::uint8_t> frames) {
+    if (!running_) {
+        return;
+    }
+    const auto refused_before = gate_.stats().missions_refused;
+    auto out = gate_.from_ground(frames);
+    if (gate_.stats().missions_refused != refused_before) {
+        spdlog::info("{}refused a mission write from a ground station ({} so far): missions are flight plans",
+                     prefix_, gate_.stats().missions_refused);
+    }
+    for (const auto& answer : out.to_ground) {
+        to_ground_stations(answer);
+    }
+    if (!keeper_.is_open()) {
+        return;
+    }
+    for (auto& frame : out.to_autopilot) {
+        if (config_.tlog.enabled) {
+            tlog_.record(frame, std::chrono::system_clock::now(), SteadyClock::now());
+        }
+        keeper_.write(std::move(frame));
+    }
+}
+
+// The endpoint's ground stations are on the board's network: they get every frame, unthrottled.
+void AutopilotService::to_ground_stations(const ForwardedFrame& frame) {
+    if (endpoint_) {
+        endpoint_->from_vehicle(frame.bytes);
+    }
+    if (config_.forward_frames) {
+        ctx_.bus.publish(frame);
+    }
 }
 
 void AutopilotService::on_request(const AutopilotRequest& r) {

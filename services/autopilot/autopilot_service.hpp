@@ -5,9 +5,11 @@
 // pulses the reset line when the driver asks, reopens the port at the rate the driver's baud probing asks
 // for, and records every frame in the .tlog when enabled (its flush deadline shares the driver's timer).
 //
-// Bus: subscribes AutopilotRequest (answered through its Reply), JoystickInput, OperatorReset; publishes the
-// other autopilot::Event types as events, and AutopilotStatus and Telemetry as variables. A request without a
-// Reply runs unanswered. Log prefix: autopilot[<device>]: .
+// Bus: subscribes AutopilotRequest (answered through its Reply), JoystickInput, OperatorReset,
+// GroundStationFrames (through the GcsGate: mission writes are answered, not written); publishes the other
+// autopilot::Event types as events, AutopilotStatus and Telemetry as variables, and with forward_frames each
+// frame from the autopilot (and the gate's answers) as a ForwardedFrame. A request without a Reply runs
+// unanswered. Log prefix: autopilot[<device>]: .
 #include <map>
 #include <memory>
 #include <optional>
@@ -16,6 +18,8 @@
 #include "services/autopilot/ardupilot/driver.hpp"
 #include "services/autopilot/autopilot.hpp"
 #include "services/autopilot/autopilot_config.hpp"
+#include "services/autopilot/gcs_endpoint.hpp"
+#include "services/autopilot/gcs_gate.hpp"
 #include "services/autopilot/tlog_writer.hpp"
 #include "services/common/deadline_timer.hpp"
 #include "services/common/port_keeper.hpp"
@@ -32,6 +36,12 @@ struct AutopilotServiceConfig {
     // Status and telemetry are published after each input from the autopilot, at most this often, and at
     // every progress tick (so a change waits at most for the next input or the next tick).
     Duration status_spacing = milliseconds(50);
+    /// Publish every frame from the autopilot as a ForwardedFrame (groundlink.mavlink_forward.enabled), for
+    /// standard ground stations through the ground link.
+    bool forward_frames = false;
+    /// autopilot.gcs_endpoint: ground stations on the board's network, straight to the autopilot (through
+    /// the same gate), every frame from the autopilot to them; none = off.
+    std::optional<GcsEndpointConfig> gcs_endpoint;
 };
 
 class AutopilotService : public Service {
@@ -42,6 +52,8 @@ class AutopilotService : public Service {
 
     /// The driver, for tests and the status service; touch only on strand().
     const ardupilot::Driver& driver() const { return driver_; }
+    /// The ground station endpoint (autopilot.gcs_endpoint), or null; touch only on strand().
+    const GcsEndpoint* gcs_endpoint() const { return endpoint_.get(); }
 
   protected:
     void on_start() override;
@@ -59,6 +71,8 @@ class AutopilotService : public Service {
     void pulse_reset(unsigned attempt);
     void switch_baud(unsigned baud);
     void update_health();
+    void from_ground_station(std::span<const std::uint8_t> frames);
+    void to_ground_stations(const ForwardedFrame& frame);
 
     AutopilotServiceConfig config_;
     hal::GpioFactory* gpio_;
@@ -66,6 +80,8 @@ class AutopilotService : public Service {
     ardupilot::Driver driver_;
     PortKeeper keeper_;
     TlogWriter tlog_;
+    GcsGate gate_;
+    std::unique_ptr<GcsEndpoint> endpoint_;
     DeadlineTimer timer_;
     TimePoint status_published_at_{};
     std::map<std::uint32_t, Reply<RequestDone>> requesters_;  // driver id -> who waits for the result

@@ -115,6 +115,10 @@ void GroundlinkService::subscribe_bus() {
     using Sev = protocol::Event::Severity;
     subscriptions_.push_back(bus.subscribe<autopilot::Telemetry>(
         strand(), [this](const autopilot::Telemetry& t) { vehicle_ = t; }));
+    if (config_.mavlink_forward.enabled) {
+        subscriptions_.push_back(bus.subscribe<autopilot::ForwardedFrame>(
+            strand(), [this](const autopilot::ForwardedFrame& f) { on_forwarded(f); }));
+    }
     subscriptions_.push_back(
         bus.subscribe<flightplan::PlanProgress>(strand(), [this](const flightplan::PlanProgress& p) {
             plan_ = PlanProgressSample{

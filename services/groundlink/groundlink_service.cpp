@@ -55,6 +55,9 @@ GroundlinkService::GroundlinkService(ServiceContext& ctx, GroundlinkServiceConfi
       config_(std::move(config)),
       scheduler_(config_.telemetry, transport_config_for(config_).link_rate_bytes_per_s, SteadyClock::now()),
       telemetry_timer_(strand()),
+      forwarder_(config_.mavlink_forward, transport_config_for(config_).link_rate_bytes_per_s,
+                 SteadyClock::now()),
+      forward_timer_(strand()),
       stats_timer_(strand()) {}
 
 GroundlinkService::~GroundlinkService() = default;
@@ -173,6 +176,7 @@ void GroundlinkService::attach_writers() {
 void GroundlinkService::on_stop() {
     stats_timer_.cancel();
     telemetry_timer_.cancel();
+    forward_timer_.cancel();
     subscriptions_.clear();
     if (driver_) {
         driver_->stop();
@@ -196,6 +200,8 @@ void GroundlinkService::on_message(Delivered message) {
         on_command(*command);
     } else if (auto* joystick = std::get_if<protocol::Joystick>(&*decoded.message)) {
         on_joystick(*joystick);
+    } else if (auto* frames = std::get_if<protocol::MavlinkFrames>(&*decoded.message)) {
+        on_ground_station_frames(std::move(*frames));
     } else if (auto* report = std::get_if<protocol::ReceptionReport>(&*decoded.message)) {
         // A message needs about half a round trip to arrive; the margin covers the radios' buffering.
         const auto lag = std::chrono::duration_cast<Duration>(
@@ -259,6 +265,47 @@ void GroundlinkService::on_joystick(const protocol::Joystick& joystick) {
     ctx_.bus.publish(autopilot::JoystickInput{joystick.steering, joystick.throttle});
 }
 
+void GroundlinkService::on_ground_station_frames(protocol::MavlinkFrames frames) {
+    if (!config_.mavlink_forward.enabled || ground_role() != Role::Control) {
+        if (from_ground_refused_++ == 0) {
+            spdlog::warn(
+                "groundlink: MAVLink frames from the ground dropped ({})",
+                config_.mavlink_forward.enabled ? "monitor key" : "groundlink.mavlink_forward is off");
+        }
+        return;
+    }
+    ++from_ground_frames_;
+    ctx_.bus.publish(autopilot::GroundStationFrames{std::move(frames.bytes)});
+}
+
+void GroundlinkService::on_forwarded(const autopilot::ForwardedFrame& frame) {
+    if (!driver_ || !driver_->link_up()) {
+        return;  // as with telemetry: nobody listens, and a frame kept now would be stale
+    }
+    forwarder_.offer(frame, SteadyClock::now());
+    pump_forward();
+}
+
+// Everything the forwarder lets go now, then its timer for the next.
+void GroundlinkService::pump_forward() {
+    const TimePoint now = SteadyClock::now();
+    if (driver_) {
+        driver_->batch([&] {
+            while (auto out = forwarder_.poll(now)) {
+                const auto bytes = protocol::encode(protocol::MavlinkFrames{std::move(out->bytes)});
+                const auto r = out->delivery == autopilot::ForwardedFrame::Delivery::Reliable
+                                   ? driver_->send_safe(protocol::kPriorityBulk, bytes)
+                                   : driver_->send_fast(protocol::kPriorityBulk,
+                                                        protocol::mavlink_topic(out->id), bytes);
+                if (r == SendResult::QueueFull || r == SendResult::TooLarge || r == SendResult::BadPriority) {
+                    ++forward_refused_;
+                }
+            }
+        });
+    }
+    forward_timer_.arm(forwarder_.poll_timeout(), [this] { pump_forward(); });
+}
+
 void GroundlinkService::on_event(const TransportEvent& event) {
     switch (event.kind) {
         case TransportEvent::Kind::LinkUp:
@@ -267,6 +314,7 @@ void GroundlinkService::on_event(const TransportEvent& event) {
             break;
         case TransportEvent::Kind::LinkDown:
             spdlog::warn("groundlink: link down");
+            forwarder_.clear();
             break;
         case TransportEvent::Kind::PeerRestarted:
             spdlog::info("groundlink: the ground end restarted; session resynchronised");
@@ -442,7 +490,9 @@ void GroundlinkService::publish_status() {
          counters = std::array{commands_, commands_refused_, joystick_inputs_, joystick_refused_,
                                events_sent_, events_dropped_, bad_messages_},
          role = std::string(!stats.authenticated ? "control (unauthenticated)" : to_string(ground_role())),
-         rates = rates_snapshot()] {
+         rates = rates_snapshot(), fwd = forwarder_.stats(), fwd_enabled = config_.mavlink_forward.enabled,
+         fwd_budget = forwarder_.budget_bytes_per_s(),
+         fwd_counters = std::array{forward_refused_, from_ground_frames_, from_ground_refused_}] {
             nlohmann::json g;
             g["mode"] = mode;
             g["link"] = up ? "up" : "down";
@@ -479,6 +529,16 @@ void GroundlinkService::publish_status() {
             g["events_dropped"] = counters[5];
             g["bad_messages"] = counters[6];
             g["telemetry"] = rates_json(rates);
+            g["mavlink_forward"] = {{"enabled", fwd_enabled},
+                                    {"budget_bytes_per_s", std::round(fwd_budget)},
+                                    {"offered", fwd.offered},
+                                    {"forwarded", fwd.forwarded},
+                                    {"forwarded_bytes", fwd.forwarded_bytes},
+                                    {"replaced", fwd.replaced},
+                                    {"filtered", fwd.filtered},
+                                    {"dropped", fwd.dropped + fwd_counters[0]},
+                                    {"from_ground", fwd_counters[1]},
+                                    {"from_ground_refused", fwd_counters[2]}};
             g["tx"] = {{"safe", class_json(s.tx_safe)}, {"fast", class_json(s.tx_fast)}};
             g["rx"] = {{"safe", class_json(s.rx_safe)}, {"fast", class_json(s.rx_fast)}};
             auto& paths = g["paths"] = nlohmann::json::array();

@@ -11,6 +11,7 @@
 #include "services/common/port_keeper.hpp"
 #include "services/common/service.hpp"
 #include "services/groundlink/delivery_meter.hpp"
+#include "services/groundlink/frame_forwarder.hpp"
 #include "services/groundlink/link/link_driver.hpp"
 #include "services/groundlink/protocol/ground_protocol.hpp"
 #include "services/groundlink/telemetry_sample.hpp"
@@ -31,6 +32,9 @@ struct GroundlinkServiceConfig {
     hal::UdpConfig udp;
     TransportConfig transport;  // paths, path_mode, link rate, key and boot nonce are set by the service
     Duration stats_interval = std::chrono::seconds(1);
+    /// groundlink.mavlink_forward: the autopilot's frames for standard ground stations (ForwardedFrame from
+    /// the bus, as MavlinkFrames messages) and theirs back (GroundStationFrames, control key only).
+    FrameForwarderConfig mavlink_forward;
 };
 
 class GroundlinkService : public Service {
@@ -55,6 +59,9 @@ class GroundlinkService : public Service {
     void on_message(Delivered message);
     void on_command(const protocol::Command& command);
     void on_joystick(const protocol::Joystick& joystick);
+    void on_ground_station_frames(protocol::MavlinkFrames frames);
+    void on_forwarded(const autopilot::ForwardedFrame& frame);
+    void pump_forward();
     void on_event(const TransportEvent& event);
     void send_event(protocol::Event::Severity severity, std::string text);
     void do_stats();
@@ -81,6 +88,11 @@ class GroundlinkService : public Service {
     TelemetryScheduler scheduler_;
     DeliveryMeter delivery_;
     DeadlineTimer telemetry_timer_;
+    FrameForwarder forwarder_;
+    DeadlineTimer forward_timer_;
+    std::uint64_t forward_refused_ = 0;      // forwarded frames the transport did not take (queue full)
+    std::uint64_t from_ground_frames_ = 0;   // MavlinkFrames messages passed to the autopilot
+    std::uint64_t from_ground_refused_ = 0;  // ... dropped: forwarding off, or from a monitor key
     std::optional<autopilot::Telemetry> vehicle_;
     PlanProgressSample plan_;
     std::vector<Subscription> subscriptions_;

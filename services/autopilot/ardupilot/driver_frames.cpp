@@ -28,16 +28,8 @@ void Driver::tap_incoming(const mav::Frame& f) {
     if (!tap_) {
         return;
     }
-    const mav::MessageInfo* info = mav::find_message(f.msgid);
-    if (!info) {
-        return;
-    }
-    std::array<std::uint8_t, mav::kMaxFrameLength> buf{};
-    const mav::FrameHeader h{f.version, f.seq, f.sysid, f.compid, f.msgid, f.compat_flags};
-    const std::size_t n =
-        mav::encode_frame(h, info->crc_extra, std::span(f.payload).first(f.wire_length), buf);
-    if (n > 0) {
-        tap_(false, std::span<const std::uint8_t>(buf.data(), n));
+    if (const auto bytes = mav::reencode(f); !bytes.empty()) {
+        tap_(false, bytes);
     }
 }
 

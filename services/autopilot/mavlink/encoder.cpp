@@ -68,4 +68,16 @@ std::size_t encode_message(const FrameHeader& header, const MessageInfo& info,
                         full.first(wire_payload_length(header.version, full, info.base_length)), out);
 }
 
+std::vector<std::uint8_t> reencode(const Frame& frame) {
+    const MessageInfo* info = find_message(frame.msgid);
+    if (!info) {
+        return {};
+    }
+    std::array<std::uint8_t, kMaxFrameLength> buf{};
+    const FrameHeader h{frame.version, frame.seq, frame.sysid, frame.compid, frame.msgid, frame.compat_flags};
+    const std::size_t n =
+        encode_frame(h, info->crc_extra, std::span(frame.payload).first(frame.wire_length), buf);
+    return {buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(n)};
+}
+
 }  // namespace airseg::mavlink

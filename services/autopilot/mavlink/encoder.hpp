@@ -47,6 +47,10 @@ std::size_t encode_message(const FrameHeader& header, const MessageInfo& info,
                            std::span<const std::uint8_t> payload,
                            std::span<std::uint8_t, kMaxFrameLength> out);
 
+/// The bytes of a frame as the parser delivered it (same header, the payload as received, unsigned: a
+/// signature is not kept), for passing a verified frame on; empty when its message id is unknown.
+std::vector<std::uint8_t> reencode(const Frame& frame);
+
 class Encoder {
   public:
     Encoder(std::uint8_t sysid, std::uint8_t compid, Version version = Version::V2)

@@ -43,6 +43,7 @@ inline constexpr std::uint8_t kMissionUnsupportedFrame = 2;
 inline constexpr std::uint8_t kMissionUnsupported = 3;
 inline constexpr std::uint8_t kMissionNoSpace = 4;
 inline constexpr std::uint8_t kMissionInvalidSequence = 13;
+inline constexpr std::uint8_t kMissionDenied = 14;
 inline constexpr std::uint8_t kMissionOperationCancelled = 15;
 
 // MAV_MISSION_TYPE
@@ -76,6 +77,7 @@ inline constexpr std::uint8_t kMavStatePoweroff = 7;
 
 // MAV_SEVERITY (STATUSTEXT)
 inline constexpr std::uint8_t kSeverityCritical = 2;
+inline constexpr std::uint8_t kSeverityWarning = 4;
 inline constexpr std::uint8_t kSeverityInfo = 6;
 
 }  // namespace airseg::mavlink

@@ -233,6 +233,9 @@ std::vector<std::uint8_t> encode(const Message& message) {
             } else if constexpr (std::is_same_v<T, ReceptionReport>) {
                 w.u8(static_cast<std::uint8_t>(MessageType::Reception));
                 w.le(m.received, 4);
+            } else if constexpr (std::is_same_v<T, MavlinkFrames>) {
+                w.u8(static_cast<std::uint8_t>(MessageType::MavlinkFrames));
+                w.bytes(m.bytes);
             } else {
                 w.u8(m.type);
             }
@@ -348,6 +351,15 @@ DecodeResult decode(std::span<const std::uint8_t> bytes) {
                 return out;
             }
             out.message = ReceptionReport{static_cast<std::uint32_t>(r.le(4))};
+            return out;
+        }
+        case MessageType::MavlinkFrames: {
+            if (body == 0) {
+                out.error = "MAVLink frames message carries no bytes";
+                return out;
+            }
+            const auto frames = r.rest();
+            out.message = MavlinkFrames{{frames.begin(), frames.end()}};
             return out;
         }
     }

@@ -25,6 +25,12 @@ inline constexpr std::uint16_t kTopicTelemetry = 1;
 inline constexpr std::uint16_t kTopicLinkStats = 2;
 inline constexpr std::uint16_t kTopicJoystick = 3;
 inline constexpr std::uint16_t kTopicReception = 4;
+/// Fast topics of forwarded MAVLink frames: one per message id, so only the freshest frame of an id waits.
+/// Ids above 0x7fff share topics modulo 0x8000 (none of the common telemetry messages is that high).
+inline constexpr std::uint16_t kTopicMavlinkBase = 0x8000;
+inline constexpr std::uint16_t mavlink_topic(std::uint32_t msgid) {
+    return static_cast<std::uint16_t>(kTopicMavlinkBase | (msgid & 0x7fff));
+}
 
 enum class MessageType : std::uint8_t {
     Telemetry = 0x01,
@@ -36,6 +42,7 @@ enum class MessageType : std::uint8_t {
     Reception = 0x13,
     CommandDeflated = 0x14,  ///< a command whose CBOR is compressed (deflate_codec.hpp)
     ResultDeflated = 0x15,   ///< a result whose CBOR is compressed
+    MavlinkFrames = 0x16,    ///< whole MAVLink frames for or from a standard ground station
 };
 
 /// One vehicle telemetry sample. Units are chosen so the whole message fits 29 bytes.
@@ -107,13 +114,20 @@ struct ReceptionReport {
     bool operator==(const ReceptionReport&) const = default;
 };
 
+/// One or more whole MAVLink frames (v1 or v2), concatenated, carried opaquely: the ground link does not know
+/// MAVLink; the autopilot room parses and checks them. Never empty.
+struct MavlinkFrames {
+    std::vector<std::uint8_t> bytes;
+    bool operator==(const MavlinkFrames&) const = default;
+};
+
 struct Unknown {
     std::uint8_t type = 0;
     bool operator==(const Unknown&) const = default;
 };
 
-using Message =
-    std::variant<Telemetry, LinkStatsReport, Event, Command, Result, Joystick, ReceptionReport, Unknown>;
+using Message = std::variant<Telemetry, LinkStatsReport, Event, Command, Result, Joystick, ReceptionReport,
+                             MavlinkFrames, Unknown>;
 
 std::vector<std::uint8_t> encode(const Message& message);
 

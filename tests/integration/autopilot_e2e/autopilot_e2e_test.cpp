@@ -3,6 +3,7 @@
 // really did. Simulated time runs faster than real time on the board's side (--speedup); every wait is on a
 // condition with a generous deadline.
 #include <gtest/gtest.h>
+#include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/socket.h>
@@ -10,11 +11,14 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <nlohmann/json.hpp>
 
+#include "services/autopilot/mavlink/parser.hpp"
 #include "tests/support/control_client.hpp"
+#include "tests/support/ground_station.hpp"
 #include "tests/support/process.hpp"
 
 namespace airseg::test {
@@ -218,6 +222,68 @@ TEST_F(AutopilotBaudProbeE2e, ProbesTheConfiguredRatesAndKeepsTheOneThatWorks) {
     EXPECT_NE(sim_->err().find("peer at 57600 baud, board at 115200"), std::string::npos) << sim_->err();
     EXPECT_NE(daemon_->err().find("trying 115200 baud"), std::string::npos) << daemon_->err();
     EXPECT_EQ(ap["reconnects"], 0) << "a baud switch is not a reconnect";
+}
+
+// A ground station on the board's network (autopilot.gcs_endpoint.udp) talks to the simulated board through
+// airsegd: it hears the board, reads a parameter, and a mission upload is refused by airsegd, the board's
+// mission untouched.
+class GcsEndpointE2e : public AutopilotE2e {
+  protected:
+    GcsEndpointE2e() : port_(free_udp_port()) {
+        extra_daemon_args_ = {"--set", "autopilot.gcs_endpoint.udp=127.0.0.1:" + std::to_string(port_)};
+    }
+    ~GcsEndpointE2e() override {
+        if (fd_ >= 0) {
+            ::close(fd_);
+        }
+    }
+    void send(const std::vector<std::uint8_t>& frame) {
+        sockaddr_in to{};
+        to.sin_family = AF_INET;
+        to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        to.sin_port = htons(static_cast<std::uint16_t>(port_));
+        ::sendto(fd_, frame.data(), frame.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
+    }
+    /// Reads what came until `found` says so or the time is up; true when found.
+    bool hear(const std::function<bool(const mavlink::Frame&)>& found, std::chrono::milliseconds limit) {
+        const auto end = std::chrono::steady_clock::now() + limit;
+        bool seen = false;
+        while (!seen && std::chrono::steady_clock::now() < end) {
+            pollfd p{fd_, POLLIN, 0};
+            if (::poll(&p, 1, 100) <= 0) {
+                continue;
+            }
+            std::array<std::uint8_t, 2048> buf{};
+            const auto n = ::recv(fd_, buf.data(), buf.size(), 0);
+            if (n > 0) {
+                parser_.push(std::span(buf).first(static_cast<std::size_t>(n)),
+                             [&](const mavlink::Frame& f) { seen = seen || found(f); });
+            }
+        }
+        return seen;
+    }
+
+    int port_;
+    int fd_ = ::socket(AF_INET, SOCK_DGRAM, 0);
+    mavlink::Parser parser_;
+    GroundStation gcs_;
+};
+
+TEST_F(GcsEndpointE2e, AGroundStationHearsTheBoardReadsAParameterAndCannotUploadAMission) {
+    ASSERT_TRUE(wait_until([&] { return ready(); }, kGenerous, kPoll)) << daemon_->err();
+    send(gcs_.heartbeat());
+    EXPECT_TRUE(hear(GroundStation::board_heartbeat, 10s)) << daemon_->err();
+    send(gcs_.read_param("CRUISE_SPEED"));
+    EXPECT_TRUE(
+        hear([](const mavlink::Frame& f) { return GroundStation::param_value(f, "CRUISE_SPEED"); }, 10s));
+
+    const auto mission_before = control_->json("state")["mission_count"];
+    send(gcs_.mission_upload(2));
+    EXPECT_TRUE(hear(GroundStation::mission_denied, 10s));
+    EXPECT_EQ(control_->json("state")["mission_count"], mission_before) << "the board's mission is untouched";
+    EXPECT_EQ(control_->json("stats")["mission_items_received"], 0);
+    EXPECT_NE(daemon_->err().find("refused a mission write from a ground station"), std::string::npos)
+        << daemon_->err();
 }
 
 INSTANTIATE_TEST_SUITE_P(Firmware, AutopilotFirmwareE2e, ::testing::Values("modern", "rover2"),

@@ -2,6 +2,7 @@
 // (57600 baud) ⇄ airsegctl. Pushed telemetry, roles by key, joystick driving, and a lossy link.
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/socket.h>
@@ -9,6 +10,7 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -16,7 +18,11 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "services/autopilot/mavlink/parser.hpp"
+#include "services/groundlink/protocol/ground_protocol.hpp"
+#include "services/groundlink/transport/transport.hpp"
 #include "tests/support/control_client.hpp"
+#include "tests/support/ground_station.hpp"
 #include "tests/support/process.hpp"
 
 namespace airseg::test {
@@ -400,6 +406,128 @@ TEST_F(GroundControlE2e, SighupAppliesTheTelemetryRatesOverThoseSetFromTheGround
     const auto rates = local({"rates"});
     EXPECT_EQ(rates["effective_hz"]["link_stats"], 0.0) << rates.dump();
     EXPECT_NE(daemon->err().find("groundlink.telemetry.rates"), std::string::npos) << daemon->err();
+}
+
+/// A ground end of the radio link in the test itself, over UDP: the transport core and the ground protocol,
+/// as a ground daemon serving standard ground stations runs them.
+class GroundEnd {
+  public:
+    explicit GroundEnd(int port) : transport_(config(), airseg::SteadyClock::now()) {
+        sockaddr_in to{};
+        to.sin_family = AF_INET;
+        to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        to.sin_port = htons(static_cast<std::uint16_t>(port));
+        ::connect(fd_, reinterpret_cast<sockaddr*>(&to), sizeof to);
+    }
+    ~GroundEnd() { ::close(fd_); }
+    GroundEnd(const GroundEnd&) = delete;
+    GroundEnd& operator=(const GroundEnd&) = delete;
+
+    /// Sends whole MAVLink frames to the vehicle (Safe, bulk channel).
+    void send(const std::vector<std::uint8_t>& frames) {
+        namespace proto = airseg::groundlink::protocol;
+        transport_.send_safe(proto::kPriorityBulk, proto::encode(proto::MavlinkFrames{frames}),
+                             airseg::SteadyClock::now());
+        pump();
+    }
+    /// Runs the link until `found` accepts a frame from the vehicle or `limit` has passed.
+    bool hear(const std::function<bool(const airseg::mavlink::Frame&)>& found,
+              std::chrono::milliseconds limit) {
+        const auto end = std::chrono::steady_clock::now() + limit;
+        bool seen = false;
+        while (!seen && std::chrono::steady_clock::now() < end) {
+            pollfd p{fd_, POLLIN, 0};
+            if (::poll(&p, 1, 20) > 0) {
+                std::array<std::uint8_t, 4096> buf{};
+                const auto n = ::recv(fd_, buf.data(), buf.size(), 0);
+                if (n > 0) {
+                    transport_.handle_bytes(0, std::span(buf).first(static_cast<std::size_t>(n)),
+                                            airseg::SteadyClock::now());
+                }
+            }
+            pump();
+            while (auto m = transport_.poll_message()) {
+                const auto d = airseg::groundlink::protocol::decode(m->bytes);
+                if (const auto* f =
+                        d.message ? std::get_if<airseg::groundlink::protocol::MavlinkFrames>(&*d.message)
+                                  : nullptr) {
+                    ++messages_;
+                    airseg::mavlink::Parser parser;
+                    parser.push(f->bytes,
+                                [&](const airseg::mavlink::Frame& frame) { seen = seen || found(frame); });
+                }
+            }
+        }
+        return seen;
+    }
+    std::size_t messages() const { return messages_; }
+
+  private:
+    static airseg::groundlink::TransportConfig config() {
+        airseg::groundlink::TransportConfig c;
+        c.half_duplex = false;
+        c.boot_nonce = 0x5eed;
+        return c;
+    }
+    void pump() {
+        const auto now = airseg::SteadyClock::now();
+        if (transport_.poll_timeout() <= now) {
+            transport_.handle_timeout(now);
+        }
+        while (auto frame = transport_.poll_transmit(0, now)) {
+            ::send(fd_, frame->data(), frame->size(), 0);
+        }
+    }
+
+    int fd_ = ::socket(AF_INET, SOCK_DGRAM, 0);
+    airseg::groundlink::Transport transport_;
+    std::size_t messages_ = 0;
+};
+
+// A standard ground station's MAVLink through the radio link (groundlink.mavlink_forward): the ground end
+// hears the board's telemetry, reads a parameter, and a mission upload is answered DENIED by airsegd, the
+// board's mission untouched; the status document counts both directions.
+TEST_F(GroundControlE2e, MavlinkForwardCarriesAGroundStationsTrafficAndRefusesMissionUploads) {
+    start_sim();
+    const int port = free_udp_port();
+    start_daemon({"--set", "groundlink.mode=udp", "--set", "groundlink.udp.bind=127.0.0.1", "--set",
+                  "groundlink.udp.port=" + std::to_string(port), "--set",
+                  "groundlink.mavlink_forward.enabled=true", "--set",
+                  "groundlink.mavlink_forward.rates={ATTITUDE: 2, default: 1}"});
+    const auto local_status = [&] {
+        auto r = run(
+            {binary("client/airsegctl"), "--local", "--socket", dir.file("status.sock"), "--json", "status"});
+        auto j = Json::parse(r.out, nullptr, false);
+        return r.exit_code == 0 && !j.is_discarded() ? j : Json::object();
+    };
+    ASSERT_TRUE(
+        wait_until([&] { return local_status().value("autopilot", Json::object()).value("ready", false); },
+                   kGenerous, 500ms))
+        << daemon->err();
+
+    GroundEnd ground_end(port);
+    GroundStation gcs;
+    EXPECT_TRUE(ground_end.hear(GroundStation::board_heartbeat, 20s)) << daemon->err();
+    ground_end.send(gcs.read_param("CRUISE_SPEED"));
+    EXPECT_TRUE(ground_end.hear(
+        [](const airseg::mavlink::Frame& f) { return GroundStation::param_value(f, "CRUISE_SPEED"); }, 20s));
+
+    const auto mission_before = sim_control->json("state")["mission_count"];
+    ground_end.send(gcs.mission_upload(2));
+    EXPECT_TRUE(ground_end.hear(GroundStation::mission_denied, 20s));
+    EXPECT_EQ(sim_control->json("state")["mission_count"], mission_before);
+
+    // The section is refreshed once a second.
+    Json fwd;
+    EXPECT_TRUE(wait_until(
+        [&] {
+            fwd = local_status()["groundlink"]["mavlink_forward"];
+            return fwd.is_object() && fwd["forwarded"].get<int>() > 3 && fwd["from_ground"] == 2;
+        },
+        10s, 200ms))
+        << fwd.dump();
+    EXPECT_EQ(fwd["enabled"], true) << fwd.dump();
+    EXPECT_EQ(fwd["budget_bytes_per_s"], 1728) << fwd.dump();
 }
 
 }  // namespace

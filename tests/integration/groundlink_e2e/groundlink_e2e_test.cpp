@@ -163,19 +163,6 @@ TEST_F(GroundlinkEndToEnd, SplitModeOverTwoRadioPairsKeepsWorkingWhenOnePairDies
     daemon.reset();
 }
 
-/// A UDP port free at the moment of asking (the kernel picks it).
-int free_udp_port() {
-    const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-    sockaddr_in addr{};
-    addr.sin_family = AF_INET;
-    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    ::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
-    socklen_t len = sizeof addr;
-    ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
-    ::close(fd);
-    return ntohs(addr.sin_port);
-}
-
 TEST_F(GroundlinkEndToEnd, UdpModeServesTheSameCommands) {
     const int port = free_udp_port();
     start_daemon({"--set", "groundlink.mode=udp", "--set", "groundlink.udp.bind=127.0.0.1", "--set",

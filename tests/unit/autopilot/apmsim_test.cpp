@@ -2,6 +2,7 @@
 // in simulated time: the acceptance scenarios of the autopilot layer.
 #include <gtest/gtest.h>
 
+#include <deque>
 #include <iostream>
 #include <map>
 
@@ -48,7 +49,14 @@ struct SimRig {
             driver.handle_bytes(b, now);
             drain();
         };
-        p.transmit = [this] { return driver.poll_transmit(); };
+        p.transmit = [this]() -> std::optional<std::vector<std::uint8_t>> {
+            if (!also_sent.empty()) {  // a ground station's frames, sharing the port between ours
+                auto frame = std::move(also_sent.front());
+                also_sent.pop_front();
+                return frame;
+            }
+            return driver.poll_transmit();
+        };
         p.on_timeout = [this](TimePoint now) {
             driver.handle_timeout(now);
             drain();
@@ -117,6 +125,7 @@ struct SimRig {
     apmsim::RoverSim sim;
     Harness harness;
     std::vector<Event> events;
+    std::deque<std::vector<std::uint8_t>> also_sent;
 };
 
 std::vector<MissionItem> square(std::size_t n, double step_deg = 2e-4) {
@@ -394,6 +403,66 @@ TEST(DriverWithApmSim, RcOverrideDrivesAndIsReleasedWhenTheJoystickStops) {
     EXPECT_EQ(rig.driver.rc_override().releases(), 1u);
     rig.harness.run_for(seconds(10));
     EXPECT_EQ(rig.sim.state().speed, 0.0);
+}
+
+TEST(DriverWithApmSim, TheBoardAnswersASecondGroundStationByItsSystemId) {
+    // A ground station (system 254) sharing airsegd's port to the autopilot reads the mission and a
+    // parameter and sends a command; the board answers it, not airsegd, and airsegd stays ready.
+    SimRig rig(Board::Pixhawk);
+    ASSERT_TRUE(rig.open_and_wait_ready());
+    std::vector<mav::Frame> heard;
+    rig.driver.set_frame_tap([&](bool outgoing, std::span<const std::uint8_t> bytes) {
+        if (!outgoing) {
+            mav::Parser p;
+            p.push(bytes, [&](const mav::Frame& f) { heard.push_back(f); });
+        }
+    });
+    mav::Encoder gcs(254, 190);
+    mav::MissionRequestList list;
+    list.target_system = 1;
+    list.target_component = 1;
+    mav::ParamRequestRead read;
+    read.target_system = 1;
+    read.target_component = 1;
+    read.param_index = -1;
+    mav::set_text(read.param_id, "CRUISE_SPEED");
+    mav::CommandLong cmd;
+    cmd.target_system = 1;
+    cmd.target_component = 1;
+    cmd.command = 31000;  // no such command: answered as unsupported
+    rig.also_sent = {gcs.encode(list), gcs.encode(read), gcs.encode(cmd)};
+    auto addressed_to_254 = [&](std::uint32_t msgid) {
+        for (const auto& f : heard) {
+            if (f.msgid != msgid) {
+                continue;
+            }
+            if (msgid == mav::MissionCount::kId &&
+                mav::decode_payload<mav::MissionCount>(f.payload_view()).target_system == 254) {
+                return true;
+            }
+            if (msgid == mav::CommandAck::kId &&
+                mav::decode_payload<mav::CommandAck>(f.payload_view()).target_system == 254) {
+                return true;
+            }
+            if (msgid == mav::ParamValue::kId &&
+                mav::text_of(mav::decode_payload<mav::ParamValue>(f.payload_view()).param_id) ==
+                    "CRUISE_SPEED") {
+                return true;
+            }
+        }
+        return false;
+    };
+    EXPECT_TRUE(rig.harness.run_until(
+        [&] {
+            return addressed_to_254(mav::MissionCount::kId) && addressed_to_254(mav::CommandAck::kId) &&
+                   addressed_to_254(mav::ParamValue::kId);
+        },
+        rig.now() + seconds(5)))
+        << "mission count " << addressed_to_254(mav::MissionCount::kId) << ", command ack "
+        << addressed_to_254(mav::CommandAck::kId) << ", parameter " << addressed_to_254(mav::ParamValue::kId);
+    rig.harness.run_for(seconds(2));
+    EXPECT_TRUE(rig.driver.ready());
+    EXPECT_TRUE(rig.all<AutopilotRebooted>().empty());
 }
 
 }  // namespace

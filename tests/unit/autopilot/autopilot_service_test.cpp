@@ -12,6 +12,9 @@
 #include <iterator>
 
 #include "hal/pty.hpp"
+#include "services/autopilot/mavlink/encoder.hpp"
+#include "services/autopilot/mavlink/enums.hpp"
+#include "services/autopilot/mavlink/parser.hpp"
 #include "tests/unit/autopilot/fake_rover.hpp"
 #include "tools/mavdump/tlog_reader.hpp"
 
@@ -69,36 +72,30 @@ struct RoverOnPty {
     asio::steady_timer timer;
 };
 
-TEST(AutopilotService, ReachesReadyOnAPtyAndAnswersBusRequests) {
-    const fs::path dir = fs::temp_directory_path() / ("airseg-ap-" + std::to_string(::getpid()));
-    fs::create_directories(dir);
-    asio::io_context io;
-    Bus bus;
-    HealthRegistry health;
-    CommandDispatcher commands;
-    ServiceContext ctx{io, bus, health, commands, milliseconds(100)};
+/// A service on a pseudo-terminal with the scripted Rover behind it, in a directory of its own.
+struct ServiceOnPty {
+    explicit ServiceOnPty(const std::string& name)
+        : dir(fs::temp_directory_path() / (name + "-" + std::to_string(::getpid()))) {
+        fs::create_directories(dir);
+        rover = std::make_unique<RoverOnPty>(io, (dir / "ttyACM0").string());
+        rover->start();
+    }
+    ~ServiceOnPty() { fs::remove_all(dir); }
 
-    RoverOnPty rover(io, (dir / "ttyACM0").string());
-    rover.start();
-
-    AutopilotServiceConfig config;
-    config.autopilot = AutopilotConfig::defaults_for(Board::Pixhawk);
-    config.autopilot.bauds = {57600};
-    config.port.serial.path = (dir / "ttyACM0").string();
-    config.port.reconnect_min = milliseconds(20);
-    config.tlog.enabled = true;
-    config.tlog.path = (dir / "autopilot.tlog").string();
-    auto service = std::make_unique<AutopilotService>(ctx, config, nullptr);
-    health.add("autopilot", SteadyClock::now());
-
-    Strand test_strand = asio::make_strand(io);
-    std::vector<Ready> ready;
-    std::vector<RequestDone> done;
-    auto s1 = bus.subscribe<Ready>(test_strand, [&](const Ready& r) { ready.push_back(r); });
-    auto s2 = bus.subscribe<RequestDone>(test_strand, [&](const RequestDone& d) { done.push_back(d); });
-    service->start();
-
-    const auto run_until = [&](const std::function<bool()>& cond) {
+    AutopilotServiceConfig config() const {
+        AutopilotServiceConfig c;
+        c.autopilot = AutopilotConfig::defaults_for(Board::Pixhawk);
+        c.autopilot.bauds = {57600};
+        c.port.serial.path = (dir / "ttyACM0").string();
+        c.port.reconnect_min = milliseconds(20);
+        return c;
+    }
+    std::unique_ptr<AutopilotService> make(const AutopilotServiceConfig& c) {
+        auto service = std::make_unique<AutopilotService>(ctx, c, nullptr);
+        health.add("autopilot", SteadyClock::now());
+        return service;
+    }
+    bool run_until(const std::function<bool()>& cond) {
         const auto deadline = SteadyClock::now() + seconds(15);
         while (!cond() && SteadyClock::now() < deadline) {
             io.run_for(milliseconds(10));
@@ -107,7 +104,44 @@ TEST(AutopilotService, ReachesReadyOnAPtyAndAnswersBusRequests) {
             }
         }
         return cond();
-    };
+    }
+    bool ready() const {
+        const auto s = bus.latest<AutopilotStatus>();
+        return s && s->ready;
+    }
+    void finish(std::unique_ptr<AutopilotService>& service) {
+        service->stop();
+        rover->stop();
+        io.run_for(milliseconds(50));
+        service.reset();
+    }
+
+    fs::path dir;
+    asio::io_context io;
+    Bus bus;
+    HealthRegistry health;
+    CommandDispatcher commands;
+    ServiceContext ctx{io, bus, health, commands, milliseconds(100)};
+    std::unique_ptr<RoverOnPty> rover;
+};
+
+TEST(AutopilotService, ReachesReadyOnAPtyAndAnswersBusRequests) {
+    ServiceOnPty rig("airseg-ap");
+    auto& bus = rig.bus;
+    auto& health = rig.health;
+    const auto& dir = rig.dir;
+    auto config = rig.config();
+    config.tlog.enabled = true;
+    config.tlog.path = (dir / "autopilot.tlog").string();
+    auto service = rig.make(config);
+
+    Strand test_strand = asio::make_strand(rig.io);
+    std::vector<Ready> ready;
+    std::vector<RequestDone> done;
+    auto s1 = bus.subscribe<Ready>(test_strand, [&](const Ready& r) { ready.push_back(r); });
+    auto s2 = bus.subscribe<RequestDone>(test_strand, [&](const RequestDone& d) { done.push_back(d); });
+    service->start();
+    const auto run_until = [&](const std::function<bool()>& cond) { return rig.run_until(cond); };
     ASSERT_TRUE(run_until([&] { return !ready.empty(); }));
     EXPECT_LT(ready[0].seconds_from_open, 5.0);
 
@@ -151,12 +185,8 @@ TEST(AutopilotService, ReachesReadyOnAPtyAndAnswersBusRequests) {
     EXPECT_EQ(replied.size(), 1u);
     EXPECT_TRUE(done.empty()) << "answers go through the Reply, not the bus";
 
-    service->stop();
-    rover.stop();
-    io.run_for(milliseconds(50));
-    service.reset();
+    rig.finish(service);
     EXPECT_GT(fs::file_size(dir / "autopilot.tlog"), 1000u);
-    fs::remove_all(dir);
 }
 
 struct TlogOnDisk {
@@ -189,42 +219,14 @@ std::uint64_t wall_us() {
 // The recorder's 2 s flush deadline on the service's timer: frames reach the file during the flight, not only
 // in 32 KiB blocks or at the stop (the traffic here is far below 32 KiB in the time allowed).
 TEST(AutopilotService, TheTlogOnDiskFollowsTheLinkWhileTheServiceRuns) {
-    const fs::path dir = fs::temp_directory_path() / ("airseg-ap-tlog-" + std::to_string(::getpid()));
-    fs::create_directories(dir);
-    asio::io_context io;
-    Bus bus;
-    HealthRegistry health;
-    CommandDispatcher commands;
-    ServiceContext ctx{io, bus, health, commands, milliseconds(100)};
-
-    RoverOnPty rover(io, (dir / "ttyACM0").string());
-    rover.start();
-
-    AutopilotServiceConfig config;
-    config.autopilot = AutopilotConfig::defaults_for(Board::Pixhawk);
-    config.autopilot.bauds = {57600};
-    config.port.serial.path = (dir / "ttyACM0").string();
-    config.port.reconnect_min = milliseconds(20);
+    ServiceOnPty rig("airseg-ap-tlog");
+    auto config = rig.config();
     config.tlog.enabled = true;
-    config.tlog.path = (dir / "autopilot.tlog").string();
-    auto service = std::make_unique<AutopilotService>(ctx, config, nullptr);
-    health.add("autopilot", SteadyClock::now());
+    config.tlog.path = (rig.dir / "autopilot.tlog").string();
+    auto service = rig.make(config);
     service->start();
-
-    const auto run_until = [&](const std::function<bool()>& cond) {
-        const auto deadline = SteadyClock::now() + seconds(15);
-        while (!cond() && SteadyClock::now() < deadline) {
-            io.run_for(milliseconds(10));
-            if (io.stopped()) {
-                io.restart();
-            }
-        }
-        return cond();
-    };
-    ASSERT_TRUE(run_until([&] {
-        const auto s = bus.latest<AutopilotStatus>();
-        return s && s->ready;
-    }));
+    const auto run_until = [&](const std::function<bool()>& cond) { return rig.run_until(cond); };
+    ASSERT_TRUE(run_until([&] { return rig.ready(); }));
     // Twice in a row, a frame exchanged from now on reaches the file while the service keeps running.
     std::uint64_t bytes_before = 0;
     for (int round = 0; round < 2; ++round) {
@@ -242,14 +244,86 @@ TEST(AutopilotService, TheTlogOnDiskFollowsTheLinkWhileTheServiceRuns) {
         bytes_before = bytes;
     }
 
-    service->stop();
-    rover.stop();
-    io.run_for(milliseconds(50));
-    service.reset();
+    rig.finish(service);
     const auto end = read_tlog(config.tlog.path);
     EXPECT_EQ(end.skipped_bytes, 0u) << "whole records only";
     EXPECT_GT(end.records, 0u);
-    fs::remove_all(dir);
+}
+
+// Ground stations through airsegd: one on the endpoint (UDP), one through the ground link (the bus). Both
+// get the autopilot's frames; a mission upload from either is answered DENIED by airsegd, not written.
+TEST(AutopilotService, GroundStationsGetTheAutopilotsFramesAndMissionUploadsAreRefused) {
+    ServiceOnPty rig("airseg-ap-gcs");
+    auto& io = rig.io;
+    auto& bus = rig.bus;
+    auto config = rig.config();
+    config.forward_frames = true;
+    config.gcs_endpoint = GcsEndpointConfig{"127.0.0.1:0", "", ""};
+    auto service = rig.make(config);
+    Strand test_strand = asio::make_strand(io);
+    std::vector<ForwardedFrame> forwarded;
+    auto sub =
+        bus.subscribe<ForwardedFrame>(test_strand, [&](const ForwardedFrame& f) { forwarded.push_back(f); });
+    service->start();
+    const auto run_until = [&](const std::function<bool()>& cond) { return rig.run_until(cond); };
+    ASSERT_TRUE(run_until([&] { return rig.ready(); }));
+    ASSERT_NE(service->gcs_endpoint(), nullptr);
+    const auto port = service->gcs_endpoint()->udp_port();
+    ASSERT_NE(port, 0);
+
+    // The ground station on the endpoint asks to upload a mission.
+    asio::ip::udp::socket gcs(io, asio::ip::udp::endpoint(asio::ip::udp::v4(), 0));
+    mavlink::Encoder encoder(254, 190);
+    mavlink::MissionCount count;
+    count.target_system = 1;
+    count.target_component = 1;
+    count.count = 3;
+    gcs.send_to(asio::buffer(encoder.encode(count)),
+                asio::ip::udp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+    std::vector<mavlink::Frame> heard;
+    std::array<std::uint8_t, 2048> buf{};
+    std::function<void()> receive = [&] {
+        gcs.async_receive(asio::buffer(buf), [&](boost::system::error_code ec, std::size_t n) {
+            if (ec) {
+                return;
+            }
+            mavlink::Parser p;
+            p.push(std::span(buf).first(n), [&](const mavlink::Frame& f) { heard.push_back(f); });
+            receive();
+        });
+    };
+    receive();
+    const auto has = [&](std::uint32_t msgid) {
+        return std::any_of(heard.begin(), heard.end(),
+                           [&](const mavlink::Frame& f) { return f.msgid == msgid; });
+    };
+    ASSERT_TRUE(run_until([&] { return has(mavlink::MissionAck::kId) && has(mavlink::Heartbeat::kId); }));
+    for (const auto& f : heard) {
+        if (f.msgid == mavlink::MissionAck::kId) {
+            const auto ack = mavlink::decode_payload<mavlink::MissionAck>(f.payload_view());
+            EXPECT_EQ(ack.target_system, 254);
+            EXPECT_EQ(ack.type, mavlink::kMissionDenied);
+        }
+    }
+    // The same answer went to the ground link's stations, reliably, with the autopilot's own frames.
+    EXPECT_TRUE(run_until([&] {
+        return std::any_of(forwarded.begin(), forwarded.end(), [](const ForwardedFrame& f) {
+            return f.id == mavlink::MissionAck::kId && f.delivery == ForwardedFrame::Delivery::Reliable;
+        });
+    }));
+    EXPECT_TRUE(std::any_of(forwarded.begin(), forwarded.end(), [](const ForwardedFrame& f) {
+        return f.id == mavlink::Heartbeat::kId && f.delivery == ForwardedFrame::Delivery::Freshest;
+    }));
+    // A ground station on the ground link asks too (through the bus).
+    const auto acks = [&] {
+        return std::count_if(forwarded.begin(), forwarded.end(),
+                             [](const ForwardedFrame& f) { return f.id == mavlink::MissionAck::kId; });
+    };
+    const auto before = acks();
+    bus.publish(GroundStationFrames{encoder.encode(count)});
+    EXPECT_TRUE(run_until([&] { return acks() > before; }));
+    EXPECT_TRUE(service->driver().ready());
+    rig.finish(service);
 }
 
 }  // namespace

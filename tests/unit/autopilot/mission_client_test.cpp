@@ -299,19 +299,54 @@ TEST(MissionClient, CancelAllEndsEveryOperationOnce) {
     EXPECT_EQ(client.poll_timeout(), kNever);
 }
 
+/// airsegd's mission client (system 255) next to a ground station with another system id, both talking to
+/// the autopilot (system 1) through the same port.
+struct SharedPort {
+    Outbox out{255, 190, mav::Version::V2};
+    MissionClient client{out, 1, 1, {}};
+    mav::Encoder vehicle{1, 1};
+    mav::Parser parser;
+
+    template <class M>
+    void from_vehicle(const M& m) {
+        parser.push(vehicle.encode(m), [&](const mav::Frame& f) { client.handle_frame(f, kStart); });
+    }
+};
+
 TEST(MissionClient, IgnoresAnotherGroundStationsTransfer) {
-    Outbox out(255, 190, mav::Version::V2);
-    MissionClient client(out, 1, 1, {});
-    client.upload(make_items(3), kStart);
-    (void)out.poll_transmit();
+    SharedPort port;
+    port.client.upload(make_items(3), kStart);
+    (void)port.out.poll_transmit();
     // A request addressed to sysid 254 must not make us send an item.
-    mav::Encoder vehicle(1, 1);
     mav::MissionRequestInt r;
     r.target_system = 254;
     r.seq = 0;
-    mav::Parser p;
-    p.push(vehicle.encode(r), [&](const mav::Frame& f) { client.handle_frame(f, kStart); });
-    EXPECT_TRUE(out.empty());
+    port.from_vehicle(r);
+    EXPECT_TRUE(port.out.empty());
+}
+
+TEST(MissionClient, ADownloadIgnoresAnswersToAnotherGroundStation) {
+    // A ground station (system 254) downloads the mission through airsegd while airsegd downloads it too:
+    // the autopilot's answers to the ground station must not be taken for ours.
+    SharedPort port;
+    port.client.download(kStart);
+    (void)port.out.poll_transmit();
+    mav::MissionCount count;
+    count.target_system = 254;
+    count.count = 7;
+    mav::MissionItemInt item;
+    item.target_system = 254;
+    port.from_vehicle(count);
+    port.from_vehicle(item);
+    EXPECT_TRUE(port.out.empty());  // no MISSION_REQUEST_INT for the other station's items
+    EXPECT_FALSE(port.client.poll_completion());
+    // Our own answer still works.
+    count.target_system = 255;
+    count.count = 0;
+    port.from_vehicle(count);
+    const auto done = port.client.poll_completion();
+    ASSERT_TRUE(done);
+    EXPECT_EQ(done->result, MissionResult::Success);
 }
 
 }  // namespace

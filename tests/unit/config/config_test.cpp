@@ -137,6 +137,27 @@ TEST(Config, ShippedExampleIsValidAndDocumentsEveryKey) {
     EXPECT_TRUE(diff_config(Config{}, r.config).empty());
 }
 
+TEST(Config, MavlinkForwardRatesTakeNamesIdsAndADefault) {
+    auto r = load_config_text(
+        "groundlink:\n  mavlink_forward:\n    enabled: true\n    rates: {ATTITUDE: 4, \"33\": 2, default: "
+        "0.5}\n",
+        "f.yaml");
+    ASSERT_TRUE(r.ok()) << r.errors[0].to_string();
+    const auto f = mavlink_forward_setup(r.config);
+    EXPECT_TRUE(f.problems.empty());
+    EXPECT_TRUE(f.config.enabled);
+    EXPECT_EQ(f.config.rate_hz.at(30), 4.0);
+    EXPECT_EQ(f.config.rate_hz.at(33), 2.0);
+    EXPECT_EQ(f.config.default_hz, 0.5);
+    EXPECT_TRUE(autopilot_setup(r.config).service.forward_frames);
+
+    auto bad = load_config_text(
+        "groundlink:\n  mavlink_forward:\n    rates: {NO_SUCH_MESSAGE: 1, ATTITUDE: 90}\n", "b.yaml");
+    ASSERT_EQ(bad.errors.size(), 2u);
+    EXPECT_EQ(bad.errors[0].key, "groundlink.mavlink_forward.rates");
+    EXPECT_NE(bad.errors[0].to_string().find("NO_SUCH_MESSAGE"), std::string::npos);
+}
+
 TEST(Config, DiffNamesRuntimeChanges) {
     Config a, b;
     b.log_level = "debug";

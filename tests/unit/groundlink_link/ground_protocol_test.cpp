@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 namespace airseg::groundlink::protocol {
@@ -248,6 +249,30 @@ TEST(GroundProtocol, ReceptionReportRoundTrips) {
     EXPECT_EQ(bytes[5], 0x01);
     EXPECT_EQ(std::get<ReceptionReport>(*decode(bytes).message), ReceptionReport{0x01020304});
     EXPECT_FALSE(decode(std::vector<std::uint8_t>{kVersion, 0x13, 1, 2}).message);
+}
+
+TEST(GroundProtocol, MavlinkFramesCarryTheirBytesUnchanged) {
+    // Two frames back to back (a v2 HEARTBEAT and the start of another): the protocol does not look inside.
+    const std::vector<std::uint8_t> frames{0xfd, 0x09, 0x00, 0x00, 0x00, 0x01, 0x01, 0x00, 0x00, 0x00, 0x00,
+                                           0x00, 0x00, 0x00, 0x0a, 0x03, 0x81, 0x04, 0x03, 0xc7, 0xc7, 0xfe};
+    const auto bytes = encode(MavlinkFrames{frames});
+    ASSERT_EQ(bytes.size(), 2 + frames.size());
+    EXPECT_EQ(bytes[1], 0x16);
+    EXPECT_TRUE(std::equal(frames.begin(), frames.end(), bytes.begin() + 2));
+    const auto d = decode(bytes);
+    ASSERT_TRUE(d.message) << d.error;
+    EXPECT_EQ(std::get<MavlinkFrames>(*d.message).bytes, frames);
+    // An empty one carries nothing and is refused.
+    EXPECT_FALSE(decode(std::vector<std::uint8_t>{kVersion, 0x16}).message);
+}
+
+TEST(GroundProtocol, MavlinkTopicsArePerMessageIdAndApartFromAirsegTopics) {
+    EXPECT_EQ(mavlink_topic(0), 0x8000);
+    EXPECT_EQ(mavlink_topic(30), 0x801e);
+    EXPECT_NE(mavlink_topic(30), mavlink_topic(33));
+    for (const auto own : {kTopicTelemetry, kTopicLinkStats, kTopicJoystick, kTopicReception}) {
+        EXPECT_LT(own, kTopicMavlinkBase);
+    }
 }
 
 TEST(GroundProtocol, StateNames) {

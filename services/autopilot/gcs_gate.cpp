@@ -1,0 +1,159 @@
+#include "services/autopilot/gcs_gate.hpp"
+
+#include <array>
+#include <optional>
+
+#include "services/autopilot/mavlink/enums.hpp"
+#include "services/autopilot/mavlink/messages.hpp"
+#include "services/autopilot/mavlink/parser.hpp"
+
+namespace airseg::autopilot {
+
+namespace mav = airseg::mavlink;
+
+namespace {
+
+constexpr std::array<const char*, 3> kRefusal{
+    "airseg: ground station mission upload refused",
+    "airseg: missions are flight plans, kept on board",
+    "airseg: load one with: airsegctl plan load FILE",
+};
+
+struct Target {
+    std::uint8_t system = 0;
+    std::uint8_t component = 0;
+    std::uint8_t mission_type = 0;
+};
+
+template <class M>
+Target target_of(const mav::Frame& f) {
+    const auto m = mav::decode_payload<M>(f.payload_view());
+    if constexpr (requires { m.mission_type; }) {
+        return {m.target_system, m.target_component, m.mission_type};
+    } else {
+        return {m.target_system, m.target_component, mav::kMissionTypeMission};
+    }
+}
+
+/// The addressee of a mission write, or nothing when the frame is none.
+std::optional<Target> mission_write(const mav::Frame& f) {
+    switch (f.msgid) {
+        case mav::MissionCount::kId:
+            return target_of<mav::MissionCount>(f);
+        case mav::MissionItem::kId:
+            return target_of<mav::MissionItem>(f);
+        case mav::MissionItemInt::kId:
+            return target_of<mav::MissionItemInt>(f);
+        case mav::MissionClearAll::kId:
+            return target_of<mav::MissionClearAll>(f);
+        case mav::MissionSetCurrent::kId:
+            return target_of<mav::MissionSetCurrent>(f);
+        case mav::MissionWritePartialList::kId:
+            return target_of<mav::MissionWritePartialList>(f);
+        default:
+            return std::nullopt;
+    }
+}
+
+}  // namespace
+
+ForwardedFrame::Delivery delivery_of(std::uint32_t msgid) {
+    switch (msgid) {
+        case mav::ParamValue::kId:
+        case mav::CommandAck::kId:
+        case mav::Statustext::kId:
+        case mav::AutopilotVersion::kId:
+        case mav::MissionItem::kId:
+        case mav::MissionRequest::kId:
+        case mav::MissionCount::kId:
+        case mav::MissionAck::kId:
+        case mav::MissionItemReached::kId:
+        case mav::MissionRequestInt::kId:
+        case mav::MissionItemInt::kId:
+            return ForwardedFrame::Delivery::Reliable;
+        default:
+            // MISSION_CURRENT is telemetry: the current slot, repeated at a stream rate.
+            return ForwardedFrame::Delivery::Freshest;
+    }
+}
+
+ForwardedFrame forwarded(std::span<const std::uint8_t> frame) {
+    std::uint32_t id = 0;
+    if (frame.size() >= mav::kHeaderLengthV2 && frame[0] == mav::kMagicV2) {
+        id = std::uint32_t{frame[7]} | std::uint32_t{frame[8]} << 8 | std::uint32_t{frame[9]} << 16;
+    } else if (frame.size() >= mav::kHeaderLengthV1) {
+        id = frame[5];
+    }
+    return {id, delivery_of(id), {frame.begin(), frame.end()}};
+}
+
+std::span<const char* const> mission_refusal_texts() {
+    return kRefusal;
+}
+
+GcsGate::GcsGate(std::uint8_t autopilot_sysid, std::uint8_t autopilot_compid)
+    : sysid_(autopilot_sysid), answers_(autopilot_sysid, autopilot_compid) {}
+
+GcsGate::Output GcsGate::from_ground(std::span<const std::uint8_t> frames) {
+    Output out;
+    mav::Parser parser;  // a fresh one each time: the frames are whole, and ground stations' links differ
+    auto on_frame = [&](const mav::Frame& f) {
+        if (!f.checksum_verified) {
+            ++stats_.invalid;
+            return;
+        }
+        ++stats_.frames;
+        if (refuse(f, out)) {
+            return;
+        }
+        out.to_autopilot.push_back(mav::reencode(f));
+        ++stats_.passed;
+    };
+    parser.push(frames, on_frame);
+    parser.finish(on_frame);
+    const auto& ps = parser.stats();
+    stats_.invalid += ps.bad_checksum + ps.truncated + ps.incompat_rejected + (ps.garbage_bytes > 0 ? 1 : 0);
+    return out;
+}
+
+bool GcsGate::refuse(const mav::Frame& f, Output& out) {
+    if (f.msgid == mav::CommandLong::kId) {
+        // The command form of MISSION_SET_CURRENT moves the mission as much as the message does.
+        const auto cmd = mav::decode_payload<mav::CommandLong>(f.payload_view());
+        if (cmd.command != mav::kCmdDoSetMissionCurrent ||
+            (cmd.target_system != sysid_ && cmd.target_system != 0)) {
+            return false;
+        }
+        mav::CommandAck ack;
+        ack.command = cmd.command;
+        ack.result = mav::kResultDenied;
+        ack.target_system = f.sysid;
+        ack.target_component = f.compid;
+        out.to_ground.push_back(
+            {mav::CommandAck::kId, ForwardedFrame::Delivery::Reliable, answers_.encode(ack)});
+    } else {
+        const auto target = mission_write(f);
+        if (!target || (target->system != sysid_ && target->system != 0) ||
+            target->mission_type != mav::kMissionTypeMission) {
+            return false;
+        }
+        mav::MissionAck ack;
+        ack.target_system = f.sysid;
+        ack.target_component = f.compid;
+        ack.type = mav::kMissionDenied;
+        ack.mission_type = target->mission_type;
+        out.to_ground.push_back(
+            {mav::MissionAck::kId, ForwardedFrame::Delivery::Reliable, answers_.encode(ack)});
+    }
+    ++stats_.missions_refused;
+    for (const char* line : kRefusal) {
+        mav::Statustext text;
+        text.severity = mav::kSeverityWarning;
+        mav::set_text(text.text, line);
+        out.to_ground.push_back(
+            {mav::Statustext::kId, ForwardedFrame::Delivery::Reliable, answers_.encode(text)});
+    }
+    return true;
+}
+
+}  // namespace airseg::autopilot

@@ -1,0 +1,58 @@
+#pragma once
+// What a standard ground station (system 254) says to the simulated board through airsegd, and how the
+// answers are recognised, for the end-to-end tests of both ways in: the board's network endpoint and the
+// radio link. Needs airseg_mavlink.
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+#include "services/autopilot/mavlink/encoder.hpp"
+#include "services/autopilot/mavlink/enums.hpp"
+#include "services/autopilot/mavlink/messages.hpp"
+
+namespace airseg::test {
+
+struct GroundStation {
+    mavlink::Encoder encoder{254, 190};
+
+    std::vector<std::uint8_t> heartbeat() {
+        mavlink::Heartbeat hb;
+        hb.type = 6;  // MAV_TYPE_GCS
+        return encoder.encode(hb);
+    }
+    std::vector<std::uint8_t> read_param(std::string_view name) {
+        mavlink::ParamRequestRead read;
+        read.target_system = 1;
+        read.target_component = 1;
+        read.param_index = -1;
+        mavlink::set_text(read.param_id, name);
+        return encoder.encode(read);
+    }
+    /// The start of a mission upload of `items` items.
+    std::vector<std::uint8_t> mission_upload(std::uint16_t items) {
+        mavlink::MissionCount count;
+        count.target_system = 1;
+        count.target_component = 1;
+        count.count = items;
+        return encoder.encode(count);
+    }
+
+    static bool board_heartbeat(const mavlink::Frame& f) {
+        return f.msgid == mavlink::Heartbeat::kId && f.sysid == 1;
+    }
+    static bool param_value(const mavlink::Frame& f, std::string_view name) {
+        return f.msgid == mavlink::ParamValue::kId &&
+               mavlink::text_of(mavlink::decode_payload<mavlink::ParamValue>(f.payload_view()).param_id) ==
+                   name;
+    }
+    /// MISSION_ACK MAV_MISSION_DENIED addressed to this station.
+    static bool mission_denied(const mavlink::Frame& f) {
+        if (f.msgid != mavlink::MissionAck::kId) {
+            return false;
+        }
+        const auto ack = mavlink::decode_payload<mavlink::MissionAck>(f.payload_view());
+        return ack.target_system == 254 && ack.type == mavlink::kMissionDenied;
+    }
+};
+
+}  // namespace airseg::test
