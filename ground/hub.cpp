@@ -394,7 +394,8 @@ void Hub::on_vehicle(proto::Message message) {
                 hub::encode(hub::FrameType::Ground,
                             proto::encode(proto::Result{pending.client_request, result->answer})));
         }
-    } else {
+    } else if (!std::holds_alternative<proto::MavlinkFrames>(message)) {
+        // The autopilot's own MAVLink is for ground stations (GcsFeed), not for the hub's clients.
         broadcast(hub::encode(hub::FrameType::Ground, proto::encode(message)));
     }
     for (const auto& listener : listeners_) {

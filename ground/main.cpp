@@ -13,6 +13,7 @@
 
 #include "cli/command_line.hpp"
 #include "client/radio_options.hpp"
+#include "ground/gcs_feed.hpp"
 #include "ground/hub.hpp"
 #include "ground/map_feed.hpp"
 
@@ -38,6 +39,7 @@ const char* const kUsageTail =
 struct Options {
     airseg::ground::HubConfig hub;
     airseg::ground::MapConfig map;
+    airseg::ground::GcsConfig gcs;
     bool radio_given = false;
     std::string log_level = "info";
 };
@@ -69,6 +71,21 @@ int main(int argc, char** argv) {
                "tile server for the map, e.g. https://tile.openstreetmap.org/{z}/{x}/{y}.png (default: an "
                "offline grid)",
                text(o.map.tile_url))
+        .value(
+            "mavlink-udp", "HOST:PORT",
+            "send the vehicle's MAVLink here, where ground stations listen (default 127.0.0.1:14550; 'off')",
+            [&o](std::string_view, std::string_view v) { o.gcs.udp_to = v == "off" ? "" : std::string(v); })
+        .value(
+            "mavlink-udp-listen", "ADDR:PORT",
+            "hear ground stations over UDP here (default 127.0.0.1:0, the port the hub sends from; 'off' for "
+            "no UDP at all)",
+            [&o](std::string_view, std::string_view v) {
+                o.gcs.udp_listen = v == "off" ? "" : std::string(v);
+            })
+        .value("mavlink-tcp", "ADDR:PORT",
+               "serve ground stations over TCP here (default 127.0.0.1:5760; 'off'; 0.0.0.0 opens it to the "
+               "network)",
+               [&o](std::string_view, std::string_view v) { o.gcs.tcp = v == "off" ? "" : std::string(v); })
         .value("log-level", "LEVEL", "trace, debug, info, warn or error (default info)", text(o.log_level))
         .help_and_version();
     const Program program{"airseg-ground", [&table] { return kUsageHead + describe(table) + kUsageTail; }};
@@ -97,6 +114,15 @@ int main(int argc, char** argv) {
         std::cerr << "airseg-ground: " << error << '\n';
         return 1;
     }
+    std::unique_ptr<airseg::ground::GcsFeed> gcs;
+    if (!o.gcs.udp_listen.empty() || !o.gcs.tcp.empty()) {
+        gcs = std::make_unique<airseg::ground::GcsFeed>(strand, hub, o.gcs);
+        if (auto error = gcs->start(); !error.empty()) {
+            std::cerr << "airseg-ground: MAVLink for ground stations: " << error << '\n';
+            return 1;
+        }
+        spdlog::info("ground hub: MAVLink for ground stations on {}", gcs->where());
+    }
     std::unique_ptr<airseg::ground::MapFeed> map;
     if (!o.map.listen.empty()) {
         map = std::make_unique<airseg::ground::MapFeed>(strand, hub, o.map);
@@ -115,6 +141,9 @@ int main(int argc, char** argv) {
             boost::asio::dispatch(strand, [&] {
                 if (map) {
                     map->stop();
+                }
+                if (gcs) {
+                    gcs->stop();
                 }
                 hub.stop();
                 io.stop();

@@ -71,12 +71,14 @@ class GroundHubE2e : public ::testing::Test {
                 binary("daemon/airsegd"), "--config", source_path("config/airseg.yaml"), "--set",
                 "status.socket=" + dir.file("status.sock"), "--set", "state_dir=" + dir.file("state"),
                 "--set", "autopilot.port=" + dir.file("ttyACM0"), "--set",
-                "groundlink.ports=[" + dir.file("air") + "]", "--set", "groundlink.key_file=" + key},
+                "groundlink.ports=[" + dir.file("air") + "]", "--set", "groundlink.key_file=" + key, "--set",
+                "groundlink.mavlink_forward.enabled=true"},
             std::map<std::string, std::string>{}, dir.path());
         hub = std::make_unique<Subprocess>(
             std::vector<std::string>{binary("ground/airseg-ground"), "--link", dir.file("ground"), "--key",
                                      key, "--socket", socket(), "--map", "127.0.0.1:0", "--tcp",
-                                     "127.0.0.1:0"},
+                                     "127.0.0.1:0", "--mavlink-udp", "off", "--mavlink-udp-listen",
+                                     "127.0.0.1:0", "--mavlink-tcp", "127.0.0.1:0"},
             std::map<std::string, std::string>{}, dir.path());
         ASSERT_TRUE(wait_until([&] { return exists(socket()); })) << hub->err();
         Json doc;
@@ -130,6 +132,17 @@ class GroundHubE2e : public ::testing::Test {
         }
         const auto begin = at + std::string("clients on tcp ").size();
         return log.substr(begin, log.find_first_of(" \n", begin) - begin);
+    }
+
+    /// HOST:PORT where the hub hears ground stations over UDP, from its log line.
+    std::string mavlink_udp() const {
+        const auto log = hub->err();
+        const auto at = log.find("ground hub: MAVLink for ground stations on udp ");
+        if (at == std::string::npos) {
+            return {};
+        }
+        const auto begin = at + std::string("ground hub: MAVLink for ground stations on udp ").size();
+        return log.substr(begin, log.find_first_of(" ,\n", begin) - begin);
     }
 
     /// The map's address, from the hub's log line.
@@ -318,6 +331,47 @@ TEST_F(GroundHubE2e, TheMapShowsThePlanAndTheVehicleDrivingIt) {
     // Drawn, not only counted: the track and the vehicle marker are in the page's SVG and markers.
     EXPECT_NE(dom.find("airseg-track"), std::string::npos);
     EXPECT_NE(dom.find("airseg-vehicle"), std::string::npos);
+}
+
+// A standard ground station on the hub's MAVLink endpoint, played by node-mavlink as QGroundControl behaves
+// on connect: heartbeats and position at 1 Hz or more, every parameter, the mission, a mode change (LOITER).
+// Meanwhile airseg's own telemetry keeps its rate on the same 57600-baud link.
+TEST_F(GroundHubE2e, AGroundStationGetsTheAutopilotsMavlinkThroughTheHub) {
+    start_chain();
+    ASSERT_FALSE(mavlink_udp().empty()) << hub->err();
+    const auto node = run({"/bin/sh", "-c", "command -v node"});
+    ASSERT_EQ(node.exit_code, 0) << "node is not installed: sudo apt-get install nodejs";
+    // A paused plan: the autopilot's mission holds its window, and nothing drives while the mode changes.
+    auto loaded = ctl({"plan", "load", plan_file(), "--paused"}, true);
+    ASSERT_EQ(loaded.exit_code, 0) << loaded.out << loaded.err;
+    Subprocess watcher(ctl_argv({"watch", "--duration", "40000"}, false), {}, dir.path());
+    auto gcs = run(
+        {node.out.substr(0, node.out.find('\n')), source_path("tests/integration/ground_hub/gcs_client.js"),
+         mavlink_udp(), binary("mavlink_interop/node_modules"), "5"},
+        {}, 240s);
+    const auto summary = Json::parse(gcs.out, nullptr, false);
+    ASSERT_TRUE(summary.is_object()) << gcs.out << gcs.err << "\nhub:\n" << hub->err();
+    EXPECT_TRUE(summary["ok"].get<bool>()) << summary.dump(2);
+    EXPECT_GE(summary["heartbeat_hz"].get<double>(), 0.9) << summary.dump();
+    EXPECT_GE(summary["position_hz"].get<double>(), 0.9) << summary.dump();
+    EXPECT_GT(summary["params"]["count"].get<int>(), 20) << summary.dump();
+    EXPECT_EQ(summary["params"]["received"], summary["params"]["count"]) << summary.dump();
+    EXPECT_GE(summary["mission"]["count"].get<int>(), 3) << "home and the plan's window: " << summary.dump();
+    EXPECT_EQ(summary["mission"]["received"], summary["mission"]["count"]) << summary.dump();
+    EXPECT_EQ(summary["mode"]["ack"], 0) << summary.dump();
+    EXPECT_TRUE(summary["mode"]["seen"].get<bool>()) << summary.dump();
+
+    // airseg's own Fast telemetry (2 Hz) kept its rate while the ground station downloaded.
+    watcher.signal(SIGTERM);
+    ASSERT_TRUE(watcher.wait_exit(kGenerous));
+    const auto lines = json_lines(watcher.out());
+    ASSERT_FALSE(lines.empty()) << watcher.err();
+    EXPECT_GE(lines.back()["sample_rate"].get<double>(), 1.8) << lines.back().dump();
+    // And the vehicle counted both directions.
+    auto status = ctl({"status"});
+    const auto forward = Json::parse(status.out, nullptr, false)["groundlink"]["mavlink_forward"];
+    EXPECT_GT(forward.value("forwarded", 0), 0) << forward.dump();
+    EXPECT_GT(forward.value("from_ground", 0), 0) << forward.dump();
 }
 
 }  // namespace
