@@ -54,12 +54,14 @@ fi
 "$build/daemon/airsegd" --config config/airseg.yaml \
   --set "status.socket=$run_dir/status.sock" --set "state_dir=$run_dir/state" \
   --set "autopilot.port=$autopilot_port" --set "groundlink.ports=[$run_dir/radio-air]" \
+  --set groundlink.mavlink_forward.enabled=true \
   > "$run_dir/airsegd.log" 2>&1 &
 pids+=($!)
 
 # The map on a free port (named in the hub's log): a fixed one may be taken on a developer's machine.
 "$build/ground/airseg-ground" --link "$run_dir/radio-ground" --baud 57600 --socket "$run_dir/ground.sock" \
-  --map "127.0.0.1:${AIRSEG_DEMO_MAP_PORT:-0}" --map-control > "$run_dir/airseg-ground.log" 2>&1 &
+  --map "127.0.0.1:${AIRSEG_DEMO_MAP_PORT:-0}" --map-control --mavlink-tcp "127.0.0.1:${AIRSEG_DEMO_MAVLINK_TCP:-0}" \
+  > "$run_dir/airseg-ground.log" 2>&1 &
 pids+=($!)
 wait_for "$run_dir/ground.sock"
 map_url=""
