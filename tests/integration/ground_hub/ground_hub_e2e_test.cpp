@@ -6,11 +6,12 @@
 #include <signal.h>
 #include <sys/stat.h>
 
+#include <filesystem>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "client/hub_client.hpp"
 #include "tests/support/control_client.hpp"
+#include "tests/support/json_lines.hpp"
 #include "tests/support/process.hpp"
 
 namespace airseg::test {
@@ -20,23 +21,6 @@ using Json = nlohmann::json;
 constexpr auto kGenerous = 60s;
 constexpr double kHomeLat = 41.2756;
 constexpr double kHomeLon = 1.9866;
-
-bool exists(const std::string& path) {
-    struct stat st {};
-    return ::stat(path.c_str(), &st) == 0;
-}
-
-std::vector<Json> json_lines(const std::string& text) {
-    std::vector<Json> out;
-    std::istringstream in(text);
-    for (std::string line; std::getline(in, line);) {
-        auto j = Json::parse(line, nullptr, false);
-        if (!j.is_discarded()) {
-            out.push_back(std::move(j));
-        }
-    }
-    return out;
-}
 
 class GroundHubE2e : public ::testing::Test {
   protected:
@@ -57,15 +41,16 @@ class GroundHubE2e : public ::testing::Test {
             std::vector<std::string>{binary("tools/linksim/airseg-linksim"), "--a", dir.file("air"), "--b",
                                      dir.file("ground"), "--baud", "57600", "--seed", "7"},
             std::map<std::string, std::string>{}, dir.path());
-        ASSERT_TRUE(wait_until([&] { return exists(dir.file("air")) && exists(dir.file("ground")); }))
-            << linksim->err();
+        ASSERT_TRUE(wait_until([&] {
+            return std::filesystem::exists(dir.file("air")) && std::filesystem::exists(dir.file("ground"));
+        })) << linksim->err();
         sim = std::make_unique<Subprocess>(
             std::vector<std::string>{binary("tools/apmsim/airseg-apmsim"), "--link", dir.file("ttyACM0"),
                                      "--home", std::to_string(kHomeLat) + "," + std::to_string(kHomeLon),
                                      "--boot-delay", "0.5", "--calib-time", "0.5", "--speedup", "4",
                                      "--quiet"},
             std::map<std::string, std::string>{}, dir.path());
-        ASSERT_TRUE(wait_until([&] { return exists(dir.file("ttyACM0")); })) << sim->err();
+        ASSERT_TRUE(wait_until([&] { return std::filesystem::exists(dir.file("ttyACM0")); })) << sim->err();
         daemon = std::make_unique<Subprocess>(
             std::vector<std::string>{
                 binary("daemon/airsegd"), "--config", source_path("config/airseg.yaml"), "--set",
@@ -80,7 +65,7 @@ class GroundHubE2e : public ::testing::Test {
                                      "127.0.0.1:0", "--mavlink-udp", "off", "--mavlink-udp-listen",
                                      "127.0.0.1:0", "--mavlink-tcp", "127.0.0.1:0"},
             std::map<std::string, std::string>{}, dir.path());
-        ASSERT_TRUE(wait_until([&] { return exists(socket()); })) << hub->err();
+        ASSERT_TRUE(wait_until([&] { return std::filesystem::exists(socket()); })) << hub->err();
         Json doc;
         ASSERT_TRUE(wait_until(
             [&] {
@@ -123,38 +108,21 @@ class GroundHubE2e : public ::testing::Test {
 
     std::string socket() const { return dir.file("ground.sock"); }
 
-    /// HOST:PORT of the hub's TCP listener, from its log line.
-    std::string tcp_address() const {
+    /// The word after `prefix` in the hub's log (an address it bound to), empty until it is there.
+    std::string logged_after(const std::string& prefix) const {
         const auto log = hub->err();
-        const auto at = log.find("clients on tcp ");
+        const auto at = log.find(prefix);
         if (at == std::string::npos) {
             return {};
         }
-        const auto begin = at + std::string("clients on tcp ").size();
-        return log.substr(begin, log.find_first_of(" \n", begin) - begin);
-    }
-
-    /// HOST:PORT where the hub hears ground stations over UDP, from its log line.
-    std::string mavlink_udp() const {
-        const auto log = hub->err();
-        const auto at = log.find("ground hub: MAVLink for ground stations on udp ");
-        if (at == std::string::npos) {
-            return {};
-        }
-        const auto begin = at + std::string("ground hub: MAVLink for ground stations on udp ").size();
+        const auto begin = at + prefix.size();
         return log.substr(begin, log.find_first_of(" ,\n", begin) - begin);
     }
-
-    /// The map's address, from the hub's log line.
-    std::string map_url() const {
-        const auto log = hub->err();
-        const auto at = log.find("the map on http://");
-        if (at == std::string::npos) {
-            return {};
-        }
-        const auto begin = at + std::string("the map on ").size();
-        return log.substr(begin, log.find_first_of(" \n", begin) - begin);
+    std::string tcp_address() const { return logged_after("clients on tcp "); }
+    std::string mavlink_udp() const {
+        return logged_after("ground hub: MAVLink for ground stations on udp ");
     }
+    std::string map_url() const { return logged_after("the map on "); }
 
     /// What the page drew, as its own counts (window.airsegMap.state(), mirrored into the DOM), from a real
     /// headless browser that follows the vehicle for `seconds`.

@@ -23,6 +23,7 @@
 #include "services/groundlink/transport/transport.hpp"
 #include "tests/support/control_client.hpp"
 #include "tests/support/ground_station.hpp"
+#include "tests/support/json_lines.hpp"
 #include "tests/support/process.hpp"
 
 namespace airseg::test {
@@ -38,18 +39,6 @@ using SimControl = ControlClient;
 bool exists(const std::string& path) {
     struct stat st {};
     return ::stat(path.c_str(), &st) == 0;
-}
-
-std::vector<Json> json_lines(const std::string& text) {
-    std::vector<Json> out;
-    std::istringstream in(text);
-    for (std::string line; std::getline(in, line);) {
-        auto j = Json::parse(line, nullptr, false);
-        if (!j.is_discarded()) {
-            out.push_back(std::move(j));
-        }
-    }
-    return out;
 }
 
 class GroundControlE2e : public ::testing::Test {
