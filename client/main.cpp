@@ -21,6 +21,8 @@
 #include "client/hub_client.hpp"
 #include "client/live_commands.hpp"
 #include "client/local_client.hpp"
+#include "client/mqtt_client.hpp"
+#include "client/mqtt_options.hpp"
 #include "client/plan_command.hpp"
 #include "client/radio_client.hpp"
 #include "client/radio_options.hpp"
@@ -72,8 +74,11 @@ struct Options {
     std::string socket = "/run/airseg/status.sock";
     airseg::client::RadioOptions radio;
     airseg::client::HubOptions hub;
+    airseg::client::MqttOptions mqtt;
+    std::string vehicle;
     bool use_radio = false;
     bool use_hub = false;
+    bool use_mqtt = false;
     bool local_chosen = false;  // --local or --socket: never look for a ground hub instead
     bool json = false;
     long timeout_ms = 5000;
@@ -110,7 +115,8 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
                    o.local_chosen = true;
                })
         .flag("ground",
-              "through the ground hub airseg-ground on its default socket (/run/airseg-ground/ground.sock); chosen "
+              "through the ground hub airseg-ground on its default socket (/run/airseg-ground/ground.sock); "
+              "chosen "
               "by itself when that socket exists and airsegd's does not",
               [&o] { o.use_hub = true; })
         .value("ground-socket", "PATH", "through the ground hub on this Unix socket",
@@ -124,6 +130,7 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
                    o.use_hub = true;
                });
     airseg::client::add_radio_options(table, o.radio, [&o] { o.use_radio = true; });
+    airseg::client::add_mqtt_options(table, o.mqtt, o.vehicle, [&o] { o.use_mqtt = true; });
     table
         .value("timeout", "MS", "how long to wait for an answer, in milliseconds (default 5000)",
                [&o](std::string_view option, std::string_view v) {
@@ -147,6 +154,14 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
     if (o.positional.empty()) {
         return usage_error("no command given");
     }
+    if (o.use_mqtt + o.use_radio + o.use_hub > 1) {
+        return usage_error(
+            "choose one way to the vehicle: the radio (--link, --udp), the ground hub (--ground...) "
+            "or an MQTT broker (--mqtt)");
+    }
+    if (o.use_mqtt && o.vehicle.empty()) {
+        return usage_error("--mqtt needs --vehicle ID: a broker serves many vehicles");
+    }
     if (o.use_radio && o.use_hub) {
         return usage_error(
             "--ground and the radio options (--link, --udp) exclude each other: the hub owns the "
@@ -157,7 +172,7 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
             return usage_error(problem);
         }
     }
-    if (!o.use_radio && !o.use_hub && !o.local_chosen && !exists(o.socket) &&
+    if (!o.use_radio && !o.use_hub && !o.use_mqtt && !o.local_chosen && !exists(o.socket) &&
         exists(std::string(airseg::client::hub::kDefaultSocket))) {
         o.use_hub = true;  // a ground laptop: no airsegd here, but a hub
     }
@@ -274,7 +289,8 @@ int live_command(const Options& o, Requester& client, airseg::client::VehicleLin
             std::chrono::milliseconds(static_cast<long>(interval_ms)), live);
     }
     if (radio == nullptr) {
-        return usage_error(cmd + " needs the radio link (--link, --udp or --ground): the vehicle pushes it");
+        return usage_error(
+            cmd + " needs the radio link (--link, --udp, --ground or --mqtt): the vehicle pushes it");
     }
     if (cmd == "log") {
         return airseg::client::run_log(*radio, live);
@@ -303,6 +319,17 @@ int main(int argc, char** argv) {
             return kNoLink;
         }
         radio = std::move(direct);
+    } else if (o.use_mqtt) {
+        if (cmd == "joystick") {
+            return usage_error(
+                "joystick needs the radio or the ground hub: a broker's latency is no way to drive");
+        }
+        auto broker = std::make_unique<airseg::client::MqttClient>(o.mqtt, o.vehicle);
+        if (auto error = broker->open(timeout); !error.empty()) {
+            std::cerr << "airsegctl: " << error << "\n";
+            return kNoLink;
+        }
+        radio = std::move(broker);
     } else if (o.use_hub) {
         auto options = o.hub;
         options.key_file = o.radio.key_file;

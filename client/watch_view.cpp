@@ -12,23 +12,6 @@ namespace {
 
 constexpr auto kRateWindow = std::chrono::seconds(5);
 
-const char* plan_state_name(std::uint8_t s) {
-    switch (s) {
-        case 1:
-            return "running";
-        case 2:
-            return "paused";
-        case 3:
-            return "done";
-        case 4:
-            return "interrupted";
-        case 5:
-            return "failed";
-        default:
-            return "none";
-    }
-}
-
 // The wire carries the autopilot's mode number; its name comes from the autopilot's own table, and a number
 // without one (or the "no mode" code) shows as "?".
 const char* mode_name(std::uint8_t code) {
@@ -52,6 +35,23 @@ double seconds(std::chrono::steady_clock::duration d) {
 }
 
 }  // namespace
+
+const char* plan_state_name(std::uint8_t s) {
+    switch (s) {
+        case 1:
+            return "running";
+        case 2:
+            return "paused";
+        case 3:
+            return "done";
+        case 4:
+            return "interrupted";
+        case 5:
+            return "failed";
+        default:
+            return "none";
+    }
+}
 
 nlohmann::json telemetry_json(const proto::Telemetry& t) {
     nlohmann::json j{{"state", proto::vehicle_state_name(t.vehicle_state)},

@@ -39,6 +39,8 @@ class WatchState {
     nlohmann::json ground_link_ = nlohmann::json::object();
 };
 
+/// The telemetry's plan state code by name: none, running, paused, done, interrupted, failed.
+const char* plan_state_name(std::uint8_t code);
 /// A telemetry sample as JSON (state and mode by name, position, speeds, battery, GPS, plan progress).
 nlohmann::json telemetry_json(const groundlink::protocol::Telemetry& t);
 /// An event as one line for people: "warning: text".
