@@ -82,7 +82,7 @@ struct AutopilotConfig {
     Duration boot_timeout = seconds(30);      // autopilot.boot_timeout (1..120 s)
     Duration heartbeat_timeout = seconds(3);  // autopilot.heartbeat_timeout (0.5..30 s)
     std::uint8_t own_sysid = 255;             // autopilot.own_sysid
-    std::uint8_t own_compid = 190;            // autopilot.own_compid (MAV_COMP_ID_MISSIONPLANNER)
+    std::uint8_t own_compid = 191;            // autopilot.own_compid (MAV_COMP_ID_ONBOARD_COMPUTER)
     std::uint8_t target_sysid = 1;            // autopilot.target_sysid
     std::uint8_t target_compid = 1;           // autopilot.target_compid
     bool gcs_heartbeat = true;  // autopilot.gcs_heartbeat (off: false): send our 1 Hz HEARTBEAT
