@@ -14,7 +14,7 @@ namespace mav = airseg::mavlink;
 namespace {
 
 constexpr std::array<const char*, 3> kRefusal{
-    "airseg: ground station mission upload refused",
+    "airseg: ground station mission write refused",
     "airseg: missions are flight plans, kept on board",
     "airseg: load one with: airsegctl plan load FILE",
 };
