@@ -205,10 +205,24 @@ struct ForwardedFrame {
     std::vector<std::uint8_t> bytes;  // one whole frame
 };
 /// Whole frames from a standard ground station for the autopilot, unchecked: the autopilot service parses
-/// them, keeps mission writes from the autopilot (the flight plan manager owns the mission) and writes the
-/// rest to the autopilot.
+/// them, keeps mission writes from the autopilot (the flight plan manager owns the mission: an upload
+/// becomes a GroundStationMission) and writes the rest to the autopilot.
 struct GroundStationFrames {
     std::vector<std::uint8_t> bytes;
+};
+
+/// The flight plan manager's verdict on a ground station's mission.
+struct GroundStationMissionResult {
+    bool accepted = false;
+    std::string reason;  // for the ground station's operator, when refused
+};
+/// A mission a standard ground station uploaded, received by the autopilot room in the autopilot's name
+/// instead of being written to it: the flight plan manager loads it as its plan or refuses it. The ground
+/// station gets MISSION_ACK once the reply came.
+struct GroundStationMission {
+    std::string station;             // "SYSID/COMPID", for logs
+    std::vector<MissionItem> items;  // Waypoint (with hold_s for a timed hold) or Stop; home left out
+    Reply<GroundStationMissionResult> reply;
 };
 
 /// What status shows as autopilot.* keys.

@@ -82,23 +82,23 @@ struct AutopilotConfig {
     Duration boot_timeout = seconds(30);      // autopilot.boot_timeout (1..120 s)
     Duration heartbeat_timeout = seconds(3);  // autopilot.heartbeat_timeout (0.5..30 s)
     std::uint8_t own_sysid = 255;             // autopilot.own_sysid
-    std::uint8_t own_compid = 190;            // autopilot.own_compid (MAV_COMP_ID_MISSIONPLANNER)
+    std::uint8_t own_compid = 191;            // autopilot.own_compid (MAV_COMP_ID_ONBOARD_COMPUTER)
     std::uint8_t target_sysid = 1;            // autopilot.target_sysid
     std::uint8_t target_compid = 1;           // autopilot.target_compid
-    bool gcs_heartbeat = true;  // autopilot.gcs_heartbeat (off: false): send our 1 Hz HEARTBEAT
+    bool gcs_heartbeat = true;                // autopilot.gcs_heartbeat (off: false): send our 1 Hz HEARTBEAT
     std::uint8_t gcs_heartbeat_type = kMavTypeGcs;  // autopilot.gcs_heartbeat: gcs | onboard
-    int mavlink_version = 1;    // autopilot.mavlink_version: 1 | 2 (default per board)
-    bool use_message_interval = false;            // autopilot.use_message_interval (default per board)
-    std::vector<StreamRate> stream_rates;         // autopilot.streams: {position: 4, extra1: 4, ...}
-    std::vector<MessageRate> message_rates;       // autopilot.message_rates: {GLOBAL_POSITION_INT: 4, ...}
-    std::vector<ParamSetting> params;             // autopilot.params: {NAME: value, ...}
-    Duration param_timeout = seconds(1);          // autopilot.param_timeout: per PARAM_SET / read attempt
-    unsigned param_retries = 3;                   // autopilot.param_retries
-    Duration param_list_timeout = seconds(60);    // autopilot.param_list_timeout: the whole download
-    Duration mode_timeout = milliseconds(1500);   // autopilot.mode_timeout: per attempt
-    unsigned mode_retries = 3;                    // autopilot.mode_retries
-    Duration unresponsive_timeout = seconds(20);  // autopilot.reset.unresponsive_timeout
-    unsigned max_reset_pulses = 3;                // autopilot.reset.max_pulses (0: never pulse)
+    int mavlink_version = 1;                        // autopilot.mavlink_version: 1 | 2 (default per board)
+    bool use_message_interval = false;              // autopilot.use_message_interval (default per board)
+    std::vector<StreamRate> stream_rates;           // autopilot.streams: {position: 4, extra1: 4, ...}
+    std::vector<MessageRate> message_rates;         // autopilot.message_rates: {GLOBAL_POSITION_INT: 4, ...}
+    std::vector<ParamSetting> params;               // autopilot.params: {NAME: value, ...}
+    Duration param_timeout = seconds(1);            // autopilot.param_timeout: per PARAM_SET / read attempt
+    unsigned param_retries = 3;                     // autopilot.param_retries
+    Duration param_list_timeout = seconds(60);      // autopilot.param_list_timeout: the whole download
+    Duration mode_timeout = milliseconds(1500);     // autopilot.mode_timeout: per attempt
+    unsigned mode_retries = 3;                      // autopilot.mode_retries
+    Duration unresponsive_timeout = seconds(20);    // autopilot.reset.unresponsive_timeout
+    unsigned max_reset_pulses = 3;                  // autopilot.reset.max_pulses (0: never pulse)
     MissionConfig mission;
     RcOverrideConfig rc_override;
 

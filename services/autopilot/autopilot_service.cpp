@@ -43,8 +43,10 @@ AutopilotService::AutopilotService(ServiceContext& ctx, AutopilotServiceConfig c
                                    }}),
       tlog_(config_.tlog),
       gate_(config_.autopilot.target_sysid, config_.autopilot.target_compid),
+      uploads_(config_.autopilot.target_sysid, config_.autopilot.target_compid),
       timer_(strand()),
       prefix_("autopilot[" + config_.port.serial.path + "]: ") {
+    gate_.receive_uploads(uploads_);
     if (config_.gcs_endpoint) {
         endpoint_ = std::make_unique<GcsEndpoint>(
             strand(), *config_.gcs_endpoint,
@@ -66,6 +68,7 @@ AutopilotService::~AutopilotService() = default;
 
 void AutopilotService::on_start() {
     running_ = true;
+    calls_.emplace();
     if (config_.reset_line) {
         if (!gpio_) {
             spdlog::warn("{}reset line configured but no GPIO backend; reset pulses disabled", prefix_);
@@ -100,6 +103,7 @@ void AutopilotService::on_start() {
 
 void AutopilotService::on_stop() {
     running_ = false;
+    calls_.reset();
     subscriptions_.clear();
     timer_.cancel();
     if (endpoint_) {
@@ -115,7 +119,7 @@ void AutopilotService::from_ground_station(std::span<const std::uint8_t> frames)
         return;
     }
     const auto refused_before = gate_.stats().missions_refused;
-    auto out = gate_.from_ground(frames);
+    auto out = gate_.from_ground(frames, SteadyClock::now());
     if (gate_.stats().missions_refused != refused_before) {
         spdlog::info("{}refused a mission write from a ground station ({} so far): missions are flight plans",
                      prefix_, gate_.stats().missions_refused);
@@ -123,6 +127,7 @@ void AutopilotService::from_ground_station(std::span<const std::uint8_t> frames)
     for (const auto& answer : out.to_ground) {
         to_ground_stations(answer);
     }
+    drain_uploads();
     if (!keeper_.is_open()) {
         return;
     }
@@ -142,6 +147,31 @@ void AutopilotService::to_ground_stations(const ForwardedFrame& frame) {
     if (config_.forward_frames) {
         ctx_.bus.publish(frame);
     }
+}
+
+void AutopilotService::drain_uploads() {
+    for (const auto& answer : uploads_.take_output()) {
+        to_ground_stations(answer);
+    }
+    if (auto m = uploads_.poll_mission(); m && calls_) {
+        const auto station = std::to_string(m->sysid) + "/" + std::to_string(m->compid);
+        spdlog::info("{}ground station {} uploaded a mission of {} items: handed to the flight plan manager",
+                     prefix_, station, m->items.size());
+        GroundStationMissionResult unanswered;
+        unanswered.reason = "airseg: no flight plan manager is running";
+        ctx_.bus.publish(GroundStationMission{
+            station, std::move(m->items),
+            Reply<GroundStationMissionResult>(
+                strand(), *calls_, std::move(unanswered),
+                [this, station](const GroundStationMissionResult& r) {
+                    if (!r.accepted) {
+                        spdlog::info("{}ground station {}'s mission refused: {}", prefix_, station, r.reason);
+                    }
+                    uploads_.answer(r.accepted, r.reason);
+                    drain_uploads();
+                })});
+    }
+    arm_timer();
 }
 
 void AutopilotService::on_request(const AutopilotRequest& r) {
@@ -251,7 +281,8 @@ void AutopilotService::publish(Event e) {
 
 // One timer for the driver's deadlines and the .tlog's flush deadline.
 void AutopilotService::arm_timer() {
-    timer_.arm(std::min(driver_.poll_timeout(), tlog_.poll_timeout()), [this] { on_timer(); });
+    timer_.arm(std::min({driver_.poll_timeout(), tlog_.poll_timeout(), uploads_.poll_timeout()}),
+               [this] { on_timer(); });
 }
 
 // Published from the wake-up that brought the change, so the status costs no wake-up of its own. Inputs
@@ -280,6 +311,8 @@ void AutopilotService::on_timer() {
     const TimePoint now = SteadyClock::now();
     driver_.handle_timeout(now);
     tlog_.handle_timeout(now);
+    uploads_.handle_timeout(now);
+    drain_uploads();
     pump();
 }
 

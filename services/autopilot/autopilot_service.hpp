@@ -6,9 +6,10 @@
 // for, and records every frame in the .tlog when enabled (its flush deadline shares the driver's timer).
 //
 // Bus: subscribes AutopilotRequest (answered through its Reply), JoystickInput, OperatorReset,
-// GroundStationFrames (through the GcsGate: mission writes are answered, not written); publishes the other
-// autopilot::Event types as events, AutopilotStatus and Telemetry as variables, and with forward_frames each
-// frame from the autopilot (and the gate's answers) as a ForwardedFrame. A request without a Reply runs
+// GroundStationFrames (through the GcsGate: mission writes are answered, not written; an upload is received
+// and published as a GroundStationMission, answered to the ground station with its Reply); publishes the
+// other autopilot::Event types as events, AutopilotStatus and Telemetry as variables, and with forward_frames
+// each frame from the autopilot (and the gate's answers) as a ForwardedFrame. A request without a Reply runs
 // unanswered. Log prefix: autopilot[<device>]: .
 #include <map>
 #include <memory>
@@ -73,6 +74,8 @@ class AutopilotService : public Service {
     void update_health();
     void from_ground_station(std::span<const std::uint8_t> frames);
     void to_ground_stations(const ForwardedFrame& frame);
+    /// Sends the receiver's answers and hands a complete upload to the flight plan manager.
+    void drain_uploads();
 
     AutopilotServiceConfig config_;
     hal::GpioFactory* gpio_;
@@ -81,6 +84,8 @@ class AutopilotService : public Service {
     PortKeeper keeper_;
     TlogWriter tlog_;
     GcsGate gate_;
+    MissionReceiver uploads_;
+    std::optional<ReplyGuard> calls_;  // the flight plan manager's verdicts run only while started
     std::unique_ptr<GcsEndpoint> endpoint_;
     DeadlineTimer timer_;
     TimePoint status_published_at_{};

@@ -14,7 +14,7 @@ namespace mav = airseg::mavlink;
 namespace {
 
 constexpr std::array<const char*, 3> kRefusal{
-    "airseg: ground station mission upload refused",
+    "airseg: ground station mission write refused",
     "airseg: missions are flight plans, kept on board",
     "airseg: load one with: airsegctl plan load FILE",
 };
@@ -94,7 +94,7 @@ std::span<const char* const> mission_refusal_texts() {
 GcsGate::GcsGate(std::uint8_t autopilot_sysid, std::uint8_t autopilot_compid)
     : sysid_(autopilot_sysid), answers_(autopilot_sysid, autopilot_compid) {}
 
-GcsGate::Output GcsGate::from_ground(std::span<const std::uint8_t> frames) {
+GcsGate::Output GcsGate::from_ground(std::span<const std::uint8_t> frames, TimePoint now) {
     Output out;
     mav::Parser parser;  // a fresh one each time: the frames are whole, and ground stations' links differ
     auto on_frame = [&](const mav::Frame& f) {
@@ -103,6 +103,10 @@ GcsGate::Output GcsGate::from_ground(std::span<const std::uint8_t> frames) {
             return;
         }
         ++stats_.frames;
+        if (uploads_ && uploads_->handle_frame(f, now)) {
+            ++stats_.upload_frames;
+            return;
+        }
         if (refuse(f, out)) {
             return;
         }

@@ -9,14 +9,18 @@
 // the mission itself; fences and rally points pass; and COMMAND_LONG MAV_CMD_DO_SET_MISSION_CURRENT) never
 // reach the autopilot: the gate answers the ground station itself, as the autopilot, with MISSION_ACK
 // MAV_MISSION_DENIED (COMMAND_ACK MAV_RESULT_DENIED for the command) and STATUSTEXTs saying why and what to
-// do. Reading the mission, parameters, commands and everything else pass unchanged.
+// do. With receive_uploads(), a mission upload goes to a MissionReceiver instead, which answers in the
+// autopilot's name and hands the mission to the flight plan manager. Reading the mission, parameters,
+// commands and everything else pass unchanged.
 #include <cstdint>
 #include <span>
 #include <vector>
 
+#include "base/time.hpp"
 #include "services/autopilot/autopilot.hpp"
 #include "services/autopilot/mavlink/encoder.hpp"
 #include "services/autopilot/mavlink/frame.hpp"
+#include "services/autopilot/mission_receiver.hpp"
 
 namespace airseg::autopilot {
 
@@ -35,6 +39,7 @@ struct GcsGateStats {
     std::uint64_t frames = 0;            // valid frames from ground stations
     std::uint64_t passed = 0;            // of those, written to the autopilot
     std::uint64_t missions_refused = 0;  // mission writes answered with MAV_MISSION_DENIED
+    std::uint64_t upload_frames = 0;     // mission upload frames handed to the MissionReceiver
     std::uint64_t invalid = 0;           // bytes that were no valid frame of a known message
 };
 
@@ -48,7 +53,11 @@ class GcsGate {
         std::vector<ForwardedFrame> to_ground;                // answers, one frame each
     };
     /// One or more whole frames from a ground station.
-    Output from_ground(std::span<const std::uint8_t> frames);
+    Output from_ground(std::span<const std::uint8_t> frames, TimePoint now = {});
+
+    /// Mission uploads (MISSION_COUNT and the items) go to `receiver` instead of being refused; the other
+    /// mission writes stay refused. The receiver answers the ground station itself (its take_output()).
+    void receive_uploads(MissionReceiver& receiver) { uploads_ = &receiver; }
 
     [[nodiscard]] const GcsGateStats& stats() const { return stats_; }
 
@@ -58,6 +67,7 @@ class GcsGate {
     std::uint8_t sysid_;
     mavlink::Encoder answers_;
     GcsGateStats stats_;
+    MissionReceiver* uploads_ = nullptr;
 };
 
 }  // namespace airseg::autopilot

@@ -3,7 +3,10 @@
 #include <cmath>
 #include <fstream>
 
+#include <spdlog/spdlog.h>
+
 #include "services/flightplan/flightplan_service.hpp"
+#include "services/flightplan/ground_mission.hpp"
 
 namespace airseg::flightplan {
 
@@ -143,6 +146,25 @@ void FlightplanService::cmd_load(const Json& req, CommandDispatcher::Reply reply
     const bool start_paused = paused != req.end() && paused->get<bool>();
     controller_.load(id, std::move(*plan), append, start_paused, source, SteadyClock::now());
     flush();
+}
+
+void FlightplanService::on_ground_station_mission(const autopilot::GroundStationMission& m) {
+    if (auto refusal = ground_mission_refusal(controller_.progress())) {
+        spdlog::info("{}ground station {}'s mission refused: a plan runs", kPrefix, m.station);
+        m.reply({false, std::move(*refusal)});
+        return;
+    }
+    spdlog::info("{}loading ground station {}'s mission ({} items) as the plan", kPrefix, m.station,
+                 m.items.size());
+    Json req = Json::object();
+    req["text"] = ground_mission_plan(m.items);
+    req["source"] = kGroundMissionSource;
+    cmd_load(
+        req,
+        [reply = m.reply](const CommandResult& r) {
+            reply({r.status == CommandStatus::Ok, r.status == CommandStatus::Ok ? "" : "airseg: " + r.error});
+        },
+        false);
 }
 
 void FlightplanService::cmd_geometry(const Json& req, CommandDispatcher::Reply reply) {

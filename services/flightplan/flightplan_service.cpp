@@ -87,6 +87,8 @@ void FlightplanService::on_start() {
             controller_.on_current(c.seq, SteadyClock::now());
             flush();
         }));
+    subscriptions_.push_back(bus.subscribe<autopilot::GroundStationMission>(
+        strand(), [this](const autopilot::GroundStationMission& m) { on_ground_station_mission(m); }));
     subscriptions_.push_back(
         bus.subscribe<autopilot::AutopilotRebooted>(strand(), [this](const autopilot::AutopilotRebooted&) {
             controller_.on_rebooted(SteadyClock::now());

@@ -5,11 +5,12 @@
 // keeps plan and progress in the state directory (StateStore) and resumes them at start.
 //
 // Commands (command dispatcher; see docs/flight-plan.md): plan.load, plan.append, plan.show, plan.geometry,
-// plan.skip, plan.pause, plan.resume. A command that changes the vehicle is answered once the autopilot has confirmed
-// everything it required (the feeder has nothing left to ask), or with the failure.
+// plan.skip, plan.pause, plan.resume. A command that changes the vehicle is answered once the autopilot has
+// confirmed everything it required (the feeder has nothing left to ask), or with the failure.
 //
 // Bus: subscribes autopilot::AutopilotStatus, Telemetry, WaypointReached, MissionCurrentChanged, ModeChanged,
-// AutopilotRebooted, groundlink::LinkState (the ground link's up/down state, a typed variable); publishes
+// AutopilotRebooted, GroundStationMission (answered through its Reply), groundlink::LinkState (the ground
+// link's up/down state, a typed variable); publishes
 // AutopilotRequest (answered through its Reply), FeederEvent and ReactionTrigger (events) and the "plan"
 // status section.
 // Log prefix: flightplan: .
@@ -53,6 +54,8 @@ class FlightplanService : public Service {
     void cmd_skip(const Json& req, CommandDispatcher::Reply reply);
     void cmd_geometry(const Json& req, CommandDispatcher::Reply reply);
     CommandId keep_reply(CommandDispatcher::Reply reply);
+    /// A ground station's mission: loaded as plan.load would load it, or refused while a plan runs.
+    void on_ground_station_mission(const autopilot::GroundStationMission& m);
 
     /// Carries out what the controller decided after an input: bus, replies, state store, logs, timer.
     void flush();

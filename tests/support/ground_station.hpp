@@ -28,6 +28,27 @@ struct GroundStation {
         mavlink::set_text(read.param_id, name);
         return encoder.encode(read);
     }
+    /// A mission item, the answer to the vehicle's request for `seq`.
+    std::vector<std::uint8_t> mission_item(std::uint16_t seq, double lat, double lon,
+                                           std::uint16_t command = mavlink::kCmdNavWaypoint) {
+        mavlink::MissionItemInt item;
+        item.target_system = 1;
+        item.target_component = 1;
+        item.seq = seq;
+        item.frame = mavlink::kFrameGlobalRelativeAltInt;
+        item.command = command;
+        item.autocontinue = 1;
+        item.x = static_cast<std::int32_t>(lat * 1e7);
+        item.y = static_cast<std::int32_t>(lon * 1e7);
+        return encoder.encode(item);
+    }
+    /// MISSION_CLEAR_ALL for the vehicle's mission.
+    std::vector<std::uint8_t> mission_clear() {
+        mavlink::MissionClearAll clear;
+        clear.target_system = 1;
+        clear.target_component = 1;
+        return encoder.encode(clear);
+    }
     /// The start of a mission upload of `items` items.
     std::vector<std::uint8_t> mission_upload(std::uint16_t items) {
         mavlink::MissionCount count;
@@ -44,6 +65,18 @@ struct GroundStation {
         return f.msgid == mavlink::ParamValue::kId &&
                mavlink::text_of(mavlink::decode_payload<mavlink::ParamValue>(f.payload_view()).param_id) ==
                    name;
+    }
+    /// The item a MISSION_REQUEST_INT or MISSION_REQUEST addressed to this station asks for, or -1.
+    static int mission_request(const mavlink::Frame& f) {
+        if (f.msgid == mavlink::MissionRequestInt::kId) {
+            const auto r = mavlink::decode_payload<mavlink::MissionRequestInt>(f.payload_view());
+            return r.target_system == 254 ? r.seq : -1;
+        }
+        if (f.msgid == mavlink::MissionRequest::kId) {
+            const auto r = mavlink::decode_payload<mavlink::MissionRequest>(f.payload_view());
+            return r.target_system == 254 ? r.seq : -1;
+        }
+        return -1;
     }
     /// MISSION_ACK MAV_MISSION_DENIED addressed to this station.
     static bool mission_denied(const mavlink::Frame& f) {

@@ -252,6 +252,9 @@ void Driver::on_time_boot(std::uint32_t time_boot_ms, TimePoint now) {
 }
 
 void Driver::on_command_ack(const mav::CommandAck& ack, TimePoint now) {
+    if (!out_.addressed_to_us(ack.target_system, ack.target_component)) {
+        return;  // a ground station's command, answered to it
+    }
     if (ack.command == mavlink::kCmdDoChangeSpeed) {
         on_speed_ack(ack.result, now);
         return;

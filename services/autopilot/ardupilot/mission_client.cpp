@@ -454,10 +454,6 @@ std::optional<MissionCompletion> MissionClient::poll_completion() {
 
 // --- receiving ---------------------------------------------------------------------------------------------
 
-bool MissionClient::addressed_to_us(std::uint8_t target_system) const {
-    return target_system == 0 || target_system == out_.sysid();
-}
-
 bool MissionClient::handle_frame(const mav::Frame& f, TimePoint now) {
     if (f.sysid != target_sysid_) {
         return false;
@@ -465,42 +461,48 @@ bool MissionClient::handle_frame(const mav::Frame& f, TimePoint now) {
     switch (f.msgid) {
         case mav::MissionRequestInt::kId: {
             const auto m = mav::decode_payload<mav::MissionRequestInt>(f.payload_view());
-            if (addressed_to_us(m.target_system) && m.mission_type == mav::kMissionTypeMission) {
+            if (out_.addressed_to_us(m.target_system, m.target_component) &&
+                m.mission_type == mav::kMissionTypeMission) {
                 on_request(m.seq, true, now);
             }
             return true;
         }
         case mav::MissionRequest::kId: {
             const auto m = mav::decode_payload<mav::MissionRequest>(f.payload_view());
-            if (addressed_to_us(m.target_system) && m.mission_type == mav::kMissionTypeMission) {
+            if (out_.addressed_to_us(m.target_system, m.target_component) &&
+                m.mission_type == mav::kMissionTypeMission) {
                 on_request(m.seq, false, now);
             }
             return true;
         }
         case mav::MissionAck::kId: {
             const auto m = mav::decode_payload<mav::MissionAck>(f.payload_view());
-            if (addressed_to_us(m.target_system) && m.mission_type == mav::kMissionTypeMission) {
+            if (out_.addressed_to_us(m.target_system, m.target_component) &&
+                m.mission_type == mav::kMissionTypeMission) {
                 on_ack(m.type, now);
             }
             return true;
         }
         case mav::MissionCount::kId: {
             const auto m = mav::decode_payload<mav::MissionCount>(f.payload_view());
-            if (addressed_to_us(m.target_system) && m.mission_type == mav::kMissionTypeMission) {
+            if (out_.addressed_to_us(m.target_system, m.target_component) &&
+                m.mission_type == mav::kMissionTypeMission) {
                 on_count(m.count, now);
             }
             return true;
         }
         case mav::MissionItemInt::kId: {
             const auto m = mav::decode_payload<mav::MissionItemInt>(f.payload_view());
-            if (addressed_to_us(m.target_system) && m.mission_type == mav::kMissionTypeMission) {
+            if (out_.addressed_to_us(m.target_system, m.target_component) &&
+                m.mission_type == mav::kMissionTypeMission) {
                 on_item(m, now);
             }
             return true;
         }
         case mav::MissionItem::kId: {
             const auto m = mav::decode_payload<mav::MissionItem>(f.payload_view());
-            if (addressed_to_us(m.target_system) && m.mission_type == mav::kMissionTypeMission) {
+            if (out_.addressed_to_us(m.target_system, m.target_component) &&
+                m.mission_type == mav::kMissionTypeMission) {
                 on_item(to_int_item(m), now);
             }
             return true;

@@ -169,7 +169,6 @@ class MissionClient {
     void on_count(std::uint16_t count, TimePoint now);
     void on_item(const mavlink::MissionItemInt& item, TimePoint now);
     void on_current(std::uint16_t seq, TimePoint now);
-    bool addressed_to_us(std::uint8_t target_system) const;
     /// Sends `m` to the vehicle's mission (not its fence or rally points), addressed to the target.
     template <class M>
     void send_to_mission(M m);

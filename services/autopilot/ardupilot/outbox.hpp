@@ -43,6 +43,13 @@ class Outbox {
     std::uint64_t dropped() const { return dropped_; }
     std::uint8_t sysid() const { return encoder_.sysid(); }
     std::uint8_t compid() const { return encoder_.compid(); }
+    /// Whether an answer is meant for this sender. Zero means anyone (old boards, broadcast). The component
+    /// counts too: a ground station on the same system id (QGroundControl's default 255) sends the same
+    /// requests, and the autopilot answers each requester's system and component.
+    bool addressed_to_us(std::uint8_t target_system, std::uint8_t target_component) const {
+        return (target_system == 0 || target_system == sysid()) &&
+               (target_component == 0 || target_component == compid());
+    }
     void set_version(mavlink::Version v) { encoder_.set_version(v); }
 
   private:

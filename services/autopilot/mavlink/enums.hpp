@@ -9,6 +9,7 @@ namespace airseg::mavlink {
 // MAV_CMD
 inline constexpr std::uint16_t kCmdNavWaypoint = 16;
 inline constexpr std::uint16_t kCmdNavLoiterUnlim = 17;
+inline constexpr std::uint16_t kCmdNavLoiterTime = 19;
 inline constexpr std::uint16_t kCmdDoSetMode = 176;
 inline constexpr std::uint16_t kCmdDoJump = 177;
 inline constexpr std::uint16_t kCmdDoChangeSpeed = 178;
@@ -53,6 +54,7 @@ inline constexpr std::uint8_t kMissionTypeMission = 0;
 inline constexpr std::uint8_t kFrameGlobal = 0;
 inline constexpr std::uint8_t kFrameMission = 2;
 inline constexpr std::uint8_t kFrameGlobalRelativeAlt = 3;
+inline constexpr std::uint8_t kFrameGlobalInt = 5;
 inline constexpr std::uint8_t kFrameGlobalRelativeAltInt = 6;
 
 // MAV_TYPE, MAV_AUTOPILOT

@@ -225,8 +225,8 @@ TEST_F(AutopilotBaudProbeE2e, ProbesTheConfiguredRatesAndKeepsTheOneThatWorks) {
 }
 
 // A ground station on the board's network (autopilot.gcs_endpoint.udp) talks to the simulated board through
-// airsegd: it hears the board, reads a parameter, and a mission upload is refused by airsegd, the board's
-// mission untouched.
+// airsegd: it hears the board, reads a parameter, and its mission upload becomes the flight plan when none
+// runs, or is refused with the reason while one does.
 class GcsEndpointE2e : public AutopilotE2e {
   protected:
     GcsEndpointE2e() : port_(free_udp_port()) {
@@ -263,13 +263,50 @@ class GcsEndpointE2e : public AutopilotE2e {
         return seen;
     }
 
+    struct Upload {
+        int ack = -1;  // the MISSION_ACK type, -1 when none came
+        std::string texts;
+    };
+    /// Uploads home and `points` as waypoints, the last one a stop until released, answering each request.
+    Upload upload(const std::vector<std::pair<double, double>>& points) {
+        Upload u;
+        send(gcs_.mission_upload(static_cast<std::uint16_t>(points.size() + 1)));
+        const auto answer = [&](const mavlink::Frame& f) {
+            if (const int seq = GroundStation::mission_request(f); seq >= 0) {
+                const auto& p = seq == 0 ? std::pair{kHomeLat, kHomeLon} : points[seq - 1];
+                const bool last = static_cast<std::size_t>(seq) == points.size();
+                send(gcs_.mission_item(static_cast<std::uint16_t>(seq), p.first, p.second,
+                                       last ? mavlink::kCmdNavLoiterUnlim : mavlink::kCmdNavWaypoint));
+            } else if (f.msgid == mavlink::Statustext::kId && f.sysid == 1) {
+                u.texts +=
+                    mavlink::text_of(mavlink::decode_payload<mavlink::Statustext>(f.payload_view()).text);
+                u.texts += ' ';
+            } else if (f.msgid == mavlink::MissionAck::kId) {
+                const auto ack = mavlink::decode_payload<mavlink::MissionAck>(f.payload_view());
+                if (ack.target_system == 254) {
+                    u.ack = ack.type;
+                    return true;
+                }
+            }
+            return false;
+        };
+        hear(answer, kGenerous);
+        hear(
+            [&](const mavlink::Frame& f) {
+                answer(f);
+                return false;  // the texts that follow the acknowledgement
+            },
+            500ms);
+        return u;
+    }
+
     int port_;
     int fd_ = ::socket(AF_INET, SOCK_DGRAM, 0);
     mavlink::Parser parser_;
     GroundStation gcs_;
 };
 
-TEST_F(GcsEndpointE2e, AGroundStationHearsTheBoardReadsAParameterAndCannotUploadAMission) {
+TEST_F(GcsEndpointE2e, AGroundStationsMissionBecomesThePlanAndAnotherIsRefusedWhileItRuns) {
     ASSERT_TRUE(wait_until([&] { return ready(); }, kGenerous, kPoll)) << daemon_->err();
     send(gcs_.heartbeat());
     EXPECT_TRUE(hear(GroundStation::board_heartbeat, 10s)) << daemon_->err();
@@ -277,13 +314,24 @@ TEST_F(GcsEndpointE2e, AGroundStationHearsTheBoardReadsAParameterAndCannotUpload
     EXPECT_TRUE(
         hear([](const mavlink::Frame& f) { return GroundStation::param_value(f, "CRUISE_SPEED"); }, 10s));
 
-    const auto mission_before = control_->json("state")["mission_count"];
-    send(gcs_.mission_upload(2));
-    EXPECT_TRUE(hear(GroundStation::mission_denied, 10s));
-    EXPECT_EQ(control_->json("state")["mission_count"], mission_before) << "the board's mission is untouched";
-    EXPECT_EQ(control_->json("stats")["mission_items_received"], 0);
-    EXPECT_NE(daemon_->err().find("refused a mission write from a ground station"), std::string::npos)
-        << daemon_->err();
+    // No plan runs: the mission becomes the plan, and the flight plan manager drives it.
+    const auto first = upload({{kHomeLat + 0.0003, kHomeLon}, {kHomeLat + 0.0006, kHomeLon + 0.0003}});
+    ASSERT_EQ(first.ack, mavlink::kMissionAccepted) << first.texts << daemon_->err();
+    const auto shown = ctl({"plan", "show"});
+    ASSERT_EQ(shown.exit_code, 0);
+    EXPECT_EQ(shown.json["name"], "ground station mission") << shown.json.dump();
+    EXPECT_EQ(shown.json["state"], "running") << shown.json.dump();
+    EXPECT_GT(control_->json("stats")["mission_items_received"], 0) << "the plan's window went to the board";
+    EXPECT_TRUE(wait_until([&] { return control_->json("state")["mode"] == "AUTO"; }, kGenerous, kPoll))
+        << control_->json("state").dump();
+
+    // While it runs, another upload is refused with the reason, and the plan stays.
+    const auto second = upload({{kHomeLat - 0.0003, kHomeLon}});
+    EXPECT_EQ(second.ack, mavlink::kMissionDenied) << second.texts;
+    EXPECT_NE(second.texts.find("a flight plan is running (ground station mission)"), std::string::npos)
+        << second.texts;
+    EXPECT_EQ(ctl({"plan", "show"}).json["name"], "ground station mission");
+    EXPECT_NE(daemon_->err().find("uploaded a mission"), std::string::npos) << daemon_->err();
 }
 
 INSTANTIATE_TEST_SUITE_P(Firmware, AutopilotFirmwareE2e, ::testing::Values("modern", "rover2"),

@@ -474,9 +474,9 @@ class GroundEnd {
 };
 
 // A standard ground station's MAVLink through the radio link (groundlink.mavlink_forward): the ground end
-// hears the board's telemetry, reads a parameter, and a mission upload is answered DENIED by airsegd, the
+// hears the board's telemetry, reads a parameter, and clearing the mission is answered DENIED by airsegd, the
 // board's mission untouched; the status document counts both directions.
-TEST_F(GroundControlE2e, MavlinkForwardCarriesAGroundStationsTrafficAndRefusesMissionUploads) {
+TEST_F(GroundControlE2e, MavlinkForwardCarriesAGroundStationsTrafficAndRefusesMissionClears) {
     start_sim();
     const int port = free_udp_port();
     start_daemon({"--set", "groundlink.mode=udp", "--set", "groundlink.udp.bind=127.0.0.1", "--set",
@@ -502,7 +502,7 @@ TEST_F(GroundControlE2e, MavlinkForwardCarriesAGroundStationsTrafficAndRefusesMi
         [](const airseg::mavlink::Frame& f) { return GroundStation::param_value(f, "CRUISE_SPEED"); }, 20s));
 
     const auto mission_before = sim_control->json("state")["mission_count"];
-    ground_end.send(gcs.mission_upload(2));
+    ground_end.send(gcs.mission_clear());
     EXPECT_TRUE(ground_end.hear(GroundStation::mission_denied, 20s));
     EXPECT_EQ(sim_control->json("state")["mission_count"], mission_before);
 

@@ -252,7 +252,7 @@ TEST(AutopilotService, TheTlogOnDiskFollowsTheLinkWhileTheServiceRuns) {
 
 // Ground stations through airsegd: one on the endpoint (UDP), one through the ground link (the bus). Both
 // get the autopilot's frames; a mission upload from either is answered DENIED by airsegd, not written.
-TEST(AutopilotService, GroundStationsGetTheAutopilotsFramesAndMissionUploadsAreRefused) {
+TEST(AutopilotService, GroundStationsGetTheAutopilotsFramesAndMissionUploadsAreReceivedInItsName) {
     ServiceOnPty rig("airseg-ap-gcs");
     auto& io = rig.io;
     auto& bus = rig.bus;
@@ -271,15 +271,16 @@ TEST(AutopilotService, GroundStationsGetTheAutopilotsFramesAndMissionUploadsAreR
     const auto port = service->gcs_endpoint()->udp_port();
     ASSERT_NE(port, 0);
 
-    // The ground station on the endpoint asks to upload a mission.
+    // The ground station on the endpoint uploads a mission; the service receives it in the autopilot's name
+    // and, with no flight plan manager to take it, refuses it.
     asio::ip::udp::socket gcs(io, asio::ip::udp::endpoint(asio::ip::udp::v4(), 0));
+    const asio::ip::udp::endpoint to_service(asio::ip::make_address("127.0.0.1"), port);
     mavlink::Encoder encoder(254, 190);
     mavlink::MissionCount count;
     count.target_system = 1;
     count.target_component = 1;
     count.count = 3;
-    gcs.send_to(asio::buffer(encoder.encode(count)),
-                asio::ip::udp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+    gcs.send_to(asio::buffer(encoder.encode(count)), to_service);
     std::vector<mavlink::Frame> heard;
     std::array<std::uint8_t, 2048> buf{};
     std::function<void()> receive = [&] {
@@ -288,7 +289,21 @@ TEST(AutopilotService, GroundStationsGetTheAutopilotsFramesAndMissionUploadsAreR
                 return;
             }
             mavlink::Parser p;
-            p.push(std::span(buf).first(n), [&](const mavlink::Frame& f) { heard.push_back(f); });
+            p.push(std::span(buf).first(n), [&](const mavlink::Frame& f) {
+                heard.push_back(f);
+                if (f.msgid == mavlink::MissionRequestInt::kId) {
+                    const auto r = mavlink::decode_payload<mavlink::MissionRequestInt>(f.payload_view());
+                    mavlink::MissionItemInt item;
+                    item.target_system = 1;
+                    item.target_component = 1;
+                    item.seq = r.seq;
+                    item.frame = mavlink::kFrameGlobalRelativeAltInt;
+                    item.command = mavlink::kCmdNavWaypoint;
+                    item.x = 412750000 + r.seq * 1000;
+                    item.y = 19870000;
+                    gcs.send_to(asio::buffer(encoder.encode(item)), to_service);
+                }
+            });
             receive();
         });
     };
@@ -298,13 +313,20 @@ TEST(AutopilotService, GroundStationsGetTheAutopilotsFramesAndMissionUploadsAreR
                            [&](const mavlink::Frame& f) { return f.msgid == msgid; });
     };
     ASSERT_TRUE(run_until([&] { return has(mavlink::MissionAck::kId) && has(mavlink::Heartbeat::kId); }));
+    std::string said;
     for (const auto& f : heard) {
         if (f.msgid == mavlink::MissionAck::kId) {
             const auto ack = mavlink::decode_payload<mavlink::MissionAck>(f.payload_view());
             EXPECT_EQ(ack.target_system, 254);
             EXPECT_EQ(ack.type, mavlink::kMissionDenied);
         }
+        if (f.msgid == mavlink::Statustext::kId) {
+            said += std::string(
+                mavlink::text_of(mavlink::decode_payload<mavlink::Statustext>(f.payload_view()).text));
+        }
     }
+    EXPECT_TRUE(has(mavlink::MissionRequestInt::kId));
+    EXPECT_NE(said.find("no flight plan manager"), std::string::npos) << said;
     // The same answer went to the ground link's stations, reliably, with the autopilot's own frames.
     EXPECT_TRUE(run_until([&] {
         return std::any_of(forwarded.begin(), forwarded.end(), [](const ForwardedFrame& f) {
@@ -314,13 +336,15 @@ TEST(AutopilotService, GroundStationsGetTheAutopilotsFramesAndMissionUploadsAreR
     EXPECT_TRUE(std::any_of(forwarded.begin(), forwarded.end(), [](const ForwardedFrame& f) {
         return f.id == mavlink::Heartbeat::kId && f.delivery == ForwardedFrame::Delivery::Freshest;
     }));
-    // A ground station on the ground link asks too (through the bus).
+    // A ground station on the ground link clears the mission (through the bus): refused as ever.
     const auto acks = [&] {
         return std::count_if(forwarded.begin(), forwarded.end(),
                              [](const ForwardedFrame& f) { return f.id == mavlink::MissionAck::kId; });
     };
     const auto before = acks();
-    bus.publish(GroundStationFrames{encoder.encode(count)});
+    mavlink::MissionClearAll clear;
+    clear.target_system = 1;
+    bus.publish(GroundStationFrames{encoder.encode(clear)});
     EXPECT_TRUE(run_until([&] { return acks() > before; }));
     EXPECT_TRUE(service->driver().ready());
     rig.finish(service);

@@ -173,13 +173,13 @@ void FakeRover::request_item(TimePoint now) {
     if (options_.request_int) {
         mav::MissionRequestInt r;
         r.target_system = 255;
-        r.target_component = 190;
+        r.target_component = requester_compid_;
         r.seq = request_i_;
         send(r);
     } else {
         mav::MissionRequest r;
         r.target_system = 255;
-        r.target_component = 190;
+        r.target_component = requester_compid_;
         r.seq = request_i_;
         send(r);
     }
@@ -188,7 +188,7 @@ void FakeRover::request_item(TimePoint now) {
 void FakeRover::send_ack(std::uint8_t type) {
     mav::MissionAck a;
     a.target_system = 255;
-    a.target_component = 190;
+    a.target_component = requester_compid_;
     a.type = type;
     send(a);
 }
@@ -207,6 +207,7 @@ void FakeRover::set_mode(std::uint32_t mode, TimePoint now) {
 }
 
 void FakeRover::on_frame(const mav::Frame& f, TimePoint now) {
+    requester_compid_ = f.compid;  // answers go to the requester's component, as ArduPilot's do
     switch (f.msgid) {
         case mav::MissionCount::kId: {
             const auto m = mav::decode_payload<mav::MissionCount>(f.payload_view());
@@ -300,7 +301,7 @@ void FakeRover::on_frame(const mav::Frame& f, TimePoint now) {
         case mav::MissionRequestList::kId: {
             mav::MissionCount c;
             c.target_system = 255;
-            c.target_component = 190;
+            c.target_component = requester_compid_;
             c.count = static_cast<std::uint16_t>(mission_.size());
             send(c);
             return;
@@ -314,14 +315,14 @@ void FakeRover::on_frame(const mav::Frame& f, TimePoint now) {
             }
             mav::MissionItemInt item = mission_[seq];
             item.target_system = 255;
-            item.target_component = 190;
+            item.target_component = requester_compid_;
             item.seq = seq;
             if (f.msgid == mav::MissionRequestInt::kId) {
                 send(item);
             } else {
                 mav::MissionItem fi;
                 fi.target_system = 255;
-                fi.target_component = 190;
+                fi.target_component = requester_compid_;
                 fi.seq = seq;
                 fi.frame = item.frame;
                 fi.command = item.command;
@@ -394,7 +395,7 @@ void FakeRover::on_frame(const mav::Frame& f, TimePoint now) {
             mav::CommandAck ack;
             ack.command = m.command;
             ack.target_system = 255;
-            ack.target_component = 190;
+            ack.target_component = requester_compid_;
             if (m.command == 176) {  // MAV_CMD_DO_SET_MODE
                 const auto mode = static_cast<std::uint32_t>(m.param2);
                 ack.result = refused_modes_.contains(mode) ? 4 : 0;

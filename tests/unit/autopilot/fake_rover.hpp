@@ -95,6 +95,7 @@ class FakeRover {
     mav::Encoder encoder_;
     mav::Parser parser_;
     std::deque<std::vector<std::uint8_t>> out_;
+    std::uint8_t requester_compid_ = 191;
     TimePoint boot_start_;
     TimePoint boot_done_;
     TimePoint stall_until_{};

@@ -163,5 +163,28 @@ TEST(GcsFrames, AnswersTravelReliablyTelemetryFreshest) {
     EXPECT_EQ(f.delivery, D::Reliable);
 }
 
+TEST(GcsGate, WithAReceiverAnUploadIsReceivedAndOtherMissionWritesStayRefused) {
+    Rig rig;
+    MissionReceiver uploads{1, 1};
+    rig.gate.receive_uploads(uploads);
+    mav::MissionCount count;
+    count.target_system = 1;
+    count.count = 2;
+    auto out = rig.gate.from_ground(rig.gcs.encode(count), TimePoint{} + seconds(5));
+    EXPECT_TRUE(out.to_autopilot.empty());
+    EXPECT_TRUE(out.to_ground.empty());  // the receiver answers
+    const auto asked = uploads.take_output();
+    ASSERT_EQ(asked.size(), 1u);
+    EXPECT_EQ(asked[0].id, mav::MissionRequestInt::kId);
+    EXPECT_EQ(rig.gate.stats().upload_frames, 1u);
+    EXPECT_EQ(rig.gate.stats().missions_refused, 0u);
+    mav::MissionClearAll clear;
+    clear.target_system = 1;
+    out = rig.gate.from_ground(rig.gcs.encode(clear));
+    EXPECT_TRUE(out.to_autopilot.empty());
+    EXPECT_EQ(out.to_ground[0].id, mav::MissionAck::kId);
+    EXPECT_EQ(rig.gate.stats().missions_refused, 1u);
+}
+
 }  // namespace
 }  // namespace airseg::autopilot

@@ -349,5 +349,38 @@ TEST(MissionClient, ADownloadIgnoresAnswersToAnotherGroundStation) {
     EXPECT_EQ(done->result, MissionResult::Success);
 }
 
+TEST(MissionClient, IgnoresAnswersToAGroundStationOnTheSameSystemId) {
+    // QGroundControl's default identity (255/190) next to airsegd's (255/191): the autopilot answers each
+    // requester's system and component, so only the component tells the answers apart.
+    Outbox out{255, 191, mav::Version::V2};
+    MissionClient client{out, 1, 1, {}};
+    mav::Encoder vehicle{1, 1};
+    mav::Parser parser;
+    auto from_vehicle = [&](const auto& m) {
+        parser.push(vehicle.encode(m), [&](const mav::Frame& f) { client.handle_frame(f, kStart); });
+    };
+    client.download(kStart);
+    (void)out.poll_transmit();
+    mav::MissionCount count;
+    count.target_system = 255;
+    count.target_component = 190;
+    count.count = 7;
+    from_vehicle(count);
+    EXPECT_TRUE(out.empty());
+    EXPECT_FALSE(client.poll_completion());
+    count.target_component = 191;
+    count.count = 0;
+    from_vehicle(count);
+    const auto done = client.poll_completion();
+    ASSERT_TRUE(done);
+    EXPECT_EQ(done->result, MissionResult::Success);
+    // Component 0 is anyone's: boards that fill in the system only still reach us.
+    client.download(kStart);
+    (void)out.poll_transmit();
+    count.target_component = 0;
+    from_vehicle(count);
+    ASSERT_TRUE(client.poll_completion());
+}
+
 }  // namespace
 }  // namespace airseg::autopilot::ardupilot
