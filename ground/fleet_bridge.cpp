@@ -95,6 +95,12 @@ void FleetBridge::publish_status() {
             kQos1, true);
 }
 
+void FleetBridge::publish_plan() {
+    auto plan = *plan_;
+    plan["at"] = unix_now();
+    publish("plan", plan, kQos1, true);
+}
+
 void FleetBridge::on_connection(bool up, const std::string& why) {
     const auto broker = config_.mqtt.host + ":" + std::to_string(config_.mqtt.port);
     if (up) {
@@ -103,7 +109,7 @@ void FleetBridge::on_connection(bool up, const std::string& why) {
         last_why_.clear();
         publish_status();
         if (plan_) {
-            publish("plan", *plan_, kQos1, true);  // a broker without persistence forgot it
+            publish_plan();  // a broker without persistence forgot it
         }
         return;
     }
@@ -176,9 +182,8 @@ void FleetBridge::on_vehicle(const proto::Message& message) {
             "plan",
             Json{{"state", "none"}, {"element", t->plan_element}, {"next_waypoint", t->next_waypoint}});
         if (plan_ != plan) {
-            plan_ = plan;
-            plan["at"] = unix_now();
-            publish("plan", plan, kQos1, true);
+            plan_ = std::move(plan);
+            publish_plan();
         }
     } else if (const auto* e = std::get_if<proto::Event>(&message)) {
         publish(

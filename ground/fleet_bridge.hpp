@@ -46,6 +46,7 @@ class FleetBridge {
     void on_vehicle(const groundlink::protocol::Message& message);
     void publish(std::string_view leaf, const nlohmann::json& payload, int qos, bool retain = false);
     void publish_status();
+    void publish_plan();
     void answer(const nlohmann::json& id, const nlohmann::json& answer);
     /// Remembers `key` as running; false when it was seen before (its answer, if any, is sent again).
     bool first_time(const std::string& key, const nlohmann::json& id);

@@ -291,6 +291,18 @@ TEST_F(FleetE2e, TwoVehiclesOnOneBroker) {
         << "rover1 says it is online again: " << after->out();
     ASSERT_TRUE(wait_until([&] { return !on(*after, "airseg/rover2/telemetry").empty(); }, kGenerous, 100ms))
         << "rover2's hub is back too" << logs();
+
+    // A hub that stops says so itself: a clean disconnect does not fire the will.
+    rover2->hub->signal(SIGTERM);
+    ASSERT_EQ(rover2->hub->wait_exit(30s), 0) << logs();
+    ASSERT_TRUE(wait_until(
+        [&] {
+            const auto status = on(*after, "airseg/rover2/status");
+            return !status.empty() && !status.back().retained &&
+                   status.back().payload == Json{{"online", false}, {"vehicle", "rover2"}};
+        },
+        kGenerous, 100ms))
+        << after->out();
 }
 
 }  // namespace
