@@ -44,12 +44,14 @@ struct MqttSession::State : std::enable_shared_from_this<MqttSession::State> {
     std::mutex mutex;  // subscriptions: the network thread renews them on connect
     std::vector<std::pair<std::string, int>> subscriptions;
     std::atomic<bool> stopped{false};
+    std::atomic<bool> connected{false};  // on the network thread only; atomic for the sanitizers' sake
     bool started = false;
 
     // libmosquitto's callbacks, on its network thread: hand over to the executor. The state may be gone by
     // then, so the posted work holds a weak reference.
     static void on_connect(mosquitto* m, void* self, int rc) {
         auto* s = static_cast<State*>(self);
+        s->connected = rc == 0;
         if (rc == 0) {
             std::lock_guard lock(s->mutex);
             for (const auto& [topic, qos] : s->subscriptions) {
@@ -60,7 +62,10 @@ struct MqttSession::State : std::enable_shared_from_this<MqttSession::State> {
     }
     static void on_disconnect(mosquitto*, void* self, int rc) {
         auto* s = static_cast<State*>(self);
-        s->post_connection(false, rc == 0 ? "disconnected" : "connection lost");
+        // A refused connection is followed by a disconnect too; the refusal already said why.
+        if (s->connected.exchange(false)) {
+            s->post_connection(false, rc == 0 ? "disconnected" : "connection lost");
+        }
     }
     static void on_message(mosquitto*, void* self, const mosquitto_message* msg) {
         auto* s = static_cast<State*>(self);

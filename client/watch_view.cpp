@@ -19,17 +19,6 @@ const char* mode_name(std::uint8_t code) {
     return name != nullptr ? name : "?";
 }
 
-const char* severity_name(proto::Event::Severity s) {
-    switch (s) {
-        case proto::Event::Severity::Warning:
-            return "warning";
-        case proto::Event::Severity::Error:
-            return "error";
-        default:
-            return "info";
-    }
-}
-
 double seconds(std::chrono::steady_clock::duration d) {
     return std::chrono::duration<double>(d).count();
 }
@@ -75,8 +64,19 @@ nlohmann::json telemetry_json(const proto::Telemetry& t) {
     return j;
 }
 
+const char* event_severity_name(proto::Event::Severity s) {
+    switch (s) {
+        case proto::Event::Severity::Warning:
+            return "warning";
+        case proto::Event::Severity::Error:
+            return "error";
+        default:
+            return "info";
+    }
+}
+
 std::string event_line(const proto::Event& e) {
-    return fmt::format("{}: {}", severity_name(e.severity), e.text);
+    return fmt::format("{}: {}", event_severity_name(e.severity), e.text);
 }
 
 void WatchState::take(const proto::Message& message, Clock::time_point now) {

@@ -43,6 +43,8 @@ class WatchState {
 const char* plan_state_name(std::uint8_t code);
 /// A telemetry sample as JSON (state and mode by name, position, speeds, battery, GPS, plan progress).
 nlohmann::json telemetry_json(const groundlink::protocol::Telemetry& t);
+/// "info", "warning" or "error".
+const char* event_severity_name(groundlink::protocol::Event::Severity s);
 /// An event as one line for people: "warning: text".
 std::string event_line(const groundlink::protocol::Event& e);
 

@@ -6,11 +6,11 @@
 #include <signal.h>
 #include <sys/stat.h>
 
-#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "client/hub_client.hpp"
 #include "tests/support/control_client.hpp"
+#include "tests/support/ground_chain.hpp"
 #include "tests/support/json_lines.hpp"
 #include "tests/support/process.hpp"
 
@@ -19,79 +19,23 @@ namespace {
 
 using Json = nlohmann::json;
 constexpr auto kGenerous = 60s;
-constexpr double kHomeLat = 41.2756;
-constexpr double kHomeLon = 1.9866;
+constexpr double kHomeLat = GroundChain::kHomeLat;
+constexpr double kHomeLon = GroundChain::kHomeLon;
 
 class GroundHubE2e : public ::testing::Test {
   protected:
-    void TearDown() override {
-        for (auto* p : {hub.get(), daemon.get()}) {
-            if (p != nullptr && p->running()) {
-                p->signal(SIGTERM);
-                p->wait_exit(10s);
-            }
-        }
-    }
-
     void start_chain() {
-        key = dir.file("control.key");
-        write_file(key, std::string(64, 'c') + "\n");
-        ::chmod(key.c_str(), 0600);
-        linksim = std::make_unique<Subprocess>(
-            std::vector<std::string>{binary("tools/linksim/airseg-linksim"), "--a", dir.file("air"), "--b",
-                                     dir.file("ground"), "--baud", "57600", "--seed", "7"},
-            std::map<std::string, std::string>{}, dir.path());
-        ASSERT_TRUE(wait_until([&] {
-            return std::filesystem::exists(dir.file("air")) && std::filesystem::exists(dir.file("ground"));
-        })) << linksim->err();
-        sim = std::make_unique<Subprocess>(
-            std::vector<std::string>{binary("tools/apmsim/airseg-apmsim"), "--link", dir.file("ttyACM0"),
-                                     "--home", std::to_string(kHomeLat) + "," + std::to_string(kHomeLon),
-                                     "--boot-delay", "0.5", "--calib-time", "0.5", "--speedup", "4",
-                                     "--quiet"},
-            std::map<std::string, std::string>{}, dir.path());
-        ASSERT_TRUE(wait_until([&] { return std::filesystem::exists(dir.file("ttyACM0")); })) << sim->err();
-        daemon = std::make_unique<Subprocess>(
-            std::vector<std::string>{
-                binary("daemon/airsegd"), "--config", source_path("config/airseg.yaml"), "--set",
-                "status.socket=" + dir.file("status.sock"), "--set", "state_dir=" + dir.file("state"),
-                "--set", "autopilot.port=" + dir.file("ttyACM0"), "--set",
-                "groundlink.ports=[" + dir.file("air") + "]", "--set", "groundlink.key_file=" + key, "--set",
-                "groundlink.mavlink_forward.enabled=true"},
-            std::map<std::string, std::string>{}, dir.path());
-        hub = std::make_unique<Subprocess>(
-            std::vector<std::string>{binary("ground/airseg-ground"), "--link", dir.file("ground"), "--key",
-                                     key, "--socket", socket(), "--map", "127.0.0.1:0", "--tcp",
-                                     "127.0.0.1:0", "--mavlink-udp", "off", "--mavlink-udp-listen",
-                                     "127.0.0.1:0", "--mavlink-tcp", "127.0.0.1:0"},
-            std::map<std::string, std::string>{}, dir.path());
-        ASSERT_TRUE(wait_until([&] { return std::filesystem::exists(socket()); })) << hub->err();
-        Json doc;
-        ASSERT_TRUE(wait_until(
-            [&] {
-                auto r = ctl({"status"});
-                doc = Json::parse(r.out, nullptr, false);
-                return r.exit_code == 0 && doc.is_object() &&
-                       doc.value("autopilot", Json::object()).value("ready", false);
-            },
-            kGenerous, 500ms))
-            << doc.dump() << "\nhub:\n"
-            << hub->err() << "\ndaemon:\n"
-            << daemon->err();
+        const auto error = chain.start();
+        ASSERT_EQ(error, "");
+        hub = chain.hub.get();
+        key = chain.key();
     }
 
     std::vector<std::string> ctl_argv(std::vector<std::string> args, bool with_key) const {
-        std::vector<std::string> argv{
-            binary("client/airsegctl"), "--ground-socket", socket(), "--timeout", "30000", "--json"};
-        if (with_key) {
-            argv.insert(argv.end(), {"--key", key});
-        }
-        argv.insert(argv.end(), args.begin(), args.end());
-        return argv;
+        return chain.ctl_argv(std::move(args), with_key);
     }
-
     RunResult ctl(std::vector<std::string> args, bool with_key = false) {
-        return run(ctl_argv(std::move(args), with_key), {}, 90s);
+        return chain.ctl(std::move(args), with_key);
     }
 
     std::string plan_file() {
@@ -106,7 +50,7 @@ class GroundHubE2e : public ::testing::Test {
         return path;
     }
 
-    std::string socket() const { return dir.file("ground.sock"); }
+    std::string socket() const { return chain.socket(); }
 
     /// The word after `prefix` in the hub's log (an address it bound to), empty until it is there.
     std::string logged_after(const std::string& prefix) const {
@@ -168,8 +112,11 @@ class GroundHubE2e : public ::testing::Test {
     }
 
     TempDir dir;
+    GroundChain chain{dir.path(),
+                      {"--map", "127.0.0.1:0", "--tcp", "127.0.0.1:0", "--mavlink-udp", "off",
+                       "--mavlink-udp-listen", "127.0.0.1:0", "--mavlink-tcp", "127.0.0.1:0"}};
+    Subprocess* hub = nullptr;
     std::string key;
-    std::unique_ptr<Subprocess> linksim, sim, daemon, hub;
 };
 
 TEST_F(GroundHubE2e, ThreeWatchersAndOneOperatorShareTheRadio) {
