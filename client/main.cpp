@@ -162,6 +162,9 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
     if (o.use_mqtt && o.vehicle.empty()) {
         return usage_error("--mqtt needs --vehicle ID: a broker serves many vehicles");
     }
+    if (auto problem = airseg::client::check_mqtt_options(o.mqtt); o.use_mqtt && !problem.empty()) {
+        return usage_error(problem);
+    }
     if (o.use_radio && o.use_hub) {
         return usage_error(
             "--ground and the radio options (--link, --udp) exclude each other: the hub owns the "

@@ -8,7 +8,7 @@ void add_mqtt_options(cli::OptionTable& table, MqttOptions& options, std::string
                       std::function<void()> chosen) {
     using namespace airseg::cli;
     table
-        .value("mqtt", "HOST[:PORT]", "through an MQTT broker (port 1883 unless given); docs/fleet.md",
+        .value("mqtt", "HOST[:PORT]", "the fleet's MQTT broker (port 1883 unless given); docs/fleet.md",
                [&options, chosen](std::string_view option, std::string_view v) {
                    if (auto problem = parse_broker(v, options); !problem.empty()) {
                        throw UsageError(std::string(option) + ": " + problem);
@@ -23,11 +23,25 @@ void add_mqtt_options(cli::OptionTable& table, MqttOptions& options, std::string
                    }
                })
         .value("mqtt-user", "NAME", "broker user name", text(options.username))
-        .value("mqtt-password-file", "FILE", "the broker password, on the first line of FILE",
+        .value("mqtt-password-file", "FILE",
+               "the broker password, on the first line of FILE (with --mqtt-user)",
                text(options.password_file))
         .value("mqtt-ca", "FILE", "TLS to the broker, trusting this CA certificate", text(options.ca_file))
         .value("mqtt-cert", "FILE", "TLS client certificate (with --mqtt-key)", text(options.cert_file))
         .value("mqtt-key", "FILE", "TLS client key", text(options.key_file));
+}
+
+std::string check_mqtt_options(const MqttOptions& m) {
+    if (!m.password_file.empty() && m.username.empty()) {
+        return "--mqtt-password-file needs --mqtt-user";
+    }
+    if (m.cert_file.empty() != m.key_file.empty()) {
+        return "--mqtt-cert and --mqtt-key go together";
+    }
+    if (!m.cert_file.empty() && m.ca_file.empty()) {
+        return "--mqtt-cert needs --mqtt-ca (TLS)";
+    }
+    return {};
 }
 
 std::string check_vehicle_id(const std::string& id) {

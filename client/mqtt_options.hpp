@@ -13,6 +13,10 @@ namespace airseg::client {
 void add_mqtt_options(cli::OptionTable& table, MqttOptions& options, std::string& vehicle,
                       std::function<void()> chosen);
 
+/// The options together (a password needs a user, a client certificate its key and a CA); an error for
+/// people, empty when fine.
+std::string check_mqtt_options(const MqttOptions& options);
+
 /// A vehicle id fit for a topic level: 1 to 64 of A-Z a-z 0-9 _ -. An error for people, empty when fine.
 std::string check_vehicle_id(const std::string& id);
 

@@ -36,13 +36,6 @@ Json bad_request(const std::string& why) {
 
 }  // namespace
 
-bool valid_vehicle_id(std::string_view id) {
-    return !id.empty() && id.size() <= 64 && std::all_of(id.begin(), id.end(), [](char c) {
-        return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' ||
-               c == '-';
-    });
-}
-
 FleetBridge::FleetBridge(asio::any_io_executor strand, Hub& hub, FleetConfig config)
     : hub_(hub),
       config_(std::move(config)),

@@ -22,9 +22,6 @@ struct FleetConfig {
     std::string hub_version;   // "airseg-ground 1.2.3", for the status topic
 };
 
-/// A vehicle id fit for a topic level: [A-Za-z0-9_-]{1,64}.
-bool valid_vehicle_id(std::string_view id);
-
 class FleetBridge {
   public:
     /// Command ids remembered, so that a QoS 1 command delivered twice runs once.

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "cli/command_line.hpp"
+#include "client/mqtt_options.hpp"
 #include "client/mqtt_session.hpp"
 #include "client/radio_options.hpp"
 #include "ground/fleet_bridge.hpp"
@@ -43,7 +44,7 @@ struct Options {
     airseg::ground::MapConfig map;
     airseg::ground::GcsConfig gcs;
     airseg::ground::FleetConfig fleet;
-    std::string mqtt;  // HOST[:PORT]; empty = no fleet bridge
+    bool mqtt_given = false;  // --mqtt: the fleet bridge runs
     bool radio_given = false;
     std::string log_level = "info";
 };
@@ -51,27 +52,16 @@ struct Options {
 /// The MQTT options together; an error for people or empty.
 std::string check_fleet(Options& o) {
     const auto& m = o.fleet.mqtt;
-    if (o.mqtt.empty()) {
+    if (!o.mqtt_given) {
         const bool any = !o.fleet.vehicle.empty() || !m.username.empty() || !m.password_file.empty() ||
                          !m.ca_file.empty() || !m.cert_file.empty() || !m.key_file.empty();
         return any ? "--vehicle and the --mqtt-* options need --mqtt HOST[:PORT]" : "";
     }
-    if (auto problem = airseg::client::parse_broker(o.mqtt, o.fleet.mqtt); !problem.empty()) {
-        return "--mqtt: " + problem;
+    if (o.fleet.vehicle.empty()) {
+        return "--mqtt needs --vehicle ID";
     }
-    if (!airseg::ground::valid_vehicle_id(o.fleet.vehicle)) {
-        return o.fleet.vehicle.empty()
-                   ? "--mqtt needs --vehicle ID"
-                   : "--vehicle '" + o.fleet.vehicle + "' is not 1 to 64 letters, digits, '_' or '-'";
-    }
-    if (!m.password_file.empty() && m.username.empty()) {
-        return "--mqtt-password-file needs --mqtt-user";
-    }
-    if (m.cert_file.empty() != m.key_file.empty()) {
-        return "--mqtt-cert and --mqtt-key go together";
-    }
-    if (!m.cert_file.empty() && m.ca_file.empty()) {
-        return "--mqtt-cert needs --mqtt-ca (TLS)";
+    if (auto problem = airseg::client::check_mqtt_options(m); !problem.empty()) {
+        return problem;
     }
     o.fleet.hub_version = std::string("airseg-ground ") + AIRSEG_VERSION;
     return {};
@@ -118,21 +108,9 @@ int main(int argc, char** argv) {
         .value("mavlink-tcp", "ADDR:PORT",
                "serve ground stations over TCP here (default 127.0.0.1:5760; 'off'; 0.0.0.0 opens it to the "
                "network)",
-               [&o](std::string_view, std::string_view v) { o.gcs.tcp = v == "off" ? "" : std::string(v); })
-        .value("mqtt", "HOST[:PORT]",
-               "publish to and take commands from this MQTT broker (port 1883 by default; off by default)",
-               text(o.mqtt))
-        .value("vehicle", "ID", "the vehicle's id in the MQTT topics airseg/ID/... (required with --mqtt)",
-               text(o.fleet.vehicle))
-        .value("mqtt-user", "NAME", "the user name at the MQTT broker", text(o.fleet.mqtt.username))
-        .value("mqtt-password-file", "FILE", "the MQTT password, the file's first line (with --mqtt-user)",
-               text(o.fleet.mqtt.password_file))
-        .value("mqtt-ca", "FILE", "TLS to the MQTT broker, trusting this CA certificate",
-               text(o.fleet.mqtt.ca_file))
-        .value("mqtt-cert", "FILE", "TLS client certificate for the MQTT broker (with --mqtt-key)",
-               text(o.fleet.mqtt.cert_file))
-        .value("mqtt-key", "FILE", "the TLS client certificate's private key", text(o.fleet.mqtt.key_file))
-        .value("log-level", "LEVEL", "trace, debug, info, warn or error (default info)", text(o.log_level))
+               [&o](std::string_view, std::string_view v) { o.gcs.tcp = v == "off" ? "" : std::string(v); });
+    airseg::client::add_mqtt_options(table, o.fleet.mqtt, o.fleet.vehicle, [&o] { o.mqtt_given = true; });
+    table.value("log-level", "LEVEL", "trace, debug, info, warn or error (default info)", text(o.log_level))
         .help_and_version();
     const Program program{"airseg-ground", [&table] { return kUsageHead + describe(table) + kUsageTail; }};
     auto line = run(program, std::vector<std::string>(argv + std::min(argc, 1), argv + argc), table,
@@ -184,7 +162,7 @@ int main(int argc, char** argv) {
                      o.map.control ? " (its buttons command the vehicle)" : "");
     }
     std::unique_ptr<airseg::ground::FleetBridge> fleet;
-    if (!o.mqtt.empty()) {
+    if (o.mqtt_given) {
         fleet = std::make_unique<airseg::ground::FleetBridge>(strand, hub, o.fleet);
         if (auto error = fleet->start(); !error.empty()) {
             std::cerr << "airseg-ground: " << error << '\n';

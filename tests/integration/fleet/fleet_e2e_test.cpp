@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "tests/support/ground_chain.hpp"
+#include "tests/support/json_lines.hpp"
 #include "tests/support/process.hpp"
 
 namespace airseg::test {
@@ -248,6 +249,38 @@ TEST_F(FleetE2e, TwoVehiclesOnOneBroker) {
         EXPECT_NE(s.payload.value("id", ""), "obs-1") << "the ACL let the observer's command through";
     }
     EXPECT_TRUE(results(*watcher, "rover1", "op-2").empty()) << watcher->out();
+
+    // airsegctl --mqtt HOST --vehicle ID: the operator's command answered through the broker, the observer's
+    // live view of rover1, and the observer's command never answered (the ACL drops it).
+    const auto airsegctl = [&](const std::string& user, long timeout_ms, std::vector<std::string> args) {
+        std::vector<std::string> argv{binary("client/airsegctl"),
+                                      "--mqtt",
+                                      "127.0.0.1:" + std::to_string(port),
+                                      "--vehicle",
+                                      "rover1",
+                                      "--mqtt-user",
+                                      user,
+                                      "--mqtt-password-file",
+                                      dir.file(user + ".password"),
+                                      "--json",
+                                      "--timeout",
+                                      std::to_string(timeout_ms)};
+        argv.insert(argv.end(), args.begin(), args.end());
+        return run(argv, {}, 90s);
+    };
+    const auto by_operator = airsegctl("operator", 30'000, {"status"});
+    ASSERT_EQ(by_operator.exit_code, 0) << by_operator.out << by_operator.err << logs();
+    EXPECT_TRUE(Json::parse(by_operator.out, nullptr, false).value("autopilot", Json()).is_object())
+        << by_operator.out;
+    const auto view = airsegctl("observer", 30'000, {"watch", "--duration", "4000"});
+    ASSERT_EQ(view.exit_code, 0) << view.err;
+    const auto lines = json_lines(view.out);
+    ASSERT_FALSE(lines.empty()) << view.err;
+    EXPECT_GE(lines.back()["samples"].get<int>(), 3) << lines.back().dump();
+    EXPECT_TRUE(lines.back()["vehicle"]["lat"].is_number()) << lines.back().dump();
+    EXPECT_EQ(lines.back()["ground_link"]["link"], "up") << lines.back().dump();
+    EXPECT_EQ(airsegctl("observer", 3'000, {"status"}).exit_code, 3)
+        << "the broker drops an observer's command";
 
     // A wrong password is refused by the broker.
     auto intruder = client_argv(mosquitto_sub, "operator");
