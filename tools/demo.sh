@@ -61,6 +61,7 @@ pids+=($!)
 # The map on a free port (named in the hub's log): a fixed one may be taken on a developer's machine.
 "$build/ground/airseg-ground" --link "$run_dir/radio-ground" --baud 57600 --socket "$run_dir/ground.sock" \
   --map "127.0.0.1:${AIRSEG_DEMO_MAP_PORT:-0}" --map-control --mavlink-tcp "127.0.0.1:${AIRSEG_DEMO_MAVLINK_TCP:-0}" \
+  --mavlink-udp "${AIRSEG_DEMO_MAVLINK_UDP:-127.0.0.1:14550}" \
   > "$run_dir/airseg-ground.log" 2>&1 &
 pids+=($!)
 wait_for "$run_dir/ground.sock"

@@ -1,17 +1,18 @@
 // A ground station as QGroundControl behaves on connect, written with node-mavlink (an independent MAVLink
-// implementation): it talks UDP to airseg-ground's MAVLink endpoint, sends its own HEARTBEAT as a GCS once a
+// implementation): it listens on a UDP port (QGroundControl: 14550) and answers whoever sends the vehicle's
+// MAVLink there (listen:PORT), or sends to HOST:PORT first; it sends its own HEARTBEAT as a GCS once a
 // second, measures the vehicle's HEARTBEAT and GLOBAL_POSITION_INT rates, downloads every parameter
 // (PARAM_REQUEST_LIST, then PARAM_REQUEST_READ by index for what is missing), downloads the mission
 // (MISSION_REQUEST_LIST, MISSION_REQUEST_INT per item, MISSION_ACK) and changes the mode (COMMAND_LONG
 // MAV_CMD_DO_SET_MODE, then the next heartbeats must show it). Prints one JSON summary line.
-//   node gcs_client.js HOST:PORT NODE_MODULES_DIR MODE_NUMBER
+//   node gcs_client.js listen:PORT|HOST:PORT NODE_MODULES_DIR MODE_NUMBER
 'use strict';
 const dgram = require('dgram');
 const path = require('path');
 
 const [target, modules, modeArg] = process.argv.slice(2);
 if (!target || !modules || modeArg === undefined) {
-    console.error('usage: node gcs_client.js HOST:PORT NODE_MODULES_DIR MODE_NUMBER');
+    console.error('usage: node gcs_client.js listen:PORT|HOST:PORT NODE_MODULES_DIR MODE_NUMBER');
     process.exit(2);
 }
 let mavlink;
@@ -27,7 +28,11 @@ const REGISTRY = { ...minimal.REGISTRY, ...common.REGISTRY, ...ardupilotmega.REG
 const BY_NAME = Object.fromEntries(Object.values(REGISTRY).map(c => [c.MSG_NAME, c]));
 const make = name => new BY_NAME[name]();
 const wantedMode = Number(modeArg);
-const [host, port] = [target.slice(0, target.lastIndexOf(':')), Number(target.slice(target.lastIndexOf(':') + 1))];
+const listening = target.startsWith('listen:');
+// Where our frames go: HOST:PORT, or (listening) wherever the vehicle's frames come from.
+let [host, port] = [target.slice(0, target.lastIndexOf(':')), Number(target.slice(target.lastIndexOf(':') + 1))];
+const bindPort = listening ? port : 0;
+let peerKnown = !listening;
 
 const GCS_SYSID = 255;
 const GCS_COMPID = 190;
@@ -35,7 +40,9 @@ const protocol = new MavLinkProtocolV2(GCS_SYSID, GCS_COMPID);
 const socket = dgram.createSocket('udp4');
 let seq = 0;
 function send(msg) {
-    socket.send(protocol.serialize(msg, seq++ % 256), port, host);
+    if (peerKnown) {
+        socket.send(protocol.serialize(msg, seq++ % 256), port, host);
+    }
 }
 
 const started = Date.now();
@@ -66,7 +73,12 @@ function waitFor(match, ms) {
 const splitter = new MavLinkPacketSplitter({}, { onCrcError: () => {} });
 const parser = new MavLinkPacketParser();
 splitter.pipe(parser);
-socket.on('message', buffer => splitter.write(buffer));
+socket.on('message', (buffer, rinfo) => {
+    if (!peerKnown) {
+        [host, port, peerKnown] = [rinfo.address, rinfo.port, true];
+    }
+    splitter.write(buffer);
+});
 parser.on('data', packet => {
     const clazz = REGISTRY[packet.header.msgid];
     if (!clazz) {
@@ -223,7 +235,10 @@ async function setMode() {
 }
 
 async function main() {
-    socket.bind(0, '127.0.0.1');
+    await new Promise((resolve, reject) => {
+        socket.once('error', reject);
+        socket.bind(bindPort, '127.0.0.1', resolve);
+    });
     heartbeat();
     const beating = setInterval(heartbeat, 1000);
     for (let i = 0; i < 300 && !vehicle; i++) {
