@@ -116,7 +116,7 @@ done
 for want in airsegd airseg-client airseg-sim airseg; do
   [[ " ${seen[*]} " == *" $want "* ]] || bad "package $want was not given"
 done
-[ "${#programs[@]}" = 5 ] || bad "${#programs[@]} programs in the packages, expected 5"
+[ "${#programs[@]}" = 6 ] || bad "${#programs[@]} programs in the packages, expected 6"
 
 # The hand-written manual pages must name every option and command the programs' --help names.
 if [ "$arch" = "$(dpkg --print-architecture)" ]; then
