@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <charconv>
+#include <cstdint>
 
 namespace airseg::ground::http {
 
@@ -189,15 +190,17 @@ RequestParser::State RequestParser::parse_head(std::string_view head) {
         if (++lengths > 1) {
             return fail(400, "more than one Content-Length");
         }
-        std::size_t value = 0;
+        // 64 bits whatever size_t is: a length beyond a 32-bit board's size_t is too large, not malformed.
+        std::uint64_t value = 0;
         const auto [ptr, ec] = std::from_chars(v.data(), v.data() + v.size(), value);
-        if (v.empty() || ec != std::errc() || ptr != v.data() + v.size()) {
+        const bool digits_only = !v.empty() && ptr == v.data() + v.size();
+        if (!digits_only || (ec != std::errc() && ec != std::errc::result_out_of_range)) {
             return fail(400, "Content-Length is not a number");
         }
-        if (value > limits_.body_bytes) {
+        if (ec == std::errc::result_out_of_range || value > limits_.body_bytes) {
             return fail(413, "body larger than " + std::to_string(limits_.body_bytes) + " bytes");
         }
-        body_length_ = value;
+        body_length_ = static_cast<std::size_t>(value);  // at most body_bytes
     }
     return state_;
 }

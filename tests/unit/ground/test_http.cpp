@@ -53,6 +53,9 @@ TEST(MapHttp, MalformedRequestsAreRefusedWithTheirReason) {
         {"POST /x HTTP/1.1\r\nHost: a\r\nContent-Length: -1\r\n\r\n", 400, "not a number"},
         {"POST /x HTTP/1.1\r\nHost: a\r\nTransfer-Encoding: chunked\r\n\r\n", 501, "Content-Length"},
         {"POST /x HTTP/1.1\r\nHost: a\r\nContent-Length: 99999999999\r\n\r\n", 413, "larger than"},
+        {"POST /x HTTP/1.1\r\nHost: a\r\nContent-Length: 999999999999999999999999\r\n\r\n", 413,
+         "larger than"},
+        {"POST /x HTTP/1.1\r\nHost: a\r\nContent-Length: 12x\r\n\r\n", 400, "not a number"},
         {"GET /%zz HTTP/1.1\r\nHost: a\r\n\r\n", 400, "percent"},
     };
     for (const auto& c : cases) {
