@@ -18,9 +18,10 @@
 #   not started, `systemd-analyze verify` clean, `airsegd --check-config` accepts the shipped file with a
 #   drop-in, manual pages, the licence and the docs under /usr/share/doc;
 # - upgrade with a local setting in conf.d: no conffile prompt (dpkg runs without stdin), the new shipped
-#   file installed, the drop-in kept, try-restart of airsegd.service asked;
+#   file installed, the drop-in kept, try-restart of airsegd.service and airseg-ground.service asked and
+#   no unit stopped before the new files are in place;
 # - removal: stop asked, the daemon gone, the conffile kept; purge: the conffile, /var/lib/airseg and
-#   /var/log/airseg gone.
+#   /var/log/airseg gone; removing airseg-client asks to stop the hub.
 set -euo pipefail
 . "$(dirname "$0")/lib.sh"
 
@@ -141,6 +142,8 @@ check "the new shipped configuration is installed" grep -qx "# shipped by $next"
 check "the drop-in is kept" grep -qx 'log_level: debug' /etc/airseg/conf.d/50-local.yaml
 invoked "try-restart airsegd.service" && ok "upgrade asks systemd to try-restart airsegd.service" \
   || bad "no try-restart on upgrade: $(cat /tmp/invoked)"
+invoked "try-restart airseg-ground.service" && ok "upgrade asks systemd to try-restart airseg-ground.service" \
+  || bad "no try-restart of the hub on upgrade: $(cat /tmp/invoked)"
 grep -q '^stop' /tmp/invoked && bad "the upgrade stopped the daemon before the new files were in place" \
   || ok "no stop during the upgrade"
 
@@ -158,6 +161,11 @@ check "dpkg -P removes the conffile" test ! -e /etc/airseg/airseg.yaml
 check "dpkg -P removes /var/lib/airseg" test ! -e /var/lib/airseg
 check "dpkg -P removes /var/log/airseg" test ! -e /var/log/airseg
 check "dpkg -P removes the enablement link" test ! -e /etc/systemd/system/multi-user.target.wants/airsegd.service
+: >/tmp/invoked
+dpkg -r airseg-sim airseg-client </dev/null >/dev/null || bad "dpkg -r airseg-client failed"
+invoked "stop airseg-ground.service" && ok "removing airseg-client asks systemd to stop airseg-ground.service" \
+  || bad "no stop of the hub on removal: $(cat /tmp/invoked)"
+check "dpkg -r removes the hub" test ! -e /usr/bin/airseg-ground
 exit $fail
 CHECKS
 
