@@ -137,13 +137,19 @@ void BM_LoadAndValidateMillionWaypointPlan(benchmark::State& state) {
 }
 BENCHMARK(BM_LoadAndValidateMillionWaypointPlan)->Unit(benchmark::kMillisecond);
 
-// A plan written as an explicit list: `count` waypoints, one per line, about 50 bytes each.
-std::string explicit_list_plan(int count) {
+// A plan written as an explicit list: `count` waypoints, one per line, about 50 bytes each (coordinates to
+// 1e-7 degrees, as a ground station writes them), or 38 (`short_lines`: one decimal, the shortest usual
+// line).
+std::string explicit_list_plan(int count, bool short_lines = false) {
     std::string text = "plan:\n  name: explicit\n  vehicle: {type: rover}\n  elements:\n";
     char line[96];
     for (int i = 0; i < count; ++i) {
-        std::snprintf(line, sizeof line, "    - waypoint: {lat: %.7f, lon: %.7f}\n", 41.0 + (i / 200) * 5e-5,
-                      2.0 + (i % 200) * 5e-5);
+        const double lat = 41.0 + (i / 200) * 5e-5;
+        const double lon = 2.0 + (i % 200) * 5e-5;
+        std::snprintf(line, sizeof line,
+                      short_lines ? "    - waypoint: {lat: %.1f, lon: %.1f}\n"
+                                  : "    - waypoint: {lat: %.7f, lon: %.7f}\n",
+                      lat, lon);
         text += line;
     }
     return text;
@@ -152,9 +158,9 @@ std::string explicit_list_plan(int count) {
 // Heap kept per element after the load, and the heap peak while loading relative to the file's size. Two
 // ways in: load_plan_file (reads the file itself; its peak includes whatever it buffers of the text) and
 // load_plan_text (the daemon's way: the text is already in memory, held by the caller, and not counted).
-void BM_LoadExplicitList(benchmark::State& state, bool from_file) {
+void BM_LoadExplicitList(benchmark::State& state, bool from_file, bool short_lines) {
     const int count = static_cast<int>(state.range(0));
-    const std::string text = explicit_list_plan(count);
+    const std::string text = explicit_list_plan(count, short_lines);
     const auto file = std::filesystem::temp_directory_path() /
                       ("airseg-bench-explicit-" + std::to_string(::getpid()) + ".yaml");
     if (from_file) {
@@ -164,6 +170,7 @@ void BM_LoadExplicitList(benchmark::State& state, bool from_file) {
     options.max_elements = 1'000'000;
     std::int64_t kept = 0, peak = 0;
     std::size_t elements = 0;
+    PlanReading reading = PlanReading::Whole;
     for (auto _ : state) {
         const auto base = g_live.load();
         g_peak.store(base);
@@ -175,6 +182,7 @@ void BM_LoadExplicitList(benchmark::State& state, bool from_file) {
         peak = g_peak.load() - base;
         kept = g_live.load() - base;
         elements = r.plan->children(r.plan->main_list).size();
+        reading = r.reading;
         benchmark::DoNotOptimize(r.plan);
     }
     if (from_file) {
@@ -185,9 +193,24 @@ void BM_LoadExplicitList(benchmark::State& state, bool from_file) {
     state.counters["kept_bytes_per_element"] = static_cast<double>(kept) / static_cast<double>(elements);
     state.counters["peak_heap_bytes"] = static_cast<double>(peak);
     state.counters["peak_over_file"] = static_cast<double>(peak) / static_cast<double>(text.size());
+    state.counters["spliced"] = reading == PlanReading::Spliced ? 1.0 : 0.0;  // the main list read in batches
 }
-BENCHMARK_CAPTURE(BM_LoadExplicitList, text, false)->Arg(4'000)->Arg(40'000)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_LoadExplicitList, file, true)->Arg(4'000)->Arg(40'000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_LoadExplicitList, text, false, false)
+    ->Arg(4'000)
+    ->Arg(40'000)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_LoadExplicitList, text_short_lines, false, true)
+    ->Arg(4'000)
+    ->Arg(40'000)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_LoadExplicitList, file, true, false)
+    ->Arg(4'000)
+    ->Arg(40'000)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_LoadExplicitList, file_short_lines, true, true)
+    ->Arg(4'000)
+    ->Arg(40'000)
+    ->Unit(benchmark::kMillisecond);
 
 // plan.append: `running` explicit-list elements, then `appended` more. The merge streams the running text
 // (parser events to an emitter) and copies the appended items in, so its peak is about the merged text plus

@@ -26,11 +26,23 @@ struct LoadOptions {
     /// The profile of a plan without `vehicle` (flightplan.vehicle), and the base a plan's `vehicle` fields
     /// without `type` refine.
     VehicleProfile default_vehicle;
+    /// A text's main list longer than this is read in batches of this many items (list_splice.hpp), which
+    /// bounds yaml-cpp's per-item memory; 0 never splits it. Any value loads the same plan and diagnostics.
+    std::size_t splice_batch_items = 256;
+};
+
+/// How a document was read, cheapest first; each later way is taken when the one before cannot be. All give
+/// the same plan and diagnostics.
+enum class PlanReading : unsigned char {
+    Spliced,   // the main list cut out and read in batches (a text whose layout allows it)
+    Streamed,  // element lists read one item at a time (plan_stream.hpp)
+    Whole,     // the document as one tree
 };
 
 struct LoadResult {
     std::shared_ptr<const Plan> plan;  // null when errors is not empty
     std::vector<Diagnostic> errors;
+    PlanReading reading = PlanReading::Whole;
     bool ok() const { return plan != nullptr; }
 };
 

@@ -1,6 +1,10 @@
 #include "services/flightplan/plan_stream.hpp"
 
+#include <yaml-cpp/parser.h>
+
 #include <utility>
+
+#include "services/flightplan/text_stream.hpp"
 
 namespace airseg::flightplan {
 
@@ -27,7 +31,104 @@ PlanEventReader::PlanEventReader(PlanParser& parser, const LoadOptions& options,
 
 PlanEventReader::~PlanEventReader() = default;
 
+namespace {
+
+/// Passes a batch's items to the reader: the batch is one block list, whose own start and end are the
+/// stand-in's business.
+class BatchEvents final : public YAML::EventHandler {
+  public:
+    explicit BatchEvents(YAML::EventHandler& reader) : reader_(reader) {}
+
+    bool was_one_list() const { return lists_ == 1 && depth_ == 0; }
+
+    void OnDocumentStart(const YAML::Mark&) override {}
+    void OnDocumentEnd() override {}
+    void OnNull(const YAML::Mark& mark, YAML::anchor_t anchor) override {
+        item();
+        reader_.OnNull(mark, anchor);
+    }
+    void OnAlias(const YAML::Mark&, YAML::anchor_t) override { throw NotStreamable{}; }
+    void OnScalar(const YAML::Mark& mark, const std::string& tag, YAML::anchor_t anchor,
+                  const std::string& value) override {
+        item();
+        reader_.OnScalar(mark, tag, anchor, value);
+    }
+    void OnSequenceStart(const YAML::Mark& mark, const std::string& tag, YAML::anchor_t anchor,
+                         YAML::EmitterStyle::value style) override {
+        if (depth_++ == 0) {
+            if (++lists_ != 1 || style != YAML::EmitterStyle::Block || anchor != YAML::NullAnchor) {
+                throw NotStreamable{};
+            }
+            return;
+        }
+        reader_.OnSequenceStart(mark, tag, anchor, style);
+    }
+    void OnSequenceEnd() override {
+        if (--depth_ > 0) {
+            reader_.OnSequenceEnd();
+        }
+    }
+    void OnMapStart(const YAML::Mark& mark, const std::string& tag, YAML::anchor_t anchor,
+                    YAML::EmitterStyle::value style) override {
+        item();
+        ++depth_;
+        reader_.OnMapStart(mark, tag, anchor, style);
+    }
+    void OnMapEnd() override {
+        --depth_;
+        reader_.OnMapEnd();
+    }
+
+  private:
+    void item() const {
+        if (depth_ == 0) {
+            throw NotStreamable{};  // the batch is not a list
+        }
+    }
+
+    YAML::EventHandler& reader_;
+    int depth_ = 0;
+    int lists_ = 0;
+};
+
+}  // namespace
+
+void PlanEventReader::splice(std::string_view text, const ListSplice& splice) {
+    text_ = text;
+    splice_ = &splice;
+}
+
+YAML::Mark PlanEventReader::place(const YAML::Mark& mark) const {
+    if (batch_ != nullptr && !mark.is_null()) {
+        if (static_cast<std::size_t>(mark.pos) >= batch_->end - batch_->begin) {
+            return batch_->after;
+        }
+        YAML::Mark m = mark;
+        m.pos += static_cast<int>(batch_->begin);
+        m.line += batch_->first_line;
+        return m;
+    }
+    return splice_ != nullptr && batch_ == nullptr ? splice_->original(mark) : mark;
+}
+
+void PlanEventReader::read_batches() {
+    for (const ListSplice::Batch& batch : splice_->batches) {
+        TextStream in(text_.substr(batch.begin, batch.end - batch.begin));
+        YAML::Parser parser(in);
+        BatchEvents events(*this);
+        batch_ = &batch;
+        parser.HandleNextDocument(events);
+        batch_ = nullptr;
+        if (!events.was_one_list()) {
+            throw NotStreamable{};
+        }
+    }
+}
+
 LoadResult PlanEventReader::result() {
+    if (splice_ != nullptr && !spliced_) {
+        throw NotStreamable{};
+    }
     if (!result_) {
         result_ = parser_.run(YRef(), options_);  // no document at all
     }
@@ -103,7 +204,7 @@ void PlanEventReader::OnNull(const YAML::Mark& mark, YAML::anchor_t anchor) {
     }
     pending_ = Pending::None;
     before_node(nullptr, next_is_key());
-    if (const YNode* tree = l.builder.null(mark, anchor)) {
+    if (const YNode* tree = l.builder.null(place(mark), anchor)) {
         finished(tree, Open{});
     }
 }
@@ -132,19 +233,31 @@ void PlanEventReader::OnScalar(const YAML::Mark& mark, const std::string&, YAML:
     probe.type = YNode::Type::Scalar;
     probe.scalar = value;
     before_node(&probe, key);
-    if (const YNode* tree = l.builder.scalar(mark, anchor, value)) {
+    if (const YNode* tree = l.builder.scalar(place(mark), anchor, value)) {
         finished(tree, Open{});
     }
 }
 
 void PlanEventReader::OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
                                       YAML::EmitterStyle::value) {
-    start(YNode::Type::Sequence, mark, anchor);
+    const bool stand_in =
+        splice_ != nullptr && batch_ == nullptr && !mark.is_null() &&
+        static_cast<std::size_t>(mark.pos) >= splice_->cut_begin &&
+        static_cast<std::size_t>(mark.pos) < splice_->cut_begin + ListSplice::kStandIn.size();
+    if (stand_in != (pending_ == Pending::PlanElements && stream_ && splice_ != nullptr &&
+                     batch_ == nullptr && !spliced_ && level().kind == Level::Kind::Document)) {
+        throw NotStreamable{};  // the list is not where the splice was made, or the stand-in is read as data
+    }
+    start(YNode::Type::Sequence, place(mark), anchor);
+    if (stand_in) {
+        spliced_ = true;
+        read_batches();
+    }
 }
 
 void PlanEventReader::OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
                                  YAML::EmitterStyle::value) {
-    start(YNode::Type::Map, mark, anchor);
+    start(YNode::Type::Map, place(mark), anchor);
 }
 
 void PlanEventReader::start(YNode::Type type, const YAML::Mark& mark, YAML::anchor_t anchor) {

@@ -8,13 +8,19 @@
 // other key after a streamed "elements" (but "blocks" after the plan's), one key per element, no anchor on
 // what holds the list. When a document breaks that promise after streaming began, reading stops with
 // NotStreamable and the loader reads it again as a whole tree (stream = false): same result, more memory.
+//
+// With a ListSplice, the parser reads the text with the plan's main list cut out (list_splice.hpp); the
+// reader reads the list's batches itself where the stand-in list starts, and gives every mark as a place in
+// the original text. A document that does not meet the splice where expected stops with NotStreamable too.
 #include <yaml-cpp/eventhandler.h>
 
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "services/flightplan/list_splice.hpp"
 #include "services/flightplan/plan_parser.hpp"
 #include "services/flightplan/yaml_tree.hpp"
 
@@ -27,7 +33,11 @@ class PlanEventReader final : public YAML::EventHandler {
     PlanEventReader(PlanParser& parser, const LoadOptions& options, bool stream);
     ~PlanEventReader() override;
 
-    /// After the parser's HandleNextDocument (or without any document).
+    /// The parser reads `text` through a SplicedBuffer made with `splice` (both outlive the reader).
+    void splice(std::string_view text, const ListSplice& splice);
+
+    /// After the parser's HandleNextDocument (or without any document). With a splice, throws NotStreamable
+    /// unless the stand-in was read as the plan's list (it may have been inside a scalar).
     LoadResult result();
 
     void OnDocumentStart(const YAML::Mark&) override {}
@@ -65,6 +75,9 @@ class PlanEventReader final : public YAML::EventHandler {
     void end();
     void finished(const YNode* tree, const Open& role);
     void list_ended();
+    /// A mark of the text being parsed as a mark of the original text.
+    YAML::Mark place(const YAML::Mark& mark) const;
+    void read_batches();
 
     PlanParser& parser_;
     const LoadOptions& options_;
@@ -73,6 +86,10 @@ class PlanEventReader final : public YAML::EventHandler {
     std::vector<std::unique_ptr<Level>> levels_;
     Pending pending_ = Pending::None;
     std::optional<LoadResult> result_;
+    std::string_view text_;
+    const ListSplice* splice_ = nullptr;
+    const ListSplice::Batch* batch_ = nullptr;  // the batch being read
+    bool spliced_ = false;
 };
 
 }  // namespace airseg::flightplan
