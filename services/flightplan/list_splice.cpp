@@ -1,6 +1,7 @@
 #include "services/flightplan/list_splice.hpp"
 
 #include <algorithm>
+#include <cstdint>
 
 namespace airseg::flightplan {
 
@@ -61,6 +62,41 @@ bool is_item(std::string_view line, std::size_t indent) {
            (line.size() == indent + 1 || line[indent + 1] == ' ');
 }
 
+/// Printable text: tabs, line feeds, printable ASCII and well-formed UTF-8 only. yaml-cpp decodes other bytes
+/// (malformed UTF-8, controls) in ways that depend on where they fall in its read buffer, so a batch could
+/// read them otherwise than the whole text does.
+bool plain_text(std::string_view text) {
+    std::size_t i = 0;
+    while (i < text.size()) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c < 0x80) {
+            if ((c < 0x20 && c != '\n' && c != '\t') || c == 0x7f) {
+                return false;
+            }
+            ++i;
+            continue;
+        }
+        const std::size_t length = c >= 0xf0 ? 4 : c >= 0xe0 ? 3 : c >= 0xc0 ? 2 : 0;
+        if (length == 0 || c > 0xf4 || c < 0xc2 || i + length > text.size()) {
+            return false;
+        }
+        std::uint32_t code = c & (0x7fu >> length);
+        for (std::size_t k = 1; k < length; ++k) {
+            const auto next = static_cast<unsigned char>(text[i + k]);
+            if ((next & 0xc0) != 0x80) {
+                return false;
+            }
+            code = (code << 6) | (next & 0x3fu);
+        }
+        const std::uint32_t least[] = {0, 0, 0x80, 0x800, 0x10000};
+        if (code < least[length] || code > 0x10ffff || (code >= 0xd800 && code <= 0xdfff) || code == 0xfeff) {
+            return false;
+        }
+        i += length;
+    }
+    return true;
+}
+
 }  // namespace
 
 YAML::Mark ListSplice::original(YAML::Mark mark) const {
@@ -73,7 +109,7 @@ YAML::Mark ListSplice::original(YAML::Mark mark) const {
 }
 
 std::optional<ListSplice> find_list_splice(std::string_view text, std::size_t items_per_batch) {
-    if (items_per_batch == 0 || text.find('\r') != std::string_view::npos) {
+    if (items_per_batch == 0 || !plain_text(text)) {
         return std::nullopt;
     }
     Lines lines(text);

@@ -8,7 +8,8 @@
 // whose "elements:" key holds a block list). A line at the list's column starting with "- " is an item;
 // the text cannot be inside a quoted scalar or a flow collection there without that batch ending in an
 // unterminated one, which its parser refuses, and the loader then reads the document whole. Lists with
-// anchors or aliases, tabs in indentation or carriage returns are left alone.
+// anchors or aliases or tabs in indentation, and texts with carriage returns, other control characters or
+// malformed UTF-8 are left alone.
 #include <cstddef>
 #include <optional>
 #include <streambuf>

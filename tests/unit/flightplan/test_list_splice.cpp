@@ -74,6 +74,9 @@ TEST(ListSplice, OtherLayoutsAreLeftAlone) {
         "plan:\n  elements: [{waypoint: {lat: 1, lon: 2}}]\n",
         "plan:\n  elements:\n" + list + "\t- waypoint: {lat: 1, lon: 2}\n",
         "plan:\r\n  elements:\r\n" + list,
+        "plan:\n  elements:\n" + list + "    - hold: {name: \"\xff\"}\n",
+        "plan:\n  elements:\n" + list + "    - hold: {name: \"\xc0\xaf\"}\n",
+        "plan:\n  elements:\n" + list + "    - hold: {name: \"a" + std::string(1, '\0') + "b\"}\n",
         "plan:\n  blocks:\n    - name: b\n      elements:\n" + waypoints(8, "        "),
         "plan: {elements: []}\n",
         "plan:\n  elements:\n      - waypoint: {lat: 1, lon: 2}\n" + waypoints(4, "      ") + "    name: x\n",
@@ -83,6 +86,9 @@ TEST(ListSplice, OtherLayoutsAreLeftAlone) {
         EXPECT_FALSE(find_list_splice(text, text.empty() ? 1 : 4).has_value()) << text;
     }
     EXPECT_TRUE(find_list_splice("plan:\n  elements:\n" + list, 3).has_value());
+    EXPECT_TRUE(
+        find_list_splice("plan:\n  elements:\n" + list + "    - hold: {name: Plaça \xf0\x9f\x9a\x80}\n", 3)
+            .has_value());
 }
 
 /// Everything the loader keeps of a plan, one line per node.
