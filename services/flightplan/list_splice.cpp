@@ -188,7 +188,7 @@ std::optional<ListSplice> find_list_splice(std::string_view text, std::size_t it
     for (std::size_t i = 0; i < starts.size(); ++i) {
         ListSplice::Batch batch;
         batch.begin = starts[i].begin;
-        batch.end = i + 1 < starts.size() ? starts[i + 1].begin : last_end;
+        batch.end = i + 1 < starts.size() ? starts[i + 1].begin : std::min(last_end + 1, text.size());
         batch.first_line = starts[i].number;
         if (i + 1 < starts.size()) {
             batch.after = mark_at(starts[i + 1].begin + column, starts[i + 1].number, column);
@@ -204,10 +204,7 @@ std::optional<ListSplice> find_list_splice(std::string_view text, std::size_t it
     return splice;
 }
 
-SplicedBuffer::SplicedBuffer(std::string_view text, const ListSplice& splice)
-    : pieces_{text.substr(0, splice.cut_begin), ListSplice::kStandIn, text.substr(splice.cut_end)} {}
-
-SplicedBuffer::int_type SplicedBuffer::underflow() {
+PiecesBuffer::int_type PiecesBuffer::underflow() {
     while (next_ < 3) {
         const std::string_view piece = pieces_[next_++];
         if (!piece.empty()) {

@@ -45,10 +45,10 @@ struct ListSplice {
 /// one or the list is too short to be worth it.
 std::optional<ListSplice> find_list_splice(std::string_view text, std::size_t items_per_batch);
 
-/// The text with the list replaced by ListSplice::kStandIn, read where it lies.
-class SplicedBuffer : public std::streambuf {
+/// Pieces of text read one after the other, where they lie (none is copied).
+class PiecesBuffer : public std::streambuf {
   public:
-    SplicedBuffer(std::string_view text, const ListSplice& splice);
+    PiecesBuffer(std::string_view a, std::string_view b, std::string_view c = {}) : pieces_{a, b, c} {}
 
   protected:
     int_type underflow() override;
@@ -56,6 +56,22 @@ class SplicedBuffer : public std::streambuf {
   private:
     std::string_view pieces_[3];
     std::size_t next_ = 0;
+};
+
+/// The text with the list replaced by ListSplice::kStandIn.
+class SplicedBuffer : public PiecesBuffer {
+  public:
+    SplicedBuffer(std::string_view text, const ListSplice& splice)
+        : PiecesBuffer(text.substr(0, splice.cut_begin), ListSplice::kStandIn, text.substr(splice.cut_end)) {}
+};
+
+/// A batch's text, then a comment line: yaml-cpp is more lenient at the very end of a text than before a
+/// following line (a plain scalar ending a mapping there is taken as a key), and in the whole text more
+/// lines follow the batch.
+class BatchBuffer : public PiecesBuffer {
+  public:
+    explicit BatchBuffer(std::string_view batch)
+        : PiecesBuffer(batch, !batch.empty() && batch.back() == '\n' ? "#\n" : "\n#\n") {}
 };
 
 }  // namespace airseg::flightplan

@@ -2,9 +2,8 @@
 
 #include <yaml-cpp/parser.h>
 
+#include <istream>
 #include <utility>
-
-#include "services/flightplan/text_stream.hpp"
 
 namespace airseg::flightplan {
 
@@ -113,7 +112,8 @@ YAML::Mark PlanEventReader::place(const YAML::Mark& mark) const {
 
 void PlanEventReader::read_batches() {
     for (const ListSplice::Batch& batch : splice_->batches) {
-        TextStream in(text_.substr(batch.begin, batch.end - batch.begin));
+        BatchBuffer buffer(text_.substr(batch.begin, batch.end - batch.begin));
+        std::istream in(&buffer);
         YAML::Parser parser(in);
         BatchEvents events(*this);
         batch_ = &batch;
