@@ -44,6 +44,7 @@ nlohmann::json state_json(const RoverSim& sim, TimePoint now) {
         {"reached", sim.reached().size()},
         {"cruise_speed", s.cruise_speed},
         {"firmware", firmware_name(sim.config().firmware.firmware)},
+        {"frozen", sim.frozen()},
     };
     if (s.target) {
         j["target"] = {{"lat", s.target->lat}, {"lon", s.target->lon}, {"distance", s.target_distance}};
@@ -234,6 +235,14 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
             sim.faults().ignore_mission = w[1] == "on";
             return "ok ignore-mission " + w[1];
         }
+        if (verb == "freeze") {
+            need(2, "freeze on|off");
+            if (w[1] != "on" && w[1] != "off") {
+                return "error: freeze: expected on or off, got '" + w[1] + "'";
+            }
+            sim.freeze(w[1] == "on", now);
+            return "ok freeze " + w[1];
+        }
         if (verb == "slow") {
             need(2, "slow MS");
             sim.faults().slow = cli::parse_milliseconds(verb, w[1]);
@@ -258,7 +267,7 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
             return "ok commands: state, modes [N], reached [FROM [COUNT]], speeds [FROM [COUNT]], stats, "
                    "rcpilot MODE, mode MODE, reboot [S], unplug, replug, hbstall S, loss P [BURST], corrupt "
                    "P, "
-                   "ignore-mission on|off, slow MS, param NAME [VALUE]";
+                   "ignore-mission on|off, freeze on|off, slow MS, param NAME [VALUE]";
         }
         return "error: unknown command '" + verb + "' (try help)";
     } catch (const cli::UsageError& e) {

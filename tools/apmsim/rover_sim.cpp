@@ -217,7 +217,9 @@ void RoverSim::advance(TimePoint now) {
     // The electronics draw a steady current whether or not the car moves.
     consumed_mah_ += kIdleAmps * std::chrono::duration<double>(now - now_).count() * 1000.0 / 3600.0;
     // Whole physics steps up to `now`; mission events happen at the step that causes them.
-    if (!physics_active()) {
+    if (frozen_) {
+        last_step_ = std::max(last_step_, now);  // not one step: the vehicle must not move at all
+    } else if (!physics_active()) {
         last_step_ = std::max(last_step_, now - config_.physics_step);
     }
     while (last_step_ + config_.physics_step <= now) {

@@ -187,6 +187,12 @@ class RoverSim {
     bool set_param(const std::string& name, float value, TimePoint now, const std::string& cause = "control");
     /// Heartbeats stop for `d` from `now` (everything else goes on).
     void stall_heartbeats(Duration d, TimePoint now) { hb_stall_until_ = now + d; }
+    /// Stops (true) or restarts the vehicle's motion (its physics clock): while frozen it keeps its place,
+    /// heading and speed, so it reaches nothing, while the clock, heartbeats, telemetry, modes and the
+    /// mission protocol go on. A test holds the vehicle still with it while a ground program, however slow
+    /// on a loaded machine, acts, instead of racing the accelerated clock.
+    void freeze(bool on, TimePoint now);
+    bool frozen() const { return frozen_; }
 
     Faults& faults() { return faults_; }
     const Faults& faults() const { return faults_; }
@@ -312,6 +318,7 @@ class RoverSim {
     TimePoint next_heartbeat_ = kNever;
     TimePoint hb_stall_until_{};
     TimePoint last_step_{};
+    bool frozen_ = false;
     bool heartbeat_sent_this_boot_ = false;
 
     RoverMode mode_ = RoverMode::Initialising;

@@ -26,7 +26,17 @@ DriveLimits RoverSim::limits() const {
     return l;
 }
 
+void RoverSim::freeze(bool on, TimePoint now) {
+    // Motion up to `now` happens first; a frozen spell is then skipped, not caught up when released.
+    advance(now);
+    frozen_ = on;
+    last_step_ = std::max(last_step_, now_);
+}
+
 bool RoverSim::physics_active() const {
+    if (frozen_) {
+        return false;
+    }
     if (vehicle_.speed() != 0) {
         return true;
     }

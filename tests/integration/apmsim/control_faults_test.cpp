@@ -49,6 +49,12 @@ TEST(ApmsimControl, QueriesAndFaults) {
     EXPECT_EQ(apply_control(h.sim, "ignore-mission on", h.now, link), "ok ignore-mission on");
     EXPECT_TRUE(h.sim.faults().ignore_mission);
     EXPECT_EQ(apply_control(h.sim, "ignore-mission maybe", h.now, link).rfind("error: ", 0), 0u);
+    EXPECT_EQ(apply_control(h.sim, "freeze on", h.now, link), "ok freeze on");
+    EXPECT_TRUE(h.sim.frozen());
+    EXPECT_EQ(nlohmann::json::parse(apply_control(h.sim, "state", h.now, link))["frozen"], true);
+    EXPECT_EQ(apply_control(h.sim, "freeze off", h.now, link), "ok freeze off");
+    EXPECT_FALSE(h.sim.frozen());
+    EXPECT_EQ(apply_control(h.sim, "freeze", h.now, link).rfind("error: ", 0), 0u);
     EXPECT_EQ(apply_control(h.sim, "slow 250", h.now, link), "ok slow 250 ms");
     EXPECT_EQ(h.sim.faults().slow, milliseconds(250));
     EXPECT_EQ(apply_control(h.sim, "param WP_RADIUS 3", h.now, link), "ok param WP_RADIUS 3");

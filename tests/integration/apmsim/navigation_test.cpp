@@ -106,6 +106,33 @@ TEST(ApmsimNav, NewMissionKeepsTheTargetBeingDrivenTo) {
     (void)from;
 }
 
+// A frozen vehicle stays where it is however much time passes, while the board still talks (heartbeats, the
+// mission protocol); released, it carries on from the same place to the same target without catching up.
+TEST(ApmsimNav, AFrozenVehicleKeepsItsPlaceWhileTheLinkGoesOnAndCarriesOnWhenReleased) {
+    SimHarness h;
+    h.boot();
+    ASSERT_EQ(h.upload(line_mission(h.sim.config().home, 4, 40)), 0);
+    h.set_mode(RoverMode::Auto);
+    ASSERT_TRUE(h.run_until([&] { return !h.sim.reached().empty(); }, seconds(60)));
+    h.sim.freeze(true, h.now);
+    EXPECT_TRUE(h.sim.frozen());
+    const auto held = h.sim.state();
+    const std::size_t from = h.received.size();
+    h.run_for(seconds(120));
+    EXPECT_EQ(h.sim.reached().size(), 1u);
+    EXPECT_EQ(distance_m(h.sim.state().position, held.position), 0.0);
+    EXPECT_EQ(h.sim.state().mode, RoverMode::Auto);
+    EXPECT_GE(h.all<mv::Heartbeat>(from).size(), 100u) << "the link goes on";
+    ASSERT_EQ(h.upload(line_mission(h.sim.config().home, 4, 40)), 0) << "and so does the mission protocol";
+    EXPECT_EQ(distance_m(h.sim.state().position, held.position), 0.0);
+
+    h.sim.freeze(false, h.now);
+    h.run_for(milliseconds(100));
+    EXPECT_LT(distance_m(h.sim.state().position, held.position), 1.0) << "a frozen spell is not caught up";
+    ASSERT_TRUE(h.run_until([&] { return h.sim.state().mode == RoverMode::Hold; }, seconds(120)));
+    EXPECT_EQ(reached_seqs(h), (std::vector<std::uint16_t>{1, 2, 3, 4}));
+}
+
 TEST(ApmsimNav, RebootStopsTheMissionAndResumesNothing) {
     SimHarness h;
     h.boot();

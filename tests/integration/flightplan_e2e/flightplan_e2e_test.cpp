@@ -209,6 +209,13 @@ class FlightplanE2e : public ::testing::TestWithParam<std::string> {
         return holds;
     }
     double sim_time() { return control_->json("state").value("t", 0.0); }
+    /// Stops (or restarts) the simulated vehicle's motion while the board's link goes on: a command whose
+    /// outcome depends on where the vehicle is when the daemon acts is given with the vehicle held still, or
+    /// at this speedup the result would hang on how fast a loaded machine runs the daemon.
+    void freeze(bool on) {
+        const auto reply = control_->ask(on ? "freeze on" : "freeze off");
+        ASSERT_TRUE(reply && reply->rfind("ok", 0) == 0) << reply.value_or("no answer");
+    }
     /// The board's reached log from event `from` on, without the wrap's pass-through point.
     std::vector<Reached> board_log(std::uint64_t from) {
         return plan_waypoints_of(reached_log(*control_, from), window_);
@@ -279,10 +286,9 @@ TEST_P(FlightplanE2e, LongScanRunsToTheEndWithEveryWaypointReachedOnceInOrderAnd
 }
 
 TEST_P(FlightplanE2e, ReplacingThePlanMidRouteHeadsForTheNewFirstWaypointWithoutStopping) {
-    // A's legs take 1 s of real time at this speedup, and the new plan goes in just after the board has
-    // reached a waypoint: its first item is then written well within the leg even under qemu on a loaded
-    // machine. Loaded near a leg's end, the vehicle can reach the kept target before that write, and then the
-    // feeder rightly holds rather than let it drive to a stale slot.
+    // The new plan goes in while the vehicle is held still just after it reached a waypoint: however long a
+    // loaded machine takes to write B's first item, the vehicle has not yet reached the kept target (had it,
+    // the feeder would rightly hold rather than let it drive to a stale slot). A's legs are 50 s simulated.
     const auto a_file = write_plan("a.yaml", line_plan("route-a", kHomeLat, kHomeLon + 0.0001, 0, 20, 200));
     const auto b_file =
         write_plan("b.yaml", line_plan("route-b", kHomeLat + 0.0005, kHomeLon + 0.0010, 90, 20, 8));
@@ -297,9 +303,11 @@ TEST_P(FlightplanE2e, ReplacingThePlanMidRouteHeadsForTheNewFirstWaypointWithout
     const auto leg_started = reached_total(*control_);
     ASSERT_TRUE(wait_until([&] { return reached_total(*control_) > leg_started; }, kGenerous,
                            std::chrono::milliseconds(5)));
+    freeze(true);
     auto replaced = ctl({"plan", "load", b_file});
     ASSERT_EQ(replaced.exit_code, 0) << replaced.json.dump() << replaced.err;
     const auto reached_at_answer = reached_total(*control_);
+    freeze(false);
     EXPECT_EQ(replaced.json["name"], "route-b");
     ASSERT_TRUE(wait_until([&] { return show().value("state", "") == "done"; }, 60s, kPoll)) << show().dump();
 
@@ -441,6 +449,9 @@ TEST_P(FlightplanE2e, SkipPauseResumeAndAppendAreConfirmedByTheBoard) {
     ASSERT_EQ(ctl({"plan", "load", file}).exit_code, 0);
     ASSERT_TRUE(wait_until([&] { return show().value("waypoints_reached", 0) >= 3; }, kGenerous, kPoll));
 
+    // Legs of 25 m take 125 ms of real time: held still, the vehicle cannot pass the slots being rewritten
+    // (nor, on a board restarting its mission on entering AUTO, head for item 1) before the daemon is done.
+    freeze(true);
     auto skipped = ctl({"plan", "skip", "20"});
     ASSERT_EQ(skipped.exit_code, 0) << skipped.json.dump() << skipped.err;
     EXPECT_EQ(skipped.json["next_waypoint"], 20);
@@ -457,6 +468,7 @@ TEST_P(FlightplanE2e, SkipPauseResumeAndAppendAreConfirmedByTheBoard) {
 
     auto appended = ctl({"plan", "append", more});
     ASSERT_EQ(appended.exit_code, 0) << appended.json.dump() << appended.err;
+    freeze(false);
     ASSERT_TRUE(wait_until([&] { return show().value("state", "") == "done"; }, 60s, kPoll)) << show().dump();
 
     // On the board: the start of the route, at most the target it was heading for, then 20..29 and the
