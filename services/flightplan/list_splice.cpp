@@ -171,9 +171,10 @@ std::optional<ListSplice> find_list_splice(std::string_view text, std::size_t it
         return std::nullopt;
     }
     const std::string_view cut = text.substr(splice.cut_begin, last_end - splice.cut_begin);
-    // An anchor or alias would span batches (a parser knows its own anchors only). The characters are
-    // looked for anywhere, in scalars and comments too: rare there, and then the list is read unsplit.
-    if (items <= items_per_batch || cut.find_first_of("&*") != std::string_view::npos) {
+    // An anchor or alias would span batches (a parser knows its own anchors only). A quoted scalar may run
+    // over an item's line, and yaml-cpp ends an unterminated one quietly at the end of a batch. The
+    // characters are looked for anywhere, in comments too: then the list is read unsplit.
+    if (items <= items_per_batch || cut.find_first_of("&*\"'") != std::string_view::npos) {
         return std::nullopt;
     }
     splice.cut_end = last_end;

@@ -5,11 +5,11 @@
 // while the rest of the document is read with "[]" where the list was.
 //
 // The cut is found by looking at the text's lines, for the usual layout only (a top-level "plan:" mapping
-// whose "elements:" key holds a block list). A line at the list's column starting with "- " is an item;
-// the text cannot be inside a quoted scalar or a flow collection there without that batch ending in an
-// unterminated one, which its parser refuses, and the loader then reads the document whole. Lists with
-// anchors or aliases or tabs in indentation, and texts with carriage returns, other control characters or
-// malformed UTF-8 are left alone.
+// whose "elements:" key holds a block list). A line at the list's column starting with "- " is an item's
+// first line unless it is inside a flow collection, and then the batch before it ends with that collection
+// open, which its parser refuses: the loader then reads the document unsplit. Lists with quotes (yaml-cpp
+// ends an unterminated quoted scalar quietly where a batch ends), anchors or aliases or tabs in indentation,
+// and texts with carriage returns, other control characters or malformed UTF-8 are left alone.
 #include <cstddef>
 #include <optional>
 #include <streambuf>
