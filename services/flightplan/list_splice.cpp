@@ -189,7 +189,8 @@ std::optional<ListSplice> find_list_splice(std::string_view text, std::size_t it
     for (std::size_t i = 0; i < starts.size(); ++i) {
         ListSplice::Batch batch;
         batch.begin = starts[i].begin;
-        batch.end = i + 1 < starts.size() ? starts[i + 1].begin : std::min(last_end + 1, text.size());
+        batch.end = i + 1 < starts.size() ? starts[i + 1].begin : followed ? last_end + 1 : text.size();
+        batch.ends_text = i + 1 == starts.size() && !followed;
         batch.first_line = starts[i].number;
         if (i + 1 < starts.size()) {
             batch.after = mark_at(starts[i + 1].begin + column, starts[i + 1].number, column);

@@ -29,6 +29,7 @@ struct ListSplice {
         /// Where the whole text's next token after the batch is. A mark at the batch's end (a null or a
         /// collection's end takes the next token's mark) is moved there, as the unsplit text would give it.
         YAML::Mark after;
+        bool ends_text = false;  // nothing but comments after it: read to the text's end, as it is
     };
     static constexpr std::string_view kStandIn = " []";
 
@@ -65,13 +66,15 @@ class SplicedBuffer : public PiecesBuffer {
         : PiecesBuffer(text.substr(0, splice.cut_begin), ListSplice::kStandIn, text.substr(splice.cut_end)) {}
 };
 
-/// A batch's text, then a comment line: yaml-cpp is more lenient at the very end of a text than before a
-/// following line (a plain scalar ending a mapping there is taken as a key), and in the whole text more
-/// lines follow the batch.
+/// A batch's text, then a comment line unless the batch ends the text: yaml-cpp is more lenient at the very
+/// end of a text than before a following line (a plain scalar ending a mapping there is taken as a key).
 class BatchBuffer : public PiecesBuffer {
   public:
-    explicit BatchBuffer(std::string_view batch)
-        : PiecesBuffer(batch, !batch.empty() && batch.back() == '\n' ? "#\n" : "\n#\n") {}
+    BatchBuffer(std::string_view text, const ListSplice::Batch& batch)
+        : PiecesBuffer(text.substr(batch.begin, batch.end - batch.begin),
+                       batch.ends_text                                          ? ""
+                       : batch.end > batch.begin && text[batch.end - 1] == '\n' ? "#\n"
+                                                                                : "\n#\n") {}
 };
 
 }  // namespace airseg::flightplan

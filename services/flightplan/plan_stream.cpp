@@ -112,7 +112,7 @@ YAML::Mark PlanEventReader::place(const YAML::Mark& mark) const {
 
 void PlanEventReader::read_batches() {
     for (const ListSplice::Batch& batch : splice_->batches) {
-        BatchBuffer buffer(text_.substr(batch.begin, batch.end - batch.begin));
+        BatchBuffer buffer(text_, batch);
         std::istream in(&buffer);
         YAML::Parser parser(in);
         BatchEvents events(*this);
