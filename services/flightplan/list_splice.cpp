@@ -1,6 +1,7 @@
 #include "services/flightplan/list_splice.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdint>
 
 namespace airseg::flightplan {
@@ -55,6 +56,19 @@ bool is_bare_key(std::string_view line, std::size_t indent, std::string_view key
     const std::string_view s = line.substr(indent);
     return s.size() > key.size() && s.substr(0, key.size()) == key && s[key.size()] == ':' &&
            rest_is_empty(line, indent + key.size() + 1);
+}
+
+/// "- key:" with a plain key: the first line of a mapping item, as every plan element is. yaml-cpp runs a
+/// plain scalar item on into a following "- " line, so a list with other items is read unsplit.
+bool is_mapping_item(std::string_view line, std::size_t indent) {
+    const std::size_t key = indent + 2;
+    std::size_t end = key;
+    while (end < line.size() && (std::isalnum(static_cast<unsigned char>(line[end])) != 0 ||
+                                 line[end] == '_' || line[end] == '-')) {
+        ++end;
+    }
+    return end > key && end < line.size() && line[end] == ':' &&
+           (end + 1 == line.size() || line[end + 1] == ' ');
 }
 
 bool is_item(std::string_view line, std::size_t indent) {
@@ -159,6 +173,9 @@ std::optional<ListSplice> find_list_splice(std::string_view text, std::size_t it
         if (line.indent < column || (line.indent == column && !is_item(s, column))) {
             followed = true;
             break;
+        }
+        if (line.indent == column && !is_mapping_item(s, column)) {
+            return std::nullopt;
         }
         if (line.indent == column && items++ % items_per_batch == 0) {
             starts.push_back(line);

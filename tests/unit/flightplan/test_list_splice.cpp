@@ -75,6 +75,8 @@ TEST(ListSplice, OtherLayoutsAreLeftAlone) {
         "plan:\n  elements:\n" + list + "\t- waypoint: {lat: 1, lon: 2}\n",
         "plan:\r\n  elements:\r\n" + list,
         "plan:\n  elements:\n" + list + "    - hold: {name: \"gate\"}\n",
+        "plan:\n  elements:\n" + list + "    - a plain scalar item\n",
+        "plan:\n  elements:\n" + list + "    - {hold: {seconds: 1}}\n",
         "plan:\n  elements:\n" + list + "    - hold: {name: it's}\n",
         "plan:\n  elements:\n" + list + "    - hold: {name: \xff}\n",
         "plan:\n  elements:\n" + list + "    - hold: {name: \xc0\xaf}\n",
