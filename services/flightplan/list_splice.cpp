@@ -71,6 +71,22 @@ bool is_mapping_item(std::string_view line, std::size_t indent) {
            (end + 1 == line.size() || line[end + 1] == ' ');
 }
 
+/// A line that is only a plain scalar, without a ": " or a final ':' (not "key: value", not a list entry, not
+/// flow or quoted text). Where a mapping's key belongs, yaml-cpp runs such a line on into the next line, even
+/// a "- " line at the list's column; elsewhere it is rare in a plan (a multi-line plain scalar, a block
+/// scalar's text, the end of a flow collection written over lines). Lists with one are read unsplit.
+bool bare_plain_line(std::string_view text) {
+    if (text.empty() || text.rfind("- ", 0) == 0 || text == "-" ||
+        std::string_view("{}[],\"'#&*!|>%@`").find(text[0]) != std::string_view::npos) {
+        return false;
+    }
+    text = text.substr(0, text.find(" #"));  // a comment
+    while (!text.empty() && text.back() == ' ') {
+        text.remove_suffix(1);
+    }
+    return text.find(": ") == std::string_view::npos && text.back() != ':';  // no mapping indicator
+}
+
 bool is_item(std::string_view line, std::size_t indent) {
     return line.size() > indent && line[indent] == '-' &&
            (line.size() == indent + 1 || line[indent + 1] == ' ');
@@ -174,7 +190,8 @@ std::optional<ListSplice> find_list_splice(std::string_view text, std::size_t it
             followed = true;
             break;
         }
-        if (line.indent == column && !is_mapping_item(s, column)) {
+        if ((line.indent == column && !is_mapping_item(s, column)) ||
+            bare_plain_line(s.substr(line.indent))) {
             return std::nullopt;
         }
         if (line.indent == column && items++ % items_per_batch == 0) {

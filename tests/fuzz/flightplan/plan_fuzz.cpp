@@ -26,8 +26,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const LoadResult result = load_plan_text(text, "fuzz.yaml", options);
     options.splice_batch_items = 0;
     const LoadResult unsplit = load_plan_text(text, "fuzz.yaml", options);
-    // Both readings accept the same documents, as the same plan. A malformed document may be refused with
-    // other diagnostics (yaml-cpp can give one syntax error for the whole text where a batch reads cleanly).
+    require(result.errors.size() == unsplit.errors.size());
+    for (std::size_t i = 0; i < result.errors.size(); ++i) {
+        require(result.errors[i].to_string() == unsplit.errors[i].to_string());
+    }
     require(result.ok() == unsplit.ok());
     if (result.ok()) {
         const auto& a = result.plan->nodes;

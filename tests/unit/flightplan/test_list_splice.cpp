@@ -76,6 +76,8 @@ TEST(ListSplice, OtherLayoutsAreLeftAlone) {
         "plan:\r\n  elements:\r\n" + list,
         "plan:\n  elements:\n" + list + "    - hold: {name: \"gate\"}\n",
         "plan:\n  elements:\n" + list + "    - a plain scalar item\n",
+        "plan:\n  elements:\n" + list + "    - hold: {seconds: 1}\n      stray words\n",
+        "plan:\n  elements:\n" + list + "    - repeat:\n        :not a key\n",
         "plan:\n  elements:\n" + list + "    - {hold: {seconds: 1}}\n",
         "plan:\n  elements:\n" + list + "    - hold: {name: it's}\n",
         "plan:\n  elements:\n" + list + "    - hold: {name: \xff}\n",
