@@ -25,10 +25,10 @@ function(airseg_add_library name)
   target_link_libraries(${name} PUBLIC airseg_options ${A_LIBS})
 endfunction()
 
-# airseg_add_test(NAME SOURCES... [LIBS ...] [LABELS ...] [TIMEOUT seconds] [RESOURCE_GROUPS groups])
+# airseg_add_test(NAME SOURCES... [LIBS ...] [LABELS ...] [TIMEOUT seconds] [RESOURCE_LOCK name])
 # One GoogleTest executable whose cases ctest discovers one by one.
 function(airseg_add_test name)
-  cmake_parse_arguments(A "" "TIMEOUT;RESOURCE_GROUPS" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(A "" "TIMEOUT;RESOURCE_LOCK" "SOURCES;LIBS;LABELS" ${ARGN})
   if(NOT AIRSEG_BUILD_TESTS)
     return()
   endif()
@@ -39,12 +39,11 @@ function(airseg_add_test name)
   target_link_libraries(${name} PRIVATE airseg_options GTest::gtest GTest::gtest_main GTest::gmock ${A_LIBS})
   target_compile_definitions(${name} PRIVATE AIRSEG_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
                                              AIRSEG_BINARY_DIR="${PROJECT_BINARY_DIR}")
-  set(_resources)
-  if(A_RESOURCE_GROUPS)
-    # Slots of a resource in tests/ctest-resources.json, which build-and-test.sh and the package build give
-    # ctest (--resource-spec-file); a plain ctest without it runs the cases unconstrained.
-    set(_resources RESOURCE_GROUPS ${A_RESOURCE_GROUPS})
+  set(_lock)
+  if(A_RESOURCE_LOCK)
+    # Cases that must not run beside each other (they share a scarce resource, e.g. real-time radio links).
+    set(_lock RESOURCE_LOCK ${A_RESOURCE_LOCK})
   endif()
   gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60
-                       PROPERTIES TIMEOUT ${A_TIMEOUT} LABELS "${A_LABELS}" ${_resources})
+                       PROPERTIES TIMEOUT ${A_TIMEOUT} LABELS "${A_LABELS}" ${_lock})
 endfunction()

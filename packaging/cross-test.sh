@@ -42,6 +42,5 @@ cmake -S "$src" -B "$build" -G Ninja \
 cmake --build "$build" -j "$jobs" ${AIRSEG_TARGETS:+--target $AIRSEG_TARGETS}
 built=$SECONDS
 export QEMU_LD_PREFIX=$sysroot
-ctest --test-dir "$build" --output-on-failure --parallel "$jobs" \
-  --resource-spec-file "$AIRSEG_ROOT/tests/ctest-resources.json" "$@"
+ctest --test-dir "$build" --output-on-failure --parallel "$jobs" "$@"
 log "$arch: build $((built - start)) s, tests $((SECONDS - built)) s"

@@ -43,8 +43,7 @@ run_ctest() {
   local dir=$1
   shift
   tests/integration/mavlink_interop/setup.sh "$dir"
-  ctest --test-dir "$dir" -j"$test_jobs" --output-on-failure --timeout 600 \
-    --resource-spec-file "$PWD/tests/ctest-resources.json" "$@"
+  ctest --test-dir "$dir" -j"$test_jobs" --output-on-failure --timeout 600 "$@"
 }
 
 for s in $stages; do
