@@ -10,7 +10,7 @@ packages=(
   # The ground map's page (Leaflet) and its browser test (headless chromium).
   libjs-leaflet chromium
   # The fleet test's MQTT broker.
-  mosquitto
+  mosquitto mosquitto-clients
 )
 sudo=""
 if [ "$(id -u)" -ne 0 ]; then

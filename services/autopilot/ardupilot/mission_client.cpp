@@ -292,10 +292,12 @@ void MissionClient::send_to_mission(M m) {
 
 // Sends what the current step waits an answer for: first transmission, or a retry after a timeout.
 void MissionClient::transmit(WorkItem& w, TimePoint now, bool retry) {
+    bool item_sent = false;
     switch (w.step) {
         case Step::WaitRequest:
             if (w.any_request) {
                 send_item(w, w.next_seq, w.answer_int);
+                item_sent = true;
             } else if (w.op == MissionOperation::Upload) {
                 mav::MissionCount m;
                 m.count = static_cast<std::uint16_t>(w.items.size());
@@ -316,6 +318,7 @@ void MissionClient::transmit(WorkItem& w, TimePoint now, bool retry) {
                 send_to_mission(m);
             } else {
                 send_item(w, w.next_seq, w.answer_int);
+                item_sent = true;
             }
             break;
         case Step::WaitCount: {
@@ -347,6 +350,7 @@ void MissionClient::transmit(WorkItem& w, TimePoint now, bool retry) {
     }
     if (retry) {
         ++stats_.retransmissions;
+        stray_items_ += item_sent ? 1 : 0;
         if (rtt_.samples() == 0) {
             backoff_ = std::min(backoff_ * 2, 16u);
         }
@@ -529,6 +533,9 @@ void MissionClient::on_request(std::uint16_t seq, bool as_int, TimePoint now) {
         return;
     }
     w.last_heard = now;
+    if (!w.any_request) {
+        stray_items_ = 0;  // the vehicle answers in order: whatever was sent before this transfer is answered
+    }
     const bool fresh = !w.any_request || seq > w.highest_sent;
     if (fresh && w.any_request && w.answer_int) {
         int_proven_ = true;  // it went on after our MISSION_ITEM_INT: it takes them
@@ -565,11 +572,17 @@ void MissionClient::on_request(std::uint16_t seq, bool as_int, TimePoint now) {
     w.sent_at = now;
     if (!fresh) {
         ++stats_.retransmissions;
+        ++stray_items_;
     }
     w.deadline = now + current_timeout(w);
 }
 
 void MissionClient::on_ack(std::uint8_t type, TimePoint now) {
+    const bool may_answer_stray_item =
+        stray_items_ > 0 && (type == mav::kMissionError || type == mav::kMissionInvalidSequence);
+    if (may_answer_stray_item) {
+        --stray_items_;
+    }
     if (work_.empty()) {
         ++stats_.ignored_frames;
         return;
@@ -593,6 +606,14 @@ void MissionClient::on_ack(std::uint8_t type, TimePoint now) {
     }
     if (type == mav::kMissionInvalidSequence && uploading) {
         ++stats_.invalid_sequence_acks;
+        return;
+    }
+    if (type == mav::kMissionError && may_answer_stray_item && !(uploading && w.any_request)) {
+        // An item we repeated reached the vehicle after it had finished that transfer (ArduPilot answers an
+        // item it is not receiving with ERROR). Before this operation's first answer, it is the old
+        // transfer's. Were it the vehicle's verdict on this operation, the repeat of the request would get
+        // the verdict again, with no stray item left to blame.
+        ++stats_.stray_errors;
         return;
     }
     // The vehicle gave up waiting (ArduPilot: 8 s without an item on a bad link, OPERATION_CANCELLED), or it

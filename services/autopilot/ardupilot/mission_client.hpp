@@ -78,6 +78,7 @@ struct MissionClientStats {
     std::uint64_t ignored_frames = 0;   // mission frames that matched no running operation
     std::uint64_t restarts = 0;         // uploads started again after the vehicle cancelled them
     std::uint64_t float_fallbacks = 0;  // boards found not to take MISSION_ITEM_INT
+    std::uint64_t stray_errors = 0;     // ERRORs answering an item repeated after its transfer ended
 };
 
 class MissionClient {
@@ -186,6 +187,10 @@ class MissionClient {
     bool int_proven_ = false;  // the board went on after an item sent as MISSION_ITEM_INT
     std::string fallback_reason_;
     std::optional<std::uint8_t> refusal_;  // the MISSION_ACK type ending the running operation
+    // Items sent again for a repeated request whose answer has not come back yet. Each is answered once:
+    // MAV_MISSION_ERROR if the vehicle had finished the transfer when it arrived, and that answer can reach
+    // us after the next operation has begun.
+    unsigned stray_items_ = 0;
     MissionClientStats stats_;
 };
 

@@ -227,6 +227,41 @@ TEST(MissionClient, PartialWriteBeyondTheMissionIsDenied) {
     EXPECT_NE(fx.ground.completions[0].detail.find("MAV_MISSION_ERROR"), std::string::npos);
 }
 
+// A slow link makes the vehicle ask for an item again before the first answer has reached it. The
+// repeated answer then reaches a vehicle that has finished the transfer, and ArduPilot answers an item it
+// does not expect with MAV_MISSION_ERROR. That error belongs to the finished transfer, not to the next
+// one, which must not take it as the vehicle's verdict on its own request.
+TEST(MissionClient, AnErrorAnsweringARepeatedItemDoesNotRefuseTheNextTransfer) {
+    LinkModel radio;
+    radio.latency = milliseconds(600);  // a round trip longer than the vehicle's 1 s re-request
+    Fixture fx(radio, 5);
+    fx.ground.client.upload(make_items(8), fx.harness.now());
+    std::vector<std::vector<mav::MissionItemInt>> patches;
+    for (int i = 0; i < 4; ++i) {
+        patches.push_back(make_items(1));
+        patches.back()[0].x = 100 + i;
+        fx.ground.client.write_partial(static_cast<std::uint16_t>(2 + i), patches.back(), fx.harness.now());
+    }
+    ASSERT_TRUE(fx.run_until_done(5));
+    for (const auto& c : fx.ground.completions) {
+        EXPECT_EQ(c.result, MissionResult::Success) << c.detail;
+    }
+    for (int i = 0; i < 4; ++i) {
+        EXPECT_EQ(fx.rover.mission()[static_cast<std::size_t>(2 + i)].x, 100 + i);
+    }
+    EXPECT_GT(fx.ground.client.stats().duplicate_requests, 0u)
+        << "the link did not provoke repeated requests";
+    EXPECT_GT(fx.ground.client.stats().stray_errors, 0u) << "no error answered a repeated item";
+
+    // The vehicle's own verdict still counts when it follows a stray error.
+    fx.ground.client.write_partial(2, make_items(1), fx.harness.now());
+    fx.ground.client.write_partial(40, make_items(1), fx.harness.now());
+    ASSERT_TRUE(fx.run_until_done(7));
+    EXPECT_EQ(fx.ground.completions[5].result, MissionResult::Success) << fx.ground.completions[5].detail;
+    EXPECT_EQ(fx.ground.completions[6].result, MissionResult::Denied);
+    EXPECT_NE(fx.ground.completions[6].detail.find("MAV_MISSION_ERROR"), std::string::npos);
+}
+
 TEST(MissionClient, SetCurrentIsConfirmedByMissionCurrent) {
     Fixture fx({.frame_drop = 0.3}, 11);
     fx.ground.client.upload(make_items(6), fx.harness.now());
