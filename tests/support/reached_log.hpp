@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -68,6 +69,33 @@ inline std::uint64_t reached_total(ControlClient& sim) {
 /// neighbouring floats at these latitudes. Waypoints are metres apart, so this still tells them apart.
 inline bool same_place(const E7& a, const E7& b) {
     return std::llabs(a.first - b.first) <= 40 && std::llabs(a.second - b.second) <= 40;
+}
+
+/// The board's log around entry `at`, each entry with the plan waypoint it matches (searched near `at`), so a
+/// failure shows whether the vehicle skipped, repeated or went back, and from which slot.
+inline std::string describe_reached_around(const std::vector<Reached>& log, const std::vector<E7>& plan,
+                                           std::size_t at, std::size_t span = 8) {
+    std::ostringstream out;
+    const std::size_t from = at > span ? at - span : 0;
+    for (std::size_t i = from; i < log.size() && i <= at + span; ++i) {
+        out << (i == at ? "> " : "  ") << "#" << i << " event " << log[i].n << " t=" << log[i].t << " slot "
+            << log[i].seq << " at " << log[i].at.first << "," << log[i].at.second << ": ";
+        const std::size_t lo = i > 4 * span ? i - 4 * span : 0;
+        std::vector<std::size_t> matches;
+        for (std::size_t k = lo; k < plan.size() && k <= i + 4 * span; ++k) {
+            if (same_place(log[i].at, plan[k])) {
+                matches.push_back(k);
+            }
+        }
+        if (matches.empty()) {
+            out << "no plan waypoint near";
+        }
+        for (const auto k : matches) {
+            out << "plan waypoint " << k << " ";
+        }
+        out << "\n";
+    }
+    return out.str();
 }
 
 /// The positions a plan file expands to, as the autopilot stores them.

@@ -274,7 +274,9 @@ TEST_P(FlightplanE2e, LongScanRunsToTheEndWithEveryWaypointReachedOnceInOrderAnd
     ASSERT_GE(reached.size(), expected.size());
     for (std::size_t i = 0; i < expected.size(); ++i) {
         ASSERT_PRED2(same_place, reached[i].at, expected[i])
-            << "reached #" << i << " is not plan waypoint " << i;
+            << "reached #" << i << " is not plan waypoint " << i << "; the board's log around it:\n"
+            << describe_reached_around(reached, expected, i) << "holds: " << holds_after(t0).dump() << "\n"
+            << daemon_->err();
     }
     for (std::size_t i = expected.size(); i < reached.size(); ++i) {
         EXPECT_PRED2(same_place, reached[i].at, expected.back()) << "after the end, only the final stop";
@@ -300,12 +302,16 @@ TEST_P(FlightplanE2e, ReplacingThePlanMidRouteHeadsForTheNewFirstWaypointWithout
 
     ASSERT_EQ(ctl({"plan", "load", a_file}).exit_code, 0);
     ASSERT_TRUE(wait_until([&] { return show().value("waypoints_reached", 0) >= 8; }, kGenerous, kPoll));
-    const auto leg_started = reached_total(*control_);
-    ASSERT_TRUE(wait_until([&] { return reached_total(*control_) > leg_started; }, kGenerous,
+    // The daemon's count, not the board's: the freeze must come after the daemon has seen the arrival. Had
+    // the report still been on its way, the daemon would keep the waypoint just reached as the vehicle's
+    // target, learn of the arrival after the replacement, and rightly hold a vehicle now heading for A's next
+    // slot.
+    const auto leg_started = show().value("waypoints_reached", 0);
+    ASSERT_TRUE(wait_until([&] { return show().value("waypoints_reached", 0) > leg_started; }, kGenerous,
                            std::chrono::milliseconds(5)));
     freeze(true);
     auto replaced = ctl({"plan", "load", b_file});
-    ASSERT_EQ(replaced.exit_code, 0) << replaced.json.dump() << replaced.err;
+    ASSERT_EQ(replaced.exit_code, 0) << replaced.json.dump() << replaced.err << daemon_->err();
     const auto reached_at_answer = reached_total(*control_);
     freeze(false);
     EXPECT_EQ(replaced.json["name"], "route-b");
