@@ -9,7 +9,7 @@ packages=(
   clang libclang-rt-14-dev clang-tidy
   # The ground map's page (Leaflet) and its browser test (headless chromium).
   libjs-leaflet chromium
-  # The fleet test's MQTT broker.
+  # The fleet test's MQTT broker and its clients (mosquitto_sub, _pub, _passwd).
   mosquitto mosquitto-clients
 )
 sudo=""
