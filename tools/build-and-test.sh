@@ -6,7 +6,7 @@
 #             coverage (build-san/); the whole ctest suite, unit to system tests, any report fails the test
 #   tidy      clang-tidy's braces and naming checks (.clang-tidy) on the sources changed since the whole tree
 #             last passed them (tools/clang-tidy-check.sh; build-tidy/ is configured, not built)
-#   fuzz      each libFuzzer target for AIRSEG_FUZZ_SECONDS (default 60) on its seed corpus (tests/fuzz/run.sh,
+#   fuzz      each libFuzzer target for AIRSEG_FUZZ_SECONDS (default 30) on its seed corpus (tests/fuzz/run.sh,
 #             same build directory); a crash or a broken property fails the stage
 #   tsan      GCC build with ThreadSanitizer (build-tsan/) of the test executables listed in
 #             tests/concurrency-tests.txt (the bus and dispatcher, the serial port's threads, the daemon's
@@ -14,8 +14,9 @@
 #             report fails it
 #   cross     packaging/ci-cross.sh for the architectures in AIRSEG_CROSS (default "amd64 armhf armel arm64"): the
 #             amd64 packages are built and checked (lintian, contents, manual pages against --help) and
-#             installed, upgraded and removed in a throwaway chroot; each ARM package is cross-built with the
-#             whole test suite, which runs under qemu-arm or qemu-aarch64 (needs root)
+#             installed, upgraded and removed in a throwaway chroot; the armhf and armel packages are
+#             cross-built with the whole test suite, which runs under qemu-arm; the arm64 packages are
+#             cross-built and checked (their suite under qemu-aarch64 with AIRSEG_CROSS_TEST_ARM64=1; needs root)
 #   native    GCC build as shipped (build/, the one tools/demo.sh runs) and the whole ctest suite
 # Default: "sanitize tidy fuzz tsan cross". The shipped GCC build is tested by the cross stage on the two ARM
 # targets; "native" repeats that on amd64 and is the quickest check while developing.
@@ -90,7 +91,7 @@ fi
 
 if has_stage fuzz; then
   start=$SECONDS
-  seconds=${AIRSEG_FUZZ_SECONDS:-60}
+  seconds=${AIRSEG_FUZZ_SECONDS:-30}
   mapfile -t targets < <(find build-san/tests/fuzz -maxdepth 1 -type f -name 'fuzz_*' -perm -u+x -printf '%f\n' | sort)
   [ ${#targets[@]} -gt 0 ] || { echo "build-and-test: no fuzz targets in build-san/tests/fuzz" >&2; exit 1; }
   # Targets with an open finding (tests/fuzz/ci-skip.txt) would fail every run until it is fixed: said, not run.
@@ -113,11 +114,10 @@ fi
 
 if has_stage tsan; then
   start=$SECONDS
-  # File by file here (AIRSEG_UNITY_BUILD=OFF): every other build compiles in batches, and this one keeps each
-  # source checked on its own (a missing #include that a batch-mate provides shows up here).
+  # In batches like every other build: the tidy stage parses each changed source on its own, which is where a
+  # missing #include that a batch-mate provides shows up.
   cmake -S . -B build-tsan -G Ninja "${launcher[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" -DAIRSEG_BUILD_BENCH=OFF -DAIRSEG_SANITIZE=thread \
-    -DAIRSEG_UNITY_BUILD=OFF
+    "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" -DAIRSEG_BUILD_BENCH=OFF -DAIRSEG_SANITIZE=thread
   mapfile -t tsan_targets < <(grep '^[a-z]' tests/concurrency-tests.txt)
   cmake --build build-tsan -j"$jobs" --target "${tsan_targets[@]}"
   # Each executable runs whole and directly (ctest's label list cannot carry a second label through
