@@ -7,7 +7,8 @@
 #   tidy      clang-tidy's braces and naming checks (.clang-tidy) on the sources changed since the whole tree
 #             last passed them (tools/clang-tidy-check.sh; build-tidy/ is configured, not built)
 #   fuzz      each libFuzzer target for AIRSEG_FUZZ_SECONDS (default 30) on its seed corpus (tests/fuzz/run.sh,
-#             same build directory); a crash or a broken property fails the stage
+#             same build directory), one at a time at nice 19 beside the sanitize stage's suite (one per core
+#             without it); a crash or a broken property fails the stage
 #   tsan      GCC build with ThreadSanitizer (build-tsan/) of the test executables listed in
 #             tests/concurrency-tests.txt (the bus and dispatcher, the serial port's threads, the daemon's
 #             thread pool running all its services) and the binaries they start; each runs whole, and a race
@@ -75,6 +76,38 @@ if has_stage sanitize || has_stage fuzz; then
   elapsed "sanitizer build" "$start"
 fi
 
+# Each libFuzzer target for $seconds from its seeds, $1 at a time; each log ends with libFuzzer's statistics.
+fuzz_targets() {
+  local parallel=$1 seconds=${AIRSEG_FUZZ_SECONDS:-30} t runs
+  mapfile -t targets < <(find build-san/tests/fuzz -maxdepth 1 -type f -name 'fuzz_*' -perm -u+x -printf '%f\n' | sort)
+  [ ${#targets[@]} -gt 0 ] || { echo "build-and-test: no fuzz targets in build-san/tests/fuzz" >&2; return 1; }
+  # Targets with an open finding (tests/fuzz/ci-skip.txt) would fail every run until it is fixed: said, not run.
+  mapfile -t skipped < <(sed -n 's/^\(fuzz_[a-z_]*\):.*/\1/p' tests/fuzz/ci-skip.txt)
+  for t in "${skipped[@]}"; do
+    echo "fuzz: $t NOT RUN: open finding, see tests/fuzz/ci-skip.txt"
+    mapfile -t targets < <(printf '%s\n' "${targets[@]}" | grep -vxF "$t")
+  done
+  mkdir -p build-san/fuzz-logs
+  printf '%s\n' "${targets[@]}" | xargs -P "$parallel" -I{} sh -c \
+    'AIRSEG_FUZZ_BUILD_DIR=build-san AIRSEG_FUZZ_PREBUILT=1 tests/fuzz/run.sh {} '"$seconds"' >build-san/fuzz-logs/{}.log 2>&1 \
+       || { echo "fuzz: {} FAILED"; tail -n 40 build-san/fuzz-logs/{}.log; exit 255; }' || return 1
+  for t in "${targets[@]}"; do
+    runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "build-san/fuzz-logs/$t.log")
+    echo "fuzz: $t: ${runs:-?} executions in $seconds s, no finding"
+  done
+  echo "fuzz: ${#targets[@]} targets, $seconds s each, $parallel at a time"
+}
+
+# The fuzzers run beside the ASan+UBSan suite, one at a time at the lowest priority: most of the suite waits
+# on real time and leaves a core idle, which the fuzzers take without delaying the suite's simulated peers.
+fuzz_pid=""
+if has_stage fuzz && has_stage sanitize; then
+  fuzz_start=$SECONDS
+  mkdir -p build-logs
+  nice -n 19 bash -c "$(declare -f fuzz_targets); fuzz_targets 1" >build-logs/fuzz.log 2>&1 &
+  fuzz_pid=$!
+fi
+
 if has_stage sanitize; then
   start=$SECONDS
   # Any sanitizer report ends the process with an error, in the tests and in the programs they start.
@@ -89,27 +122,16 @@ if has_stage tidy; then
   elapsed "clang-tidy" "$start"
 fi
 
-if has_stage fuzz; then
+if [ -n "$fuzz_pid" ]; then
+  code=0
+  wait "$fuzz_pid" || code=$?
+  cat build-logs/fuzz.log
+  [ "$code" = 0 ] || { echo "build-and-test: fuzzing found a problem" >&2; exit 1; }
+  elapsed "fuzzing, beside the ASan+UBSan suite" "$fuzz_start"
+elif has_stage fuzz; then
   start=$SECONDS
-  seconds=${AIRSEG_FUZZ_SECONDS:-30}
-  mapfile -t targets < <(find build-san/tests/fuzz -maxdepth 1 -type f -name 'fuzz_*' -perm -u+x -printf '%f\n' | sort)
-  [ ${#targets[@]} -gt 0 ] || { echo "build-and-test: no fuzz targets in build-san/tests/fuzz" >&2; exit 1; }
-  # Targets with an open finding (tests/fuzz/ci-skip.txt) would fail every run until it is fixed: said, not run.
-  mapfile -t skipped < <(sed -n 's/^\(fuzz_[a-z_]*\):.*/\1/p' tests/fuzz/ci-skip.txt)
-  for t in "${skipped[@]}"; do
-    echo "fuzz: $t NOT RUN: open finding, see tests/fuzz/ci-skip.txt"
-    mapfile -t targets < <(printf '%s\n' "${targets[@]}" | grep -vxF "$t")
-  done
-  mkdir -p build-san/fuzz-logs
-  # One target per core; each log ends with libFuzzer's final statistics.
-  printf '%s\n' "${targets[@]}" | xargs -P "$jobs" -I{} sh -c \
-    'AIRSEG_FUZZ_BUILD_DIR=build-san AIRSEG_FUZZ_PREBUILT=1 tests/fuzz/run.sh {} '"$seconds"' >build-san/fuzz-logs/{}.log 2>&1 \
-       || { echo "fuzz: {} FAILED"; tail -n 40 build-san/fuzz-logs/{}.log; exit 255; }'
-  for t in "${targets[@]}"; do
-    runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "build-san/fuzz-logs/$t.log")
-    echo "fuzz: $t: ${runs:-?} executions in $seconds s, no finding"
-  done
-  elapsed "fuzzing (${#targets[@]} targets, $seconds s each)" "$start"
+  fuzz_targets "$jobs"  # one per core
+  elapsed "fuzzing" "$start"
 fi
 
 if has_stage tsan; then
