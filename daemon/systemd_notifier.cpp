@@ -74,35 +74,54 @@ SystemdNotifier::~SystemdNotifier() {
     }
 }
 
-void SystemdNotifier::send(std::string_view state) {
+bool SystemdNotifier::try_send(std::string_view state) {
+    const auto sent = ::sendto(fd_, state.data(), state.size(), MSG_NOSIGNAL | MSG_DONTWAIT,
+                               reinterpret_cast<const sockaddr*>(&address_), address_length_);
+    if (sent >= 0) {
+        return true;
+    }
+    if (errno == EAGAIN || errno == EWOULDBLOCK) {
+        return false;
+    }
+    spdlog::debug("systemd: notify failed: {}", std::strerror(errno));
+    return true;  // nobody listens: trying again would not help
+}
+
+void SystemdNotifier::send(std::string_view state, bool must_arrive) {
     if (fd_ < 0) {
         return;
     }
-    const auto sent = ::sendto(fd_, state.data(), state.size(), MSG_NOSIGNAL,
-                               reinterpret_cast<const sockaddr*>(&address_), address_length_);
-    if (sent < 0) {
-        spdlog::debug("systemd: notify failed: {}", std::strerror(errno));
+    while (!unsent_.empty() && try_send(unsent_.front())) {
+        unsent_.pop_front();
+    }
+    if (unsent_.empty() && try_send(state)) {
+        return;
+    }
+    if (must_arrive) {
+        unsent_.emplace_back(state);
+    } else {
+        spdlog::debug("systemd: notify socket full; {} dropped", state.substr(0, state.find('=')));
     }
 }
 
 void SystemdNotifier::ready() {
-    send("READY=1");
+    send("READY=1", true);
 }
 
 void SystemdNotifier::status(const std::string& line) {
-    send("STATUS=" + line);
+    send("STATUS=" + line, false);
 }
 
 void SystemdNotifier::watchdog() {
-    send("WATCHDOG=1");
+    send("WATCHDOG=1", false);
 }
 
 void SystemdNotifier::stopping() {
-    send("STOPPING=1");
+    send("STOPPING=1", true);
 }
 
 void SystemdNotifier::reloading() {
-    send("RELOADING=1");
+    send("RELOADING=1", true);
 }
 
 }  // namespace airseg::daemon

@@ -8,6 +8,7 @@
 #include <sys/un.h>
 
 #include <chrono>
+#include <deque>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -32,8 +33,14 @@ class SystemdNotifier {
     void reloading();
 
   private:
-    void send(std::string_view state);
+    /// Never blocks: the notifier shares its thread with signal handling and the watchdog, and a full socket
+    /// (systemd busy, or a reader that stalls) would otherwise hold them all. A state that must arrive
+    /// (READY, STOPPING, RELOADING) waits for the next send; a ping or STATUS line that finds the socket full
+    /// is dropped, as the next one replaces it.
+    void send(std::string_view state, bool must_arrive);
+    bool try_send(std::string_view state);
     int fd_ = -1;
+    std::deque<std::string> unsent_;
     sockaddr_un address_{};
     socklen_t address_length_ = 0;
     std::optional<std::chrono::microseconds> watchdog_;

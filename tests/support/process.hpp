@@ -2,11 +2,14 @@
 // Test support: run the real binaries as child processes and wait on conditions with generous timeouts.
 #include <sys/types.h>
 
+#include <atomic>
 #include <chrono>
 #include <functional>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace airseg::test {
@@ -88,20 +91,26 @@ class NotifyListener {
     };
     explicit NotifyListener(const std::string& path);
     ~NotifyListener();
+    NotifyListener(const NotifyListener&) = delete;
+    NotifyListener& operator=(const NotifyListener&) = delete;
     const std::string& path() const { return path_; }
-    /// Reads whatever has arrived (non-blocking).
-    void drain();
-    /// Waits until a message contains `needle`; returns its arrival time.
+    /// Waits until a message contains `needle`; returns its arrival time. Messages are read as they arrive,
+    /// on a thread of the listener's own.
     std::optional<std::chrono::steady_clock::time_point> wait_for(const std::string& needle,
                                                                   std::chrono::milliseconds timeout,
                                                                   std::size_t from_index = 0);
-    const std::vector<Message>& messages() const { return messages_; }
+    std::vector<Message> messages() const;
     std::size_t count(const std::string& needle, std::size_t from_index = 0) const;
 
   private:
+    void read_until_stopped();
+
     std::string path_;
     int fd_ = -1;
+    mutable std::mutex mutex_;
     std::vector<Message> messages_;
+    std::atomic<bool> stop_{false};
+    std::thread reader_;
 };
 
 }  // namespace airseg::test

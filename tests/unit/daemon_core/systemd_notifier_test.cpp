@@ -5,9 +5,11 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "daemon/systemd_notifier.hpp"
 #include "tests/support/process.hpp"
@@ -57,6 +59,41 @@ TEST(SystemdNotifier, SendsEachStateAsOneDatagramToTheSocketPath) {
     EXPECT_EQ(systemd.messages()[0].text, "READY=1");
     EXPECT_EQ(systemd.messages()[1].text, "STATUS=flying");
     EXPECT_EQ(systemd.messages()[2].text, "WATCHDOG=1");
+}
+
+TEST(SystemdNotifier, AFullSocketNeverBlocksAndTheStatesThatMustArriveArriveOnceItIsRead) {
+    // A socket nobody reads holds net.unix.max_dgram_qlen datagrams (10 by default); a blocking send after
+    // that would hold the daemon's signal and watchdog thread until systemd reads.
+    test::TempDir dir;
+    const std::string path = dir.path() + "/notify";
+    const int fd = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
+    ASSERT_GE(fd, 0);
+    sockaddr_un address{};
+    address.sun_family = AF_UNIX;
+    std::strncpy(address.sun_path, path.c_str(), sizeof(address.sun_path) - 1);
+    ASSERT_EQ(::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address), 0)
+        << std::strerror(errno);
+    ScopedEnv socket("NOTIFY_SOCKET", path.c_str());
+    SystemdNotifier notifier;
+    for (int i = 0; i < 2000; ++i) {  // returns at once every time, full or not
+        notifier.watchdog();
+    }
+    notifier.stopping();  // finds the socket full: kept
+    std::vector<std::string> read;
+    char buffer[64];
+    for (ssize_t n; (n = ::recv(fd, buffer, sizeof buffer, 0)) > 0;) {
+        read.emplace_back(buffer, static_cast<std::size_t>(n));
+    }
+    ASSERT_FALSE(read.empty());
+    EXPECT_LT(read.size(), 2000u) << "the socket should have filled";
+    EXPECT_EQ(std::count(read.begin(), read.end(), "STOPPING=1"), 0);
+    notifier.watchdog();  // the kept state goes first, then the ping
+    read.clear();
+    for (ssize_t n; (n = ::recv(fd, buffer, sizeof buffer, 0)) > 0;) {
+        read.emplace_back(buffer, static_cast<std::size_t>(n));
+    }
+    ::close(fd);
+    EXPECT_EQ(read, (std::vector<std::string>{"STOPPING=1", "WATCHDOG=1"}));
 }
 
 TEST(SystemdNotifier, ReachesASocketInTheAbstractNamespace) {
