@@ -64,13 +64,18 @@ mkdir -p "$AIRSEG_ROOT/dist"
 # Copies the source tree into DIR with debian/ at its top, keeping DIR's build directory
 # (obj-*) so that a rebuild is incremental unless --clean is given.
 stage_source() {
-  local dir=$1
+  local dir=$1 lock
+  # Builds of several architectures run side by side (packaging/ci-cross.sh): one copies at a time, as a
+  # directory created in the tree's top while tar reads it fails the copy ("file changed as we read it").
+  exec {lock}>"$AIRSEG_ROOT/dist/.stage-lock"
+  flock "$lock"
   mkdir -p "$dir"
   find "$dir" -mindepth 1 -maxdepth 1 ! -name 'obj-*' -exec rm -rf {} +
   if [ "$clean" = 1 ]; then rm -rf "$dir"/obj-*; fi
   tar -C "$source_tree" --exclude=./.git --exclude='./build*' --exclude=./dist --exclude=./sysroots \
-      --exclude=./.cache -cf - . | tar -C "$dir" -xf -
+      --exclude=./.cache --exclude=./Testing -cf - . | tar -C "$dir" -xf -
   cp -a "$source_tree/packaging/debian" "$dir/debian"
+  exec {lock}>&-
 }
 
 build_one() {
