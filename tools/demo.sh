@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # tools/demo.sh [--resume] [--duration MS]
 #
-# The bench on one machine: airseg-linksim (a 57600-baud radio pair with a little loss) between airsegd and
-# the ground, the simulated autopilot when it is built (airseg-apmsim), airsegd on config/airseg.yaml, the
+# The bench on one machine: airseg-linksim (a 57600-baud radio pair with a little loss, each radio on its
+# host's USB through an FTDI-class adapter at its default 16-ms latency timer) between airsegd and the
+# ground, the simulated autopilot when it is built (airseg-apmsim), airsegd on config/airseg.yaml, the
 # ground station hub airseg-ground on the radio's ground end (with its live map in a browser), and airsegctl's
 # live view through the hub in the foreground. Ctrl-C stops everything.
 # Everything runs under build/demo/ (ptys, sockets, state, logs; AIRSEG_DEMO_DIR to put it elsewhere); no
@@ -40,7 +41,7 @@ wait_for() {  # wait_for PATH: until a pty link appears (at most 10 s)
 }
 
 "$build/tools/linksim/airseg-linksim" --a "$run_dir/radio-air" --b "$run_dir/radio-ground" --baud 57600 \
-  --frame-loss 0.02 --seed 1 --control "$run_dir/linksim.ctl" > "$run_dir/linksim.log" 2>&1 &
+  --usb-latency 16 --frame-loss 0.02 --seed 1 --control "$run_dir/linksim.ctl" > "$run_dir/linksim.log" 2>&1 &
 pids+=($!)
 wait_for "$run_dir/radio-air"
 

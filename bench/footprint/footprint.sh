@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # bench/footprint/footprint.sh [--build DIR] [--idle S] [--busy S] [--plan FILE] [--emulator armhf|armel]
-#                              [--set KEY=VALUE]...   (passed to airsegd, e.g. --set threads=1)
+#                              [--usb-latency MS] [--set KEY=VALUE]...   (passed to airsegd, e.g. threads=1)
 #
 # airsegd's memory and CPU on the bench wiring of tools/demo.sh, without the live view: airseg-linksim (a
-# 57600-baud radio pair, 2 % frame loss), airseg-apmsim, airsegd on config/airseg.yaml, and a ground peer
-# (airsegctl log over the radio, so the ground session is up and the 2 Hz vehicle telemetry flows).
+# 57600-baud radio pair, 2 % frame loss, each radio on its host's USB through an FTDI-class adapter whose
+# latency timer is --usb-latency, default 16 ms as FTDI ships it; 0 = bytes reach the host as they leave a
+# bare UART), airseg-apmsim, airsegd on config/airseg.yaml, and a ground peer (airsegctl log over the radio,
+# so the ground session is up and the 2 Hz vehicle telemetry flows).
 # It measures in two phases:
 #   idle  (--idle S, default 60): the link up, no plan; CPU seconds per minute.
 #   busy  (--busy S, default 30): a plan running (--plan, default config/plans/rover-survey.yaml); CPU per
@@ -25,6 +27,7 @@ idle_s=60
 busy_s=30
 plan=config/plans/rover-survey.yaml
 emulator=""
+usb_latency=16
 extra=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -33,8 +36,9 @@ while [ $# -gt 0 ]; do
     --busy) busy_s=${2:?--busy needs seconds}; shift 2 ;;
     --plan) plan=${2:?--plan needs FILE}; shift 2 ;;
     --emulator) emulator=${2:?--emulator needs armhf or armel}; shift 2 ;;
+    --usb-latency) usb_latency=${2:?--usb-latency needs milliseconds}; shift 2 ;;
     --set) extra+=(--set "${2:?--set needs KEY=VALUE}"); shift 2 ;;
-    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,21p' "$0"; exit 0 ;;
     *) echo "footprint: unknown argument '$1'; see $0 --help" >&2; exit 2 ;;
   esac
 done
@@ -74,7 +78,7 @@ wait_for() {  # wait_for PATH: until a pty link appears (at most 10 s)
 }
 
 "$native/tools/linksim/airseg-linksim" --a "$run_dir/radio-air" --b "$run_dir/radio-ground" --baud 57600 \
-  --frame-loss 0.02 --seed 1 > "$run_dir/linksim.log" 2>&1 &
+  --usb-latency "$usb_latency" --frame-loss 0.02 --seed 1 > "$run_dir/linksim.log" 2>&1 &
 pids+=($!)
 wait_for "$run_dir/radio-air"
 "$native/tools/apmsim/airseg-apmsim" --link "$run_dir/apm" > "$run_dir/apmsim.log" 2>&1 &
@@ -141,7 +145,7 @@ heap_kib() { awk '/\[heap\]/ { h = 1; next } /^[0-9a-f]+-[0-9a-f]+ / { h = 0 } h
 
 echo "footprint: airsegd (pid $daemon_pid) $(readlink -f "$daemon")${emulator:+ under qemu-arm-static ($emulator)}"
 if [ -z "$emulator" ]; then
-  echo "idle (link up, no plan, 2 Hz telemetry), ${idle_s} s: CPU $(cpu_per_minute "$idle_s")"
+  echo "idle (link up, no plan, 2 Hz telemetry, radio adapters' latency timer ${usb_latency} ms), ${idle_s} s: CPU $(cpu_per_minute "$idle_s")"
 else
   sleep "$idle_s"
 fi

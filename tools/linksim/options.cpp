@@ -75,7 +75,20 @@ void fill_table(cli::OptionTable& table, LinkSimOptions& o) {
         .value("packet-overhead", "B", "bytes sent on air with every packet [0]",
                number(o.radio.air_packet_overhead, 0, 65536))
         .value("buffer", "BYTES", "each radio's serial-side FIFO; overflow is dropped [2048]",
-               number(o.radio.radio_buffer, 1, 1U << 24));
+               number(o.radio.radio_buffer, 1, 1U << 24))
+        .value("usb-latency", "MS",
+               "both hosts reach their radio through a USB serial adapter (FTDI class) with this latency "
+               "timer, 1..255 (FTDI's default is 16); 0: bytes reach the host as they leave the UART [0]",
+               [&o](std::string_view opt, std::string_view v) {
+                   o.radio.usb_latency[index(Side::A)] = parse_milliseconds(opt, v);
+                   o.radio.usb_latency[index(Side::B)] = o.radio.usb_latency[index(Side::A)];
+               })
+        .value("usb-latency-a", "MS", "the same, host A's adapter only",
+               in_milliseconds(o.radio.usb_latency[index(Side::A)]))
+        .value("usb-latency-b", "MS", "the same, host B's adapter only",
+               in_milliseconds(o.radio.usb_latency[index(Side::B)]))
+        .value("usb-packet", "BYTES", "data bytes per USB packet of an adapter [62]",
+               number(o.radio.usb_packet, 1, 65536));
     // Each impairment also as --NAME-ab / --NAME-ba for one direction, e.g. --loss-ab 0.01.
     add_impairment(table, o.radio, "latency", "MS", "added delay per air packet",
                    [](DirectionImpairment& d, auto opt, auto v) { d.latency = parse_milliseconds(opt, v); });

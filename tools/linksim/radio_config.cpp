@@ -64,6 +64,16 @@ std::string RadioConfig::validate() const {
     if (host_buffer == 0 || host_buffer > (1U << 24)) {
         return "host_buffer must be within [1, 16777216]";
     }
+    for (Side s : {Side::A, Side::B}) {
+        const Duration l = usb_latency[index(s)];
+        if (l < Duration::zero() || l > std::chrono::milliseconds(255)) {
+            return std::string("usb_latency of host ") + to_string(s) +
+                   " must be within [0, 255] ms (0: no adapter)";
+        }
+    }
+    if (usb_packet == 0 || usb_packet > 65536) {
+        return "usb_packet must be within [1, 65536]";
+    }
     if (auto e = check_direction(impairment[0], "a->b"); !e.empty()) {
         return e;
     }

@@ -52,6 +52,11 @@ struct RadioConfig {
     std::size_t radio_buffer = 2048;  ///< each radio's serial-side FIFO; bytes arriving when full are dropped
     std::size_t host_buffer = 4096;   ///< each host's UART transmit buffer (the kernel's tty buffer)
     std::array<DirectionImpairment, 2> impairment{};  ///< indexed by the sending side
+    /// A USB serial adapter between a receiving radio and its host (FTDI class), indexed by the host's side:
+    /// the adapter sends the bytes it holds when it has usb_packet of them or when its latency timer, which
+    /// restarts at every packet, expires. 0 = no adapter: each byte reaches the host as it leaves the UART.
+    std::array<Duration, 2> usb_latency{};
+    std::size_t usb_packet = 62;  ///< data bytes per USB packet (FTDI full speed: 64 minus 2 status bytes)
     std::uint64_t seed = 1;
 
     /// Empty when usable, otherwise a message naming the first bad field.

@@ -39,6 +39,7 @@ RadioModel::RadioModel(RadioConfig config, TimePoint start)
         d.rng.seed(seq);
         d.serial_in_free = start;
         d.serial_out_free = start;
+        d.adapter_sent = start;
         for (const Outage& o : config_.impairment[index(s)].outages) {
             d.outages.push_back({start + o.start, start + o.start + o.length});
         }
@@ -80,18 +81,49 @@ std::vector<std::uint8_t> RadioModel::poll_output(Side to, TimePoint now) {
     Direction& d = dir(other(to));
     std::vector<std::uint8_t> out;
     while (!d.serial_out.empty() && d.serial_out.front().at <= now) {
-        out.push_back(d.serial_out.front().byte);
-        d.serial_out.pop_front();
+        const std::optional<Packet> p = next_handover(d, to);
+        if (p->at > now) {
+            break;
+        }
+        for (std::size_t i = 0; i < p->bytes; ++i) {
+            out.push_back(d.serial_out.front().byte);
+            d.serial_out.pop_front();
+        }
+        d.adapter_sent = p->at;
     }
     d.stats.bytes_out += out.size();
     return out;
 }
 
+std::optional<RadioModel::Packet> RadioModel::next_handover(const Direction& d, Side to) const {
+    if (d.serial_out.empty()) {
+        return std::nullopt;
+    }
+    const TimePoint first = d.serial_out.front().at;
+    const Duration latency = config_.usb_latency[index(to)];
+    if (latency <= Duration::zero()) {
+        return Packet{first, 1};
+    }
+    // The timer expires every `latency` after the last packet (an empty one when nothing arrived); the
+    // first byte leaves at the first expiry after it arrived, or earlier with a packet's worth behind it.
+    TimePoint expiry = d.adapter_sent + latency;
+    if (expiry < first) {
+        expiry += ((first - expiry + latency - Duration{1}) / latency) * latency;
+    }
+    const std::size_t full = config_.usb_packet;
+    if (d.serial_out.size() >= full && d.serial_out[full - 1].at < expiry) {
+        return Packet{d.serial_out[full - 1].at, full};
+    }
+    const auto end = std::upper_bound(d.serial_out.begin(), d.serial_out.end(), expiry,
+                                      [](TimePoint t, const Timed& x) { return t < x.at; });
+    return Packet{expiry, static_cast<std::size_t>(end - d.serial_out.begin())};
+}
+
 TimePoint RadioModel::poll_timeout() const {
     TimePoint next = kNever;
-    for (const Direction& d : dirs_) {
-        if (!d.serial_out.empty()) {
-            next = std::min(next, d.serial_out.front().at);
+    for (Side to : {Side::A, Side::B}) {
+        if (auto p = next_handover(dir(other(to)), to)) {
+            next = std::min(next, p->at);
         }
     }
     for (Side s : {Side::A, Side::B}) {

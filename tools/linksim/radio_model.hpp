@@ -30,6 +30,9 @@
 //   that
 //      is down, then per byte loss and corruption.
 //   5. Receiving radio: the packet is delivered `latency` after it ends, then written to the host at baud/10.
+//   6. Optional USB serial adapter at the receiving host (usb_latency > 0): as FTDI documents its chips
+//      (AN232B-04), the adapter passes bytes on in packets of usb_packet bytes, or whatever it holds when its
+//      latency timer expires; the timer restarts at every packet (16 ms is FTDI's default).
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -98,8 +101,9 @@ class RadioModel {
         std::deque<Timed> serial_in;  // host→radio UART; `at` = when the byte is fully inside the radio
         TimePoint serial_in_free{};
         std::deque<std::uint8_t> fifo;
-        std::deque<Timed> serial_out;  // receiving radio→host UART; `at` = delivery time
+        std::deque<Timed> serial_out;  // receiving radio→host UART; `at` = when the byte leaves the UART
         TimePoint serial_out_free{};
+        TimePoint adapter_sent{};  // the receiving host's USB adapter: its last packet (latency timer start)
         std::vector<Interval> outages;
         std::mt19937_64 rng;
         DirectionStats stats;
@@ -120,6 +124,14 @@ class RadioModel {
     const Channel& channel_of(Side from) const {
         return config_.duplex == Duplex::Half ? channels_[0] : channels_[index(from)];
     }
+
+    struct Packet {
+        TimePoint at;
+        std::size_t bytes;
+    };
+    /// The next hand-over of bytes from direction `d` to its receiving host: the next byte alone without a
+    /// USB adapter, the adapter's next packet with one. Nothing when no byte is on its way.
+    std::optional<Packet> next_handover(const Direction& d, Side to) const;
 
     void advance(TimePoint now);
     void advance_channel(Channel& ch, std::span<const Side> senders, TimePoint now);

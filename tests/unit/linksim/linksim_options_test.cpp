@@ -52,6 +52,18 @@ TEST(LinkSimOptions, DirectionalVariantsApplyToOneDirection) {
     EXPECT_EQ(o.radio.seed, 9u);
 }
 
+TEST(LinkSimOptions, UsbLatencySetsBothAdaptersOrOne) {
+    auto o = parse({"--usb-latency", "16"});
+    EXPECT_EQ(o.radio.usb_latency[index(Side::A)], milliseconds(16));
+    EXPECT_EQ(o.radio.usb_latency[index(Side::B)], milliseconds(16));
+    o = parse({"--usb-latency-a", "4", "--usb-packet", "30"});
+    EXPECT_EQ(o.radio.usb_latency[index(Side::A)], milliseconds(4));
+    EXPECT_EQ(o.radio.usb_latency[index(Side::B)], Duration::zero());
+    EXPECT_EQ(o.radio.usb_packet, 30u);
+    EXPECT_EQ(parse({}).radio.usb_latency[index(Side::A)], Duration::zero()) << "no adapter unless asked";
+    EXPECT_NE(error_of({"--usb-latency", "300"}).find("usb_latency"), std::string::npos);
+}
+
 TEST(LinkSimOptions, BadInputNamesTheOption) {
     EXPECT_NE(error_of({"--loss", "1.5"}).find("--loss"), std::string::npos);
     EXPECT_NE(error_of({"--ber-ab", "x"}).find("--ber-ab"), std::string::npos);

@@ -159,6 +159,80 @@ TEST(RadioModel, SingleByteLatencyIsSerialPlusAirPlusConfigured) {
     EXPECT_EQ(model.poll_timeout(), kNever);
 }
 
+struct Piece {
+    TimePoint at;
+    std::vector<std::uint8_t> bytes;
+};
+
+// Every hand-over to host `to`, at the instants the model announces, until nothing is left in flight.
+std::vector<Piece> pieces_for(RadioModel& model, Side to) {
+    std::vector<Piece> pieces;
+    for (TimePoint now = model.poll_timeout(); now != kNever; now = model.poll_timeout()) {
+        if (auto out = model.poll_output(to, now); !out.empty()) {
+            pieces.push_back({now, std::move(out)});
+        }
+    }
+    return pieces;
+}
+
+Duration since_start(TimePoint t) {
+    return t - kStart;
+}
+
+TEST(RadioModel, UsbAdapterHandsAShortFrameOverWholeWhenItsLatencyTimerExpires) {
+    RadioConfig c = clean(Duplex::Full);
+    c.usb_latency[index(Side::B)] = milliseconds(16);
+    RadioModel model(c, kStart);
+    const auto frame = pattern(20);
+    model.push(Side::A, frame, kStart);
+    const auto pieces = pieces_for(model, Side::B);
+    ASSERT_EQ(pieces.size(), 1u) << "a 20-byte frame fits one USB packet";
+    EXPECT_EQ(pieces[0].bytes, frame);
+    // The last byte leaves the UART after 20 bytes in, air and 20 bytes out (about 7.1 ms); the timer,
+    // running since the start, expires at 16 ms.
+    EXPECT_EQ(since_start(pieces[0].at), milliseconds(16));
+}
+
+TEST(RadioModel, UsbAdapterSendsAFullPacketAtOnceAndLessOnlyWhenItsTimerExpires) {
+    RadioConfig c = clean(Duplex::Full);
+    c.usb_latency[index(Side::B)] = milliseconds(16);
+    RadioModel model(c, kStart);
+    const auto data = pattern(400);
+    model.push(Side::A, data, kStart);
+    const auto pieces = pieces_for(model, Side::B);
+    std::vector<std::uint8_t> joined;
+    std::size_t full = 0;
+    TimePoint timer_start = kStart;  // the timer restarts at every packet
+    for (std::size_t i = 0; i < pieces.size(); ++i) {
+        const auto& p = pieces[i];
+        ASSERT_LE(p.bytes.size(), 62u) << "piece " << i;
+        if (p.bytes.size() == 62) {
+            ++full;
+            EXPECT_LT(p.at - timer_start, milliseconds(16)) << "a full packet does not wait for the timer";
+        } else {
+            EXPECT_EQ((p.at - timer_start) % milliseconds(16), Duration::zero())
+                << "piece " << i << " of " << p.bytes.size() << " bytes left between two expiries";
+        }
+        timer_start = p.at;
+        joined.insert(joined.end(), p.bytes.begin(), p.bytes.end());
+    }
+    EXPECT_EQ(joined, data);
+    // 62 bytes take 10.8 ms at 57600 baud, less than the timer: a steady stream goes in full packets.
+    EXPECT_GE(full, 4u);
+    EXPECT_LE(pieces.size(), 8u);
+}
+
+TEST(RadioModel, WithoutAnAdapterBytesReachTheHostAsTheyLeaveTheUart) {
+    RadioConfig c = clean(Duplex::Full);
+    c.usb_latency[index(Side::B)] = milliseconds(16);  // host B's adapter does not change what A receives
+    RadioModel model(c, kStart);
+    model.push(Side::B, pattern(20), kStart);
+    const auto pieces = pieces_for(model, Side::A);
+    ASSERT_EQ(pieces.size(), 20u) << "one hand-over per byte";
+    const double gap_ms = std::chrono::duration<double, std::milli>(pieces[1].at - pieces[0].at).count();
+    EXPECT_NEAR(gap_ms, 0.1736, 0.001);
+}
+
 std::vector<std::uint8_t> run_impaired(std::uint64_t seed) {
     RadioConfig c = clean(Duplex::Half);
     c.seed = seed;
@@ -262,6 +336,12 @@ TEST(RadioModel, RejectsInvalidConfigurationWithTheFieldName) {
     c = RadioConfig{};
     c.baud = 0;
     EXPECT_NE(c.validate().find("baud"), std::string::npos);
+    c = RadioConfig{};
+    c.usb_latency[index(Side::A)] = milliseconds(256);
+    EXPECT_NE(c.validate().find("usb_latency of host a"), std::string::npos) << c.validate();
+    c = RadioConfig{};
+    c.usb_packet = 0;
+    EXPECT_NE(c.validate().find("usb_packet"), std::string::npos) << c.validate();
 }
 
 }  // namespace
