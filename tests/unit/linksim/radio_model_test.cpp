@@ -179,13 +179,19 @@ Duration since_start(TimePoint t) {
     return t - kStart;
 }
 
-TEST(RadioModel, UsbAdapterHandsAShortFrameOverWholeWhenItsLatencyTimerExpires) {
+// Host B reaches its radio through a USB adapter with a 16-ms latency timer, host A through a bare UART.
+// `from` writes `bytes` at the start; returns what the other host receives, piece by piece.
+std::vector<Piece> through_b_adapter(Side from, const std::vector<std::uint8_t>& bytes) {
     RadioConfig c = clean(Duplex::Full);
     c.usb_latency[index(Side::B)] = milliseconds(16);
     RadioModel model(c, kStart);
+    model.push(from, bytes, kStart);
+    return pieces_for(model, other(from));
+}
+
+TEST(RadioModel, UsbAdapterHandsAShortFrameOverWholeWhenItsLatencyTimerExpires) {
     const auto frame = pattern(20);
-    model.push(Side::A, frame, kStart);
-    const auto pieces = pieces_for(model, Side::B);
+    const auto pieces = through_b_adapter(Side::A, frame);
     ASSERT_EQ(pieces.size(), 1u) << "a 20-byte frame fits one USB packet";
     EXPECT_EQ(pieces[0].bytes, frame);
     // The last byte leaves the UART after 20 bytes in, air and 20 bytes out (about 7.1 ms); the timer,
@@ -194,12 +200,8 @@ TEST(RadioModel, UsbAdapterHandsAShortFrameOverWholeWhenItsLatencyTimerExpires) 
 }
 
 TEST(RadioModel, UsbAdapterSendsAFullPacketAtOnceAndLessOnlyWhenItsTimerExpires) {
-    RadioConfig c = clean(Duplex::Full);
-    c.usb_latency[index(Side::B)] = milliseconds(16);
-    RadioModel model(c, kStart);
     const auto data = pattern(400);
-    model.push(Side::A, data, kStart);
-    const auto pieces = pieces_for(model, Side::B);
+    const auto pieces = through_b_adapter(Side::A, data);
     std::vector<std::uint8_t> joined;
     std::size_t full = 0;
     TimePoint timer_start = kStart;  // the timer restarts at every packet
@@ -223,11 +225,8 @@ TEST(RadioModel, UsbAdapterSendsAFullPacketAtOnceAndLessOnlyWhenItsTimerExpires)
 }
 
 TEST(RadioModel, WithoutAnAdapterBytesReachTheHostAsTheyLeaveTheUart) {
-    RadioConfig c = clean(Duplex::Full);
-    c.usb_latency[index(Side::B)] = milliseconds(16);  // host B's adapter does not change what A receives
-    RadioModel model(c, kStart);
-    model.push(Side::B, pattern(20), kStart);
-    const auto pieces = pieces_for(model, Side::A);
+    // Host B's adapter does not change what A receives.
+    const auto pieces = through_b_adapter(Side::B, pattern(20));
     ASSERT_EQ(pieces.size(), 20u) << "one hand-over per byte";
     const double gap_ms = std::chrono::duration<double, std::milli>(pieces[1].at - pieces[0].at).count();
     EXPECT_NEAR(gap_ms, 0.1736, 0.001);
