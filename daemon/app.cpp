@@ -19,6 +19,7 @@
 #include "daemon/systemd_notifier.hpp"
 #include "hal/gpio_libgpiod.hpp"
 #include "services/autopilot/autopilot_service.hpp"
+#include "services/common/wake_sharing.hpp"
 #include "services/flightplan/flightplan_service.hpp"
 #include "services/groundlink/groundlink_messages.hpp"
 #include "services/groundlink/groundlink_service.hpp"
@@ -53,7 +54,7 @@ class App::Impl {
           adapters_strand_(asio::make_strand(io_)),
           signals_(strand_, SIGTERM, SIGINT, SIGHUP),
           watchdog_timer_(strand_),
-          context_{io_, bus_, health_, commands_, progress_interval()} {}
+          context_{io_, bus_, health_, commands_, progress_interval(), &wakes_} {}
 
     int run() {
         ensure_state_dir();
@@ -303,6 +304,7 @@ class App::Impl {
     Bus bus_;
     HealthRegistry health_;
     CommandDispatcher commands_;
+    WakeSharing wakes_;
     ServiceContext context_;
     hal::LibgpiodFactory gpio_;
     std::vector<std::unique_ptr<Service>> services_;

@@ -36,6 +36,7 @@ AutopilotService::AutopilotService(ServiceContext& ctx, AutopilotServiceConfig c
                                    [this](std::span<const std::uint8_t> bytes) {
                                        driver_.handle_bytes(bytes, SteadyClock::now());
                                        pump();
+                                       woke_for_input();
                                    },
                                    [this](const std::string& reason) {
                                        driver_.on_port_closed(reason, SteadyClock::now());
@@ -44,7 +45,7 @@ AutopilotService::AutopilotService(ServiceContext& ctx, AutopilotServiceConfig c
       tlog_(config_.tlog),
       gate_(config_.autopilot.target_sysid, config_.autopilot.target_compid),
       uploads_(config_.autopilot.target_sysid, config_.autopilot.target_compid),
-      timer_(strand()),
+      timer_(strand(), ctx.wakes),
       prefix_("autopilot[" + config_.port.serial.path + "]: ") {
     gate_.receive_uploads(uploads_);
     if (config_.gcs_endpoint) {

@@ -2,20 +2,23 @@
 // One asio steady_timer following the poll_timeout() of sans-IO cores (time.hpp). Cores are asked for their
 // next deadline after every input, and it mostly comes back unchanged: re-arming the timer for the same
 // instant would cost a timer-queue update (and often a timerfd syscall) per input for nothing, so an
-// unchanged deadline keeps the wait already running. kNever means no wake-up at all.
+// unchanged deadline keeps the wait already running. kNever means no wake-up at all. Given a WakeSharing, a
+// deadline that wakes the daemon lets the periodic work already due run in the same wake-up.
 #include <cstdint>
 #include <memory>
 #include <utility>
 
 #include "base/time.hpp"
 #include "services/common/asio.hpp"
+#include "services/common/wake_sharing.hpp"
 
 namespace airseg {
 
 class DeadlineTimer {
   public:
-    /// Handlers run on `executor` (the owner's strand).
-    explicit DeadlineTimer(asio::any_io_executor executor) : timer_(std::move(executor)) {}
+    /// Handlers run on `executor` (the owner's strand); `sharing` may be null.
+    explicit DeadlineTimer(asio::any_io_executor executor, WakeSharing* sharing = nullptr)
+        : timer_(std::move(executor)), sharing_(sharing) {}
     DeadlineTimer(const DeadlineTimer&) = delete;
     DeadlineTimer& operator=(const DeadlineTimer&) = delete;
     // The state goes with the owner: a completion already queued when it is destroyed finds nothing to call.
@@ -34,11 +37,14 @@ class DeadlineTimer {
             cancel();
             return;
         }
+        if (state_->armed != kNever && deadline > state_->armed) {
+            reprogram_reactor();
+        }
         state_->armed = deadline;
         const std::uint64_t generation = ++state_->generation;
         timer_.expires_at(deadline);
         timer_.async_wait(
-            [state = std::weak_ptr<State>(state_), generation,
+            [state = std::weak_ptr<State>(state_), generation, sharing = sharing_,
              on_due = std::forward<Handler>(on_due)](const boost::system::error_code& ec) mutable {
                 // A completion queued before a re-arm, a cancel or the owner's destruction cannot be taken
                 // back by asio; the generation tells it apart from the wait armed now.
@@ -47,27 +53,43 @@ class DeadlineTimer {
                     return;
                 }
                 s->armed = kNever;
+                if (sharing != nullptr) {
+                    sharing->woke(SteadyClock::now());
+                }
                 on_due();
             });
     }
 
     /// No wake-up until the next arm(); a completion already queued is dropped.
     void cancel() {
+        const bool was_armed = state_->armed != kNever;
         state_->armed = kNever;
         ++state_->generation;
         timer_.cancel();
+        if (was_armed) {
+            reprogram_reactor();
+        }
     }
 
     /// The deadline the timer waits for, kNever when none.
     TimePoint armed() const { return state_->armed; }
 
   private:
+    // asio reprograms its timerfd only for a new earliest deadline or when the timerfd fires: a deadline
+    // moved later, or cancelled, would still wake the process at its old instant, for nothing. A wait already
+    // due makes asio reprogram the timerfd at once, without sleeping (its completion finds nothing to do).
+    void reprogram_reactor() {
+        timer_.expires_at(TimePoint{});
+        timer_.async_wait([](const boost::system::error_code&) {});
+    }
+
     struct State {
         TimePoint armed = kNever;
         std::uint64_t generation = 0;
     };
 
     asio::steady_timer timer_;
+    WakeSharing* sharing_;
     std::shared_ptr<State> state_ = std::make_shared<State>();
 };
 

@@ -5,7 +5,7 @@
 namespace airseg {
 
 Service::Service(std::string name, ServiceContext& ctx)
-    : ctx_(ctx), name_(std::move(name)), strand_(asio::make_strand(ctx.io)), tick_timer_(strand_) {
+    : ctx_(ctx), name_(std::move(name)), strand_(asio::make_strand(ctx.io)), tick_timer_(strand_, ctx.wakes) {
     ctx_.health.add(name_, SteadyClock::now());
 }
 
@@ -66,12 +66,9 @@ void Service::do_tick() {
     const TimePoint now = SteadyClock::now();
     ctx_.health.progress(name_, now);
     on_tick(now);
-    tick_timer_.expires_at(next_on_grid(now, ctx_.progress_interval));
-    tick_timer_.async_wait([this](boost::system::error_code ec) {
-        if (!ec) {
-            do_tick();
-        }
-    });
+    // Up to a quarter interval late, to share a wake-up: the watchdog allows two intervals (app.cpp).
+    tick_timer_.arm(next_on_grid(now, ctx_.progress_interval), ctx_.progress_interval / 4,
+                    [this] { do_tick(); });
 }
 
 }  // namespace airseg

@@ -14,6 +14,8 @@
 #include "services/common/bus.hpp"
 #include "services/common/command_dispatcher.hpp"
 #include "services/common/health.hpp"
+#include "services/common/slack_timer.hpp"
+#include "services/common/wake_sharing.hpp"
 
 namespace airseg {
 
@@ -23,6 +25,9 @@ struct ServiceContext {
     HealthRegistry& health;
     CommandDispatcher& commands;
     Duration progress_interval = std::chrono::seconds(1);
+    /// Where periodic work waits for a wake-up to share (wake_sharing.hpp); null: every tick on its own
+    /// timer.
+    WakeSharing* wakes = nullptr;
 };
 
 class Service {
@@ -50,6 +55,13 @@ class Service {
     /// the same instants): for slow housekeeping that needs no wake-up of its own.
     virtual void on_tick(TimePoint /*now*/) {}
 
+    /// Input arrived (bytes from a port or a socket): periodic work already due runs in this wake-up.
+    void woke_for_input() {
+        if (ctx_.wakes != nullptr) {
+            ctx_.wakes->woke(SteadyClock::now());
+        }
+    }
+
     /// Health changes are logged once per change and shown in the status document.
     void set_health(Health health, std::string error = {});
 
@@ -60,7 +72,7 @@ class Service {
 
     std::string name_;
     Strand strand_;
-    asio::steady_timer tick_timer_;
+    SlackTimer tick_timer_;
     bool running_ = false;
 
     std::mutex hang_mutex_;

@@ -53,8 +53,8 @@ FlightplanService::FlightplanService(ServiceContext& ctx, FlightplanServiceConfi
     : Service("flightplan", ctx),
       config_(std::move(config)),
       controller_(controller_config(config_)),
-      timer_(strand()),
-      status_timer_(strand()) {
+      timer_(strand(), ctx.wakes),
+      status_timer_(strand(), ctx.wakes) {
     if (!config_.state_dir.empty()) {
         store_.emplace(config_.state_dir, config_.durability);
     }
@@ -184,16 +184,17 @@ void FlightplanService::flush() {
 }
 
 void FlightplanService::schedule_status() {
-    // On the grid the services' progress ticks use: one wake-up for both (time.hpp).
-    status_timer_.expires_at(next_on_grid(SteadyClock::now(), config_.status_period));
-    status_timer_.async_wait([this](const boost::system::error_code& ec) {
-        if (ec || !running_) {
-            return;
-        }
-        controller_.publish_status(true);
-        flush();
-        schedule_status();
-    });
+    // On the grid the services' progress ticks use, and up to half a period late to share a wake-up
+    // (time.hpp, wake_sharing.hpp).
+    status_timer_.arm(next_on_grid(SteadyClock::now(), config_.status_period), config_.status_period / 2,
+                      [this] {
+                          if (!running_) {
+                              return;
+                          }
+                          controller_.publish_status(true);
+                          flush();
+                          schedule_status();
+                      });
 }
 
 }  // namespace airseg::flightplan

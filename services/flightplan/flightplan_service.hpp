@@ -21,6 +21,7 @@
 
 #include "services/common/deadline_timer.hpp"
 #include "services/common/service.hpp"
+#include "services/common/slack_timer.hpp"
 #include "services/flightplan/persistence.hpp"
 #include "services/flightplan/plan_controller.hpp"
 
@@ -71,7 +72,7 @@ class FlightplanService : public Service {
     CommandId next_command_id_ = 1;
 
     DeadlineTimer timer_;
-    asio::steady_timer status_timer_;
+    SlackTimer status_timer_;
     std::vector<Subscription> subscriptions_;
     std::optional<ReplyGuard> calls_;  // the autopilot's answers run only while started
     bool running_ = false;

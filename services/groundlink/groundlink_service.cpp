@@ -54,11 +54,11 @@ GroundlinkService::GroundlinkService(ServiceContext& ctx, GroundlinkServiceConfi
     : Service("groundlink", ctx),
       config_(std::move(config)),
       scheduler_(config_.telemetry, transport_config_for(config_).link_rate_bytes_per_s, SteadyClock::now()),
-      telemetry_timer_(strand()),
+      telemetry_timer_(strand(), ctx.wakes),
       forwarder_(config_.mavlink_forward, transport_config_for(config_).link_rate_bytes_per_s,
                  SteadyClock::now()),
-      forward_timer_(strand()),
-      stats_timer_(strand()) {}
+      forward_timer_(strand(), ctx.wakes),
+      stats_timer_(strand(), ctx.wakes) {}
 
 GroundlinkService::~GroundlinkService() = default;
 
@@ -111,6 +111,7 @@ void GroundlinkService::on_start() {
             udp_->start_receiving(
                 [this](std::span<const std::uint8_t> d, const hal::UdpSocket::Endpoint&) {
                     driver_->handle_bytes(0, d);
+                    woke_for_input();
                 },
                 [](std::error_code, const std::string& what) { spdlog::warn("groundlink[udp]: {}", what); });
             attach_writers();
@@ -122,18 +123,20 @@ void GroundlinkService::on_start() {
             pc.serial.baud = config_.baud;
             pc.reconnect_min = config_.reconnect_min;
             pc.reconnect_max = config_.reconnect_max;
-            keepers_.push_back(std::make_unique<PortKeeper>(
-                strand(), pc,
-                PortKeeper::Handlers{
-                    [this] {
-                        attach_writers();
-                        update_health();
-                    },
-                    [this, i](std::span<const std::uint8_t> b) { driver_->handle_bytes(i, b); },
-                    [this, i](const std::string&) {
-                        driver_->set_writer(i, {});
-                        update_health();
-                    }}));
+            keepers_.push_back(
+                std::make_unique<PortKeeper>(strand(), pc,
+                                             PortKeeper::Handlers{[this] {
+                                                                      attach_writers();
+                                                                      update_health();
+                                                                  },
+                                                                  [this, i](std::span<const std::uint8_t> b) {
+                                                                      driver_->handle_bytes(i, b);
+                                                                      woke_for_input();
+                                                                  },
+                                                                  [this, i](const std::string&) {
+                                                                      driver_->set_writer(i, {});
+                                                                      update_health();
+                                                                  }}));
         }
         for (auto& k : keepers_) {
             k->start();
@@ -152,7 +155,8 @@ void GroundlinkService::make_driver() {
     driver_ =
         std::make_unique<LinkDriver>(strand(), transport_,
                                      LinkDriver::Handlers{[this](Delivered m) { on_message(std::move(m)); },
-                                                          [this](const TransportEvent& e) { on_event(e); }});
+                                                          [this](const TransportEvent& e) { on_event(e); }},
+                                     ctx_.wakes);
     last_rx_bytes_ = 0;
     delivery_.reset();
     last_fast_messages_ = last_fast_replaced_ = 0;
@@ -367,13 +371,10 @@ void GroundlinkService::do_stats() {
     }
     update_health();
     publish_status();
-    // On the grid the services' progress ticks use: one wake-up for both (time.hpp).
-    stats_timer_.expires_at(next_on_grid(now, config_.stats_interval));
-    stats_timer_.async_wait([this](boost::system::error_code ec) {
-        if (!ec) {
-            do_stats();
-        }
-    });
+    // On the grid the services' progress ticks use, and up to half a period late to share a wake-up
+    // (time.hpp, wake_sharing.hpp).
+    stats_timer_.arm(next_on_grid(now, config_.stats_interval), config_.stats_interval / 2,
+                     [this] { do_stats(); });
 }
 
 void GroundlinkService::feed_scheduler(TimePoint now) {
@@ -394,7 +395,8 @@ void GroundlinkService::feed_scheduler(TimePoint now) {
 }
 
 void GroundlinkService::arm_telemetry() {
-    telemetry_timer_.arm(scheduler_.poll_timeout(), [this] { on_telemetry_timer(); });
+    telemetry_timer_.arm(scheduler_.poll_timeout(), scheduler_.poll_slack(),
+                         [this] { on_telemetry_timer(); });
 }
 
 void GroundlinkService::on_telemetry_timer() {

@@ -10,6 +10,7 @@
 #include "services/common/deadline_timer.hpp"
 #include "services/common/port_keeper.hpp"
 #include "services/common/service.hpp"
+#include "services/common/slack_timer.hpp"
 #include "services/groundlink/delivery_meter.hpp"
 #include "services/groundlink/frame_forwarder.hpp"
 #include "services/groundlink/link/link_driver.hpp"
@@ -87,7 +88,7 @@ class GroundlinkService : public Service {
     std::optional<std::array<std::uint8_t, kKeyBytes>> control_key_;
     TelemetryScheduler scheduler_;
     DeliveryMeter delivery_;
-    DeadlineTimer telemetry_timer_;
+    SlackTimer telemetry_timer_;
     FrameForwarder forwarder_;
     DeadlineTimer forward_timer_;
     std::uint64_t forward_refused_ = 0;      // forwarded frames the transport did not take (queue full)
@@ -99,7 +100,7 @@ class GroundlinkService : public Service {
     bool commands_registered_ = false;
     std::vector<std::unique_ptr<PortKeeper>> keepers_;
     std::unique_ptr<hal::UdpSocket> udp_;
-    asio::steady_timer stats_timer_;
+    SlackTimer stats_timer_;
     std::string fatal_;  // a configuration problem found at start (bad key file): the link stays down
     std::uint64_t last_rx_bytes_ = 0;
     std::uint64_t last_fast_messages_ = 0;

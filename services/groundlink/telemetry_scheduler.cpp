@@ -172,6 +172,18 @@ TimePoint TelemetryScheduler::poll_timeout() const {
     return t;
 }
 
+Duration TelemetryScheduler::poll_slack() const {
+    Duration slack = Duration::zero();
+    for (auto k : kAllTelemetryKinds) {
+        const auto i = static_cast<std::size_t>(k);
+        if (effective_[i] > 0) {
+            const Duration half = period_of(effective_[i]) / 2;
+            slack = slack == Duration::zero() ? half : std::min(slack, half);
+        }
+    }
+    return slack;
+}
+
 double TelemetryScheduler::requested_hz(TelemetryKind kind) const {
     return requested_[static_cast<std::size_t>(kind)];
 }

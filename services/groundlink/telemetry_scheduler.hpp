@@ -5,7 +5,8 @@
 //   inputs   set_config (configuration, SIGHUP), set_rate (from the ground), update_link (once per link
 //            statistics tick: the transport's measured loss and how many Fast messages it had to replace)
 //   outputs  poll_due(now) (one kind due now, or nothing; call until nothing), poll_timeout() (the earliest
-//            next deadline), effective_hz / factor / budget figures for the status document.
+//            next deadline), poll_slack() (how late polling may be), effective_hz / factor / budget figures
+//            for the status document.
 //
 // Effective rate of a kind = requested rate × budget scale × weak-link factor, never below min_hz (unless the
 // kind is off). The budget scale keeps the pushed telemetry within budget_share of the link rate. The
@@ -74,6 +75,9 @@ class TelemetryScheduler {
     /// One kind whose message is due now (its next deadline moves on), or nothing.
     std::optional<TelemetryKind> poll_due(TimePoint now);
     [[nodiscard]] TimePoint poll_timeout() const;
+    /// How late a poll may come without costing a kind its rate: half the shortest period of the kinds on
+    /// (zero when all are off). A late poll lands on the next grid point, so the rates hold.
+    [[nodiscard]] Duration poll_slack() const;
 
     [[nodiscard]] double requested_hz(TelemetryKind kind) const;
     [[nodiscard]] double effective_hz(TelemetryKind kind) const;

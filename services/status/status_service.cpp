@@ -10,7 +10,7 @@ StatusService::StatusService(ServiceContext& ctx, StatusServiceConfig config)
     : Service("status", ctx),
       config_(std::move(config)),
       server_(strand(), ctx.commands),
-      refresh_timer_(strand()),
+      refresh_timer_(strand(), ctx.wakes),
       socket_timer_(strand()),
       started_at_(SteadyClock::now()) {}
 
@@ -66,13 +66,10 @@ void StatusService::do_open_socket() {
 
 void StatusService::do_refresh() {
     publish_summary();
-    // On the grid the services' progress ticks use: one wake-up for both (time.hpp).
-    refresh_timer_.expires_at(next_on_grid(SteadyClock::now(), config_.refresh_interval));
-    refresh_timer_.async_wait([this](boost::system::error_code ec) {
-        if (!ec) {
-            do_refresh();
-        }
-    });
+    // On the grid the services' progress ticks use, and up to half a period late to share a wake-up
+    // (time.hpp, wake_sharing.hpp).
+    refresh_timer_.arm(next_on_grid(SteadyClock::now(), config_.refresh_interval),
+                       config_.refresh_interval / 2, [this] { do_refresh(); });
 }
 
 void StatusService::publish_summary() {

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "services/common/service.hpp"
+#include "services/common/slack_timer.hpp"
 #include "services/status/local_command_server.hpp"
 #include "services/status/status_messages.hpp"
 
@@ -37,7 +38,7 @@ class StatusService : public Service {
 
     StatusServiceConfig config_;
     LocalCommandServer server_;
-    asio::steady_timer refresh_timer_;
+    SlackTimer refresh_timer_;
     asio::steady_timer socket_timer_;
     // Rendered when the document is read (document() is const to its callers, the cache is not).
     mutable std::map<std::string, nlohmann::json> sections_;

@@ -121,7 +121,23 @@ void Driver::handle_bytes(std::span<const std::uint8_t> bytes, TimePoint now) {
         on_frame(f, now);
     });
     drain_clients(now);
+    send_gcs_heartbeat_if_due(now);
     flush_rc(now);
+}
+
+// On the whole-second grid the daemon's other periodic work uses (time.hpp), and sent with the first input
+// after it is due: the board streams several times a second, so the heartbeat costs no wake-up of its own.
+// Only a silent board leaves it to the timer, half a second late (kGcsHeartbeatSlack).
+void Driver::send_gcs_heartbeat_if_due(TimePoint now) {
+    if (now < next_gcs_heartbeat_) {
+        return;
+    }
+    mav::Heartbeat hb;
+    hb.type = config_.gcs_heartbeat_type;
+    hb.autopilot = 8;      // MAV_AUTOPILOT_INVALID
+    hb.system_status = 4;  // MAV_STATE_ACTIVE
+    out_.send(hb);
+    next_gcs_heartbeat_ = next_on_grid(now, seconds(1));
 }
 
 void Driver::handle_timeout(TimePoint now) {
@@ -150,15 +166,7 @@ void Driver::handle_timeout(TimePoint now) {
     } else if (due.pulses_exhausted) {
         last_error_ = "autopilot unresponsive; reset pulses exhausted";
     }
-    if (now >= next_gcs_heartbeat_) {
-        mav::Heartbeat hb;
-        hb.type = config_.gcs_heartbeat_type;
-        hb.autopilot = 8;      // MAV_AUTOPILOT_INVALID
-        hb.system_status = 4;  // MAV_STATE_ACTIVE
-        out_.send(hb);
-        // On the whole-second grid the daemon's other periodic work uses: one wake-up for all (time.hpp).
-        next_gcs_heartbeat_ = next_on_grid(now, seconds(1));
-    }
+    send_gcs_heartbeat_if_due(now);
     if (now >= phase_deadline_) {
         phase_deadline_ = kNever;
         if (phase_ == Phase::WaitBoot) {
@@ -178,9 +186,10 @@ void Driver::handle_timeout(TimePoint now) {
 }
 
 TimePoint Driver::poll_timeout() const {
-    TimePoint t = std::min({missions_.poll_timeout(), params_.poll_timeout(), phase_deadline_,
-                            rc_.poll_timeout(), next_gcs_heartbeat_, auto_check_.poll_timeout(),
-                            link_.poll_timeout(), modes_.poll_timeout()});
+    TimePoint t =
+        std::min({missions_.poll_timeout(), params_.poll_timeout(), phase_deadline_, rc_.poll_timeout(),
+                  next_gcs_heartbeat_ == kNever ? kNever : next_gcs_heartbeat_ + kGcsHeartbeatSlack,
+                  auto_check_.poll_timeout(), link_.poll_timeout(), modes_.poll_timeout()});
     if (speed_request_) {
         t = std::min(t, speed_request_->deadline);
     }

@@ -164,6 +164,7 @@ class Driver {
     void update_state(TimePoint now, bool requested);
     void emit(Event e) { events_.push_back(std::move(e)); }
     void flush_rc(TimePoint now);
+    void send_gcs_heartbeat_if_due(TimePoint now);
 
     // driver_frames.cpp: what comes from the autopilot
     void on_frame(const mavlink::Frame& f, TimePoint now);
@@ -205,6 +206,8 @@ class Driver {
     std::optional<double> ready_s_;
 
     TimePoint next_gcs_heartbeat_ = kNever;
+    // How late our heartbeat may go when no input comes to carry it: ArduPilot's GCS failsafe waits seconds.
+    static constexpr Duration kGcsHeartbeatSlack = std::chrono::milliseconds(500);
 
     // Vehicle.
     std::optional<std::uint32_t> mode_;

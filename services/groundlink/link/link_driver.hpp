@@ -22,7 +22,9 @@ class LinkDriver {
         std::function<void(const TransportEvent&)> on_event;
     };
 
-    LinkDriver(asio::any_io_executor strand, TransportConfig config, Handlers handlers);
+    /// `wakes`: where the daemon's periodic work waits to share a wake-up (may be null).
+    LinkDriver(asio::any_io_executor strand, TransportConfig config, Handlers handlers,
+               WakeSharing* wakes = nullptr);
     LinkDriver(const LinkDriver&) = delete;
     LinkDriver& operator=(const LinkDriver&) = delete;
 

@@ -54,7 +54,9 @@ std::vector<std::string> TransportConfig::validate() const {
     need(fast_reassembly_timeout > Duration::zero(), "fast_reassembly_timeout must be positive");
     need(keepalive_interval > Duration::zero(), "keepalive_interval must be positive");
     need(hello_interval > Duration::zero(), "hello_interval must be positive");
-    need(link_down_after > keepalive_interval, "link_down_after must be longer than keepalive_interval");
+    need(link_down_after > keepalive_interval * 3 / 2,
+         "link_down_after must be longer than 1.5 x keepalive_interval (an idle path's longest gap between "
+         "probes)");
     need(link_up_frames >= 1 && link_up_frames <= 100, "link_up_frames must be 1..100");
     need(delivery_queue_cap >= 1, "delivery_queue_cap must be at least 1");
     need(boot_nonce != 0, "boot_nonce must not be 0 (the adapter supplies a random value)");

@@ -104,7 +104,8 @@ struct TransportConfig {
     /// fast_reassembly_timeout: an incomplete fragmented Fast message is dropped after this.
     Duration fast_reassembly_timeout = std::chrono::milliseconds(1000);
 
-    /// keepalive_interval: an idle path gets a probe frame this often.
+    /// keepalive_interval: an idle path owes a probe frame after this much quiet; it goes with the next poll,
+    /// or on its own timer after 1.5 x this.
     Duration keepalive_interval = std::chrono::milliseconds(500);
     /// hello_interval: handshake retry period.
     Duration hello_interval = std::chrono::milliseconds(500);

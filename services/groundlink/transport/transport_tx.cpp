@@ -181,7 +181,11 @@ TimePoint Transport::Impl::content_due(std::size_t path) const {
         t = std::min(t, ack_due());
     }
     if (keeps_alive(path)) {
-        t = std::min(t, ps.last_sent + cfg.keepalive_interval);
+        // Half an interval of slack: a probe is owed after keepalive_interval of quiet and goes with any
+        // poll after that, but wakes the process for itself only when the quiet has lasted 1.5 intervals.
+        // A path carrying periodic data is never probed then, even when that data comes a little late to
+        // share a wake-up (the vehicle's 2 Hz telemetry, the same period as the probes).
+        t = std::min(t, ps.last_sent + cfg.keepalive_interval + cfg.keepalive_interval / 2);
     }
     return t;
 }

@@ -56,6 +56,27 @@ TEST(TelemetryScheduler, SendsEachKindAtItsRequestedRateOnAGoodLink) {
     EXPECT_DOUBLE_EQ(sim.scheduler.factor(), 1.0);
 }
 
+TEST(TelemetryScheduler, PollsLateByUpToTheSlackKeepEveryRate) {
+    // The service polls at the first wake-up after a deadline, up to poll_slack() late (wake_sharing.hpp).
+    Sim sim;
+    const Duration slack = sim.scheduler.poll_slack();
+    EXPECT_EQ(slack, std::chrono::milliseconds(250));  // half the vehicle sample's 500 ms
+    std::map<TelemetryKind, int> counts;
+    const TimePoint end = sim.now + std::chrono::seconds(20);
+    for (int i = 0; sim.now < end; ++i) {
+        // Late by a different share of the slack each time, never beyond it.
+        sim.now = sim.scheduler.poll_timeout() + slack * (i % 5) / 4;
+        while (auto k = sim.scheduler.poll_due(sim.now)) {
+            ++counts[*k];
+        }
+    }
+    EXPECT_NEAR(counts[TelemetryKind::Vehicle], 40, 1);
+    EXPECT_NEAR(counts[TelemetryKind::LinkStats], 20, 1);
+    TelemetrySchedulerConfig off;
+    off.rate_hz = {0.0, 0.0};
+    EXPECT_EQ(TelemetryScheduler(off, k57600, sim.now).poll_slack(), Duration::zero());
+}
+
 TEST(TelemetryScheduler, KeepsPushedTelemetryWithinTheLinkBudget) {
     TelemetrySchedulerConfig c;
     c.rate_hz = {10.0, 1.0};  // 10 × 48 + 37 = 517 B/s wanted
