@@ -14,6 +14,16 @@
 
 namespace airseg {
 
+/// asio reprograms its timerfd only for a new earliest deadline or when the timerfd fires: a deadline moved
+/// later, or cancelled, would still wake the process at its old instant, for nothing. A wait already due
+/// makes asio reprogram the timerfd at once, without sleeping (its completion finds nothing to do). Drops the
+/// timer's pending wait, as expires_at() does.
+template <class Timer>
+void reprogram_reactor(Timer& timer) {
+    timer.expires_at(TimePoint{});
+    timer.async_wait([](const boost::system::error_code&) {});
+}
+
 class DeadlineTimer {
   public:
     /// Handlers run on `executor` (the owner's strand); `sharing` may be null.
@@ -38,7 +48,7 @@ class DeadlineTimer {
             return;
         }
         if (state_->armed != kNever && deadline > state_->armed) {
-            reprogram_reactor();
+            reprogram_reactor(timer_);
         }
         state_->armed = deadline;
         const std::uint64_t generation = ++state_->generation;
@@ -65,9 +75,10 @@ class DeadlineTimer {
         const bool was_armed = state_->armed != kNever;
         state_->armed = kNever;
         ++state_->generation;
-        timer_.cancel();
         if (was_armed) {
-            reprogram_reactor();
+            reprogram_reactor(timer_);
+        } else {
+            timer_.cancel();
         }
     }
 
@@ -75,14 +86,6 @@ class DeadlineTimer {
     TimePoint armed() const { return state_->armed; }
 
   private:
-    // asio reprograms its timerfd only for a new earliest deadline or when the timerfd fires: a deadline
-    // moved later, or cancelled, would still wake the process at its old instant, for nothing. A wait already
-    // due makes asio reprogram the timerfd at once, without sleeping (its completion finds nothing to do).
-    void reprogram_reactor() {
-        timer_.expires_at(TimePoint{});
-        timer_.async_wait([](const boost::system::error_code&) {});
-    }
-
     struct State {
         TimePoint armed = kNever;
         std::uint64_t generation = 0;

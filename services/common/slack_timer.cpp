@@ -14,18 +14,11 @@ SlackTimer::~SlackTimer() {
 void SlackTimer::cancel() {
     const bool was_armed = state_->due != kNever;
     disarm();
-    timer_.cancel();
     if (was_armed) {
-        reprogram_reactor();
+        reprogram_reactor(timer_);
+    } else {
+        timer_.cancel();
     }
-}
-
-// asio reprograms its timerfd only for a new earliest deadline or when the timerfd fires: a deadline moved
-// later, or cancelled, would still wake the process at its old instant, for nothing. A wait already due makes
-// asio reprogram the timerfd at once, without sleeping (its completion finds nothing to do).
-void SlackTimer::reprogram_reactor() {
-    timer_.expires_at(TimePoint{});
-    timer_.async_wait([](const boost::system::error_code&) {});
 }
 
 void SlackTimer::disarm() {
@@ -39,7 +32,7 @@ void SlackTimer::disarm() {
 
 void SlackTimer::start(TimePoint due, Duration slack, std::function<void()> on_due) {
     if (state_->due != kNever) {
-        reprogram_reactor();
+        reprogram_reactor(timer_);
     }
     disarm();
     const std::uint64_t generation = state_->generation;
@@ -73,7 +66,7 @@ void SlackTimer::run(bool own_wake_up) {
     auto handler = std::move(state_->handler);
     disarm();  // a registration WakeSharing ran is already forgotten there
     if (!own_wake_up) {
-        reprogram_reactor();  // the wait for due + slack is dropped
+        reprogram_reactor(timer_);  // the wait for due + slack is dropped
     } else if (sharing_ != nullptr) {
         // This tick woke the daemon: the others already due share the wake-up.
         sharing_->woke(SteadyClock::now());

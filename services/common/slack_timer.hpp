@@ -12,6 +12,7 @@
 
 #include "base/time.hpp"
 #include "services/common/asio.hpp"
+#include "services/common/deadline_timer.hpp"
 #include "services/common/wake_sharing.hpp"
 
 namespace airseg {
@@ -56,7 +57,6 @@ class SlackTimer {
     void start(TimePoint due, Duration slack, std::function<void()> on_due);
     void run(bool own_wake_up);
     void disarm();
-    void reprogram_reactor();
 
     Strand strand_;
     WakeSharing* sharing_;
