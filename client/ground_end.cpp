@@ -41,7 +41,7 @@ std::string validate(const RadioOptions& o) {
     return {};
 }
 
-GroundEnd::GroundEnd(asio::any_io_executor strand, RadioOptions options, Handlers handlers)
+GroundEnd::GroundEnd(Strand strand, RadioOptions options, Handlers handlers)
     : strand_(std::move(strand)),
       options_(std::move(options)),
       handlers_(std::move(handlers)),

@@ -38,7 +38,7 @@ class GroundEnd {
         std::function<void(const groundlink::TransportEvent&)> on_event;
     };
 
-    GroundEnd(asio::any_io_executor strand, RadioOptions options, Handlers handlers);
+    GroundEnd(Strand strand, RadioOptions options, Handlers handlers);
     ~GroundEnd();
     GroundEnd(const GroundEnd&) = delete;
     GroundEnd& operator=(const GroundEnd&) = delete;
@@ -66,7 +66,7 @@ class GroundEnd {
     void do_report();
     void on_delivered(groundlink::Delivered m);
 
-    asio::any_io_executor strand_;
+    Strand strand_;
     RadioOptions options_;
     Handlers handlers_;
     std::unique_ptr<groundlink::LinkDriver> driver_;

@@ -35,7 +35,7 @@ std::pair<std::string, std::string> split_host_port(const std::string& text) {
 }
 }  // namespace
 
-Hub::Hub(asio::any_io_executor strand, HubConfig config)
+Hub::Hub(Strand strand, HubConfig config)
     : strand_(std::move(strand)),
       config_(std::move(config)),
       end_(strand_, config_.radio,

@@ -34,7 +34,7 @@ class Hub {
     /// The name of each relayed command ("plan.load") and the vehicle's answer to it.
     using ResultListener = std::function<void(const std::string& cmd, const nlohmann::json& answer)>;
 
-    Hub(asio::any_io_executor strand, HubConfig config);
+    Hub(Strand strand, HubConfig config);
     ~Hub();
     Hub(const Hub&) = delete;
     Hub& operator=(const Hub&) = delete;
@@ -85,7 +85,7 @@ class Hub {
     void broadcast(const std::vector<std::uint8_t>& frame);
     void tick();
 
-    asio::any_io_executor strand_;
+    Strand strand_;
     HubConfig config_;
     client::GroundEnd end_;
     std::optional<std::array<std::uint8_t, 32>> key_;

@@ -55,6 +55,7 @@ struct Telemetry {
     VehicleState state = VehicleState::Unknown;
     std::uint16_t mission_current = 0;
     std::optional<Position> home;
+    bool operator==(const Telemetry&) const = default;
 };
 
 /// One slot of the autopilot's mission, in neutral terms.

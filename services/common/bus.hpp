@@ -14,6 +14,7 @@
 // completes with the requester's fallback, so a request needs no id and no subscription to its result.
 #include <any>
 #include <atomic>
+#include <concepts>
 #include <functional>
 #include <map>
 #include <memory>
@@ -97,15 +98,24 @@ class Bus {
         }
     }
 
-    /// Variable: the newest value replaces an undelivered older one; the value is retained.
+    /// Variable: the newest value replaces an undelivered older one; the value is retained. A value equal to
+    /// the retained one (for a type that can be compared) changes nothing and is not delivered again: a
+    /// publisher may refresh its variables on every input without waking its subscribers for nothing.
     template <class Msg>
     void publish_latest(Msg msg) {
-        auto shared = std::make_shared<const Msg>(std::move(msg));
+        std::shared_ptr<const Msg> shared;
         std::vector<std::shared_ptr<Subscriber<Msg>>> subs;
         {
             std::lock_guard lock(mutex_);
             auto& topic = topics_[std::type_index(typeid(Msg))];
-            topic.latest = std::shared_ptr<const Msg>(shared);
+            if constexpr (std::equality_comparable<Msg>) {
+                if (topic.latest.has_value() &&
+                    *std::any_cast<std::shared_ptr<const Msg>&>(topic.latest) == msg) {
+                    return;
+                }
+            }
+            shared = std::make_shared<const Msg>(std::move(msg));
+            topic.latest = shared;
             subs = typed_subscribers<Msg>(topic);
         }
         for (auto& sub : subs) {

@@ -24,11 +24,15 @@ void reprogram_reactor(Timer& timer) {
     timer.async_wait([](const boost::system::error_code&) {});
 }
 
+/// A steady timer whose executor type is the strand itself: converting a strand to any_io_executor, as
+/// asio::steady_timer does for every wait's completion, allocates.
+using StrandTimer = asio::basic_waitable_timer<SteadyClock, asio::wait_traits<SteadyClock>, Strand>;
+
 class DeadlineTimer {
   public:
-    /// Handlers run on `executor` (the owner's strand); `sharing` may be null.
-    explicit DeadlineTimer(asio::any_io_executor executor, WakeSharing* sharing = nullptr)
-        : timer_(std::move(executor)), sharing_(sharing) {}
+    /// Handlers run on `strand` (the owner's); `sharing` may be null.
+    explicit DeadlineTimer(Strand strand, WakeSharing* sharing = nullptr)
+        : timer_(std::move(strand)), sharing_(sharing) {}
     DeadlineTimer(const DeadlineTimer&) = delete;
     DeadlineTimer& operator=(const DeadlineTimer&) = delete;
     // The state goes with the owner: a completion already queued when it is destroyed finds nothing to call.
@@ -91,7 +95,7 @@ class DeadlineTimer {
         std::uint64_t generation = 0;
     };
 
-    asio::steady_timer timer_;
+    StrandTimer timer_;
     WakeSharing* sharing_;
     std::shared_ptr<State> state_ = std::make_shared<State>();
 };

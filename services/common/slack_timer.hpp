@@ -52,16 +52,13 @@ class SlackTimer {
         std::function<void()> handler;
         WakeSharing::Id shared_id = 0;
     };
-    using Timer = asio::basic_waitable_timer<SteadyClock, asio::wait_traits<SteadyClock>, Strand>;
-
     void start(TimePoint due, Duration slack, std::function<void()> on_due);
     void run(bool own_wake_up);
     void disarm();
 
     Strand strand_;
     WakeSharing* sharing_;
-    // The executor type is the strand itself: converting it to any_io_executor allocates on every wait.
-    Timer timer_;
+    StrandTimer timer_;
     std::shared_ptr<State> state_ = std::make_shared<State>();
 };
 

@@ -191,7 +191,7 @@ void FlightplanService::schedule_status() {
                           if (!running_) {
                               return;
                           }
-                          controller_.publish_status(true);
+                          controller_.publish_status(false);
                           flush();
                           schedule_status();
                       });

@@ -33,7 +33,7 @@ struct FlightplanServiceConfig {
     std::string state_dir;  // state_dir: plan.yaml and progress.state; empty = nothing kept
     Durability durability = Durability::Fsync;    // flightplan.fsync
     Duration command_timeout = seconds(30);       // how long a command waits for the autopilot
-    Duration status_period = milliseconds(1000);  // the "plan" section is republished at least this often
+    Duration status_period = milliseconds(1000);  // the "plan" section is checked for changes this often
 };
 
 class FlightplanService : public Service {

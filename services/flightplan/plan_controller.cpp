@@ -759,15 +759,20 @@ TimePoint PlanController::poll_timeout() const {
     return next;
 }
 
+PlanController::StatusKey PlanController::status_key(const FeederProgress& p) const {
+    return {p.state,        p.plan_name,    p.element, p.waypoints_reached, p.next_waypoint, p.window,
+            last_reaction_, p.interruption, problem_};
+}
+
 void PlanController::publish_status(bool force) {
     const auto p = feeder_.progress();
     StatusUpdate u{
         PlanProgress{p.state, top_element_index(p.element), p.next_waypoint.value_or(0), p.waypoints_reached},
         std::nullopt};
-    Json j = progress_json();
-    if (force || j != last_status_) {
-        last_status_ = j;
-        u.section = std::move(j);
+    auto key = status_key(p);
+    if (force || key != last_status_) {
+        last_status_ = std::move(key);
+        u.section = progress_json();
     }
     statuses_.push_back(std::move(u));
 }

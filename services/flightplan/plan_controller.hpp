@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -154,6 +155,12 @@ class PlanController {
     bool returning_home() const { return returning_home_; }
     FeederProgress progress() const { return feeder_.progress(); }
     Json progress_json() const;
+    // What progress_json() shows, as plain values: compared at every status check, where building the JSON
+    // to compare would cost about 10,000 instructions.
+    using StatusKey =
+        std::tuple<PlanState, std::string, std::string, std::uint64_t, std::optional<std::uint64_t>,
+                   std::size_t, std::string, std::string, std::string>;
+    StatusKey status_key(const FeederProgress& p) const;
 
   private:
     struct Waiter {
@@ -206,7 +213,7 @@ class PlanController {
     std::optional<SavedProgress> last_written_;
     std::string problem_;        // plan.error: the last problem found (corrupt state, failed save, ...)
     std::string last_reaction_;  // plan.reaction
-    Json last_status_;
+    std::optional<StatusKey> last_status_;
 
     std::deque<PlanOutput> outputs_;
     std::deque<CommandReply> replies_;

@@ -31,7 +31,9 @@ void StatusService::on_start() {
             unrendered_.erase(s.name);
             sections_[s.name] = s.value;
         }
-        publish_summary();
+        if (s.name == "plan") {
+            publish_summary();  // the only section the line shows; health changes go with the refresh
+        }
     });
     ctx_.commands.add("status", strand(), Role::Monitor, [this](const Json&, CommandDispatcher::Reply reply) {
         reply(CommandResult::ok(document()));

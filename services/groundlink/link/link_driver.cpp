@@ -2,9 +2,10 @@
 
 namespace airseg::groundlink {
 
-LinkDriver::LinkDriver(asio::any_io_executor strand, TransportConfig config, Handlers handlers,
-                       WakeSharing* wakes)
-    : core_(std::move(config), SteadyClock::now()), handlers_(std::move(handlers)), timer_(strand, wakes) {}
+LinkDriver::LinkDriver(Strand strand, TransportConfig config, Handlers handlers, WakeSharing* wakes)
+    : core_(std::move(config), SteadyClock::now()),
+      handlers_(std::move(handlers)),
+      timer_(std::move(strand), wakes) {}
 
 void LinkDriver::set_writer(std::size_t path, Writer writer) {
     if (path < writers_.size()) {

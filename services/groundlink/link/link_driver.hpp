@@ -23,7 +23,7 @@ class LinkDriver {
     };
 
     /// `wakes`: where the daemon's periodic work waits to share a wake-up (may be null).
-    LinkDriver(asio::any_io_executor strand, TransportConfig config, Handlers handlers,
+    LinkDriver(Strand strand, TransportConfig config, Handlers handlers,
                WakeSharing* wakes = nullptr);
     LinkDriver(const LinkDriver&) = delete;
     LinkDriver& operator=(const LinkDriver&) = delete;

@@ -68,6 +68,44 @@ TEST(Bus, VariablesCoalesceToTheNewestValue) {
     EXPECT_EQ(bus.latest<Position>()->lat, 50.0);
 }
 
+struct Mode {
+    int number;
+    bool operator==(const Mode&) const = default;
+};
+
+TEST(Bus, AVariableRepublishedUnchangedWakesNoSubscriber) {
+    asio::io_context io;
+    Bus bus;
+    Strand s = asio::make_strand(io);
+    std::vector<int> seen;
+    auto sub = bus.subscribe<Mode>(s, [&](const Mode& m) { seen.push_back(m.number); });
+    bus.publish_latest(Mode{3});
+    io.run();
+    io.restart();
+    bus.publish_latest(Mode{3});
+    EXPECT_EQ(io.poll(), 0u);  // nothing was posted
+    io.restart();
+    bus.publish_latest(Mode{4});
+    bus.publish_latest(Mode{3});  // differs from the retained 4: delivered, coalesced with it
+    io.run();
+    EXPECT_EQ(seen, (std::vector<int>{3, 3}));
+    EXPECT_EQ(bus.latest<Mode>()->number, 3);
+}
+
+TEST(Bus, AVariableThatCannotBeComparedIsDeliveredAtEveryPublish) {
+    asio::io_context io;
+    Bus bus;
+    Strand s = asio::make_strand(io);
+    int deliveries = 0;
+    auto sub = bus.subscribe<Position>(s, [&](const Position&) { ++deliveries; });
+    for (int i = 0; i < 3; ++i) {
+        bus.publish_latest(Position{1.0});
+        io.run();
+        io.restart();
+    }
+    EXPECT_EQ(deliveries, 3);
+}
+
 TEST(Bus, LateSubscriberGetsTheCurrentValueOfAVariable) {
     asio::io_context io;
     Bus bus;

@@ -204,6 +204,27 @@ TEST(FlightplanController, LoadUploadsTheWindowStartsTheVehicleAndAnswersOnceCon
     EXPECT_EQ(rig.state(), "running");
 }
 
+TEST(FlightplanController, ThePlanSectionGoesOutOnlyWhenWhatItShowsChanged) {
+    Rig r;
+    const auto check = [&r](bool force) {
+        r.c.publish_status(force);
+        auto s = r.c.poll_status();
+        EXPECT_TRUE(s.has_value());  // the PlanProgress variable goes out every time
+        return s && s->section ? std::optional<std::string>((*s->section)["state"].get<std::string>())
+                               : std::nullopt;
+    };
+    EXPECT_EQ(check(false), std::nullopt);  // unchanged since the start published it
+    EXPECT_EQ(check(true), "none");
+    r.run_plan("hold", true);               // the changes went out as they came (drained)
+    EXPECT_EQ(check(false), std::nullopt);  // nothing new since
+    r.c.on_link(false, r.now);              // lost: the reaction's countdown shows nowhere yet
+    r.drain();
+    EXPECT_EQ(check(false), std::nullopt);
+    r.advance(seconds(21));
+    EXPECT_EQ(r.count(is_hold), 1u);
+    EXPECT_EQ(check(true), r.state());
+}
+
 TEST(FlightplanController, LoadWaitsForTheAutopilotAndFailsWhenItIsNotReady) {
     Rig rig;
     const auto id = rig.load(plan_text());
