@@ -75,6 +75,9 @@ std::string GroundEnd::open() {
     }
     std::random_device rd;
     t.boot_nonce = (static_cast<std::uint64_t>(rd()) << 32) | rd() | 1;
+    // Probes only on their own timer, and the reception report in their place (reception_report_timing.hpp):
+    // every frame on the idle uplink is a wake-up of the vehicle's daemon.
+    t.probe_with_next_poll = false;
     driver_ = std::make_unique<gl::LinkDriver>(
         strand_, t,
         gl::LinkDriver::Handlers{[this](gl::Delivered m) { on_delivered(std::move(m)); },
@@ -99,9 +102,9 @@ std::string GroundEnd::open() {
         if (!r.ok()) {
             return r.message;
         }
-        udp_->start_receiving([this](std::span<const std::uint8_t> d,
-                                     const hal::UdpSocket::Endpoint&) { driver_->handle_bytes(0, d); },
-                              [](std::error_code, const std::string&) {});
+        udp_->start_receiving(
+            [this](std::span<const std::uint8_t> d, const hal::UdpSocket::Endpoint&) { on_bytes(0, d); },
+            [](std::error_code, const std::string&) {});
         driver_->set_writer(0, [this](std::vector<std::uint8_t> f) {
             return udp_->send(std::move(f)) == hal::WriteResult::Queued;
         });
@@ -116,7 +119,7 @@ std::string GroundEnd::open() {
         if (!r.ok()) {
             return r.message.empty() ? "cannot open " + c.path : r.message;
         }
-        port->start_reading([this, i](std::span<const std::uint8_t> b) { driver_->handle_bytes(i, b); },
+        port->start_reading([this, i](std::span<const std::uint8_t> b) { on_bytes(i, b); },
                             [this, i](std::error_code, const std::string&) { driver_->set_writer(i, {}); });
         auto* raw = port.get();
         ports_.push_back(std::move(port));
@@ -177,14 +180,28 @@ std::uint64_t GroundEnd::bytes_sent() const {
     return driver_ ? driver_->stats().bytes_sent : 0;
 }
 
-/// Once a second while the link is up: how many pushed telemetry messages arrived, so the vehicle can
-/// measure what the link delivers.
-void GroundEnd::do_report() {
-    if (driver_->link_up()) {
+// Input makes the transport poll, which sends a probe a path owes: the report, if it is due, goes first and
+// stands in for the probe.
+void GroundEnd::on_bytes(std::size_t path, std::span<const std::uint8_t> bytes) {
+    send_report_if_due(SteadyClock::now());
+    driver_->handle_bytes(path, bytes);
+}
+
+void GroundEnd::send_report_if_due(TimePoint now) {
+    if (report_timing_.due(now, driver_->core())) {
         driver_->send_fast(proto::kPriorityStatus, proto::kTopicReception,
                            proto::encode(proto::ReceptionReport{pushed_received_}));
+        report_timing_.sent(now);
     }
-    report_timer_.expires_after(std::chrono::seconds(1));
+}
+
+// At least once a second while the link is up: how many pushed telemetry messages arrived, so the vehicle
+// can measure what the link delivers. When: reception_report_timing.hpp (it doubles as the keepalive).
+void GroundEnd::do_report() {
+    const TimePoint now = SteadyClock::now();
+    send_report_if_due(now);
+    const TimePoint next = report_timing_.next_check(now, driver_->core());
+    report_timer_.expires_at(next);
     report_timer_.async_wait([this](boost::system::error_code ec) {
         if (!ec && !stopped_) {
             do_report();

@@ -6,9 +6,11 @@
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <span>
 #include <string>
 #include <vector>
 
+#include "client/reception_report_timing.hpp"
 #include "services/common/asio.hpp"
 #include "services/groundlink/link/link_driver.hpp"
 #include "services/groundlink/protocol/ground_protocol.hpp"
@@ -64,6 +66,8 @@ class GroundEnd {
 
   private:
     void do_report();
+    void on_bytes(std::size_t path, std::span<const std::uint8_t> bytes);
+    void send_report_if_due(TimePoint now);
     void on_delivered(groundlink::Delivered m);
 
     Strand strand_;
@@ -74,6 +78,7 @@ class GroundEnd {
     std::unique_ptr<hal::UdpSocket> udp_;
     asio::steady_timer report_timer_;
     std::uint32_t pushed_received_ = 0;
+    ReportTiming report_timing_;
     bool keyed_ = false;
     bool stopped_ = false;
 };

@@ -1,7 +1,7 @@
 #pragma once
 // Measures what share of the pushed telemetry the ground really receives: the vehicle counts what it pushes,
-// the ground reports (once a second, cumulatively) what it received. Sans-IO: counts and time in, a loss
-// estimate out.
+// the ground reports (at least once a second, cumulatively) what it received. Sans-IO: counts and time in, a
+// loss estimate out.
 //
 // A report at time t is compared with what had been pushed by t − lag (messages pushed later cannot have
 // arrived yet), over the longest span since an earlier report that covers at least kMinMessages pushed

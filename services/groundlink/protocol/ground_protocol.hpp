@@ -107,8 +107,8 @@ struct Joystick {
 };
 
 /// The ground end's count of pushed telemetry messages (telemetry samples and link statistics) received since
-/// its transport session began, sent once a second: the vehicle compares it with what it pushed to measure
-/// what the link really delivers.
+/// its transport session began, sent at least once a second: the vehicle compares it with what it pushed to
+/// measure what the link really delivers.
 struct ReceptionReport {
     std::uint32_t received = 0;
     bool operator==(const ReceptionReport&) const = default;

@@ -260,6 +260,12 @@ const LinkStats& Transport::stats() const {
 bool Transport::link_up() const {
     return impl_->link;
 }
+TimePoint Transport::probe_deadline(std::size_t path) const {
+    return impl_->probe_deadline(path);
+}
+bool Transport::probe_owed(std::size_t path, TimePoint now) const {
+    return impl_->probe_deadline(path) != kNever && impl_->probe_owed(path, now);
+}
 std::size_t Transport::session_key() const {
     return impl_->session_key;
 }

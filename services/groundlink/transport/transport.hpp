@@ -107,6 +107,11 @@ struct TransportConfig {
     /// keepalive_interval: an idle path owes a probe frame after this much quiet; it goes with the next poll,
     /// or on its own timer after 1.5 x this.
     Duration keepalive_interval = std::chrono::milliseconds(500);
+    /// probe_with_next_poll: whether an owed probe goes with the next transmit poll (it then shares the
+    /// wake-up of whatever input comes, at the price of probing as soon as keepalive_interval has passed), or
+    /// only on its own timer after 1.5 x keepalive_interval (fewer frames on an idle path: each one is a
+    /// wake-up of the peer). The vehicle shares its wake-ups; the ground end spares the vehicle's.
+    bool probe_with_next_poll = true;
     /// hello_interval: handshake retry period.
     Duration hello_interval = std::chrono::milliseconds(500);
     /// link_down_after: silence that marks a path (and with all paths, the link) down.
@@ -289,6 +294,13 @@ class Transport {
     [[nodiscard]] const TransportConfig& config() const;
     /// Safe messages of `priority` queued or in flight (not yet acknowledged).
     [[nodiscard]] std::size_t safe_pending(std::uint8_t priority) const;
+    /// When `path`, left quiet, sends an empty probe on its own timer (its last frame + 1.5 ×
+    /// keepalive_interval); kNever for a path that is not probed (or before the session). Any frame sent on
+    /// the path before then makes that probe unneeded.
+    [[nodiscard]] TimePoint probe_deadline(std::size_t path) const;
+    /// Whether `path` owes a probe at `now` (keepalive_interval of quiet): the next transmit poll sends one
+    /// unless something else goes first.
+    [[nodiscard]] bool probe_owed(std::size_t path, TimePoint now) const;
 
     class Impl;
 

@@ -78,6 +78,8 @@ class Transport::Impl {
     std::optional<std::vector<std::uint8_t>> poll_transmit(std::size_t path, TimePoint now);
     [[nodiscard]] bool carries_data(std::size_t path) const;
     [[nodiscard]] bool keeps_alive(std::size_t path) const;
+    [[nodiscard]] TimePoint probe_deadline(std::size_t path) const;
+    [[nodiscard]] bool probe_owed(std::size_t path, TimePoint now) const;
     [[nodiscard]] bool peer_mask_fresh() const;
     [[nodiscard]] std::uint8_t heard_mask() const;
     [[nodiscard]] std::uint8_t header_flags() const;

@@ -180,14 +180,24 @@ TimePoint Transport::Impl::content_due(std::size_t path) const {
         }
         t = std::min(t, ack_due());
     }
-    if (keeps_alive(path)) {
-        // Half an interval of slack: a probe is owed after keepalive_interval of quiet and goes with any
-        // poll after that, but wakes the process for itself only when the quiet has lasted 1.5 intervals.
-        // A path carrying periodic data is never probed then, even when that data comes a little late to
-        // share a wake-up (the vehicle's 2 Hz telemetry, the same period as the probes).
-        t = std::min(t, ps.last_sent + cfg.keepalive_interval + cfg.keepalive_interval / 2);
+    return std::min(t, probe_deadline(path));
+}
+
+// Half an interval of slack: a probe is owed after keepalive_interval of quiet and goes with any poll after
+// that (with probe_with_next_poll), but wakes the process for itself only when the quiet has lasted 1.5
+// intervals. A path carrying periodic data is never probed then, even when that data comes a little late to
+// share a wake-up (the vehicle's 2 Hz telemetry, the same period as the probes).
+TimePoint Transport::Impl::probe_deadline(std::size_t path) const {
+    if (path >= paths.size() || !confirmed || !keeps_alive(path)) {
+        return kNever;
     }
-    return t;
+    return paths[path].last_sent + cfg.keepalive_interval + cfg.keepalive_interval / 2;
+}
+
+bool Transport::Impl::probe_owed(std::size_t path, TimePoint now) const {
+    const Duration quiet =
+        cfg.keepalive_interval + (cfg.probe_with_next_poll ? Duration::zero() : cfg.keepalive_interval / 2);
+    return keeps_alive(path) && now >= paths[path].last_sent + quiet;
 }
 
 std::optional<std::vector<std::uint8_t>> Transport::Impl::poll_transmit(std::size_t path, TimePoint now) {
@@ -360,7 +370,7 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
         ps.mirror.pop_front();
         return f;
     }
-    const bool keepalive_due = keeps_alive(path) && now >= ps.last_sent + cfg.keepalive_interval;
+    const bool keepalive_due = probe_owed(path, now);
     if (!carries_data(path)) {
         if (!keepalive_due) {
             return std::nullopt;

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <map>
 #include <optional>
 #include <random>
@@ -68,6 +69,9 @@ class SimLink {
     [[nodiscard]] Duration air_backlog(std::size_t p) const {
         return air_free_[p] > now_ ? air_free_[p] - now_ : Duration::zero();
     }
+    /// Called in every step for each endpoint (0, 1) after its input and before its transmit poll: what an
+    /// adapter does on input before the transport polls.
+    std::function<void(int)> before_poll;
     /// Largest single frame written.
     [[nodiscard]] std::size_t largest_frame() const { return largest_frame_; }
     /// Called after every step; return true to stop.
@@ -129,6 +133,9 @@ class SimLink {
             }
         }
         for (std::size_t from = 0; from < 2; ++from) {
+            if (before_poll) {
+                before_poll(static_cast<int>(from));
+            }
             for (std::size_t p = 0; p < paths_.size(); ++p) {
                 while (auto frame = ends_[from].core->poll_transmit(p, now_)) {
                     transmit(from, p, std::move(*frame));
