@@ -180,7 +180,11 @@ TimePoint Transport::Impl::content_due(std::size_t path) const {
         }
         t = std::min(t, ack_due());
     }
-    return std::min(t, probe_deadline(path));
+    if (keeps_alive(path)) {
+        // probe_deadline(), written out: this runs at every poll.
+        t = std::min(t, ps.last_sent + cfg.keepalive_interval + cfg.keepalive_interval / 2);
+    }
+    return t;
 }
 
 // Half an interval of slack: a probe is owed after keepalive_interval of quiet and goes with any poll after
@@ -194,6 +198,7 @@ TimePoint Transport::Impl::probe_deadline(std::size_t path) const {
     return paths[path].last_sent + cfg.keepalive_interval + cfg.keepalive_interval / 2;
 }
 
+// Written out in build_data(), which runs for every frame built.
 bool Transport::Impl::probe_owed(std::size_t path, TimePoint now) const {
     const Duration quiet =
         cfg.keepalive_interval + (cfg.probe_with_next_poll ? Duration::zero() : cfg.keepalive_interval / 2);
@@ -370,7 +375,10 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
         ps.mirror.pop_front();
         return f;
     }
-    const bool keepalive_due = probe_owed(path, now);
+    const bool keepalive_due =
+        keeps_alive(path) &&
+        now >= ps.last_sent + cfg.keepalive_interval +
+                   (cfg.probe_with_next_poll ? Duration::zero() : cfg.keepalive_interval / 2);
     if (!carries_data(path)) {
         if (!keepalive_due) {
             return std::nullopt;
