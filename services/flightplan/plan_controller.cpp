@@ -88,6 +88,7 @@ void PlanController::resume(ResumeResult result, TimePoint now) {
     feeder_.restore_plan(PlanFeed{std::move(r.stream), r.plan->name}, r.progress.waypoints_reached, now);
     reactions_ = std::make_unique<ReactionMonitor>(ReactionSettings::from_plan(*plan.plan));
     tell_reactions_the_link(now);
+    tell_reactions_the_telemetry(now);
     log(Level::Info, fmt::format("resuming plan '{}' ({}) at waypoint {}, {} reached{}", r.plan->name,
                                  plan.source, r.progress.next_index, r.progress.waypoints_reached,
                                  r.progress.state == PlanState::Paused ? ", paused" : ""));
@@ -109,6 +110,7 @@ void PlanController::start_plan(ActivePlan plan, bool append, TimePoint now) {
     plan.stream = raw;
     reactions_ = std::make_unique<ReactionMonitor>(ReactionSettings::from_plan(*plan.plan));
     tell_reactions_the_link(now);
+    tell_reactions_the_telemetry(now);
     active_ = std::move(plan);
     returning_home_ = false;
     problem_.clear();
@@ -121,6 +123,21 @@ void PlanController::start_plan(ActivePlan plan, bool append, TimePoint now) {
 void PlanController::tell_reactions_the_link(TimePoint now) {
     if (groundlink_seen_up_ && reactions_) {
         reactions_->on_link(groundlink_up_, now);
+    }
+}
+
+// Telemetry comes only when it changes (the bus drops a value equal to the last): a new plan's reactions
+// start from the battery and position last heard, or a plan loaded on a low battery at rest would never
+// react.
+void PlanController::tell_reactions_the_telemetry(TimePoint now) {
+    if (!reactions_) {
+        return;
+    }
+    if (last_battery_) {
+        reactions_->on_battery(*last_battery_, now);
+    }
+    if (last_position_) {
+        reactions_->on_position(*last_position_, now);
     }
 }
 
@@ -250,15 +267,14 @@ void PlanController::on_telemetry(const autopilot::Telemetry& t, TimePoint now) 
     if (t.home) {
         autopilot_home_ = t.home;
     }
+    last_battery_ = t.battery_remaining;
+    if (t.position) {
+        last_position_ = LatLon{t.position->lat, t.position->lon};
+    }
     if (!reactions_) {
         return;
     }
-    if (t.battery_remaining) {
-        reactions_->on_battery(*t.battery_remaining, now);
-    }
-    if (t.position) {
-        reactions_->on_position(LatLon{t.position->lat, t.position->lon}, now);
-    }
+    tell_reactions_the_telemetry(now);
     pump(now);
 }
 

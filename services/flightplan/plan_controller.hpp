@@ -178,6 +178,7 @@ class PlanController {
     void carry_out(const ReactionTrigger& trigger, TimePoint now);
     bool return_home(TimePoint now);
     void tell_reactions_the_link(TimePoint now);
+    void tell_reactions_the_telemetry(TimePoint now);
     void send(const FeederRequest& request, TimePoint now);
     void pump(TimePoint now);
     void handle_event(const FeederEvent& e);
@@ -199,6 +200,8 @@ class PlanController {
     // silent for a while (heartbeats lost) and still holds the window it was driving.
     std::optional<std::pair<unsigned, unsigned>> ready_counts_;
     std::optional<autopilot::Position> autopilot_home_;
+    std::optional<int> last_battery_;  // the telemetry's, for a new plan's reactions
+    std::optional<LatLon> last_position_;
     bool groundlink_seen_up_ = false;
     bool groundlink_up_ = false;
     std::map<std::uint32_t, InFlight> in_flight_;  // by AutopilotCall id

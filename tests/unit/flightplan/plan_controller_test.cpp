@@ -273,6 +273,23 @@ TEST(FlightplanController, BadAppendsAndSkipsAreAnsweredAtOnceWithoutTouchingThe
     EXPECT_TRUE(rig.requests.empty());
 }
 
+TEST(FlightplanController, APlanLoadedOnALowBatteryAtRestReactsAtOnce) {
+    // Telemetry reaches the controller only when it changes: a vehicle at rest on a low battery sends no more
+    // after the first sample, and the plan loaded afterwards must still see it.
+    Rig rig;
+    rig.ready();
+    autopilot::Telemetry t;
+    t.battery_remaining = 18;
+    t.position = autopilot::Position{41.0, 2.0, 0.0};
+    rig.c.on_telemetry(t, rig.now);
+    rig.drain();
+    std::string text = plan_text();
+    text.replace(text.find("    link_loss"), 0, "    low_battery: {below: 25, action: hold}\n");
+    rig.load(text);
+    ASSERT_EQ(rig.triggers.size(), 1u);
+    EXPECT_EQ(rig.triggers.front().cause, ReactionTrigger::Cause::LowBattery);
+}
+
 TEST(FlightplanController, LinkLostForTheConfiguredTimeHoldsTheVehicle) {
     Rig rig;
     rig.run_plan("hold", true);
