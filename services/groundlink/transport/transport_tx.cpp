@@ -198,7 +198,6 @@ TimePoint Transport::Impl::probe_deadline(std::size_t path) const {
     return paths[path].last_sent + cfg.keepalive_interval + cfg.keepalive_interval / 2;
 }
 
-// Written out in build_data(), which runs for every frame built.
 bool Transport::Impl::probe_owed(std::size_t path, TimePoint now) const {
     const Duration quiet =
         cfg.keepalive_interval + (cfg.probe_with_next_poll ? Duration::zero() : cfg.keepalive_interval / 2);
@@ -375,10 +374,7 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::build_data(std::size_t
         ps.mirror.pop_front();
         return f;
     }
-    const bool keepalive_due =
-        keeps_alive(path) &&
-        now >= ps.last_sent + cfg.keepalive_interval +
-                   (cfg.probe_with_next_poll ? Duration::zero() : cfg.keepalive_interval / 2);
+    const bool keepalive_due = probe_owed(path, now);
     if (!carries_data(path)) {
         if (!keepalive_due) {
             return std::nullopt;
