@@ -9,6 +9,15 @@ endif()
 # Boost.Asio is header-only here; keep its deprecated API out so the code stays portable to newer Boost.
 target_compile_definitions(airseg_options INTERFACE BOOST_ASIO_NO_DEPRECATED BOOST_ASIO_NO_TS_EXECUTORS
                                                     AIRSEG_VERSION="${PROJECT_VERSION}")
+# No absolute path of this checkout in any object: file names in debug information and __FILE__ are relative
+# to the top of the tree, so that a compiler cache (with CCACHE_BASEDIR at the top) serves a clone of the tree
+# in another directory, and two clones build identical objects. Tests find the trees at run time
+# (tests/support/tree_paths.hpp), not through compiled-in paths. CI turns it on; a debugger then needs
+# `set substitute-path . TOP` or to run from the top.
+option(AIRSEG_RELATIVE_PATHS "Map the tree's absolute path to . in objects (-ffile-prefix-map)" OFF)
+if(AIRSEG_RELATIVE_PATHS)
+  target_compile_options(airseg_options INTERFACE "-ffile-prefix-map=${PROJECT_SOURCE_DIR}=.")
+endif()
 if(AIRSEG_SANITIZE)
   target_compile_options(airseg_options INTERFACE -fsanitize=${AIRSEG_SANITIZE} -fno-omit-frame-pointer)
   target_link_options(airseg_options INTERFACE -fsanitize=${AIRSEG_SANITIZE})
@@ -37,8 +46,6 @@ function(airseg_add_test name)
   endif()
   add_executable(${name} ${A_SOURCES})
   target_link_libraries(${name} PRIVATE airseg_options GTest::gtest GTest::gtest_main GTest::gmock ${A_LIBS})
-  target_compile_definitions(${name} PRIVATE AIRSEG_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
-                                             AIRSEG_BINARY_DIR="${PROJECT_BINARY_DIR}")
   set(_lock)
   if(A_RESOURCE_LOCK)
     # Cases that must not run beside each other (they share a scarce resource, e.g. real-time radio links).

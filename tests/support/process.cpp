@@ -1,4 +1,5 @@
 #include "tests/support/process.hpp"
+#include "tests/support/tree_paths.hpp"
 
 #include <fcntl.h>
 #include <poll.h>
@@ -59,10 +60,10 @@ void write_file(const std::string& path, const std::string& text) {
 }
 
 std::string binary(const std::string& relative) {
-    return std::string(AIRSEG_BINARY_DIR) + "/" + relative;
+    return binary_dir() + "/" + relative;
 }
 std::string source_path(const std::string& relative) {
-    return std::string(AIRSEG_SOURCE_DIR) + "/" + relative;
+    return source_dir() + "/" + relative;
 }
 
 Subprocess::Subprocess(std::vector<std::string> argv, std::map<std::string, std::string> env,

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "tests/support/ports.hpp"
+#include "tests/support/tree_paths.hpp"
 
 namespace airseg::test {
 
