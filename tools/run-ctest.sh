@@ -7,10 +7,6 @@
 #     recorded in docs/reliability.md): such a case runs again, at most twice, and every failure before its pass
 #     is printed as "ctest: RERUN NAME: failed, passed at attempt K". No flight-plan, autopilot or system-suite
 #     case is ever rerun, whatever the file says.
-#   - The longest cases start first: ctest's cost data (Testing/Temporary/CTestCostData.txt) is seeded from
-#     tests/ctest-costs.txt when the build directory has none of its own (a fresh clone), so the chain of
-#     simulated-rover cases that run one at a time (RESOURCE_LOCK simulated_rover_chains) does not wait behind
-#     hundreds of short unit cases.
 #   - With AIRSEG_TEST_LOCK set, it waits for that lock file first and runs at nice 0 (CI's side-by-side ARM
 #     builds: one suite at a time, never behind a compile).
 #   - BUILD_DIR/ctest-summary.txt gets "passed=N failed=N skipped=N reruns=NAME,NAME", read by the table at
@@ -29,12 +25,6 @@ if [ -n "${AIRSEG_TEST_LOCK:-}" ]; then
   echo "ctest: waiting for $AIRSEG_TEST_LOCK"
   flock 9
   renice -n 0 -p $$ >/dev/null 2>&1 || echo "ctest: cannot run at nice 0 (not root): staying at nice $(nice)"
-fi
-
-costs="$dir/Testing/Temporary/CTestCostData.txt"
-if [ ! -s "$costs" ] && [ -f "$top/tests/ctest-costs.txt" ]; then
-  mkdir -p "$(dirname "$costs")"
-  grep -v '^#' "$top/tests/ctest-costs.txt" >"$costs"
 fi
 
 # junit_field FILE ATTRIBUTE: an attribute of the <testsuite> element.
