@@ -144,7 +144,7 @@ if [ ${#arm_arches[@]} -gt 0 ] && [ "${AIRSEG_CROSS_OVERLAP:-1}" = 1 ]; then
   # compile. The suite's cases then see what they see on a board that does other work too.
   step "cross-building ${arm_arches[*]} side by side (nice 0, 10, 19), the suites one at a time at nice 0"
   export AIRSEG_TEST_LOCK="$AIRSEG_CI_LOGS/arm-suite.lock"
-  arm_pids=() level=0
+  arm_pids=() level=$(nice)
   for arch in "${arm_arches[@]}"; do
     (
       t=$SECONDS
@@ -155,7 +155,7 @@ if [ ${#arm_arches[@]} -gt 0 ] && [ "${AIRSEG_CROSS_OVERLAP:-1}" = 1 ]; then
       exit "$code"
     ) &
     arm_pids+=($!)
-    level=$((level + 10 > 19 ? 19 : level + 10))
+    level=$((level + 10 > 19 ? 19 : level + 10))  # relative to this script's own priority
   done
   failed=()
   for i in "${!arm_arches[@]}"; do

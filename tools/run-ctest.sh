@@ -7,8 +7,8 @@
 #     recorded in docs/reliability.md): such a case runs again, at most twice, and every failure before its pass
 #     is printed as "ctest: RERUN NAME: failed, passed at attempt K". No flight-plan, autopilot or system-suite
 #     case is ever rerun, whatever the file says.
-#   - With AIRSEG_TEST_LOCK set, it waits for that lock file first and runs at nice 0 (CI's side-by-side ARM
-#     builds: one suite at a time, never behind a compile).
+#   - With AIRSEG_TEST_LOCK set, it waits for that lock first and runs at nice 0 (CI's side-by-side ARM
+#     builds: one suite at a time, or AIRSEG_SUITES_AT_ONCE, never behind a compile).
 #   - BUILD_DIR/ctest-summary.txt gets "passed=N failed=N skipped=N reruns=NAME,NAME", read by the table at
 #     the end of CI's log.
 # CTEST_ARGS go to every ctest run (e.g. -j8 --timeout 600 --exclude-regex ...). Exit status: 0 when every case
@@ -20,10 +20,17 @@ shift
 
 # AIRSEG_TEST_LOCK (CI's ARM package builds, which compile side by side): one suite at a time, and at nice 0
 # whatever the build around it was started at, so that no compile ever comes before a suite's cases.
+# AIRSEG_SUITES_AT_ONCE (default 1) suites may hold one of its slots at a time.
 if [ -n "${AIRSEG_TEST_LOCK:-}" ]; then
-  exec 9>>"$AIRSEG_TEST_LOCK"
-  echo "ctest: waiting for $AIRSEG_TEST_LOCK"
-  flock 9
+  echo "ctest: waiting for one of ${AIRSEG_SUITES_AT_ONCE:-1} slot(s) of $AIRSEG_TEST_LOCK"
+  while :; do
+    for ((slot = 0; slot < ${AIRSEG_SUITES_AT_ONCE:-1}; slot++)); do
+      exec 9>>"$AIRSEG_TEST_LOCK.$slot"
+      flock -n 9 && break 2
+      exec 9>&-
+    done
+    sleep 2
+  done
   renice -n 0 -p $$ >/dev/null 2>&1 || echo "ctest: cannot run at nice 0 (not root): staying at nice $(nice)"
 fi
 
