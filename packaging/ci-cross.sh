@@ -87,8 +87,10 @@ build_arm() {
   # nothing runs them under qemu, and the sanitize stage compiles them as well.
   local bench=""
   [ "$arch" = armhf ] || bench="-DAIRSEG_BUILD_BENCH=OFF"
+  # The test sources at -O1 (AIRSEG_TEST_OPTIMIZATION): 20-40 % less compile time for two thirds of the
+  # build; the libraries and programs they test stay as packaged (-O2).
   if arm_with_suite "$arch"; then
-    AIRSEG_EXTRA_CMAKE_ARGS="-DAIRSEG_TEST_HANG_INJECTION=ON${bench:+ $bench}" \
+    AIRSEG_EXTRA_CMAKE_ARGS="-DAIRSEG_TEST_HANG_INJECTION=ON -DAIRSEG_TEST_OPTIMIZATION=-O1${bench:+ $bench}" \
       "$AIRSEG_ROOT/packaging/build-debs.sh" --no-debug-info "$arch"
   else
     "$AIRSEG_ROOT/packaging/build-debs.sh" --no-check --no-debug-info "$arch"
