@@ -54,13 +54,27 @@ has_stage() { [[ " $stages " == *" $1 "* ]]; }
 # elapsed WHAT START [SUMMARY_FILE] [CCACHE_STAGE]: says how long WHAT took and records it for the closing table.
 elapsed() {
   echo "build-and-test: $1 in $((SECONDS - $2)) s"
-  [ -z "${3:-}${4:-}" ] || echo "build-and-test: $1: ccache served $(ccache_stage_rate "${4:-none}") compiles"
+  [ -z "${4:-}" ] || echo "build-and-test: $1: ccache served $(ccache_stage_rate "$4") compiles"
   record_stage "$1" "$((SECONDS - $2))" "${3:-}" "${4:-}"
 }
-# The table ends the log however the run ends; a stage that failed is its last row.
+# A process started here in the background, with everything it started.
+kill_tree() {
+  local child
+  for child in $(ps -o pid= --ppid "$1" 2>/dev/null); do
+    kill_tree "$child"
+  done
+  kill "$1" 2>/dev/null || true
+}
+# The table ends the log however the run ends; a stage that failed is its last row, and what it left running
+# in the background (fuzzers, the TSan build, the cross preparation) is stopped.
 finish() {
-  local code=$?
-  [ "$code" = 0 ] || record_stage "FAILED (exit $code) after the stages above" "-" "" ""
+  local code=$? pid
+  if [ "$code" != 0 ]; then
+    for pid in ${fuzz_pid:-} ${tsan_build_pid:-} ${prepare_pid:-}; do
+      kill_tree "$pid"
+    done
+    record_stage "FAILED (exit $code) after the stages above" "-" "" ""
+  fi
   print_stage_table "$((SECONDS - total))"
 }
 trap finish EXIT
