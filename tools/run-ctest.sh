@@ -43,7 +43,8 @@ regex_quote() { sed 's/[][\.*^$+?(){}|]/\\&/g'; }
 first="$dir/ctest-attempt-1.xml"
 rm -f "$dir"/ctest-attempt-*.xml "$dir/ctest-summary.txt"
 code=0
-ctest --test-dir "$dir" --output-on-failure --output-junit "$first" "$@" || code=$?
+# A suite that finds no test at all is a failure, not a pass.
+ctest --test-dir "$dir" --output-on-failure --no-tests=error --output-junit "$first" "$@" || code=$?
 if [ ! -f "$first" ]; then
   echo "ctest: no result file (ctest exit $code)" >&2
   echo "passed=0 failed=? skipped=0 reruns=" >"$dir/ctest-summary.txt"
@@ -84,13 +85,16 @@ while [ ${#rerun[@]} -gt 0 ] && [ $attempt -lt 3 ]; do
   rerun=("${still[@]}")
 done
 final_failed+=("${rerun[@]}")
+# ctest failed without a failing case: no test found, or a case that could not run.
+[ "$code" = 0 ] || [ ${#failed[@]} -gt 0 ] || final_failed+=("(ctest exit $code: no test found, or a case not run)")
 
 n_failed=${#final_failed[@]}
 passed=$((total - skipped - n_failed))
+[ "$passed" -ge 0 ] || passed=0
 echo "passed=$passed failed=$n_failed skipped=$skipped reruns=$(IFS=,; echo "${reruns[*]}")" >"$dir/ctest-summary.txt"
 echo "ctest: $passed passed, $n_failed failed, $skipped skipped"
 [ ${#reruns[@]} = 0 ] || echo "ctest: ${#reruns[@]} of them passed only on a rerun: ${reruns[*]}"
 for name in "${final_failed[@]}"; do
   echo "ctest: FAILED $name"
 done
-[ "$n_failed" = 0 ] && [ "$code" = 0 -o ${#failed[@]} -gt 0 ]
+[ "$n_failed" = 0 ]
