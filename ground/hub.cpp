@@ -11,6 +11,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "services/common/printable.hpp"
 #include "services/groundlink/link/key_file.hpp"
 
 namespace airseg::ground {
@@ -300,7 +301,9 @@ void Hub::on_hello(ClientState& client, const Json& hello) {
         return;
     }
     if (hello.contains("name") && hello["name"].is_string()) {
-        client.name = hello["name"].get<std::string>().substr(0, 64) + " (" + client.connection->peer() + ")";
+        // Escaped: the name goes to the hub's log and to every client's link report.
+        client.name = printable(hello["name"].get<std::string>().substr(0, 64)) + " (" +
+                      client.connection->peer() + ")";
     }
     bool proven = false;
     std::string reason;

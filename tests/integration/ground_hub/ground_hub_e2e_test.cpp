@@ -313,6 +313,9 @@ class RawHubClient {
     RawHubClient(const RawHubClient&) = delete;
     RawHubClient& operator=(const RawHubClient&) = delete;
     bool connected() const { return connected_; }
+    void send(const std::vector<std::uint8_t>& frame) {
+        ASSERT_EQ(::send(fd_, frame.data(), frame.size(), MSG_NOSIGNAL), static_cast<ssize_t>(frame.size()));
+    }
     /// The JSON frames the hub sent until it closed the connection or `timeout` passed; closed() says which.
     std::vector<Json> read_until_closed(std::chrono::milliseconds timeout) {
         std::vector<Json> out;
@@ -371,8 +374,18 @@ TEST_F(GroundHubE2e, ClientsPastTheBoundAreRefusedAndSilentOnesAreClosed) {
     }
     std::cout << "[ figures ] 64 silent clients closed " << seconds_since(waited)
               << " s after the 65th was refused\n";
+    // A name cut at 64 bytes in the middle of a character, with a terminal escape: the hub escapes it for its
+    // log and the link reports every client gets, and goes on.
+    RawHubClient named(socket());
+    named.send(client::hub::encode_json(
+        {{"hello", {{"want", "monitor"}, {"name", std::string(63, 'a') + "\xc3\xa9\x1b[2J"}}}}));
+    const auto welcome = named.read_until_closed(3s);
+    EXPECT_FALSE(named.closed());
+    EXPECT_FALSE(welcome.empty()) << "welcomed";
     const auto status = ctl({"status"});
     ASSERT_EQ(status.exit_code, 0) << status.err;
+    EXPECT_NE(hub->err().find(std::string(63, 'a') + "\\xc3 (unix) as monitor"), std::string::npos)
+        << hub->err();
 }
 
 }  // namespace
