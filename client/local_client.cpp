@@ -48,8 +48,26 @@ bool LocalClient::connect(std::string& error) {
     return true;
 }
 
+// airsegd closes a connection left idle (docs/status.md): a kept connection it has closed is opened again
+// before the request goes, so a slow watcher never sees that.
+bool LocalClient::closed_by_daemon() const {
+    if (fd_ < 0 || !pending_.empty()) {
+        return false;
+    }
+    pollfd p{fd_, POLLIN, 0};
+    if (::poll(&p, 1, 0) <= 0) {
+        return false;
+    }
+    char byte = 0;
+    return ::recv(fd_, &byte, 1, MSG_PEEK | MSG_DONTWAIT) == 0 || (p.revents & (POLLHUP | POLLERR)) != 0;
+}
+
 LocalAnswer LocalClient::request(const nlohmann::json& request) {
     LocalAnswer out;
+    if (closed_by_daemon()) {
+        ::close(fd_);
+        fd_ = -1;
+    }
     if (!connect(out.error)) {
         return out;
     }

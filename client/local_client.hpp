@@ -25,6 +25,7 @@ class LocalClient {
 
   private:
     bool connect(std::string& error);
+    bool closed_by_daemon() const;
     std::string path_;
     std::chrono::milliseconds timeout_;
     int fd_ = -1;

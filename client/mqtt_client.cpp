@@ -53,6 +53,9 @@ std::optional<proto::Telemetry> telemetry_from_json(const Json& v) {
     }
     t.gps_fix = v.value("gps_fix", std::uint8_t{0});
     t.satellites = v.value("satellites", std::uint8_t{0});
+    if (const auto valid = v.find("position_valid"); valid != v.end() && valid->is_boolean()) {
+        t.no_position = !valid->get<bool>();
+    }
     t.vehicle_state = code_named(v.value("state", ""), 15, proto::vehicle_state_name).value_or(0);
     t.mode =
         code_named(v.value("mode", ""), proto::kModeUnknown - 1, autopilot::ardupilot::rover_mode_known_name)

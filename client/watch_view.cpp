@@ -54,7 +54,8 @@ nlohmann::json telemetry_json(const proto::Telemetry& t) {
                      {"pitch_deg", t.pitch_deg},
                      {"battery_v", t.battery_v},
                      {"gps_fix", t.gps_fix},
-                     {"satellites", t.satellites}};
+                     {"satellites", t.satellites},
+                     {"position_valid", !t.no_position}};
     j["battery_pct"] = t.battery_pct ? nlohmann::json(*t.battery_pct) : nlohmann::json();
     if (t.plan_state != 0) {
         j["plan"] = {{"state", plan_state_name(t.plan_state)},
@@ -114,10 +115,12 @@ std::string WatchState::render(Clock::time_point now) const {
         const auto& t = *latest_;
         out += fmt::format("state       {:<20} mode {}\n", proto::vehicle_state_name(t.vehicle_state),
                            mode_name(t.mode));
-        if (t.gps_fix >= 2) {
-            out += fmt::format("position    {:.7f} {:.7f}  alt {:.1f} m\n", t.lat_deg, t.lon_deg, t.alt_m);
-        } else {
+        if (t.gps_fix < 2) {
             out += "position    no GPS fix\n";
+        } else if (t.no_position) {
+            out += "position    none valid (the vehicle refused what the autopilot reported)\n";
+        } else {
+            out += fmt::format("position    {:.7f} {:.7f}  alt {:.1f} m\n", t.lat_deg, t.lon_deg, t.alt_m);
         }
         out += fmt::format("speed       {:.2f} m/s  heading {:.1f}°  roll {}° pitch {}°\n",
                            t.ground_speed_mps, t.heading_deg, t.roll_deg, t.pitch_deg);

@@ -39,6 +39,8 @@ nlohmann::json autopilot_status_json(const autopilot::AutopilotStatus& s) {
     } else {
         j["position"] = nullptr;
     }
+    j["position_invalid"] =
+        s.position_invalid.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.position_invalid);
     j["mission_current"] = s.mission_current;
     j["reboots"] = s.reboots;
     j["reconnects"] = s.reconnects;
@@ -47,6 +49,18 @@ nlohmann::json autopilot_status_json(const autopilot::AutopilotStatus& s) {
     j["mission_items"] = s.mission_items;
     j["auto_restarts_corrected"] = s.auto_restarts_corrected;
     j["baud"] = s.baud;
+    j["refused_values"] = {
+        {"count", s.refused_values},
+        {"last", s.refused_value.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.refused_value)}};
+    j["params"] = {
+        {"cached", s.params_cached}, {"announced", s.params_announced}, {"dropped", s.params_dropped}};
+    auto& stations = j["ground_stations"] = {{"missions_too_large", s.gcs_missions_too_large}};
+    if (s.gcs_endpoint) {
+        stations["udp_peers"] = s.gcs_udp_peers;
+        stations["tcp_clients"] = s.gcs_tcp_clients;
+        stations["udp_peers_evicted"] = s.gcs_udp_peers_evicted;
+        stations["tcp_refused"] = s.gcs_tcp_refused;
+    }
     if (s.tlog_enabled) {
         // A recorder that cannot write (disk full, read-only) is reported; the daemon goes on without it.
         j["tlog"] = {

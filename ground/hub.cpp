@@ -11,6 +11,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "services/common/printable.hpp"
 #include "services/groundlink/link/key_file.hpp"
 
 namespace airseg::ground {
@@ -40,15 +41,19 @@ Hub::Hub(Strand strand, HubConfig config)
       config_(std::move(config)),
       end_(strand_, config_.radio,
            client::GroundEnd::Handlers{[this](proto::Message m) { on_vehicle(std::move(m)); },
-                                       [](const groundlink::TransportEvent& e) {
+                                       [this](const groundlink::TransportEvent& e) {
                                            using Kind = groundlink::TransportEvent::Kind;
+                                           const auto now = std::chrono::steady_clock::now();
                                            if (e.kind == Kind::LinkUp) {
-                                               spdlog::info("ground hub: link to the vehicle up");
+                                               log_.log("ground hub: link up", now, spdlog::level::info,
+                                                        "ground hub: link to the vehicle up");
                                            } else if (e.kind == Kind::LinkDown) {
-                                               spdlog::warn("ground hub: link to the vehicle down");
+                                               log_.log("ground hub: link down", now, spdlog::level::warn,
+                                                        "ground hub: link to the vehicle down");
                                            }
                                        }}),
-      tick_timer_(strand_) {}
+      tick_timer_(strand_),
+      accept_retry_(strand_) {}
 
 Hub::~Hub() {
     stop();
@@ -85,6 +90,7 @@ void Hub::stop() {
     }
     stopped_ = true;
     tick_timer_.cancel();
+    accept_retry_.cancel();
     boost::system::error_code ignored;
     if (unix_acceptor_) {
         unix_acceptor_->close(ignored);
@@ -182,10 +188,13 @@ void Hub::accept_unix() {
             }
             if (!ec) {
                 add_client(ClientConnection::Socket(std::move(s)), "unix", true);
-            } else {
-                spdlog::warn("ground hub: accept on {}: {}", config_.socket, ec.message());
+                accept_unix();
+                return;
             }
-            accept_unix();
+            // Out of descriptors, say: try again shortly, not in a spin.
+            log_.log("ground hub: accept on the unix socket", std::chrono::steady_clock::now(),
+                     spdlog::level::warn, "ground hub: accept on {}: {}", config_.socket, ec.message());
+            retry_accept([this] { accept_unix(); });
         });
 }
 
@@ -200,16 +209,40 @@ void Hub::accept_tcp() {
             s.set_option(asio::ip::tcp::no_delay(true), ignored);
             add_client(ClientConnection::Socket(std::move(s)),
                        fmt::format("tcp {}:{}", remote.address().to_string(), remote.port()), false);
-        } else {
-            spdlog::warn("ground hub: accept on {}: {}", config_.tcp, ec.message());
+            accept_tcp();
+            return;
         }
-        accept_tcp();
+        log_.log("ground hub: accept on tcp", std::chrono::steady_clock::now(), spdlog::level::warn,
+                 "ground hub: accept on {}: {}", config_.tcp, ec.message());
+        retry_accept([this] { accept_tcp(); });
+    });
+}
+
+void Hub::retry_accept(std::function<void()> accept) {
+    accept_retry_.expires_after(std::chrono::milliseconds(100));
+    accept_retry_.async_wait([this, accept = std::move(accept)](boost::system::error_code ec) {
+        if (!ec && !stopped_) {
+            accept();
+        }
     });
 }
 
 void Hub::add_client(ClientConnection::Socket socket, std::string peer, bool local) {
+    if (clients_.size() >= kMaxClients) {
+        ++clients_refused_;
+        log_.log("ground hub: refused a client", std::chrono::steady_clock::now(), spdlog::level::warn,
+                 "ground hub: refused a client ({}): {} already connected", peer, kMaxClients);
+        // Best effort and never blocking: the client's first read says why.
+        const auto frame = hub::encode_json(
+            {{"error", fmt::format("the ground hub has {} clients already; try again later", kMaxClients)}});
+        boost::system::error_code ignored;
+        socket.non_blocking(true, ignored);
+        socket.write_some(asio::buffer(frame), ignored);
+        return;
+    }
     const std::uint32_t id = next_client_++;
     ClientState state;
+    state.connected = std::chrono::steady_clock::now();
     state.local = local;
     state.name = peer;
     randombytes_buf(state.challenge.data(), state.challenge.size());
@@ -268,7 +301,9 @@ void Hub::on_hello(ClientState& client, const Json& hello) {
         return;
     }
     if (hello.contains("name") && hello["name"].is_string()) {
-        client.name = hello["name"].get<std::string>().substr(0, 64) + " (" + client.connection->peer() + ")";
+        // Escaped: the name goes to the hub's log and to every client's link report.
+        client.name = printable(hello["name"].get<std::string>().substr(0, 64)) + " (" +
+                      client.connection->peer() + ")";
     }
     bool proven = false;
     std::string reason;
@@ -303,8 +338,9 @@ void Hub::on_hello(ClientState& client, const Json& hello) {
     }
     client.connection->send(hub::encode_json({{"welcome", welcome}}));
     client.connection->send(hub::encode_json({{"link", link_stats()}}));
-    spdlog::info("ground hub: client {} {} as {}{}", client.connection->id(), client.name,
-                 client.control ? "control" : "monitor", reason.empty() ? "" : " (" + reason + ")");
+    log_.log("ground hub: client welcomed", std::chrono::steady_clock::now(), spdlog::level::info,
+             "ground hub: client {} {} as {}{}", client.connection->id(), client.name,
+             client.control ? "control" : "monitor", reason.empty() ? "" : " (" + reason + ")");
 }
 
 void Hub::on_client_message(ClientState& client, const proto::Message& message) {
@@ -334,14 +370,18 @@ void Hub::on_client_message(ClientState& client, const proto::Message& message) 
 
 std::uint32_t Hub::relay(Json request, Pending pending) {
     const std::uint32_t id = next_request_++;
-    const auto r = end_.send_safe(proto::kPriorityControl, proto::Command{id, request});
+    const bool busy = pending_.size() >= kMaxPending;
+    const auto r = busy ? groundlink::SendResult::QueueFull
+                        : end_.send_safe(proto::kPriorityControl, proto::Command{id, request});
     if (r != groundlink::SendResult::Accepted) {
         std::string error =
-            r == groundlink::SendResult::TooLarge
+            busy ? fmt::format("{} commands already wait for the vehicle's answer; not sent", kMaxPending)
+            : r == groundlink::SendResult::TooLarge
                 ? fmt::format("the command is more than the link carries in one message ({} bytes); not sent",
                               end_.max_message_size())
                 : fmt::format("the command could not be queued ({})", static_cast<int>(r));
-        Json answer{{"ok", false}, {"status", "bad_request"}, {"error", error}};
+        commands_busy_ += busy ? 1 : 0;
+        Json answer{{"ok", false}, {"status", busy ? "failed" : "bad_request"}, {"error", error}};
         if (pending.done) {
             pending.done(answer);
         } else if (auto it = clients_.find(pending.client); it != clients_.end()) {
@@ -369,7 +409,8 @@ void Hub::on_closed(ClientConnection& connection, const std::string& why) {
     if (it == clients_.end()) {
         return;
     }
-    spdlog::info("ground hub: client {} {} left: {}", connection.id(), it->second.name, why);
+    log_.log("ground hub: client left", std::chrono::steady_clock::now(), spdlog::level::info,
+             "ground hub: client {} {} left: {}", connection.id(), it->second.name, why);
     if (control_holder_ == connection.id()) {
         control_holder_ = 0;
     }
@@ -419,6 +460,9 @@ void Hub::broadcast(const std::vector<std::uint8_t>& frame) {
 Json Hub::link_stats() const {
     auto stats = end_.link_stats();
     stats["hub_clients"] = clients_.size();
+    stats["hub_clients_refused"] = clients_refused_;
+    stats["hub_hello_timeouts"] = hello_timeouts_;
+    stats["hub_commands_busy"] = commands_busy_;
     if (auto it = clients_.find(control_holder_); it != clients_.end()) {
         stats["control_client"] = it->second.name;
     } else {
@@ -433,6 +477,18 @@ void Hub::tick() {
     }
     broadcast(hub::encode_json({{"link", link_stats()}}));
     const auto now = std::chrono::steady_clock::now();
+    log_.flush(now);
+    std::vector<std::shared_ptr<ClientConnection>> silent;
+    for (auto& [id, client] : clients_) {
+        if (!client.welcomed && !client.timed_out && now - client.connected > kHelloTimeout) {
+            client.timed_out = true;  // closing: its error line may still be on its way
+            silent.push_back(client.connection);
+        }
+    }
+    for (const auto& connection : silent) {
+        ++hello_timeouts_;
+        connection->close(fmt::format("no hello within {} s", kHelloTimeout.count()));
+    }
     for (auto it = pending_.begin(); it != pending_.end();) {
         auto& p = it->second;
         if (now - p.sent <= (p.done ? kOwnCommandPatience : kForgetUnanswered)) {

@@ -15,6 +15,7 @@
 #include "client/hub_wire.hpp"
 #include "ground/client_connection.hpp"
 #include "services/common/asio.hpp"
+#include "services/common/limited_log.hpp"
 
 namespace airseg::ground {
 
@@ -27,6 +28,13 @@ struct HubConfig {
 
 class Hub {
   public:
+    /// Clients at once (Unix socket and TCP together); a connection beyond is closed with an error line.
+    static constexpr std::size_t kMaxClients = 64;
+    /// A client that has not said hello this long after connecting is closed.
+    static constexpr auto kHelloTimeout = std::chrono::seconds(10);
+    /// Commands relayed and not yet answered, all clients together; a command beyond is answered busy.
+    static constexpr std::size_t kMaxPending = 256;
+
     /// The vehicle's answer to a command the hub itself sent (the map's buttons, the plan shape).
     using Done = std::function<void(nlohmann::json answer)>;
     /// Everything the vehicle pushes, for the hub's own consumers (the map, the MAVLink endpoint).
@@ -56,6 +64,8 @@ class Hub {
   private:
     struct ClientState {
         std::shared_ptr<ClientConnection> connection;
+        std::chrono::steady_clock::time_point connected;
+        bool timed_out = false;  // closed for saying no hello in time
         std::array<std::uint8_t, client::hub::kChallengeBytes> challenge{};
         bool local = false;  // came over the Unix socket
         bool welcomed = false;
@@ -76,6 +86,7 @@ class Hub {
     void accept_unix();
     void accept_tcp();
     void add_client(ClientConnection::Socket socket, std::string peer, bool local);
+    void retry_accept(std::function<void()> accept);
     void on_frame(ClientConnection& connection, client::hub::Frame frame);
     void on_hello(ClientState& client, const nlohmann::json& hello);
     void on_client_message(ClientState& client, const groundlink::protocol::Message& message);
@@ -100,6 +111,11 @@ class Hub {
     std::uint32_t next_request_ = 1;
     std::uint32_t control_holder_ = 0;
     bool stopped_ = false;
+    asio::steady_timer accept_retry_;
+    LimitedLog log_;                     // every line a client or the vehicle can make the hub write
+    std::uint64_t clients_refused_ = 0;  // connections closed at once: kMaxClients already connected
+    std::uint64_t hello_timeouts_ = 0;   // clients closed for not saying hello within kHelloTimeout
+    std::uint64_t commands_busy_ = 0;    // commands answered busy: kMaxPending already waiting
 };
 
 }  // namespace airseg::ground

@@ -572,6 +572,9 @@ void MapServer::set_plan(const Json& geometry) {
 
 void MapServer::add_position(const groundlink::protocol::Telemetry& t,
                              std::chrono::system_clock::time_point at) {
+    if (t.no_position) {
+        return;  // no place to show: the vehicle and its track stay where they were last known
+    }
     auto& s = *impl_;
     const TrackPoint p{t.lat_deg, t.lon_deg, t.alt_m, t.heading_deg, t.ground_speed_mps, at};
     s.track.push_back(p);

@@ -38,7 +38,10 @@ struct Position {
 };
 
 struct Telemetry {
-    std::optional<Position> position;           // empty until the autopilot reports one
+    std::optional<Position> position;  // empty until the autopilot reports a valid one
+    // Why `position` is empty although the autopilot reported one: no GPS fix, 0/0 before a fix, or a value
+    // that is no place (latitude 199.17); empty while the position is valid or none was reported.
+    std::string position_invalid;
     double relative_alt = 0.0;                  // metres above home
     double roll = 0.0, pitch = 0.0, yaw = 0.0;  // radians
     double ground_speed = 0.0;                  // m/s
@@ -233,7 +236,8 @@ struct AutopilotStatus {
     std::optional<double> ready_s;               // autopilot.ready_s: open -> READY, seconds
     VehicleState state = VehicleState::Unknown;  // autopilot.state
     std::string mode;                            // autopilot.mode
-    std::optional<Position> position;            // autopilot.position
+    std::optional<Position> position;            // autopilot.position (only a valid place)
+    std::string position_invalid;                // autopilot.position_invalid: why there is none; "" if none
     std::uint16_t mission_current = 0;           // autopilot.mission_current
     unsigned reboots = 0;                        // autopilot.reboots
     unsigned reconnects = 0;            // autopilot.reconnects (filled by the service from its port keeper)
@@ -242,6 +246,21 @@ struct AutopilotStatus {
     std::string mission_items = "int";  // autopilot.mission_items: "int" (MISSION_ITEM_INT) or "float"
     unsigned auto_restarts_corrected = 0;  // autopilot.auto_restarts_corrected: slots set back after AUTO
     unsigned baud = 0;  // autopilot.baud: the rate the port runs at (the one kept when probing)
+    // autopilot.refused_values: values from the autopilot not taken (NaN, out of range), and the last one
+    std::uint64_t refused_values = 0;
+    std::string refused_value;
+    // autopilot.params: names cached, announced by the autopilot (PARAM_COUNT), and dropped past the bound
+    std::size_t params_cached = 0;
+    std::size_t params_announced = 0;
+    std::uint64_t params_dropped = 0;
+    // autopilot.ground_stations (filled by the service): mission uploads refused for their size, and with the
+    // MAVLink endpoint on, its UDP peers and TCP clients now, peers forgotten to make room, clients refused
+    std::uint64_t gcs_missions_too_large = 0;
+    bool gcs_endpoint = false;
+    std::size_t gcs_udp_peers = 0;
+    std::size_t gcs_tcp_clients = 0;
+    std::uint64_t gcs_udp_peers_evicted = 0;
+    std::uint64_t gcs_tcp_refused = 0;
     // autopilot.tlog (filled by the service from its .tlog writer; absent when recording is off)
     bool tlog_enabled = false;
     std::uint64_t tlog_write_errors = 0;    // autopilot.tlog.write_errors

@@ -122,8 +122,10 @@ void AutopilotService::from_ground_station(std::span<const std::uint8_t> frames)
     const auto refused_before = gate_.stats().missions_refused;
     auto out = gate_.from_ground(frames, SteadyClock::now());
     if (gate_.stats().missions_refused != refused_before) {
-        spdlog::info("{}refused a mission write from a ground station ({} so far): missions are flight plans",
-                     prefix_, gate_.stats().missions_refused);
+        log_.log(prefix_ + "refused a mission write from a ground station", SteadyClock::now(),
+                 spdlog::level::info,
+                 "{}refused a mission write from a ground station ({} so far): missions are flight plans",
+                 prefix_, gate_.stats().missions_refused);
     }
     for (const auto& answer : out.to_ground) {
         to_ground_stations(answer);
@@ -156,21 +158,24 @@ void AutopilotService::drain_uploads() {
     }
     if (auto m = uploads_.poll_mission(); m && calls_) {
         const auto station = std::to_string(m->sysid) + "/" + std::to_string(m->compid);
-        spdlog::info("{}ground station {} uploaded a mission of {} items: handed to the flight plan manager",
-                     prefix_, station, m->items.size());
+        log_.log(prefix_ + "a ground station uploaded a mission", SteadyClock::now(), spdlog::level::info,
+                 "{}ground station {} uploaded a mission of {} items: handed to the flight plan manager",
+                 prefix_, station, m->items.size());
         GroundStationMissionResult unanswered;
         unanswered.reason = "airseg: no flight plan manager is running";
         ctx_.bus.publish(GroundStationMission{
             station, std::move(m->items),
-            Reply<GroundStationMissionResult>(
-                strand(), *calls_, std::move(unanswered),
-                [this, station](const GroundStationMissionResult& r) {
-                    if (!r.accepted) {
-                        spdlog::info("{}ground station {}'s mission refused: {}", prefix_, station, r.reason);
-                    }
-                    uploads_.answer(r.accepted, r.reason);
-                    drain_uploads();
-                })});
+            Reply<GroundStationMissionResult>(strand(), *calls_, std::move(unanswered),
+                                              [this, station](const GroundStationMissionResult& r) {
+                                                  if (!r.accepted) {
+                                                      log_.log(prefix_ + "a ground station's mission refused",
+                                                               SteadyClock::now(), spdlog::level::info,
+                                                               "{}ground station {}'s mission refused: {}",
+                                                               prefix_, station, r.reason);
+                                                  }
+                                                  uploads_.answer(r.accepted, r.reason);
+                                                  drain_uploads();
+                                              })});
     }
     arm_timer();
 }
@@ -257,8 +262,9 @@ void AutopilotService::publish(Event e) {
             using T = std::decay_t<decltype(ev)>;
             if constexpr (std::is_same_v<T, RequestDone>) {
                 if (ev.result != RequestResult::Ok) {
-                    spdlog::info("{}{} #{}: {} {}", prefix_, to_string(ev.kind), ev.id, to_string(ev.result),
-                                 ev.detail);
+                    log_.log(prefix_ + to_string(ev.kind) + " " + to_string(ev.result), SteadyClock::now(),
+                             spdlog::level::info, "{}{} #{}: {} {}", prefix_, to_string(ev.kind), ev.id,
+                             to_string(ev.result), ev.detail);
                 }
                 if (auto it = requesters_.find(ev.id); it != requesters_.end()) {
                     const Reply<RequestDone> reply = std::move(it->second);
@@ -267,13 +273,17 @@ void AutopilotService::publish(Event e) {
                 }
                 return;
             } else if constexpr (std::is_same_v<T, LinkDown>) {
-                spdlog::warn("{}link down: {}", prefix_, ev.reason);
+                log_.log(prefix_ + "link down", SteadyClock::now(), spdlog::level::warn, "{}link down: {}",
+                         prefix_, ev.reason);
             } else if constexpr (std::is_same_v<T, AutopilotRebooted>) {
-                spdlog::warn("{}autopilot rebooted ({})", prefix_, ev.evidence);
+                log_.log(prefix_ + "autopilot rebooted", SteadyClock::now(), spdlog::level::warn,
+                         "{}autopilot rebooted ({})", prefix_, ev.evidence);
             } else if constexpr (std::is_same_v<T, Ready>) {
-                spdlog::info("{}ready {:.1f} s after the open", prefix_, ev.seconds_from_open);
+                log_.log(prefix_ + "ready", SteadyClock::now(), spdlog::level::info,
+                         "{}ready {:.1f} s after the open", prefix_, ev.seconds_from_open);
             } else if constexpr (std::is_same_v<T, ModeChanged>) {
-                spdlog::info("{}{} -> {} ({})", prefix_, to_string(ev.from), to_string(ev.to), ev.to_mode);
+                log_.log(prefix_ + "mode changed", SteadyClock::now(), spdlog::level::info, "{}{} -> {} ({})",
+                         prefix_, to_string(ev.from), to_string(ev.to), ev.to_mode);
             }
             ctx_.bus.publish(std::move(ev));
         },
@@ -298,7 +308,8 @@ void AutopilotService::publish_status_soon(TimePoint now) {
 
 // What changes without an event (the port keeper's retries and errors, the .tlog's counters) is refreshed
 // once a second, with every service's tick.
-void AutopilotService::on_tick(TimePoint) {
+void AutopilotService::on_tick(TimePoint now) {
+    log_.flush(now);
     if (running_) {
         publish_status();
         update_health();
@@ -325,6 +336,15 @@ void AutopilotService::publish_status() {
     s.tlog_write_errors = tlog_.stats().write_errors;
     s.tlog_dropped_frames = tlog_.stats().dropped_frames;
     s.tlog_error = tlog_.stats().last_error;
+    s.gcs_missions_too_large = uploads_.refused_too_large();
+    if (endpoint_) {
+        const auto e = endpoint_->stats();
+        s.gcs_endpoint = true;
+        s.gcs_udp_peers = e.udp_peers;
+        s.gcs_tcp_clients = e.tcp_clients;
+        s.gcs_udp_peers_evicted = e.udp_peers_evicted;
+        s.gcs_tcp_refused = e.tcp_refused;
+    }
     ctx_.bus.publish_latest(s);
     ctx_.bus.publish_latest(driver_.telemetry());
 }
@@ -346,7 +366,8 @@ void AutopilotService::update_health() {
 // Baud probing: nothing valid came at the current rate. The port is reopened from the strand's queue, not
 // from inside pump(): the reopen calls the open handler, which pumps again.
 void AutopilotService::switch_baud(unsigned baud) {
-    spdlog::info("{}no valid frame at {} baud; trying {} baud", prefix_, keeper_.baud(), baud);
+    log_.log(prefix_ + "trying another baud rate", SteadyClock::now(), spdlog::level::info,
+             "{}no valid frame at {} baud; trying {} baud", prefix_, keeper_.baud(), baud);
     asio::post(strand(), [this, baud] {
         if (!running_) {
             return;

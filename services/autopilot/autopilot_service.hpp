@@ -23,6 +23,7 @@
 #include "services/autopilot/gcs_gate.hpp"
 #include "services/autopilot/tlog_writer.hpp"
 #include "services/common/deadline_timer.hpp"
+#include "services/common/limited_log.hpp"
 #include "services/common/port_keeper.hpp"
 #include "services/common/service.hpp"
 
@@ -94,6 +95,7 @@ class AutopilotService : public Service {
     bool running_ = false;
     bool switching_baud_ = false;  // the next open is a baud probe's reopen of the same device
     std::string prefix_;
+    LimitedLog log_;  // every line the autopilot or a ground station can make us write
 };
 
 }  // namespace airseg::autopilot

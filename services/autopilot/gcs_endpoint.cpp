@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <array>
 #include <deque>
 #include <map>
@@ -10,6 +11,7 @@
 #include "hal/udp_socket.hpp"
 #include "services/autopilot/mavlink/encoder.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
+#include "services/common/limited_log.hpp"
 
 namespace airseg::autopilot {
 
@@ -17,6 +19,8 @@ namespace mav = airseg::mavlink;
 using Tcp = asio::ip::tcp;
 
 namespace {
+
+constexpr auto kAcceptRetry = std::chrono::milliseconds(100);
 
 struct HostPort {
     std::string host;
@@ -91,7 +95,8 @@ class GcsEndpoint::Impl : public std::enable_shared_from_this<Impl> {
           config_(std::move(config)),
           to_vehicle_(std::move(to_vehicle)),
           udp_(strand),
-          acceptor_(strand) {}
+          acceptor_(strand),
+          retry_(strand) {}
 
     std::string start() {
         if (auto problems = config_.validate(); !problems.empty()) {
@@ -150,6 +155,7 @@ class GcsEndpoint::Impl : public std::enable_shared_from_this<Impl> {
         udp_.close();
         boost::system::error_code ignored;
         acceptor_.close(ignored);
+        retry_.cancel();
         for (auto& [id, client] : clients_) {
             client->socket.close(ignored);
         }
@@ -230,7 +236,18 @@ class GcsEndpoint::Impl : public std::enable_shared_from_this<Impl> {
         if (!running_) {
             return;
         }
-        Peer& peer = peers_[from];
+        auto it = peers_.find(from);
+        if (it == peers_.end()) {
+            if (peers_.size() >= kMaxUdpPeers) {
+                const auto stalest = std::min_element(
+                    peers_.begin(), peers_.end(),
+                    [](const auto& a, const auto& b) { return a.second.last_heard < b.second.last_heard; });
+                peers_.erase(stalest);
+                ++stats_.udp_peers_evicted;
+            }
+            it = peers_.try_emplace(from).first;
+        }
+        Peer& peer = it->second;
         peer.last_heard = SteadyClock::now();
         pass_on(valid_frames(peer.parser, datagram, stats_));
     }
@@ -243,20 +260,36 @@ class GcsEndpoint::Impl : public std::enable_shared_from_this<Impl> {
 
     void accept() {
         auto client = std::make_shared<Client>(strand_);
-        acceptor_.async_accept(client->socket,
-                               [self = shared_from_this(), client](boost::system::error_code ec) {
-                                   if (ec || !self->running_) {
-                                       if (ec != asio::error::operation_aborted && self->running_) {
-                                           spdlog::warn("gcs endpoint: accept: {}", ec.message());
-                                           self->accept();
-                                       }
-                                       return;
-                                   }
-                                   const auto id = self->next_client_++;
-                                   self->clients_.emplace(id, client);
-                                   self->read(id, client);
-                                   self->accept();
-                               });
+        acceptor_.async_accept(client->socket, [self = shared_from_this(),
+                                                client](boost::system::error_code ec) {
+            if (ec || !self->running_) {
+                if (ec != asio::error::operation_aborted && self->running_) {
+                    // Out of descriptors, say: try again shortly, not in a spin.
+                    self->log_.log("gcs endpoint: accept", SteadyClock::now(), spdlog::level::warn,
+                                   "gcs endpoint: accept: {}", ec.message());
+                    self->retry_.expires_after(kAcceptRetry);
+                    self->retry_.async_wait([self](boost::system::error_code e) {
+                        if (!e && self->running_) {
+                            self->accept();
+                        }
+                    });
+                }
+                return;
+            }
+            if (self->clients_.size() >= kMaxTcpClients) {
+                ++self->stats_.tcp_refused;
+                self->log_.log("gcs endpoint: refused a tcp client", SteadyClock::now(), spdlog::level::warn,
+                               "gcs endpoint: refused a tcp client: {} already connected", kMaxTcpClients);
+                boost::system::error_code ignored;
+                client->socket.close(ignored);
+                self->accept();
+                return;
+            }
+            const auto id = self->next_client_++;
+            self->clients_.emplace(id, client);
+            self->read(id, client);
+            self->accept();
+        });
     }
 
     void read(std::uint64_t id, const std::shared_ptr<Client>& client) {
@@ -301,6 +334,8 @@ class GcsEndpoint::Impl : public std::enable_shared_from_this<Impl> {
     ToVehicle to_vehicle_;
     hal::UdpSocket udp_;
     Tcp::acceptor acceptor_;
+    asio::steady_timer retry_;
+    LimitedLog log_;
     std::map<hal::UdpSocket::Endpoint, Peer> peers_;
     std::map<std::uint64_t, std::shared_ptr<Client>> clients_;
     std::uint64_t next_client_ = 0;

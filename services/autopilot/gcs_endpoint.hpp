@@ -35,6 +35,8 @@ struct GcsEndpointStats {
     std::uint64_t dropped_out = 0;  // sends dropped: a client too slow to keep up, a full UDP queue
     std::size_t udp_peers = 0;      // UDP peers heard within the last kPeerTimeout
     std::size_t tcp_clients = 0;
+    std::uint64_t udp_peers_evicted = 0;  // peers forgotten to make room for a new one (kMaxUdpPeers)
+    std::uint64_t tcp_refused = 0;        // connections closed at once: kMaxTcpClients already open
 };
 
 class GcsEndpoint {
@@ -45,6 +47,12 @@ class GcsEndpoint {
     static constexpr auto kPeerTimeout = std::chrono::seconds(30);
     /// Bytes waiting for one TCP client; beyond it the vehicle's frames are dropped for that client.
     static constexpr std::size_t kMaxTcpBacklog = 64 * 1024;
+    /// UDP peers kept (each with its parser): a datagram from a new address when the table is full makes the
+    /// endpoint forget the peer heard least recently (a ground station that keeps sending is back at its next
+    /// heartbeat).
+    static constexpr std::size_t kMaxUdpPeers = 16;
+    /// TCP clients at once; a connection beyond is closed at once.
+    static constexpr std::size_t kMaxTcpClients = 8;
 
     GcsEndpoint(asio::any_io_executor strand, GcsEndpointConfig config, ToVehicle to_vehicle);
     ~GcsEndpoint();

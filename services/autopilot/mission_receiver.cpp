@@ -99,6 +99,13 @@ bool MissionReceiver::handle_frame(const mav::Frame& f, TimePoint now) {
                 end(mav::kMissionDenied, "airseg: the mission has no waypoints");
                 return true;
             }
+            if (m.count > kMaxItems) {
+                step_ = Step::Idle;
+                ++refused_too_large_;
+                end(mav::kMissionNoSpace, "airseg: " + std::to_string(m.count) + " items is more than " +
+                                              std::to_string(kMaxItems) + " (home included)");
+                return true;
+            }
             step_ = Step::Receiving;
             count_ = m.count;
             next_ = 0;
@@ -255,7 +262,12 @@ void MissionReceiver::ack(std::uint8_t sysid, std::uint8_t compid, std::uint8_t 
 }
 
 void MissionReceiver::text(std::string_view reason) {
-    for (const auto& line : statustext_lines(reason)) {
+    auto lines = statustext_lines(reason);
+    if (lines.size() > kMaxTextLines) {
+        lines.resize(kMaxTextLines);
+        lines.back() = lines.back().substr(0, kTextLength - 4) + " ...";
+    }
+    for (const auto& line : lines) {
         mav::Statustext t;
         t.severity = mav::kSeverityWarning;
         mav::set_text(t.text, line);

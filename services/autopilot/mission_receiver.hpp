@@ -44,6 +44,12 @@ std::vector<std::string> statustext_lines(std::string_view reason);
 
 class MissionReceiver {
   public:
+    /// The most items an upload may announce (MISSION_COUNT, home included); a larger one is answered
+    /// MAV_MISSION_NO_SPACE at once, so a station cannot make the vehicle hold 65,535 items.
+    static constexpr std::uint16_t kMaxItems = 5000;
+    /// STATUSTEXT lines a refusal is answered with, at most (a long reason is cut).
+    static constexpr std::size_t kMaxTextLines = 8;
+
     MissionReceiver(std::uint8_t autopilot_sysid, std::uint8_t autopilot_compid,
                     MissionReceiverConfig config = {});
 
@@ -62,6 +68,8 @@ class MissionReceiver {
     std::vector<ForwardedFrame> take_output();
 
     bool idle() const { return step_ == Step::Idle; }
+    /// Uploads refused because they announced more than kMaxItems.
+    std::uint64_t refused_too_large() const { return refused_too_large_; }
 
   private:
     enum class Step : std::uint8_t { Idle, Receiving, AwaitVerdict };
@@ -87,6 +95,7 @@ class MissionReceiver {
     std::vector<MissionItem> items_;
     std::optional<ReceivedMission> complete_;
     std::vector<ForwardedFrame> out_;
+    std::uint64_t refused_too_large_ = 0;
 };
 
 }  // namespace airseg::autopilot

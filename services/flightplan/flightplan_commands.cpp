@@ -150,12 +150,15 @@ void FlightplanService::cmd_load(const Json& req, CommandDispatcher::Reply reply
 
 void FlightplanService::on_ground_station_mission(const autopilot::GroundStationMission& m) {
     if (auto refusal = ground_mission_refusal(controller_.progress())) {
-        spdlog::info("{}ground station {}'s mission refused: a plan runs", kPrefix, m.station);
+        log_.log(std::string(kPrefix) + "a ground station's mission refused", SteadyClock::now(),
+                 spdlog::level::info, "{}ground station {}'s mission refused: a plan runs", kPrefix,
+                 m.station);
         m.reply({false, std::move(*refusal)});
         return;
     }
-    spdlog::info("{}loading ground station {}'s mission ({} items) as the plan", kPrefix, m.station,
-                 m.items.size());
+    log_.log(std::string(kPrefix) + "loading a ground station's mission", SteadyClock::now(),
+             spdlog::level::info, "{}loading ground station {}'s mission ({} items) as the plan", kPrefix,
+             m.station, m.items.size());
     Json req = Json::object();
     req["text"] = ground_mission_plan(m.items);
     req["source"] = kGroundMissionSource;

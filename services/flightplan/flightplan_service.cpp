@@ -123,6 +123,10 @@ void FlightplanService::on_stop() {
     flush();
 }
 
+void FlightplanService::on_tick(TimePoint now) {
+    log_.flush(now);
+}
+
 void FlightplanService::call(AutopilotCall c) {
     if (!calls_) {
         return;  // stopped: nothing more goes to the autopilot
@@ -163,7 +167,10 @@ void FlightplanService::flush() {
                   : CommandResult::fail(to_command_status(r->status), std::move(r->error)));
     }
     while (auto line = controller_.poll_log()) {
-        spdlog::log(to_spdlog(line->level), "{}{}", kPrefix, line->text);
+        const auto level = to_spdlog(line->level);
+        const auto name = spdlog::level::to_string_view(level);
+        log_.log(std::string(kPrefix) + "(" + std::string(name.data(), name.size()) + " lines)",
+                 SteadyClock::now(), level, "{}{}", kPrefix, line->text);
     }
     while (auto s = controller_.poll_status()) {
         ctx_.bus.publish_latest(s->progress);

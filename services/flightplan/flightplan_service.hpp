@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "services/common/deadline_timer.hpp"
+#include "services/common/limited_log.hpp"
 #include "services/common/service.hpp"
 #include "services/common/slack_timer.hpp"
 #include "services/flightplan/persistence.hpp"
@@ -44,6 +45,7 @@ class FlightplanService : public Service {
   protected:
     void on_start() override;
     void on_stop() override;
+    void on_tick(TimePoint now) override;
 
   private:
     /// What every log line of this service starts with.
@@ -76,6 +78,9 @@ class FlightplanService : public Service {
     std::vector<Subscription> subscriptions_;
     std::optional<ReplyGuard> calls_;  // the autopilot's answers run only while started
     bool running_ = false;
+    // The plan's events follow the autopilot's (reached, interrupted, reactions) and ground stations'
+    // uploads: a peer that floods them gets a burst per period, one limiter per level.
+    LimitedLog log_{LineLimiterConfig{20, seconds(10)}};
 };
 
 }  // namespace airseg::flightplan

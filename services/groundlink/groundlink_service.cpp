@@ -113,7 +113,10 @@ void GroundlinkService::on_start() {
                     driver_->handle_bytes(0, d);
                     woke_for_input();
                 },
-                [](std::error_code, const std::string& what) { spdlog::warn("groundlink[udp]: {}", what); });
+                [this](std::error_code, const std::string& what) {
+                    log_.log("groundlink[udp]: receive error", SteadyClock::now(), spdlog::level::warn,
+                             "groundlink[udp]: {}", what);
+                });
             attach_writers();
         }
     } else {
@@ -193,11 +196,17 @@ void GroundlinkService::on_stop() {
     }
 }
 
+void GroundlinkService::on_tick(TimePoint now) {
+    log_.flush(now);
+    requests_log_.flush(now);
+}
+
 void GroundlinkService::on_message(Delivered message) {
     auto decoded = protocol::decode(message.bytes);
     if (!decoded.message) {
         ++bad_messages_;
-        spdlog::warn("groundlink: dropped a ground message: {}", decoded.error);
+        log_.log("groundlink: dropped a ground message", SteadyClock::now(), spdlog::level::warn,
+                 "groundlink: dropped a ground message: {}", decoded.error);
         return;
     }
     if (auto* command = std::get_if<protocol::Command>(&*decoded.message)) {
@@ -235,7 +244,8 @@ void GroundlinkService::on_command(const protocol::Command& command) {
     if (shown.size() > kShown) {
         shown = shown.substr(0, kShown) + fmt::format("… ({} bytes)", shown.size());
     }
-    spdlog::info("groundlink: request {} from the ground ({}): {}", id, to_string(role), shown);
+    requests_log_.log("groundlink: request from the ground", SteadyClock::now(), spdlog::level::info,
+                      "groundlink: request {} from the ground ({}): {}", id, to_string(role), shown);
     ctx_.commands.dispatch(request, role, [this, id, lowered](CommandResult result) {
         asio::dispatch(strand(), [this, id, lowered, result = std::move(result)]() mutable {
             if (result.status == CommandStatus::Forbidden) {
@@ -244,7 +254,9 @@ void GroundlinkService::on_command(const protocol::Command& command) {
                                     ? " (a monitor client of the ground hub; commands need its control role)"
                                     : " (this ground station uses the monitor key; commands need the control "
                                       "key)";
-                spdlog::warn("groundlink: refused a command from a monitor: {}", result.error);
+                log_.log("groundlink: refused a command from a monitor", SteadyClock::now(),
+                         spdlog::level::warn, "groundlink: refused a command from a monitor: {}",
+                         result.error);
             }
             if (!driver_) {
                 return;
@@ -252,7 +264,8 @@ void GroundlinkService::on_command(const protocol::Command& command) {
             const auto bytes = protocol::encode(protocol::Result{id, result.to_json()});
             const auto r = driver_->send_safe(protocol::kPriorityControl, bytes);
             if (r != SendResult::Accepted) {
-                spdlog::warn("groundlink: could not queue the answer to request {}", id);
+                log_.log("groundlink: could not queue an answer", SteadyClock::now(), spdlog::level::warn,
+                         "groundlink: could not queue the answer to request {}", id);
             }
         });
     });
@@ -313,25 +326,29 @@ void GroundlinkService::pump_forward() {
 void GroundlinkService::on_event(const TransportEvent& event) {
     switch (event.kind) {
         case TransportEvent::Kind::LinkUp:
-            spdlog::info("groundlink: link up ({} key)",
-                         ground_role() == Role::Control ? "control" : "monitor");
+            log_.log("groundlink: link up", SteadyClock::now(), spdlog::level::info,
+                     "groundlink: link up ({} key)", ground_role() == Role::Control ? "control" : "monitor");
             break;
         case TransportEvent::Kind::LinkDown:
-            spdlog::warn("groundlink: link down");
+            log_.log("groundlink: link down", SteadyClock::now(), spdlog::level::warn,
+                     "groundlink: link down");
             forwarder_.clear();
             break;
         case TransportEvent::Kind::PeerRestarted:
-            spdlog::info("groundlink: the ground end restarted; session resynchronised");
+            log_.log("groundlink: the ground end restarted", SteadyClock::now(), spdlog::level::info,
+                     "groundlink: the ground end restarted; session resynchronised");
             delivery_.reset();
             break;
         case TransportEvent::Kind::SessionEstablished:
             delivery_.reset();
             break;
         case TransportEvent::Kind::PathUp:
-            spdlog::info("groundlink: path {} up", event.path);
+            log_.log("groundlink: path up", SteadyClock::now(), spdlog::level::info, "groundlink: path {} up",
+                     event.path);
             break;
         case TransportEvent::Kind::PathDown:
-            spdlog::warn("groundlink: path {} silent", event.path);
+            log_.log("groundlink: path silent", SteadyClock::now(), spdlog::level::warn,
+                     "groundlink: path {} silent", event.path);
             break;
         default:
             break;

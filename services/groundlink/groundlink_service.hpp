@@ -8,6 +8,7 @@
 #include "hal/udp_socket.hpp"
 #include "services/autopilot/autopilot.hpp"
 #include "services/common/deadline_timer.hpp"
+#include "services/common/limited_log.hpp"
 #include "services/common/port_keeper.hpp"
 #include "services/common/service.hpp"
 #include "services/common/slack_timer.hpp"
@@ -46,6 +47,7 @@ class GroundlinkService : public Service {
   protected:
     void on_start() override;
     void on_stop() override;
+    void on_tick(TimePoint now) override;
 
   private:
     /// The ground end's role, from the key its session was authenticated with: the monitor key (the
@@ -116,6 +118,8 @@ class GroundlinkService : public Service {
     std::uint64_t commands_ = 0;
     std::uint64_t bad_messages_ = 0;
     std::optional<bool> link_state_published_;
+    LimitedLog log_;  // lines the ground (or the radio) can make us write
+    LimitedLog requests_log_{LineLimiterConfig{20, seconds(10)}};  // the journal of commands from the ground
 };
 
 /// The transport configuration for a service configuration: paths and mode from `mode` and `ports`, the link

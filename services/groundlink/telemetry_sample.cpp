@@ -24,6 +24,7 @@ protocol::Telemetry make_sample(const autopilot::Telemetry& t, const PlanProgres
         s.lon_deg = t.position->lon;
         s.alt_m = t.position->alt;
     }
+    s.no_position = !t.position;
     s.ground_speed_mps = t.ground_speed;
     s.heading_deg = t.heading;
     s.roll_deg = whole_degrees(t.roll);

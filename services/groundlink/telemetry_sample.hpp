@@ -14,8 +14,8 @@ struct PlanProgressSample {
 };
 
 /// Angles in radians become whole degrees; the mode travels as the autopilot's number (protocol::kModeUnknown
-/// when absent or too large for the byte); a missing position leaves latitude and longitude 0 (the GPS fix
-/// says whether they mean anything).
+/// when absent or too large for the byte); a missing position (none yet, no fix, or refused by the driver's
+/// checks) leaves latitude and longitude 0 and sets no_position.
 protocol::Telemetry make_sample(const autopilot::Telemetry& t, const PlanProgressSample& plan = {});
 
 }  // namespace airseg::groundlink

@@ -11,19 +11,45 @@ namespace airseg::status {
 namespace fs = std::filesystem;
 using Protocol = asio::local::stream_protocol;
 
+namespace {
+// Text from outside (a plan's name, an autopilot's parameter) may be invalid UTF-8: an answer replaces such
+// bytes rather than throwing out of the dump, which would leave the client without an answer.
+std::string answer_line(const Json& value) {
+    return value.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n";
+}
+}  // namespace
+
 class LocalCommandServer::Session : public std::enable_shared_from_this<Session> {
   public:
     Session(LocalCommandServer& server, Protocol::socket socket)
         : server_(server),
           server_alive_(server.alive_),
           socket_(std::move(socket)),
-          input_(kMaxRequestBytes) {}
+          input_(kMaxRequestBytes),
+          idle_timer_(server.strand_),
+          last_active_(SteadyClock::now()) {}
 
-    void start() { do_read(); }
+    void start() {
+        arm_idle(last_active_ + server_.idle_timeout_);
+        do_read();
+    }
+    /// Closes the socket; the session leaves the table once its handlers have run.
     void close() {
+        closed_ = true;
         boost::system::error_code ignored;
         socket_.close(ignored);
+        idle_timer_.cancel();
     }
+    /// Closes it and takes it out of the table now.
+    void finish() {
+        close();
+        if (*server_alive_) {
+            server_.sessions_.erase(shared_from_this());
+        }
+    }
+    /// Waiting for a request of its own to be answered: not idle, whatever the clock says.
+    bool busy() const { return in_flight_; }
+    TimePoint last_active() const { return last_active_; }
 
   private:
     void do_read() {
@@ -36,16 +62,20 @@ class LocalCommandServer::Session : public std::enable_shared_from_this<Session>
     }
 
     void on_read(boost::system::error_code ec, std::size_t n) {
+        if (closed_ || !*server_alive_) {
+            return;
+        }
         if (ec == asio::error::not_found) {
             // The buffer is full without a newline: answer once, then drop the connection.
             send_line(CommandResult::fail(CommandStatus::BadRequest, "request longer than 1 MiB").to_json(),
                       true);
             return;
         }
-        if (ec || !*server_alive_) {
+        if (ec) {
             finish();
             return;
         }
+        last_active_ = SteadyClock::now();
         std::string line(asio::buffers_begin(input_.data()), asio::buffers_begin(input_.data()) + n);
         input_.consume(n);
         while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) {
@@ -57,30 +87,53 @@ class LocalCommandServer::Session : public std::enable_shared_from_this<Session>
         }
         Json request = Json::parse(line, nullptr, false);
         if (request.is_discarded()) {
-            send_line(CommandResult::fail(CommandStatus::BadRequest, "request is not valid JSON").to_json(),
-                      false);
-            do_read();
+            if (send_line(
+                    CommandResult::fail(CommandStatus::BadRequest, "request is not valid JSON").to_json(),
+                    false)) {
+                do_read();
+            }
             return;
         }
         // Answers are written in request order; the next request is read only after this one's answer.
+        in_flight_ = true;
         server_.dispatcher_.dispatch(
             request, Role::Control, [self = shared_from_this()](CommandResult result) {
                 asio::dispatch(self->socket_.get_executor(), [self, result = std::move(result)] {
-                    if (!*self->server_alive_) {
+                    if (!*self->server_alive_ || self->closed_) {
                         return;
                     }
-                    self->send_line(result.to_json(), false);
-                    self->do_read();
+                    self->in_flight_ = false;
+                    self->last_active_ = SteadyClock::now();
+                    if (self->send_line(result.to_json(), false)) {
+                        self->do_read();
+                    }
                 });
             });
     }
 
-    void send_line(const Json& value, bool close_after) {
-        outbox_.push_back(value.dump() + "\n");
+    /// Queues one answer; false when the client was closed instead because it does not read its answers.
+    bool send_line(const Json& value, bool close_after) {
+        std::string line = answer_line(value);
+        // One answer is always taken, however long (the socket's own buffer then holds what it can); beyond
+        // that, answers pile up only for a client that does not read them.
+        if (!outbox_.empty() && queued_bytes_ + line.size() > kMaxQueuedBytes) {
+            ++server_.stats_.closed_slow;
+            server_.log_.log(
+                "status: closing a local client that does not read its answers", SteadyClock::now(),
+                spdlog::level::warn,
+                "status: closing a local client that does not read its answers ({} bytes waiting, "
+                "limit {})",
+                queued_bytes_ + line.size(), kMaxQueuedBytes);
+            finish();
+            return false;
+        }
+        queued_bytes_ += line.size();
+        outbox_.push_back(std::move(line));
         close_after_ = close_after_ || close_after;
         if (outbox_.size() == 1) {
             do_write();
         }
+        return true;
     }
 
     void do_write() {
@@ -88,7 +141,12 @@ class LocalCommandServer::Session : public std::enable_shared_from_this<Session>
             socket_, asio::buffer(outbox_.front()),
             asio::bind_executor(server_.strand_,
                                 [self = shared_from_this()](boost::system::error_code ec, std::size_t) {
+                                    if (self->closed_ || !*self->server_alive_) {
+                                        return;
+                                    }
+                                    self->queued_bytes_ -= self->outbox_.front().size();
                                     self->outbox_.pop_front();
+                                    self->last_active_ = SteadyClock::now();
                                     if (ec) {
                                         self->finish();
                                     } else if (!self->outbox_.empty()) {
@@ -99,11 +157,29 @@ class LocalCommandServer::Session : public std::enable_shared_from_this<Session>
                                 }));
     }
 
-    void finish() {
-        close();
-        if (*server_alive_) {
-            server_.sessions_.erase(shared_from_this());
-        }
+    // One timer per client, re-armed only when it fires: activity just moves last_active_.
+    void arm_idle(TimePoint at) {
+        idle_timer_.expires_at(at);
+        idle_timer_.async_wait([self = shared_from_this()](boost::system::error_code ec) {
+            if (ec || self->closed_ || !*self->server_alive_) {
+                return;
+            }
+            const TimePoint now = SteadyClock::now();
+            const TimePoint due = self->last_active_ + self->server_.idle_timeout_;
+            if (self->in_flight_ || now < due) {
+                self->arm_idle(self->in_flight_ ? now + self->server_.idle_timeout_ : due);
+                return;
+            }
+            // Nothing came and nothing was taken: a client that holds its answers unread is a slow one.
+            const bool unread = !self->outbox_.empty();
+            ++(unread ? self->server_.stats_.closed_slow : self->server_.stats_.closed_idle);
+            self->server_.log_.log(
+                "status: closing an idle local client", now, spdlog::level::info,
+                "status: closing a local client {} for {} s",
+                unread ? "that does not read its answers" : "idle",
+                std::chrono::duration_cast<std::chrono::seconds>(self->server_.idle_timeout_).count());
+            self->finish();
+        });
     }
 
     LocalCommandServer& server_;
@@ -111,11 +187,17 @@ class LocalCommandServer::Session : public std::enable_shared_from_this<Session>
     Protocol::socket socket_;
     asio::streambuf input_;
     std::deque<std::string> outbox_;
+    std::size_t queued_bytes_ = 0;
+    asio::steady_timer idle_timer_;
+    TimePoint last_active_;
+    bool in_flight_ = false;
     bool close_after_ = false;
+    bool closed_ = false;
 };
 
-LocalCommandServer::LocalCommandServer(Strand strand, const CommandDispatcher& dispatcher)
-    : strand_(std::move(strand)), dispatcher_(dispatcher), acceptor_(strand_) {}
+LocalCommandServer::LocalCommandServer(Strand strand, const CommandDispatcher& dispatcher,
+                                       Duration idle_timeout)
+    : strand_(std::move(strand)), dispatcher_(dispatcher), idle_timeout_(idle_timeout), acceptor_(strand_) {}
 
 LocalCommandServer::~LocalCommandServer() {
     close();
@@ -172,6 +254,12 @@ void LocalCommandServer::close() {
     sessions_.clear();
 }
 
+LocalSocketStats LocalCommandServer::stats() const {
+    LocalSocketStats s = stats_;
+    s.clients = sessions_.size();
+    return s;
+}
+
 void LocalCommandServer::do_accept() {
     acceptor_.async_accept(
         asio::bind_executor(strand_, [this](boost::system::error_code ec, Protocol::socket socket) {
@@ -179,18 +267,51 @@ void LocalCommandServer::do_accept() {
                 return;
             }
             if (!ec) {
-                if (sessions_.size() >= kMaxConnections) {
-                    spdlog::warn("status: refusing a local connection: {} already open", kMaxConnections);
-                } else {
-                    auto session = std::make_shared<Session>(*this, std::move(socket));
-                    sessions_.insert(session);
-                    session->start();
-                }
+                admit(std::move(socket));
             }
             if (acceptor_.is_open()) {
                 do_accept();
             }
         }));
+}
+
+// A full table must not lock the board out: the client idle longest makes room. Only clients that all wait
+// for an answer of their own keep a newcomer out.
+void LocalCommandServer::admit(Protocol::socket socket) {
+    const TimePoint now = SteadyClock::now();
+    if (sessions_.size() >= kMaxConnections) {
+        std::shared_ptr<Session> oldest;
+        for (const auto& s : sessions_) {
+            if (!s->busy() && (!oldest || s->last_active() < oldest->last_active())) {
+                oldest = s;
+            }
+        }
+        if (!oldest) {
+            ++stats_.refused;
+            log_.log("status: refusing a local connection", now, spdlog::level::warn,
+                     "status: refusing a local connection: {} open, each running a request", kMaxConnections);
+            // Best effort and never blocking: the newcomer's first read then says why.
+            const std::string why = answer_line(
+                CommandResult::fail(CommandStatus::Failed, "too many local connections (" +
+                                                               std::to_string(kMaxConnections) +
+                                                               ", each running a request); try again")
+                    .to_json());
+            boost::system::error_code ignored;
+            socket.non_blocking(true, ignored);
+            socket.write_some(asio::buffer(why), ignored);
+            return;
+        }
+        ++stats_.evicted;
+        log_.log("status: closing the local client idle longest", now, spdlog::level::info,
+                 "status: {} local connections open: closing the one idle for {} ms to make room",
+                 kMaxConnections,
+                 std::chrono::duration_cast<std::chrono::milliseconds>(now - oldest->last_active()).count());
+        oldest->finish();
+    }
+    ++stats_.accepted;
+    auto session = std::make_shared<Session>(*this, std::move(socket));
+    sessions_.insert(session);
+    session->start();
 }
 
 }  // namespace airseg::status

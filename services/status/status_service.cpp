@@ -20,7 +20,24 @@ nlohmann::json StatusService::document() const {
         sections_[name] = render();
     }
     unrendered_.clear();
+    sections_["status"] = own_section();
     return build_document(ctx_.health.snapshot(), sections_, uptime);
+}
+
+nlohmann::json StatusService::own_section() const {
+    const auto s = server_.stats();
+    return {{"local_socket",
+             {{"clients", s.clients},
+              {"accepted", s.accepted},
+              {"refused", s.refused},
+              {"evicted", s.evicted},
+              {"closed_slow", s.closed_slow},
+              {"closed_idle", s.closed_idle}}},
+            {"log_lines_held", LimitedLog::held_everywhere()}};
+}
+
+void StatusService::on_tick(TimePoint now) {
+    server_.flush_log(now);
 }
 
 void StatusService::on_start() {

@@ -30,11 +30,14 @@ class StatusService : public Service {
   protected:
     void on_start() override;
     void on_stop() override;
+    void on_tick(TimePoint now) override;
 
   private:
     void do_refresh();
     void do_open_socket();
     void publish_summary();
+    /// status.local_socket.* and status.log_lines_held.
+    nlohmann::json own_section() const;
 
     StatusServiceConfig config_;
     LocalCommandServer server_;

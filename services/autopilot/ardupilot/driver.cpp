@@ -708,12 +708,18 @@ AutopilotStatus Driver::status() const {
     s.state = state_;
     s.mode = mode_name_;
     s.position = telemetry_.position;
+    s.position_invalid = telemetry_.position_invalid;
     s.mission_current = telemetry_.mission_current;
     s.reboots = reboots_;
     s.reset_pulses = link_.reset_pulses();
     s.speed = speed_set_;
     s.mission_items = missions_.answers_int() ? "int" : "float";
     s.auto_restarts_corrected = auto_check_.corrections();
+    s.refused_values = refused_values_;
+    s.refused_value = refused_value_;
+    s.params_cached = params_.table().size();
+    s.params_announced = params_.announced();
+    s.params_dropped = params_.dropped();
     return s;
 }
 

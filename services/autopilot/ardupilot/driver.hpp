@@ -169,6 +169,10 @@ class Driver {
     // driver_frames.cpp: what comes from the autopilot
     void on_frame(const mavlink::Frame& f, TimePoint now);
     void on_heartbeat(const mavlink::Heartbeat& hb, TimePoint now);
+    void on_position(const char* message, std::int32_t lat_e7, std::int32_t lon_e7, std::int32_t alt_mm);
+    void invalidate_position(std::string why);
+    void take_float(const char* where, float value, double& field);
+    void refuse_value(std::string why);
     void on_statustext(const mavlink::Statustext& t, TimePoint now);
     void on_time_boot(std::uint32_t time_boot_ms, TimePoint now);
     void on_command_ack(const mavlink::CommandAck& ack, TimePoint now);
@@ -217,6 +221,9 @@ class Driver {
     VehicleState state_ = VehicleState::Unknown;
     std::string mode_name_;
     Telemetry telemetry_;
+    std::optional<std::uint8_t> gps_fix_type_;  // the last GPS_RAW_INT's; none before one comes
+    std::uint64_t refused_values_ = 0;          // NaN, infinite or out-of-range values not taken
+    std::string refused_value_;                 // the last of them, e.g. "ATTITUDE.roll is NaN"
     std::optional<std::pair<std::uint16_t, TimePoint>> last_reached_;
     std::uint16_t reported_current_ = 0;  // the mission slot last reported (MissionCurrentChanged)
     bool current_reached_ = false;        // the board reported reported_current_ reached since

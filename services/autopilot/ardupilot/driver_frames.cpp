@@ -6,8 +6,10 @@
 
 #include "services/autopilot/ardupilot/driver.hpp"
 #include "services/autopilot/ardupilot/rover_modes.hpp"
+#include "services/autopilot/ardupilot/telemetry_check.hpp"
 #include "services/autopilot/mavlink/encoder.hpp"
 #include "services/autopilot/mavlink/enums.hpp"
+#include "services/common/printable.hpp"
 
 namespace airseg::autopilot::ardupilot {
 
@@ -55,9 +57,7 @@ void Driver::on_frame(const mav::Frame& f, TimePoint now) {
             break;
         case mav::GlobalPositionInt::kId: {
             const auto m = mav::decode_payload<mav::GlobalPositionInt>(p);
-            if (m.lat != 0 || m.lon != 0) {
-                telemetry_.position = Position{m.lat * 1e-7, m.lon * 1e-7, m.alt * 1e-3};
-            }
+            on_position("GLOBAL_POSITION_INT", m.lat, m.lon, m.alt);
             telemetry_.relative_alt = m.relative_alt * 1e-3;
             if (m.hdg != 65535) {
                 telemetry_.heading = m.hdg * 0.01;
@@ -66,15 +66,16 @@ void Driver::on_frame(const mav::Frame& f, TimePoint now) {
             break;
         }
         case mav::Attitude::kId: {
+            // A NaN or infinite angle is not taken: the field keeps its last number.
             const auto m = mav::decode_payload<mav::Attitude>(p);
-            telemetry_.roll = m.roll;
-            telemetry_.pitch = m.pitch;
-            telemetry_.yaw = m.yaw;
+            take_float("ATTITUDE.roll", m.roll, telemetry_.roll);
+            take_float("ATTITUDE.pitch", m.pitch, telemetry_.pitch);
+            take_float("ATTITUDE.yaw", m.yaw, telemetry_.yaw);
             break;
         }
         case mav::VfrHud::kId: {
             const auto m = mav::decode_payload<mav::VfrHud>(p);
-            telemetry_.ground_speed = m.groundspeed;
+            take_float("VFR_HUD.groundspeed", m.groundspeed, telemetry_.ground_speed);
             telemetry_.heading = (m.heading % 360 + 360) % 360;
             break;
         }
@@ -82,8 +83,11 @@ void Driver::on_frame(const mav::Frame& f, TimePoint now) {
             const auto m = mav::decode_payload<mav::GpsRawInt>(p);
             telemetry_.gps_fix = m.fix_type <= 6 ? static_cast<GpsFix>(m.fix_type) : GpsFix::RtkFixed;
             telemetry_.satellites = m.satellites_visible == 255 ? 0 : m.satellites_visible;
-            if (!telemetry_.position && m.fix_type >= 2) {
-                telemetry_.position = Position{m.lat * 1e-7, m.lon * 1e-7, m.alt * 1e-3};
+            gps_fix_type_ = m.fix_type;
+            if (!gives_position(m.fix_type)) {
+                invalidate_position("no GPS fix (GPS_RAW_INT fix_type " + std::to_string(m.fix_type) + ")");
+            } else if (!telemetry_.position) {
+                on_position("GPS_RAW_INT", m.lat, m.lon, m.alt);
             }
             break;
         }
@@ -102,7 +106,11 @@ void Driver::on_frame(const mav::Frame& f, TimePoint now) {
         }
         case mav::HomePosition::kId: {
             const auto m = mav::decode_payload<mav::HomePosition>(p);
-            telemetry_.home = Position{m.latitude * 1e-7, m.longitude * 1e-7, m.altitude * 1e-3};
+            if (const auto why = position_problem(m.latitude, m.longitude); why.empty()) {
+                telemetry_.home = Position{m.latitude * 1e-7, m.longitude * 1e-7, m.altitude * 1e-3};
+            } else if (m.latitude != 0 || m.longitude != 0) {
+                refuse_value("HOME_POSITION: " + why);  // the home kept is the last valid one
+            }
             break;
         }
         case mav::MissionCurrent::kId:
@@ -117,6 +125,42 @@ void Driver::on_frame(const mav::Frame& f, TimePoint now) {
         default:
             break;
     }
+}
+
+// A position reaches the telemetry only when it is a place and comes with a fix; otherwise the telemetry has
+// none, and says why.
+void Driver::on_position(const char* message, std::int32_t lat_e7, std::int32_t lon_e7, std::int32_t alt_mm) {
+    if (const auto why = position_problem(lat_e7, lon_e7); !why.empty()) {
+        if (lat_e7 != 0 || lon_e7 != 0) {
+            refuse_value(std::string(message) + ": " + why);
+        }
+        invalidate_position(why);
+        return;
+    }
+    if (gps_fix_type_ && !gives_position(*gps_fix_type_)) {
+        invalidate_position("no GPS fix (GPS_RAW_INT fix_type " + std::to_string(*gps_fix_type_) + ")");
+        return;
+    }
+    telemetry_.position = Position{lat_e7 * 1e-7, lon_e7 * 1e-7, alt_mm * 1e-3};
+    telemetry_.position_invalid.clear();
+}
+
+void Driver::invalidate_position(std::string why) {
+    telemetry_.position.reset();
+    telemetry_.position_invalid = std::move(why);
+}
+
+void Driver::take_float(const char* where, float value, double& field) {
+    if (auto why = float_problem(where, value); !why.empty()) {
+        refuse_value(std::move(why));
+        return;
+    }
+    field = value;
+}
+
+void Driver::refuse_value(std::string why) {
+    ++refused_values_;
+    refused_value_ = std::move(why);
 }
 
 void Driver::on_heartbeat(const mav::Heartbeat& hb, TimePoint now) {
@@ -228,7 +272,8 @@ void Driver::report_current(std::uint16_t seq) {
 }
 
 void Driver::on_statustext(const mav::Statustext& t, TimePoint now) {
-    const std::string text(mav::text_of(t.text));
+    // Escaped here, at the edge: the text goes on to logs, events for the ground and JSON.
+    const std::string text = printable(mav::text_of(t.text));
     emit(StatusText{t.severity, text});
     const std::string l = lower(text);
     if (const auto pos = l.find("reached waypoint #"); pos != std::string::npos) {

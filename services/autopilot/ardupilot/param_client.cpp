@@ -1,5 +1,6 @@
 #include "services/autopilot/ardupilot/param_client.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "services/autopilot/mavlink/messages.hpp"
@@ -172,19 +173,37 @@ bool ParamClient::handle_frame(const mav::Frame& f, TimePoint now) {
     if (name.empty()) {
         return true;
     }
+    if (!std::all_of(name.begin(), name.end(), [](char c) { return c > ' ' && c < 0x7f; })) {
+        ++dropped_;  // ArduPilot's names are letters, digits and '_'; anything else is noise or hostile
+        return true;
+    }
     if (v.param_count > 0 && v.param_count <= kMaxParams && v.param_count != announced_) {
-        announced_ = v.param_count;  // a new table (first fetch, or firmware changed): start counting again
+        // A new table (first fetch, or firmware changed): start counting again; names of the old table go.
+        if (announced_ != 0) {
+            table_.clear();
+        }
+        announced_ = v.param_count;
         have_index_.assign(announced_, false);
         have_count_ = 0;
     }
-    auto& entry = table_[name];
-    entry.value = v.param_value;
-    entry.type = v.param_type;
-    if (v.param_index != kUnsolicitedIndex) {
-        entry.index = v.param_index;
+    auto it = table_.find(name);
+    if (it == table_.end() && table_.size() < (announced_ > 0 ? announced_ : kMaxParams)) {
+        it = table_.emplace(name, ParamEntry{}).first;
     }
+    const bool cached = it != table_.end();
+    if (cached) {
+        ParamEntry& entry = it->second;
+        entry.value = v.param_value;
+        entry.type = v.param_type;
+        if (v.param_index != kUnsolicitedIndex) {
+            entry.index = v.param_index;
+        }
+    } else {
+        ++dropped_;  // more names than the table announced: not a parameter of this table
+    }
+    // A name that did not fit counts for no index: its index belongs to a name the table does hold.
     bool new_index = false;
-    if (v.param_index < have_index_.size() && !have_index_[v.param_index]) {
+    if (cached && v.param_index < have_index_.size() && !have_index_[v.param_index]) {
         have_index_[v.param_index] = true;
         ++have_count_;
         new_index = true;

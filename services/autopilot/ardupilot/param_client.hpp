@@ -44,6 +44,9 @@ struct ParamClientConfig {
 class ParamClient {
   public:
     static constexpr std::size_t kMaxQueued = 64;
+    /// The most parameters a table may announce (PARAM_COUNT) and the cache may hold: ArduPilot boards have
+    /// about 1,000 to 1,300. The cache holds at most the count announced (this many before any), and a new
+    /// table (another count) replaces the old one; names beyond it are dropped and counted (dropped()).
     static constexpr std::size_t kMaxParams = 4096;
     static constexpr std::size_t kReadsPerRound = 8;  // individual reads in flight while filling gaps
 
@@ -65,6 +68,8 @@ class ParamClient {
     /// Parameters announced by the autopilot (param_count), 0 before any PARAM_VALUE.
     std::size_t announced() const { return announced_; }
     std::uint64_t retransmissions() const { return retransmissions_; }
+    /// PARAM_VALUEs not cached: a new name past the announced count, or a name that is not printable ASCII.
+    std::uint64_t dropped() const { return dropped_; }
 
   private:
     struct Op {
@@ -99,6 +104,7 @@ class ParamClient {
     std::size_t announced_ = 0;
     std::size_t have_count_ = 0;
     std::uint64_t retransmissions_ = 0;
+    std::uint64_t dropped_ = 0;
 };
 
 }  // namespace airseg::autopilot::ardupilot

@@ -143,7 +143,8 @@ void encode_body(Writer& w, const Telemetry& t) {
     w.le(clamp_round<std::uint64_t>(t.battery_v * 1000, 0, 65535), 2);
     w.u8(t.battery_pct ? std::clamp(*t.battery_pct, 0, 100) : 255);
     w.u8((std::min<unsigned>(t.gps_fix, 15) << 4) | std::min<unsigned>(t.satellites, 15));
-    w.u8(std::min<unsigned>(t.vehicle_state, 15) | (std::min<unsigned>(t.plan_state, 7) << 4));
+    w.u8(std::min<unsigned>(t.vehicle_state, 15) | (std::min<unsigned>(t.plan_state, 7) << 4) |
+         (t.no_position ? 0x80u : 0u));
     w.u8(t.mode);
     w.le(std::min<unsigned>(t.plan_element, 0x3fff), 2);
     w.le(std::min<std::uint32_t>(t.next_waypoint, 0xffffff), 3);
@@ -169,6 +170,7 @@ Telemetry decode_telemetry(Reader& r) {
     const auto states = r.le(1);
     t.vehicle_state = static_cast<std::uint8_t>(states & 0x0f);
     t.plan_state = static_cast<std::uint8_t>((states >> 4) & 0x07);
+    t.no_position = (states & 0x80) != 0;
     t.mode = static_cast<std::uint8_t>(r.le(1));
     t.plan_element = static_cast<std::uint16_t>(r.le(2) & 0x3fff);
     t.next_waypoint = static_cast<std::uint32_t>(r.le(3));

@@ -54,13 +54,16 @@ struct Telemetry {
     double heading_deg = 0;       // 0.01 degree, 0..360
     int roll_deg = 0;             // whole degrees, ±127
     int pitch_deg = 0;
-    double battery_v = 0;             // 1 mV
-    std::optional<int> battery_pct;   // 0..100; absent when unknown
-    std::uint8_t gps_fix = 0;         // 0..15 (MAV_GPS_FIX_TYPE values)
-    std::uint8_t satellites = 0;      // capped at 15
-    std::uint8_t vehicle_state = 0;   // autopilot-neutral vehicle state (0..15)
-    std::uint8_t mode = 0;            // autopilot mode number (0..255)
-    std::uint8_t plan_state = 0;      // 0 none, 1 running, 2 paused, 3 done, 4 interrupted, 5 failed
+    double battery_v = 0;            // 1 mV
+    std::optional<int> battery_pct;  // 0..100; absent when unknown
+    std::uint8_t gps_fix = 0;        // 0..15 (MAV_GPS_FIX_TYPE values)
+    std::uint8_t satellites = 0;     // capped at 15
+    std::uint8_t vehicle_state = 0;  // autopilot-neutral vehicle state (0..15)
+    std::uint8_t mode = 0;           // autopilot mode number (0..255)
+    std::uint8_t plan_state = 0;     // 0 none, 1 running, 2 paused, 3 done, 4 interrupted, 5 failed
+    // Latitude and longitude hold no place (none reported yet, no fix, or a value the vehicle refused); they
+    // are then 0. Byte 22, bit 7; a vehicle that predates it always sends 0 there.
+    bool no_position = false;
     std::uint16_t plan_element = 0;   // capped at 16383
     std::uint32_t next_waypoint = 0;  // index in the expanded plan, capped at 2^24-1
 

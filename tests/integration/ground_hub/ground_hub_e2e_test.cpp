@@ -3,12 +3,20 @@
 // operator's plan reaches every watcher; a monitor's command is refused by the vehicle; control is held by
 // one client at a time.
 #include <gtest/gtest.h>
+#include <poll.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <cstring>
+#include <iostream>
 
 #include <nlohmann/json.hpp>
 
 #include "client/hub_client.hpp"
+#include "client/hub_wire.hpp"
 #include "tests/support/control_client.hpp"
 #include "tests/support/ground_chain.hpp"
 #include "tests/support/json_lines.hpp"
@@ -291,6 +299,95 @@ TEST_F(GroundHubE2e, AGroundStationGetsTheAutopilotsMavlinkThroughTheHub) {
     const auto forward = Json::parse(status.out, nullptr, false)["groundlink"]["mavlink_forward"];
     EXPECT_GT(forward.value("forwarded", 0), 0) << forward.dump();
     EXPECT_GT(forward.value("from_ground", 0), 0) << forward.dump();
+}
+
+/// A raw client of the hub's Unix socket that reads frames (and says nothing unless asked).
+class RawHubClient {
+  public:
+    explicit RawHubClient(const std::string& path) {
+        fd_ = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+        sockaddr_un addr{};
+        addr.sun_family = AF_UNIX;
+        std::strncpy(addr.sun_path, path.c_str(), sizeof addr.sun_path - 1);
+        connected_ = ::connect(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0;
+    }
+    ~RawHubClient() { ::close(fd_); }
+    RawHubClient(const RawHubClient&) = delete;
+    RawHubClient& operator=(const RawHubClient&) = delete;
+    bool connected() const { return connected_; }
+    void send(const std::vector<std::uint8_t>& frame) {
+        ASSERT_EQ(::send(fd_, frame.data(), frame.size(), MSG_NOSIGNAL), static_cast<ssize_t>(frame.size()));
+    }
+    /// The JSON frames the hub sent until it closed the connection or `timeout` passed; closed() says which.
+    std::vector<Json> read_until_closed(std::chrono::milliseconds timeout) {
+        std::vector<Json> out;
+        const auto deadline = std::chrono::steady_clock::now() + timeout;
+        while (!closed_ && std::chrono::steady_clock::now() < deadline) {
+            pollfd p{fd_, POLLIN, 0};
+            if (::poll(&p, 1, 50) <= 0) {
+                continue;
+            }
+            std::uint8_t buf[4096];
+            const auto n = ::recv(fd_, buf, sizeof buf, 0);
+            if (n <= 0) {
+                closed_ = true;
+                break;
+            }
+            reader_.push(std::span(buf, static_cast<std::size_t>(n)));
+            while (auto f = reader_.next()) {
+                if (f->type == client::hub::FrameType::Json) {
+                    out.push_back(Json::parse(f->payload, nullptr, false));
+                }
+            }
+        }
+        return out;
+    }
+    bool closed() const { return closed_; }
+
+  private:
+    int fd_ = -1;
+    bool connected_ = false;
+    bool closed_ = false;
+    client::hub::FrameReader reader_;
+};
+
+// 64 clients that connect and say nothing: one more is refused with a line, and the silent ones are closed
+// once their time to say hello is over; a client that says hello is served as before.
+TEST_F(GroundHubE2e, ClientsPastTheBoundAreRefusedAndSilentOnesAreClosed) {
+    start_chain();
+    std::vector<std::unique_ptr<RawHubClient>> silent;
+    for (int i = 0; i < 64; ++i) {
+        silent.push_back(std::make_unique<RawHubClient>(socket()));
+        ASSERT_TRUE(silent.back()->connected());
+    }
+    RawHubClient extra(socket());
+    const auto frames = extra.read_until_closed(kGenerous);
+    ASSERT_TRUE(extra.closed());
+    ASSERT_FALSE(frames.empty());
+    EXPECT_NE(frames.back().value("error", "").find("64 clients already"), std::string::npos)
+        << frames.back().dump();
+    // The silent ones are closed within the hello timeout and the hub's one-second tick.
+    const auto waited = std::chrono::steady_clock::now();
+    for (auto& c : silent) {
+        const auto said = c->read_until_closed(20s);
+        ASSERT_TRUE(c->closed());
+        ASSERT_FALSE(said.empty());
+        EXPECT_NE(said.back().value("error", "").find("no hello within 10 s"), std::string::npos);
+    }
+    std::cout << "[ figures ] 64 silent clients closed " << seconds_since(waited)
+              << " s after the 65th was refused\n";
+    // A name cut at 64 bytes in the middle of a character, with a terminal escape: the hub escapes it for its
+    // log and the link reports every client gets, and goes on.
+    RawHubClient named(socket());
+    named.send(client::hub::encode_json(
+        {{"hello", {{"want", "monitor"}, {"name", std::string(63, 'a') + "\xc3\xa9\x1b[2J"}}}}));
+    const auto welcome = named.read_until_closed(3s);
+    EXPECT_FALSE(named.closed());
+    EXPECT_FALSE(welcome.empty()) << "welcomed";
+    const auto status = ctl({"status"});
+    ASSERT_EQ(status.exit_code, 0) << status.err;
+    EXPECT_NE(hub->err().find(std::string(63, 'a') + "\\xc3 (unix) as monitor"), std::string::npos)
+        << hub->err();
 }
 
 }  // namespace

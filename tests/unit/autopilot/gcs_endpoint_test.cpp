@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <functional>
+#include <memory>
 
 #include "services/autopilot/mavlink/encoder.hpp"
 #include "services/autopilot/mavlink/messages.hpp"
@@ -127,6 +128,47 @@ TEST(GcsEndpoint, TcpClientsSendFramesInPiecesAndEachGetsTheVehiclesFrames) {
     // A client that leaves is forgotten; the other keeps getting frames.
     a.close();
     ASSERT_TRUE(rig.run_until([&] { return rig.endpoint.stats().tcp_clients == 1; }));
+}
+
+TEST(GcsEndpoint, UdpPeersPastTheBoundMakeTheStalestBeForgotten) {
+    Rig rig;
+    const udp::endpoint to(asio::ip::make_address("127.0.0.1"), rig.endpoint.udp_port());
+    const auto good = rig.gcs.encode(mav::Heartbeat{});
+    std::vector<std::unique_ptr<udp::socket>> peers;
+    for (std::size_t i = 0; i < GcsEndpoint::kMaxUdpPeers + 4; ++i) {
+        peers.push_back(std::make_unique<udp::socket>(rig.io, udp::endpoint(udp::v4(), 0)));
+        peers.back()->send_to(asio::buffer(good), to);
+        // One at a time, so "least recently heard" is the order they were sent in.
+        ASSERT_TRUE(rig.run_until([&] { return rig.to_vehicle.size() == i + 1; }));
+    }
+    EXPECT_EQ(rig.endpoint.stats().udp_peers, GcsEndpoint::kMaxUdpPeers);
+    EXPECT_EQ(rig.endpoint.stats().udp_peers_evicted, 4u);
+    EXPECT_EQ(rig.to_vehicle.size(), GcsEndpoint::kMaxUdpPeers + 4) << "every peer's frames still went on";
+}
+
+TEST(GcsEndpoint, TcpClientsPastTheBoundAreClosedAtOnce) {
+    Rig rig;
+    const tcp::endpoint at(asio::ip::make_address("127.0.0.1"), rig.endpoint.tcp_port());
+    std::vector<std::unique_ptr<tcp::socket>> clients;
+    for (std::size_t i = 0; i < GcsEndpoint::kMaxTcpClients; ++i) {
+        clients.push_back(std::make_unique<tcp::socket>(rig.io));
+        clients.back()->connect(at);
+    }
+    ASSERT_TRUE(
+        rig.run_until([&] { return rig.endpoint.stats().tcp_clients == GcsEndpoint::kMaxTcpClients; }));
+    tcp::socket extra(rig.io);
+    extra.connect(at);
+    std::array<std::uint8_t, 16> buf{};
+    boost::system::error_code result;
+    bool done = false;
+    extra.async_read_some(asio::buffer(buf), [&](boost::system::error_code ec, std::size_t) {
+        result = ec;
+        done = true;
+    });
+    ASSERT_TRUE(rig.run_until([&] { return done; }));
+    EXPECT_EQ(result, asio::error::eof);
+    EXPECT_EQ(rig.endpoint.stats().tcp_refused, 1u);
+    EXPECT_EQ(rig.endpoint.stats().tcp_clients, GcsEndpoint::kMaxTcpClients);
 }
 
 TEST(GcsEndpoint, AFixedUdpDestinationGetsFramesWithoutSendingFirst) {

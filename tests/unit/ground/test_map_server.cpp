@@ -243,8 +243,12 @@ TEST(MapServer, TheEventStreamStartsWithTheWholeStateThenFollowsUpdates) {
     EXPECT_EQ(state["events"][0]["text"], "hello");
     EXPECT_EQ(state["control"], false);
 
+    // A sample without a valid position is no place: neither the vehicle nor its track moves.
+    groundlink::protocol::Telemetry nowhere;
+    nowhere.no_position = true;
     t.lat_deg = 41.6;
     rig.on_strand([&] {
+        rig.map->add_position(nowhere, std::chrono::system_clock::now());
         rig.map->add_position(t, std::chrono::system_clock::now());
         rig.map->add_event("bad \xff utf-8 <b>");
     });

@@ -41,6 +41,25 @@ TEST(TelemetrySample, TheModeTravelsAsTheAutopilotsNumber) {
     EXPECT_EQ(make_sample(t).mode, protocol::kModeUnknown) << "too large for the byte";
 }
 
+TEST(TelemetrySample, WithoutAValidPositionTheSampleSaysSoAndCarriesNoPlace) {
+    autopilot::Telemetry t;
+    t.gps_fix = autopilot::GpsFix::Fix3D;
+    t.position_invalid = "latitude 199.1700000 outside ±90";
+    auto s = make_sample(t);
+    EXPECT_TRUE(s.no_position);
+    EXPECT_EQ(s.lat_deg, 0.0);
+    EXPECT_EQ(s.lon_deg, 0.0);
+    const auto decoded = protocol::decode(protocol::encode(s));
+    ASSERT_TRUE(decoded.message) << decoded.error;
+    EXPECT_TRUE(std::get<protocol::Telemetry>(*decoded.message).no_position);
+
+    t.position = autopilot::Position{41.2756, 1.9866, 12.0};
+    t.position_invalid.clear();
+    s = make_sample(t);
+    EXPECT_FALSE(s.no_position);
+    EXPECT_DOUBLE_EQ(s.lat_deg, 41.2756);
+}
+
 TEST(TelemetryOnTheWire, ASampleCostsAtMostFortyEightBytesIncludingFraming) {
     TimePoint now = TimePoint{} + std::chrono::hours(1);
     Transport vehicle(keyed(0x1111), now), ground(keyed(0x2222), now);

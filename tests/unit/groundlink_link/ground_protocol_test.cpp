@@ -72,6 +72,21 @@ TEST(GroundProtocol, EveryPlanStateRoundTripsBesideTheVehicleState) {
     }
 }
 
+TEST(GroundProtocol, TheNoPositionBitRoundTripsBesideBothStates) {
+    for (const bool none : {false, true}) {
+        auto t = sample();
+        t.plan_state = 5;
+        t.vehicle_state = 15;
+        t.no_position = none;
+        const auto decoded = decode(encode(t));
+        ASSERT_TRUE(decoded.message) << decoded.error;
+        const auto& got = std::get<Telemetry>(*decoded.message);
+        EXPECT_EQ(got.no_position, none);
+        EXPECT_EQ(got.plan_state, 5);
+        EXPECT_EQ(got.vehicle_state, 15);
+    }
+}
+
 TEST(GroundProtocol, TelemetryClampsOutOfRangeValues) {
     Telemetry t;
     t.lat_deg = -33.9;
