@@ -41,6 +41,8 @@ nlohmann::json autopilot_status_json(const autopilot::AutopilotStatus& s) {
     }
     j["mission_current"] = s.mission_current;
     j["reboots"] = s.reboots;
+    j["link_losses"] = s.link_losses;
+    j["syncs"] = s.syncs;
     j["reconnects"] = s.reconnects;
     j["reset_pulses"] = s.reset_pulses;
     j["speed"] = s.speed ? nlohmann::json(*s.speed) : nlohmann::json(nullptr);
