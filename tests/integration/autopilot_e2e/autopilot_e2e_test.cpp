@@ -14,6 +14,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "services/autopilot/mavlink/parser.hpp"
@@ -305,6 +306,53 @@ class GcsEndpointE2e : public AutopilotE2e {
     mavlink::Parser parser_;
     GroundStation gcs_;
 };
+
+// A second station on the board's network asks for the parameter list every 30 s of the board's time for 10
+// minutes (60 s here at x10). Current ArduPilot, and airseg-apmsim's modern profile, answer each with the
+// banner before the parameters, on the one link: airsegd hears every banner too. A banner is no reboot (it
+// used to be one within 10 s of the link coming up, a loop with the daemon's own parameter request); the
+// board's real reboot still is one.
+TEST_F(GcsEndpointE2e, ParameterListsFromAnotherStationBringBannersButNoReboot) {
+    ASSERT_TRUE(wait_until([&] { return ready(); }, kGenerous, kPoll)) << daemon_->err();
+    const auto at_ready = autopilot_section();
+    EXPECT_EQ(at_ready["reboots"], 0) << at_ready.dump() << daemon_->err();
+    EXPECT_EQ(at_ready["syncs"], 1) << at_ready.dump();
+    send(gcs_.heartbeat());
+    const auto board_t = [&] { return control_->json("state").value("t", 0.0); };
+    const auto banner = [](const mavlink::Frame& f) {
+        return f.msgid == mavlink::Statustext::kId && f.sysid == 1 &&
+               mavlink::text_of(mavlink::decode_payload<mavlink::Statustext>(f.payload_view()).text)
+                   .starts_with("ArduRover V4.");
+    };
+    int banners = 0;
+    const double start = board_t();
+    for (int request = 0; request < 20; ++request) {
+        const double asked = board_t();
+        send(gcs_.list_params());
+        banners += hear(banner, 10s) ? 1 : 0;
+        ASSERT_TRUE(wait_until([&] { return board_t() >= asked + 30.0; }, kGenerous, kPoll));
+    }
+    const double board_minutes = (board_t() - start) / 60.0;
+    const auto after = autopilot_section();
+    EXPECT_EQ(banners, 20) << "each request brought the banner to the station";
+    EXPECT_EQ(after["reboots"], 0) << after.dump() << daemon_->err();
+    EXPECT_EQ(after["syncs"], 1) << "the parameters and the mission were read once";
+    EXPECT_EQ(after["link_losses"], 0);
+    EXPECT_EQ(after["ready_s"], at_ready["ready_s"]);
+    EXPECT_EQ(daemon_->err().find("rebooted"), std::string::npos) << daemon_->err();
+
+    ASSERT_EQ(control_->ask("reboot").value_or("").rfind("ok", 0), 0u);
+    EXPECT_TRUE(wait_until([&] { return autopilot_section().value("reboots", 0) == 1; }, kGenerous, kPoll))
+        << daemon_->err();
+    EXPECT_TRUE(wait_until([&] { return ready(); }, kGenerous, kPoll)) << daemon_->err();
+    const auto rebooted = autopilot_section();
+    EXPECT_EQ(rebooted["reboots"], 1) << rebooted.dump();
+    EXPECT_EQ(rebooted["syncs"], 2) << rebooted.dump();
+    std::cout << "[ figures ] " << banners << " parameter lists with their banner over " << board_minutes
+              << " board minutes: " << after["reboots"] << " reboots, " << after["syncs"]
+              << " syncs; ready_s " << at_ready["ready_s"] << "; a real reboot: " << rebooted["reboots"]
+              << " reboot, " << rebooted["syncs"] << " syncs\n";
+}
 
 TEST_F(GcsEndpointE2e, AGroundStationsMissionBecomesThePlanAndAnotherIsRefusedWhileItRuns) {
     ASSERT_TRUE(wait_until([&] { return ready(); }, kGenerous, kPoll)) << daemon_->err();
