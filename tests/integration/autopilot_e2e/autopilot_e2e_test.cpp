@@ -2,9 +2,11 @@
 // operator's side is airsegctl on the local socket. The simulator's control socket says what the board
 // really did. Simulated time runs faster than real time on the board's side (--speedup); every wait is on a
 // condition with a generous deadline.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <poll.h>
+#include <pty.h>
 #include <signal.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
@@ -16,7 +18,9 @@
 #include <cstring>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <thread>
 
+#include "services/autopilot/mavlink/encoder.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
 #include "tests/support/control_client.hpp"
 #include "tests/support/ground_station.hpp"
@@ -384,6 +388,77 @@ TEST_F(GcsEndpointE2e, AGroundStationsMissionBecomesThePlanAndAnotherIsRefusedWh
 
 INSTANTIATE_TEST_SUITE_P(Firmware, AutopilotFirmwareE2e, ::testing::Values("modern", "rover2"),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
+
+// airsegd with a scripted board on a pseudo-terminal (the test holds the master end): the heartbeats of a
+// running board, and GLOBAL_POSITION_INT with time_boot_ms flipping between 2^32-1 and 0, 200 frames a
+// second for 5 s (a broken or hostile peer). Not a reboot, and no log line per frame (that was 4.3 MB of log
+// a second).
+TEST(AutopilotHostileClock, TimeBootFlippingBetweenItsLimitsIsNoRebootAndNoLogFlood) {
+    TempDir dir;
+    int master = -1;
+    int slave = -1;
+    std::array<char, 128> name{};
+    ASSERT_EQ(::openpty(&master, &slave, name.data(), nullptr, nullptr), 0);
+    ::fcntl(master, F_SETFL, ::fcntl(master, F_GETFL) | O_NONBLOCK);
+    Subprocess daemon({binary("daemon/airsegd"), "--config", source_path("config/airseg.yaml"), "--set",
+                       "status.socket=" + dir.file("status.sock"), "--set", "state_dir=" + dir.file("state"),
+                       "--set", std::string("autopilot.port=") + name.data(), "--set",
+                       "autopilot.board=pixhawk", "--set", "groundlink.ports=[" + dir.file("ttyUSB0") + "]"},
+                      {}, dir.path());
+    const auto autopilot = [&] {
+        const auto r = run({binary("client/airsegctl"), "--local", "--socket", dir.file("status.sock"),
+                            "--json", "--timeout", "5000", "status"},
+                           {}, 30s);
+        const auto j = Json::parse(r.out, nullptr, false);
+        return r.exit_code == 0 && j.is_object() ? j.value("autopilot", Json()) : Json();
+    };
+    ASSERT_TRUE(wait_until([&] { return autopilot().is_object(); }, kGenerous, kPoll)) << daemon.err();
+
+    mavlink::Encoder board(1, 1);
+    const auto put = [&](const auto& message) {
+        const auto bytes = board.encode(message);
+        EXPECT_EQ(::write(master, bytes.data(), bytes.size()), static_cast<ssize_t>(bytes.size()));
+        std::array<std::uint8_t, 4096> sink{};
+        while (::read(master, sink.data(), sink.size()) > 0) {
+            // what the daemon asks of the board goes unanswered
+        }
+    };
+    mavlink::Heartbeat hb;
+    hb.type = 10;
+    hb.autopilot = 3;
+    hb.base_mode = 1;
+    hb.custom_mode = 4;    // HOLD
+    hb.system_status = 3;  // STANDBY
+    put(hb);
+    ASSERT_TRUE(wait_until([&] { return autopilot().value("link", "") == "up"; }, kGenerous, kPoll))
+        << daemon.err();
+    const auto log_before = daemon.err().size();
+    mavlink::GlobalPositionInt position;
+    position.lat = 412756000;
+    position.lon = 19866000;
+    const auto start = std::chrono::steady_clock::now();
+    for (int frame = 0; std::chrono::steady_clock::now() - start < 5s; ++frame) {
+        if (frame % 200 == 0) {
+            put(hb);
+        }
+        position.time_boot_ms = frame % 2 == 0 ? 0xFFFFFFFFu : 0u;
+        put(position);
+        std::this_thread::sleep_for(5ms);  // the board's pace, not a wait for an outcome
+    }
+    put(hb);
+    const auto ap = autopilot();
+    const auto log_growth = daemon.err().size() - log_before;
+    EXPECT_EQ(ap.value("reboots", 99), 0) << ap.dump() << daemon.err().substr(0, 4000);
+    EXPECT_EQ(ap.value("link", ""), "up") << ap.dump();
+    EXPECT_EQ(daemon.err().find("rebooted"), std::string::npos);
+    EXPECT_LT(log_growth, 4096u) << daemon.err().substr(log_before, 4000);
+    std::cout << "[ figures ] time_boot_ms flipping 2^32-1/0 for 5 s at 200 frames/s: "
+              << ap.value("reboots", 99) << " reboots, " << log_growth << " bytes of log\n";
+    daemon.signal(SIGTERM);
+    EXPECT_EQ(daemon.wait_exit(10s), 0) << daemon.err();
+    ::close(master);
+    ::close(slave);
+}
 
 }  // namespace
 }  // namespace airseg::test
