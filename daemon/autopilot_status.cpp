@@ -43,6 +43,8 @@ nlohmann::json autopilot_status_json(const autopilot::AutopilotStatus& s) {
         s.position_invalid.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.position_invalid);
     j["mission_current"] = s.mission_current;
     j["reboots"] = s.reboots;
+    j["link_losses"] = s.link_losses;
+    j["syncs"] = s.syncs;
     j["reconnects"] = s.reconnects;
     j["reset_pulses"] = s.reset_pulses;
     j["speed"] = s.speed ? nlohmann::json(*s.speed) : nlohmann::json(nullptr);

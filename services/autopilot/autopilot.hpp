@@ -100,7 +100,7 @@ struct LinkDown {
 /// The autopilot restarted on its own: its parameters and mission were resynchronised; whoever keeps state on
 /// it (the flight plan manager's window) must rebuild it.
 struct AutopilotRebooted {
-    std::string evidence;  // "time_boot_ms went back", "heartbeat gap with boot messages"
+    std::string evidence;  // "time_boot_ms went back from 81234 to 2100 ms and ran on from there"
 };
 struct Ready {
     double seconds_from_open = 0.0;
@@ -233,13 +233,15 @@ struct GroundStationMission {
 struct AutopilotStatus {
     bool link_up = false;                        // autopilot.link
     bool ready = false;                          // autopilot.ready
-    std::optional<double> ready_s;               // autopilot.ready_s: open -> READY, seconds
+    std::optional<double> ready_s;               // autopilot.ready_s: open -> first READY, seconds
     VehicleState state = VehicleState::Unknown;  // autopilot.state
     std::string mode;                            // autopilot.mode
     std::optional<Position> position;            // autopilot.position (only a valid place)
     std::string position_invalid;                // autopilot.position_invalid: why there is none; "" if none
     std::uint16_t mission_current = 0;           // autopilot.mission_current
     unsigned reboots = 0;                        // autopilot.reboots
+    unsigned link_losses = 0;                    // autopilot.link_losses: heartbeats overdue, link down
+    unsigned syncs = 0;                          // autopilot.syncs: parameter + mission downloads started
     unsigned reconnects = 0;            // autopilot.reconnects (filled by the service from its port keeper)
     unsigned reset_pulses = 0;          // autopilot.reset_pulses
     std::optional<double> speed;        // autopilot.speed: the leg speed the board last confirmed, m/s

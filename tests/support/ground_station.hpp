@@ -20,6 +20,13 @@ struct GroundStation {
         hb.type = 6;  // MAV_TYPE_GCS
         return encoder.encode(hb);
     }
+    /// PARAM_REQUEST_LIST: the whole table (current ArduPilot sends its banner first).
+    std::vector<std::uint8_t> list_params() {
+        mavlink::ParamRequestList list;
+        list.target_system = 1;
+        list.target_component = 1;
+        return encoder.encode(list);
+    }
     std::vector<std::uint8_t> read_param(std::string_view name) {
         mavlink::ParamRequestRead read;
         read.target_system = 1;

@@ -162,6 +162,44 @@ TEST_F(SystemPlan, AutopilotHeartbeatStall) {
               << tally.sent << " radio commands answered\n";
 }
 
+// airsegd stopped (SIGSTOP) for 2-5 s at a time, as a loaded CPU or a slow SD card can stall it, while the
+// simulated board streams on at its own rates (x1): the frames of each pause wait in the port. A stall of
+// the daemon is not the autopilot's silence: no link loss, no reboot, no second download of the parameters
+// and the mission. (The time_boot_ms rule "their clock ran slower than ours" took every stall of more than
+// about 3 s for a reboot: 4 reboots in 8 stalls of 1.9-5 s, each reading the parameters and mission again.)
+TEST(SystemAutopilotLink, DaemonStoppedForSecondsKeepsItsLinkAndItsSync) {
+    BenchOptions o;
+    o.speedup = 1;
+    SystemBench bench(o);
+    ASSERT_TRUE(bench.wait_ready()) << bench.logs();
+    const auto before = section(bench.status(), "autopilot");
+    EXPECT_EQ(before.value("syncs", 0u), 1u) << before.dump();
+    const auto board_t = [&] { return bench.sim().json("state").value("t", 0.0); };
+    const std::vector<double> stalls{2.0, 3.5, 5.0, 2.5};
+    for (const double stall : stalls) {
+        ASSERT_EQ(::kill(bench.daemon_pid(), SIGSTOP), 0);
+        const double stopped = board_t();
+        ASSERT_TRUE(wait_until([&] { return board_t() >= stopped + stall; }, kGenerous, kPoll));
+        ASSERT_EQ(::kill(bench.daemon_pid(), SIGCONT), 0);
+        // Running again for the heartbeat timeout (3 s) and its read grace and more, on the board's clock.
+        const double resumed = board_t();
+        ASSERT_TRUE(wait_until([&] { return board_t() >= resumed + 5.0; }, kGenerous, kPoll));
+    }
+    const auto after = section(bench.status(), "autopilot");
+    const std::string log = bench.daemon_err();
+    EXPECT_EQ(after.value("link_losses", 99u), 0u) << after.dump() << log;
+    EXPECT_EQ(after.value("reboots", 99u), 0u) << after.dump() << log;
+    EXPECT_EQ(after.value("reconnects", 99u), 0u) << after.dump();
+    EXPECT_EQ(after.value("syncs", 99u), 1u) << "no re-download of the parameters and the mission";
+    EXPECT_EQ(after.value("ready", false), true);
+    EXPECT_EQ(log.find("link down"), std::string::npos) << log;
+    EXPECT_EQ(log.find("rebooted"), std::string::npos) << log;
+    expect_daemon_alive(bench);
+    std::cout << "[ figures ] daemon stopped " << stalls.size() << " times (2-5 s): link_losses "
+              << after.value("link_losses", 99u) << ", reboots " << after.value("reboots", 99u) << ", syncs "
+              << after.value("syncs", 99u) << ", reconnects " << after.value("reconnects", 99u) << "\n";
+}
+
 TEST_F(SystemPlan, DaemonKilledMidPlanResumesAtTheFirstUnreachedWaypoint) {
     start(plan_bench(10));
     const auto expected = load("route", 16, 20);

@@ -233,6 +233,8 @@ class RoverSim {
     bool rover2_mission() const { return config_.firmware.mission == Dialect::Rover2; }
     bool rover2_commands() const { return config_.firmware.commands == Dialect::Rover2; }
     bool rover2_telemetry() const { return config_.firmware.telemetry == Dialect::Rover2; }
+    // banner.cpp: the firmware's banner texts
+    void send_banner();
     // Speed: the log and what changes the speed.
     void note_speed(const std::string& cause, TimePoint now, std::optional<std::uint16_t> seq = {});
     void set_unsaved_param(const std::string& name, float value);

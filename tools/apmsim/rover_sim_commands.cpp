@@ -5,6 +5,7 @@
 
 #include "services/autopilot/mavlink/enums.hpp"
 #include "services/autopilot/mavlink/messages.hpp"
+#include "tools/apmsim/banner.hpp"
 #include "tools/apmsim/rover_sim.hpp"
 
 namespace airseg::apmsim {
@@ -16,6 +17,7 @@ void RoverSim::on_param(const mv::Frame& f) {
         if (!addressed(mv::decode_payload<mv::ParamRequestList>(f.payload_view()).target_system)) {
             return;
         }
+        send_banner();
         for (std::size_t i = 0; i < params_.size(); ++i) {
             send_param(i);
         }
@@ -218,6 +220,10 @@ void RoverSim::on_command_long(const mv::Frame& f, TimePoint now) {
             break;
         case mavlink::kCmdRequestAutopilotCapabilities:
             send_autopilot_version();
+            result = mavlink::kResultAccepted;
+            break;
+        case kCmdDoSendBanner:
+            send_banner();
             result = mavlink::kResultAccepted;
             break;
         case mavlink::kCmdRequestMessage: {

@@ -72,6 +72,8 @@ Driver::Driver(AutopilotConfig config)
 
 void Driver::on_port_open(TimePoint now) {
     link_.on_port_open(now);
+    sequence_start_ = now;
+    ready_s_.reset();
     parser_ = mav::Parser{};
     missions_.forget_board();  // another board may be behind the port now
     stop_as_waypoint_ = false;
@@ -148,6 +150,9 @@ void Driver::handle_timeout(TimePoint now) {
     const LinkWatch::Due due = link_.handle_timeout(now);
     if (due.lost) {
         link_lost(*due.lost, now);
+    }
+    if (due.reboot && watching_for_reboots()) {
+        reboot_detected(*due.reboot, now);
     }
     if (auto_check_.handle_timeout(now)) {
         report_current(telemetry_.mission_current);  // not back at the expected slot: say where it is
@@ -239,12 +244,11 @@ void Driver::enter(Phase p, TimePoint now) {
         case Phase::Closed:
             break;
         case Phase::WaitBoot:
-            sequence_start_ = now;
             link_.forget_boot_clock();
-            ready_s_.reset();
             phase_deadline_ = now + config_.boot_timeout;
             break;
         case Phase::Params:
+            ++syncs_;
             request_streams();
             sequence_fetch_ = params_.fetch_all(now);
             break;
@@ -257,8 +261,10 @@ void Driver::enter(Phase p, TimePoint now) {
         case Phase::Ready:
             last_error_.clear();
             link_.refill_pulses();
-            ready_s_ = seconds_between(sequence_start_, now);
-            emit(Ready{*ready_s_});
+            if (!ready_s_) {
+                ready_s_ = seconds_between(sequence_start_, now);  // later READYs (resyncs) keep it
+            }
+            emit(Ready{seconds_between(sequence_start_, now)});
             break;
     }
     update_state(now, false);
@@ -711,6 +717,8 @@ AutopilotStatus Driver::status() const {
     s.position_invalid = telemetry_.position_invalid;
     s.mission_current = telemetry_.mission_current;
     s.reboots = reboots_;
+    s.link_losses = link_.link_losses();
+    s.syncs = syncs_;
     s.reset_pulses = link_.reset_pulses();
     s.speed = speed_set_;
     s.mission_items = missions_.answers_int() ? "int" : "float";

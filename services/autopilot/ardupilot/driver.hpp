@@ -5,8 +5,9 @@
 // autopilot: bootloader noise is ignored and heartbeats must reach STANDBY/ACTIVE within boot_timeout;
 // without it the first running heartbeat will do) -> Params (stream rates requested, parameter table
 // downloaded) -> Mission (mission downloaded; slot 0 is home) -> ApplyParams (configured parameters written
-// where they differ, each read back) -> Ready (Ready event with the seconds since the open). A failed step is
-// retried after kRetryPause; last_error() says why the driver is not READY.
+// where they differ, each read back) -> Ready (Ready event with the seconds since the port's open; the
+// status's ready_s keeps the figure of the first READY after the open). A failed step is retried after
+// kRetryPause; last_error() says why the driver is not READY. Every start of Params counts as a sync.
 //
 // Baud probing (more than one configured rate): when no valid frame from the autopilot's system id arrives
 // within baud_probe of the open, the driver asks for the next rate (SwitchBaud), in turn; the service reopens
@@ -19,12 +20,13 @@
 // from MISSION_ITEM_REACHED or the "Reached waypoint #N" text; after every entry into AUTO the mission slot
 // the board was at (AutoEntryCheck: 2.x firmware restarts at item 1); the speed of the mission item being
 // driven to (its MissionItem::speed: MAV_CMD_DO_CHANGE_SPEED, or the CRUISE_SPEED parameter on a board
-// without the command, APM 2.x); link DOWN after heartbeat_timeout of silence;
-// unexpected reboots (time_boot_ms running slower than our clock, heartbeats saying BOOT/CALIBRATING,
-// boot banners right after a heartbeat gap) trigger a resync of parameters and mission and an
-// AutopilotRebooted event; an autopilot silent for unresponsive_timeout while its port is open makes the
-// driver ask for a reset pulse (at most max_reset_pulses times until it is READY again).
-// The link's timers and reboot evidence are LinkWatch's, a requested mode change from request to outcome is
+// without the command, APM 2.x); link DOWN after heartbeat_timeout of silence (judged once the input
+// waiting in the port has been read: a stall of the daemon itself is not the autopilot's silence);
+// unexpected reboots (time_boot_ms going back and running on from there, or a heartbeat gap ended by a
+// heartbeat saying BOOT/CALIBRATING/INITIALISING; never a text: LinkWatch) trigger a resync of parameters
+// and mission and an AutopilotRebooted event; an autopilot silent for unresponsive_timeout while its port is
+// open makes the driver ask for a reset pulse (at most max_reset_pulses times until it is READY again). The
+// link's timers and reboot evidence are LinkWatch's, a requested mode change from request to outcome is
 // ModeControl's; the driver feeds them and acts on what they report (events, frames, port actions).
 //
 // Contract (the service, on its strand): on_port_open/on_port_closed/on_reset_pulsed for the port; every byte
@@ -178,6 +180,8 @@ class Driver {
     void on_command_ack(const mavlink::CommandAck& ack, TimePoint now);
     void on_reached(std::uint16_t seq, TimePoint now);
     void reboot_detected(const std::string& evidence, TimePoint now);
+    /// Reboots are looked for once the autopilot has booted (not while a boot is waited for).
+    bool watching_for_reboots() const { return phase_ != Phase::WaitBoot && phase_ != Phase::Closed; }
     void link_lost(Duration silent, TimePoint now);
     void tap_incoming(const mavlink::Frame& f);
     void on_mission_current(std::uint16_t seq, TimePoint now);
@@ -203,7 +207,7 @@ class Driver {
     FrameTap tap_;
 
     Phase phase_ = Phase::Closed;
-    TimePoint sequence_start_{};
+    TimePoint sequence_start_{};         // the port's open
     TimePoint phase_deadline_ = kNever;  // boot timeout, or the pause before retrying a failed step
     bool retry_pending_ = false;
     std::string last_error_;
@@ -236,6 +240,7 @@ class Driver {
     bool speed_by_param_ = false;
     unsigned speed_changes_ = 0;
     unsigned reboots_ = 0;
+    unsigned syncs_ = 0;  // starts of the parameter and mission download (Phase::Params)
 
     // Mission and parameters.
     std::vector<MissionItem> mission_;

@@ -164,7 +164,6 @@ void Driver::refuse_value(std::string why) {
 }
 
 void Driver::on_heartbeat(const mav::Heartbeat& hb, TimePoint now) {
-    const bool came_up = link_.on_heartbeat(now);
     system_status_ = hb.system_status;
     // APM:Rover 2.x reports MAV_STATE_UNINIT in HOLD (send_heartbeat() of its GCS_Mavlink.pde): in a running
     // mode UNINIT is that quirk, not a board starting up.
@@ -173,14 +172,15 @@ void Driver::on_heartbeat(const mav::Heartbeat& hb, TimePoint now) {
     const bool booting = uninit_booting || hb.system_status == mavlink::kMavStateBoot ||
                          hb.system_status == mavlink::kMavStateCalibrating ||
                          hb.custom_mode == static_cast<std::uint32_t>(RoverMode::Initialising);
-    if (came_up) {
+    const auto seen = link_.on_heartbeat(now, booting, watching_for_reboots());
+    if (seen.came_up) {
         emit(LinkUp{});
         if (phase_ == Phase::Ready) {
             request_streams();  // the autopilot may have lost them in a reboot we cannot prove
         }
     }
-    if (booting && phase_ != Phase::WaitBoot && phase_ != Phase::Closed) {
-        reboot_detected("heartbeat reports the autopilot booting", now);
+    if (seen.reboot) {
+        reboot_detected(*seen.reboot, now);
     }
     const bool mode_changed = !mode_ || *mode_ != hb.custom_mode;
     mode_ = hb.custom_mode;
@@ -284,14 +284,10 @@ void Driver::on_statustext(const mav::Statustext& t, TimePoint now) {
             on_reached(static_cast<std::uint16_t>(seq), now);
         }
     }
-    if (link_.reboot_banner(l, now) && phase_ != Phase::WaitBoot && phase_ != Phase::Closed) {
-        reboot_detected("heartbeat gap with boot messages (\"" + text + "\")", now);
-    }
 }
 
 void Driver::on_time_boot(std::uint32_t time_boot_ms, TimePoint now) {
-    if (auto evidence =
-            link_.on_time_boot(time_boot_ms, now, phase_ != Phase::WaitBoot && phase_ != Phase::Closed)) {
+    if (auto evidence = link_.on_time_boot(time_boot_ms, now, watching_for_reboots())) {
         reboot_detected(*evidence, now);
     }
 }

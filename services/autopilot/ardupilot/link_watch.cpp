@@ -1,15 +1,24 @@
 #include "services/autopilot/ardupilot/link_watch.hpp"
 
 #include <algorithm>
+#include <cstdio>
 
 namespace airseg::autopilot::ardupilot {
 
 namespace {
-constexpr Duration kClockSlack = seconds(2);  // latency jitter allowed when comparing time_boot_ms
+/// `to` relative to `from` on the autopilot's 32-bit millisecond clock, which wraps after 49.7 days.
+std::int64_t clock_step(std::uint32_t from, std::uint32_t to) {
+    return static_cast<std::int32_t>(to - from);
+}
 
-bool is_boot_banner(std::string_view text) {
-    return text.starts_with("initialising apm") || text.starts_with("init ardu") ||
-           text.starts_with("ardurover") || text.starts_with("apm:rover");
+std::int64_t ms_of(Duration d) {
+    return std::chrono::duration_cast<milliseconds>(d).count();
+}
+
+std::string seconds_text(Duration d) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.1f", std::chrono::duration<double>(d).count());
+    return buf;
 }
 }  // namespace
 
@@ -23,7 +32,7 @@ void LinkWatch::on_port_open(TimePoint now) {
     port_open_ = true;
     quiet_since_ = now;
     heard_frame_ = false;
-    time_boot_.reset();
+    forget_boot_clock();
     baud_deadline_ = config_.bauds.size() > 1 ? now + config_.baud_probe : kNever;
     if (config_.reset_on_open) {
         // The open rebooted the autopilot: silence is expected until the boot window has passed.
@@ -34,12 +43,14 @@ void LinkWatch::on_port_open(TimePoint now) {
 bool LinkWatch::on_port_closed() {
     port_open_ = false;
     baud_deadline_ = kNever;
+    heartbeat_due_ = kNever;
+    overdue_since_.reset();
     return std::exchange(up_, false);
 }
 
 void LinkWatch::on_reset_pulsed(TimePoint now) {
     quiet_since_ = now;
-    time_boot_.reset();
+    forget_boot_clock();
 }
 
 void LinkWatch::on_frame() {
@@ -49,42 +60,81 @@ void LinkWatch::on_frame() {
     baud_deadline_ = kNever;
 }
 
-bool LinkWatch::on_heartbeat(TimePoint now) {
+LinkWatch::HeartbeatSeen LinkWatch::on_heartbeat(TimePoint now, bool booting, bool watching) {
+    HeartbeatSeen seen;
+    const Duration gap = now - last_heartbeat_;
+    if (watching && booting && last_heartbeat_ != TimePoint{} && gap >= kBootGap) {
+        seen.reboot =
+            declare("a heartbeat gap of " + seconds_text(gap) + " s ended by a booting heartbeat", now);
+    }
     last_heartbeat_ = now;
     quiet_since_ = now;
-    if (up_) {
-        return false;
-    }
-    up_ = true;
-    gap_window_end_ = now + kGapWindow;
-    return true;
-}
-
-bool LinkWatch::reboot_banner(std::string_view lowered, TimePoint now) const {
-    return is_boot_banner(lowered) && now < gap_window_end_;
+    heartbeat_due_ = now + config_.heartbeat_timeout;
+    overdue_since_.reset();
+    seen.came_up = !std::exchange(up_, true);
+    return seen;
 }
 
 std::optional<std::string> LinkWatch::on_time_boot(std::uint32_t time_boot_ms, TimePoint now, bool watching) {
-    const auto previous = std::exchange(time_boot_, std::pair{time_boot_ms, now});
-    if (!previous || !watching) {
+    const ClockSample sample{time_boot_ms, now};
+    const auto slack = ms_of(kClockBackSlack);
+    if (!clock_ || !watching || clock_step(clock_->ms, time_boot_ms) >= -slack) {
+        // The clock runs on (forward jumps included: a clock that jumps ahead restarted nothing).
+        clock_ = sample;
+        restart_first_.reset();
         return std::nullopt;
     }
-    const auto [before, at] = *previous;
-    const auto ours = std::chrono::duration_cast<milliseconds>(now - at).count();
-    const std::int64_t theirs = static_cast<std::int64_t>(time_boot_ms) - static_cast<std::int64_t>(before);
-    const auto slack =
-        std::chrono::duration_cast<milliseconds>(std::max(kClockSlack, config_.heartbeat_timeout));
-    if (theirs + slack.count() < ours) {
-        return theirs < 0 ? "time_boot_ms went back" : "time_boot_ms restarted during a silence";
+    // Behind the clock: a restart if it runs on from here, and the old clock is not seen again, for a while.
+    if (!restart_first_ || clock_step(restart_last_.ms, time_boot_ms) < -slack) {
+        restart_first_ = sample;
+        restart_last_ = sample;
+        return std::nullopt;
     }
-    return std::nullopt;
+    restart_last_ = sample;
+    if (now - restart_first_->at < kClockConfirm) {
+        return std::nullopt;
+    }
+    const std::string evidence = "time_boot_ms went back from " + std::to_string(clock_->ms) + " to " +
+                                 std::to_string(restart_first_->ms) + " ms and ran on from there";
+    clock_ = sample;
+    restart_first_.reset();
+    return declare(evidence, now);
+}
+
+void LinkWatch::forget_boot_clock() {
+    clock_.reset();
+    restart_first_.reset();
+    held_reboot_.reset();
+}
+
+std::optional<std::string> LinkWatch::declare(std::string evidence, TimePoint now) {
+    if (now < next_reboot_allowed_) {
+        ++reboots_held_;
+        if (!held_reboot_) {
+            held_reboot_ = std::move(evidence);
+        }
+        return std::nullopt;
+    }
+    next_reboot_allowed_ = now + kRebootSpacing;
+    return evidence;
 }
 
 LinkWatch::Due LinkWatch::handle_timeout(TimePoint now) {
     Due due;
-    if (up_ && now >= last_heartbeat_ + config_.heartbeat_timeout) {
-        up_ = false;
-        due.lost = now - last_heartbeat_;
+    if (up_ && now >= heartbeat_due_) {
+        if (!overdue_since_) {
+            // Overdue: the heartbeats may be in the port, unread, if the daemon itself was not running.
+            overdue_since_ = now;
+            heartbeat_due_ = now + kReadGrace;
+        } else if (now - heartbeat_due_ > kLateWake && now - *overdue_since_ < config_.heartbeat_timeout) {
+            heartbeat_due_ = now + kReadGrace;  // even the grace ended late: not awake long enough to tell
+        } else {
+            up_ = false;
+            ++link_losses_;
+            due.lost = now - last_heartbeat_;
+            heartbeat_due_ = kNever;
+            overdue_since_.reset();
+        }
     }
     if (port_open_ && now >= baud_deadline_ && !heard_frame_) {
         baud_index_ = (baud_index_ + 1) % config_.bauds.size();
@@ -97,13 +147,17 @@ LinkWatch::Due LinkWatch::handle_timeout(TimePoint now) {
         due.pulses_exhausted = !due.pulse;
         quiet_since_ = now;  // give the pulse (or the operator) time before the next one
     }
+    if (held_reboot_ && now >= next_reboot_allowed_) {
+        due.reboot = std::exchange(held_reboot_, std::nullopt);
+        next_reboot_allowed_ = now + kRebootSpacing;
+    }
     return due;
 }
 
 TimePoint LinkWatch::poll_timeout() const {
     TimePoint t = kNever;
     if (up_) {
-        t = last_heartbeat_ + config_.heartbeat_timeout;
+        t = heartbeat_due_;
     }
     if (port_open_) {
         if (!heard_frame_) {
@@ -112,6 +166,9 @@ TimePoint LinkWatch::poll_timeout() const {
         if (!up_) {
             t = std::min(t, quiet_since_ + config_.unresponsive_timeout);
         }
+    }
+    if (held_reboot_) {
+        t = std::min(t, next_reboot_allowed_);
     }
     return t;
 }

@@ -1,12 +1,20 @@
 #pragma once
 // LinkWatch: what the serial link to the autopilot is doing, sans-IO.
 //
-// Link up on the first heartbeat, down after heartbeat_timeout without one. Baud probing (more than one
-// configured rate): when no frame from the autopilot's system id arrives within baud_probe of the open, the
-// next rate is due, in turn; the first that yields such a frame is kept. An autopilot silent (link down) for
-// unresponsive_timeout while its port is open is due a reset pulse, at most max_reset_pulses until the budget
-// is refilled (the driver does so on READY). Reboot evidence: time_boot_ms running slower than our clock, and
-// boot banners within kGapWindow of the link coming back.
+// Link up on the first heartbeat, down when a heartbeat is overdue by heartbeat_timeout; the verdict waits
+// kReadGrace more, so that a daemon that was itself stopped or starved (its timer and its port ready at
+// once, the frames of the pause still in the port) reads what came before it judges (longer while even that
+// wake comes late, at most heartbeat_timeout more). Baud probing (more than one configured rate): when no
+// frame from the autopilot's system id arrives within baud_probe of the open, the next rate is due, in turn;
+// the first that yields such a frame is kept. An autopilot silent (link down) for unresponsive_timeout while
+// its port is open is due a reset pulse, at most max_reset_pulses until the budget is refilled (the driver
+// does so on READY).
+//
+// Reboot evidence, and only this: the autopilot's time_boot_ms went back by more than kClockBackSlack and
+// ran on from the new value for kClockConfirm (the old clock not seen again meanwhile), or a heartbeat gap of
+// kBootGap or more ended by a heartbeat of a booting autopilot. A text is never evidence (ArduPilot sends its
+// banner on every parameter list request). At most one reboot is declared per kRebootSpacing; evidence
+// within that is held and declared when it ends (one declaration for all of it).
 //
 // What to do about it (events, port actions, the connection sequence) is the Driver's: it feeds the port
 // lifecycle, frames and heartbeats in, calls handle_timeout(now) when poll_timeout() is due and acts on the
@@ -14,7 +22,6 @@
 #include <cstdint>
 #include <optional>
 #include <string>
-#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -34,15 +41,31 @@ struct LinkWatchConfig {
 
 class LinkWatch {
   public:
-    /// Boot banners this long after the link came back mean the autopilot rebooted in the gap.
-    static constexpr Duration kGapWindow = seconds(10);
+    /// An overdue heartbeat is judged this long later: time for the input waiting in the port to be read.
+    static constexpr Duration kReadGrace = milliseconds(250);
+    /// A wake this late past its deadline means the daemon was not running: the grace starts again.
+    static constexpr Duration kLateWake = milliseconds(250);
+    /// A heartbeat gap this long (ArduPilot beats at 1 Hz) ended by a booting heartbeat is a reboot.
+    static constexpr Duration kBootGap = milliseconds(1500);
+    /// time_boot_ms going back by less than this is jitter between messages, not a restart.
+    static constexpr Duration kClockBackSlack = seconds(1);
+    /// How long a clock that went back must run on (the old one not seen again) before it counts.
+    static constexpr Duration kClockConfirm = milliseconds(1500);
+    /// At most one reboot declared per this long.
+    static constexpr Duration kRebootSpacing = seconds(10);
 
     /// What handle_timeout() found due.
     struct Due {
-        std::optional<Duration> lost;   // the link went down after this long without a heartbeat
-        std::optional<unsigned> baud;   // reconfigure the port to this rate
-        std::optional<unsigned> pulse;  // unresponsive: ask for reset pulse number N
-        bool pulses_exhausted = false;  // unresponsive, and the pulse budget is spent
+        std::optional<Duration> lost;       // the link went down after this long without a heartbeat
+        std::optional<unsigned> baud;       // reconfigure the port to this rate
+        std::optional<unsigned> pulse;      // unresponsive: ask for reset pulse number N
+        bool pulses_exhausted = false;      // unresponsive, and the pulse budget is spent
+        std::optional<std::string> reboot;  // reboot evidence held back by kRebootSpacing, declared now
+    };
+    /// What a heartbeat told.
+    struct HeartbeatSeen {
+        bool came_up = false;               // the link came up with it
+        std::optional<std::string> reboot;  // a reboot declared now, with its evidence
     };
 
     explicit LinkWatch(LinkWatchConfig config);
@@ -53,15 +76,13 @@ class LinkWatch {
     void on_reset_pulsed(TimePoint now);
     /// A valid frame from the autopilot's system id: ends baud probing.
     void on_frame();
-    /// Returns true when the link came up with this heartbeat.
-    bool on_heartbeat(TimePoint now);
-    /// `lowered` is a STATUSTEXT in lower case; true when it is a boot banner within the gap window.
-    bool reboot_banner(std::string_view lowered, TimePoint now) const;
-    /// Feeds the autopilot's time_boot_ms; with `watching` (not waiting for a boot) returns the reboot
-    /// evidence when the autopilot's clock ran slower than ours since the last sample.
+    /// `booting`: the heartbeat says the autopilot is starting up; `watching`: reboots are looked for (not
+    /// while a boot is being waited for).
+    HeartbeatSeen on_heartbeat(TimePoint now, bool booting, bool watching);
+    /// Feeds the autopilot's time_boot_ms; with `watching`, returns a reboot declared now.
     std::optional<std::string> on_time_boot(std::uint32_t time_boot_ms, TimePoint now, bool watching);
-    /// The clock of the boot being waited for starts again.
-    void forget_boot_clock() { time_boot_.reset(); }
+    /// The clock of the boot being waited for starts again; evidence held back is dropped.
+    void forget_boot_clock();
 
     Due handle_timeout(TimePoint now);
     TimePoint poll_timeout() const;
@@ -75,20 +96,38 @@ class LinkWatch {
     unsigned baud() const { return config_.bauds[baud_index_]; }
     /// Reset pulses asked for, ever.
     unsigned reset_pulses() const { return reset_pulses_; }
+    /// Times the link went down for want of heartbeats, ever.
+    unsigned link_losses() const { return link_losses_; }
+    /// Reboot evidence that came within kRebootSpacing of a declared reboot, ever.
+    unsigned reboots_held() const { return reboots_held_; }
 
   private:
+    struct ClockSample {
+        std::uint32_t ms = 0;
+        TimePoint at{};
+    };
+    std::optional<std::string> declare(std::string evidence, TimePoint now);
+
     LinkWatchConfig config_;
     bool port_open_ = false;
     bool up_ = false;
     TimePoint last_heartbeat_{};
-    TimePoint quiet_since_{};  // reference for the unresponsive timer
+    TimePoint heartbeat_due_ = kNever;        // the next look at an overdue heartbeat
+    std::optional<TimePoint> overdue_since_;  // the first look that found it overdue
+    TimePoint quiet_since_{};                 // reference for the unresponsive timer
     bool heard_frame_ = false;
     std::size_t baud_index_ = 0;
     TimePoint baud_deadline_ = kNever;
     unsigned pulses_ = 0;
     unsigned reset_pulses_ = 0;
-    TimePoint gap_window_end_{};
-    std::optional<std::pair<std::uint32_t, TimePoint>> time_boot_;
+    unsigned link_losses_ = 0;
+    // Reboot evidence.
+    std::optional<ClockSample> clock_;          // the autopilot's clock as trusted
+    std::optional<ClockSample> restart_first_;  // where it went back to, while that is being confirmed
+    ClockSample restart_last_;                  // its latest sample since
+    TimePoint next_reboot_allowed_{};
+    std::optional<std::string> held_reboot_;
+    unsigned reboots_held_ = 0;
 };
 
 }  // namespace airseg::autopilot::ardupilot

@@ -2,9 +2,11 @@
 // operator's side is airsegctl on the local socket. The simulator's control socket says what the board
 // really did. Simulated time runs faster than real time on the board's side (--speedup); every wait is on a
 // condition with a generous deadline.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <poll.h>
+#include <pty.h>
 #include <signal.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
@@ -14,8 +16,11 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <iostream>
 #include <nlohmann/json.hpp>
+#include <thread>
 
+#include "services/autopilot/mavlink/encoder.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
 #include "tests/support/control_client.hpp"
 #include "tests/support/ground_station.hpp"
@@ -306,6 +311,68 @@ class GcsEndpointE2e : public AutopilotE2e {
     GroundStation gcs_;
 };
 
+// A second station on the board's network asks for the parameter list every 30 s of the board's time for 10
+// minutes (60 s here at x10). Current ArduPilot, and airseg-apmsim's modern profile, answer each with the
+// banner before the parameters, on the one link: airsegd hears every banner too. A banner is no reboot (it
+// used to be one within 10 s of the link coming up, a loop with the daemon's own parameter request); the
+// board's real reboot still is one.
+TEST_F(GcsEndpointE2e, ParameterListsFromAnotherStationBringBannersButNoReboot) {
+    ASSERT_TRUE(wait_until([&] { return ready(); }, kGenerous, kPoll)) << daemon_->err();
+    const auto at_ready = autopilot_section();
+    EXPECT_EQ(at_ready["reboots"], 0) << at_ready.dump() << daemon_->err();
+    EXPECT_EQ(at_ready["syncs"], 1) << at_ready.dump();
+    send(gcs_.heartbeat());
+    const auto board_t = [&] { return control_->json("state").value("t", 0.0); };
+    const auto banner = [](const mavlink::Frame& f) {
+        return f.msgid == mavlink::Statustext::kId && f.sysid == 1 &&
+               mavlink::text_of(mavlink::decode_payload<mavlink::Statustext>(f.payload_view()).text)
+                   .starts_with("ArduRover V4.");
+    };
+    // Everything the station hears is read as it comes (the parameters follow each banner, and the board's
+    // telemetry all the time), the banners counted.
+    int banners = 0;
+    const auto listen = [&](std::chrono::milliseconds for_) {
+        hear(
+            [&](const mavlink::Frame& f) {
+                banners += banner(f) ? 1 : 0;
+                return false;
+            },
+            for_);
+    };
+    const double start = board_t();
+    for (int request = 0; request < 20; ++request) {
+        const double asked = board_t();
+        send(gcs_.list_params());
+        ASSERT_TRUE(wait_until(
+            [&] {
+                listen(100ms);
+                return board_t() >= asked + 30.0;
+            },
+            kGenerous, kPoll));
+    }
+    listen(1s);
+    const double board_minutes = (board_t() - start) / 60.0;
+    const auto after = autopilot_section();
+    EXPECT_EQ(banners, 20) << "each request brought the banner to the station";
+    EXPECT_EQ(after["reboots"], 0) << after.dump() << daemon_->err();
+    EXPECT_EQ(after["syncs"], 1) << "the parameters and the mission were read once";
+    EXPECT_EQ(after["link_losses"], 0);
+    EXPECT_EQ(after["ready_s"], at_ready["ready_s"]);
+    EXPECT_EQ(daemon_->err().find("rebooted"), std::string::npos) << daemon_->err();
+
+    ASSERT_EQ(control_->ask("reboot").value_or("").rfind("ok", 0), 0u);
+    EXPECT_TRUE(wait_until([&] { return autopilot_section().value("reboots", 0) == 1; }, kGenerous, kPoll))
+        << daemon_->err();
+    EXPECT_TRUE(wait_until([&] { return ready(); }, kGenerous, kPoll)) << daemon_->err();
+    const auto rebooted = autopilot_section();
+    EXPECT_EQ(rebooted["reboots"], 1) << rebooted.dump();
+    EXPECT_EQ(rebooted["syncs"], 2) << rebooted.dump();
+    std::cout << "[ figures ] " << banners << " parameter lists with their banner over " << board_minutes
+              << " board minutes: " << after["reboots"] << " reboots, " << after["syncs"]
+              << " syncs; ready_s " << at_ready["ready_s"] << "; a real reboot: " << rebooted["reboots"]
+              << " reboot, " << rebooted["syncs"] << " syncs\n";
+}
+
 TEST_F(GcsEndpointE2e, AGroundStationsMissionBecomesThePlanAndAnotherIsRefusedWhileItRuns) {
     ASSERT_TRUE(wait_until([&] { return ready(); }, kGenerous, kPoll)) << daemon_->err();
     send(gcs_.heartbeat());
@@ -336,6 +403,77 @@ TEST_F(GcsEndpointE2e, AGroundStationsMissionBecomesThePlanAndAnotherIsRefusedWh
 
 INSTANTIATE_TEST_SUITE_P(Firmware, AutopilotFirmwareE2e, ::testing::Values("modern", "rover2"),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
+
+// airsegd with a scripted board on a pseudo-terminal (the test holds the master end): the heartbeats of a
+// running board, and GLOBAL_POSITION_INT with time_boot_ms flipping between 2^32-1 and 0, 200 frames a
+// second for 5 s (a broken or hostile peer). Not a reboot, and no log line per frame (that was 4.3 MB of log
+// a second).
+TEST(AutopilotHostileClock, TimeBootFlippingBetweenItsLimitsIsNoRebootAndNoLogFlood) {
+    TempDir dir;
+    int master = -1;
+    int slave = -1;
+    std::array<char, 128> name{};
+    ASSERT_EQ(::openpty(&master, &slave, name.data(), nullptr, nullptr), 0);
+    ::fcntl(master, F_SETFL, ::fcntl(master, F_GETFL) | O_NONBLOCK);
+    Subprocess daemon({binary("daemon/airsegd"), "--config", source_path("config/airseg.yaml"), "--set",
+                       "status.socket=" + dir.file("status.sock"), "--set", "state_dir=" + dir.file("state"),
+                       "--set", std::string("autopilot.port=") + name.data(), "--set",
+                       "autopilot.board=pixhawk", "--set", "groundlink.ports=[" + dir.file("ttyUSB0") + "]"},
+                      {}, dir.path());
+    const auto autopilot = [&] {
+        const auto r = run({binary("client/airsegctl"), "--local", "--socket", dir.file("status.sock"),
+                            "--json", "--timeout", "5000", "status"},
+                           {}, 30s);
+        const auto j = Json::parse(r.out, nullptr, false);
+        return r.exit_code == 0 && j.is_object() ? j.value("autopilot", Json()) : Json();
+    };
+    ASSERT_TRUE(wait_until([&] { return autopilot().is_object(); }, kGenerous, kPoll)) << daemon.err();
+
+    mavlink::Encoder board(1, 1);
+    const auto put = [&](const auto& message) {
+        const auto bytes = board.encode(message);
+        EXPECT_EQ(::write(master, bytes.data(), bytes.size()), static_cast<ssize_t>(bytes.size()));
+        std::array<std::uint8_t, 4096> sink{};
+        while (::read(master, sink.data(), sink.size()) > 0) {
+            // what the daemon asks of the board goes unanswered
+        }
+    };
+    mavlink::Heartbeat hb;
+    hb.type = 10;
+    hb.autopilot = 3;
+    hb.base_mode = 1;
+    hb.custom_mode = 4;    // HOLD
+    hb.system_status = 3;  // STANDBY
+    put(hb);
+    ASSERT_TRUE(wait_until([&] { return autopilot().value("link", "") == "up"; }, kGenerous, kPoll))
+        << daemon.err();
+    const auto log_before = daemon.err().size();
+    mavlink::GlobalPositionInt position;
+    position.lat = 412756000;
+    position.lon = 19866000;
+    const auto start = std::chrono::steady_clock::now();
+    for (int frame = 0; std::chrono::steady_clock::now() - start < 5s; ++frame) {
+        if (frame % 200 == 0) {
+            put(hb);
+        }
+        position.time_boot_ms = frame % 2 == 0 ? 0xFFFFFFFFu : 0u;
+        put(position);
+        std::this_thread::sleep_for(5ms);  // the board's pace, not a wait for an outcome
+    }
+    put(hb);
+    const auto ap = autopilot();
+    const auto log_growth = daemon.err().size() - log_before;
+    EXPECT_EQ(ap.value("reboots", 99), 0) << ap.dump() << daemon.err().substr(0, 4000);
+    EXPECT_EQ(ap.value("link", ""), "up") << ap.dump();
+    EXPECT_EQ(daemon.err().find("rebooted"), std::string::npos);
+    EXPECT_LT(log_growth, 4096u) << daemon.err().substr(log_before, 4000);
+    std::cout << "[ figures ] time_boot_ms flipping 2^32-1/0 for 5 s at 200 frames/s: "
+              << ap.value("reboots", 99) << " reboots, " << log_growth << " bytes of log\n";
+    daemon.signal(SIGTERM);
+    EXPECT_EQ(daemon.wait_exit(10s), 0) << daemon.err();
+    ::close(master);
+    ::close(slave);
+}
 
 }  // namespace
 }  // namespace airseg::test

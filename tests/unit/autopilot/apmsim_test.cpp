@@ -67,12 +67,23 @@ struct SimRig {
     Party board() {
         Party p;
         p.receive = [this](std::span<const std::uint8_t> b, TimePoint now) { sim.handle_bytes(b, now); };
+        // What the board has ready goes on the line in pieces of a UART's size, as a serial port delivers it:
+        // the first of a long burst (the parameter list) arrives after its own air time, not after the whole
+        // burst's.
         p.transmit = [this]() -> std::optional<std::vector<std::uint8_t>> {
-            auto bytes = sim.poll_transmit();
-            if (bytes.empty()) {
+            if (board_pending.empty()) {
+                auto bytes = sim.poll_transmit();
+                board_pending.insert(board_pending.end(), bytes.begin(), bytes.end());
+            }
+            if (board_pending.empty()) {
                 return std::nullopt;
             }
-            return bytes;
+            const auto n = std::min(board_pending.size(), kBoardChunk);
+            std::vector<std::uint8_t> piece(board_pending.begin(),
+                                            board_pending.begin() + static_cast<std::ptrdiff_t>(n));
+            board_pending.erase(board_pending.begin(),
+                                board_pending.begin() + static_cast<std::ptrdiff_t>(n));
+            return piece;
         };
         p.on_timeout = [this](TimePoint now) { sim.handle_timeout(now); };
         p.deadline = [this] { return sim.poll_timeout(); };
@@ -126,6 +137,8 @@ struct SimRig {
     Harness harness;
     std::vector<Event> events;
     std::deque<std::vector<std::uint8_t>> also_sent;
+    static constexpr std::size_t kBoardChunk = 64;  // a 16550-style UART FIFO
+    std::vector<std::uint8_t> board_pending;
 };
 
 std::vector<MissionItem> square(std::size_t n, double step_deg = 2e-4) {

@@ -405,18 +405,88 @@ TEST(Driver, RebootDuringAHeartbeatSilenceIsDetectedByItsClock) {
     EXPECT_NE(rig.all<AutopilotRebooted>()[0].evidence.find("time_boot_ms"), std::string::npos);
 }
 
-TEST(Driver, BootBannersRightAfterAGapMeanAReboot) {
-    auto opts = apm2_rover();
-    opts.calibration = Duration::zero();
-    opts.boot_delay = milliseconds(500);
-    Rig rig(apm2_config(), opts);
+TEST(Driver, ABootAfterAHeartbeatGapIsSeenAtItsFirstHeartbeat) {
+    Rig rig(apm2_config(), apm2_rover());
     rig.bring_up();
     rig.harness.run_for(seconds(30));
-    rig.rover.stall(rig.now() + seconds(6));
-    rig.harness.run_for(seconds(6));
-    rig.rover.reboot(rig.now());
+    rig.rover.reboot(rig.now());  // silent for 2 s, then heartbeats saying CALIBRATING
+    const TimePoint rebooted = rig.now();
     ASSERT_TRUE(rig.run_until_event<AutopilotRebooted>(1, seconds(20)));
+    EXPECT_LE(rig.now() - rebooted, seconds(2) + milliseconds(100));
+    EXPECT_NE(rig.all<AutopilotRebooted>()[0].evidence.find("heartbeat gap"), std::string::npos)
+        << rig.all<AutopilotRebooted>()[0].evidence;
+    ASSERT_TRUE(rig.run_until_event<Ready>(2, seconds(40)));
     EXPECT_EQ(rig.driver.status().reboots, 1u);
+    EXPECT_EQ(rig.driver.status().syncs, 2u);
+    EXPECT_EQ(rig.all<AutopilotRebooted>().size(), 1u);
+}
+
+// Current ArduPilot answers every PARAM_REQUEST_LIST with its banner ("ArduRover V4.x (hash)", the OS and
+// board lines): the daemon's own request, and every other station's. A banner is no reboot: it used to be
+// taken for one within 10 s of the link coming up, which asked for the parameters again, which brought the
+// banner again, until the 10 s were over.
+TEST(Driver, TheBannerOnEveryParameterListIsNoReboot) {
+    auto config = AutopilotConfig::defaults_for(Board::Pixhawk);
+    config.bauds = {115200};
+    FakeRover::Options o;
+    o.banner_on_param_list = true;
+    Rig rig(config, o);
+    rig.open_with_reset();
+    const TimePoint opened = rig.now();
+    ASSERT_TRUE(rig.run_until_event<Ready>(1, seconds(40))) << rig.driver.last_error();
+    const double took = std::chrono::duration<double>(rig.now() - opened).count();
+    EXPECT_LE(took, 2.0 + 1.0 + 1.0);
+    ASSERT_TRUE(rig.driver.status().ready_s);
+    EXPECT_NEAR(*rig.driver.status().ready_s, took, 1e-6) << "from the port's open";
+    // Another station asks for the parameter list every 30 s for 10 minutes.
+    for (int i = 0; i < 20; ++i) {
+        rig.rover.parameter_list_asked(rig.now());
+        rig.harness.run_for(seconds(30));
+    }
+    std::size_t banners = 0;
+    for (const auto& t : rig.all<StatusText>()) {
+        banners += t.text.starts_with("ArduRover V4") ? 1 : 0;
+    }
+    EXPECT_EQ(banners, 21u);
+    EXPECT_TRUE(rig.all<AutopilotRebooted>().empty()) << rig.all<AutopilotRebooted>()[0].evidence;
+    EXPECT_EQ(rig.driver.status().reboots, 0u);
+    EXPECT_EQ(rig.driver.status().syncs, 1u) << "the parameters and the mission were read once";
+    EXPECT_EQ(rig.all<Ready>().size(), 1u);
+    EXPECT_TRUE(rig.driver.ready());
+}
+
+// airsegd itself stopped (SIGSTOP) or starved for 1.5-5 s while the board streams on: when it runs again its
+// timer and its port are ready at once, and the timer is served first (the worst order). The heartbeats and
+// the clock samples sent meanwhile are in the port; the link was never lost and the board never rebooted.
+TEST(Driver, TheDaemonsOwnStallsAreNotTheAutopilotsSilence) {
+    Rig rig(apm2_config(), apm2_rover());
+    rig.bring_up();
+    rig.harness.run_for(seconds(20));
+    const auto link_downs = rig.all<LinkDown>().size();
+    for (const Duration stall : {milliseconds(1500), milliseconds(2100), milliseconds(3300),
+                                 milliseconds(4200), milliseconds(5000), milliseconds(2950)}) {
+        rig.harness.stall_ground(rig.now() + stall);
+        rig.harness.run_for(stall + seconds(7));
+    }
+    EXPECT_EQ(rig.all<LinkDown>().size(), link_downs);
+    EXPECT_TRUE(rig.all<AutopilotRebooted>().empty()) << rig.all<AutopilotRebooted>()[0].evidence;
+    EXPECT_EQ(rig.driver.status().reboots, 0u);
+    EXPECT_EQ(rig.driver.status().link_losses, 0u);
+    EXPECT_EQ(rig.driver.status().syncs, 1u) << "no parameter or mission re-download";
+    EXPECT_EQ(rig.all<Ready>().size(), 1u);
+    EXPECT_TRUE(rig.driver.ready());
+}
+
+// A board that really stops during the daemon's stall is still found silent, a grace later.
+TEST(Driver, ABoardSilentAcrossTheDaemonsStallIsStillLost) {
+    Rig rig(apm2_config(), apm2_rover());
+    rig.bring_up();
+    const TimePoint t0 = rig.now();
+    rig.rover.stall(t0 + seconds(30));
+    rig.harness.stall_ground(t0 + seconds(4));
+    ASSERT_TRUE(rig.run_until_event<LinkDown>(1, seconds(10)));
+    EXPECT_LE(rig.now() - t0, seconds(4) + LinkWatch::kReadGrace + milliseconds(10));
+    EXPECT_EQ(rig.driver.status().link_losses, 1u);
 }
 
 TEST(Driver, HeartbeatStallOfTenSecondsIsLinkDownThenUpWithoutReboot) {

@@ -49,6 +49,17 @@ void FakeRover::reboot(TimePoint now) {
     out_.push_back({0x00, 0xFE, 0x13, 0x37, 0xFD, 0x02});  // bootloader noise
 }
 
+void FakeRover::parameter_list_asked(TimePoint) {
+    if (options_.banner_on_param_list) {
+        text(6, "ArduRover V4.6.2 (fake0001)");
+        text(6, "ChibiOS: 6a85082c");
+        text(6, "fakeboard 00000001 00000002 00000003");
+    }
+    for (std::size_t i = 0; i < param_order_.size(); ++i) {
+        send_param(i);
+    }
+}
+
 std::uint32_t FakeRover::time_boot_ms(TimePoint now) const {
     return static_cast<std::uint32_t>(std::chrono::duration_cast<milliseconds>(now - boot_start_).count());
 }
@@ -355,9 +366,7 @@ void FakeRover::on_frame(const mav::Frame& f, TimePoint now) {
             send_ack(0);
             return;
         case mav::ParamRequestList::kId:
-            for (std::size_t i = 0; i < param_order_.size(); ++i) {
-                send_param(i);
-            }
+            parameter_list_asked(now);
             return;
         case mav::ParamRequestRead::kId: {
             const auto m = mav::decode_payload<mav::ParamRequestRead>(f.payload_view());

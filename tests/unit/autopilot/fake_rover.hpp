@@ -43,6 +43,7 @@ class FakeRover {
         bool change_speed_command = true;      // knows MAV_CMD_DO_CHANGE_SPEED (else UNSUPPORTED)
         bool loiter_unlim = true;              // stores NAV_LOITER_UNLIM (else MAV_MISSION_UNSUPPORTED)
         bool uninit_in_hold = false;           // heartbeats say MAV_STATE_UNINIT in HOLD (APM:Rover 2.x)
+        bool banner_on_param_list = false;     // the banner texts before the parameters (ArduPilot 4.x)
     };
 
     explicit FakeRover(Options options, TimePoint now);
@@ -60,6 +61,9 @@ class FakeRover {
     void pilot_sets_mode(std::uint32_t mode, TimePoint now);
     /// The vehicle reaches mission slot `seq` (MISSION_ITEM_REACHED and/or the STATUSTEXT).
     void reach(std::uint16_t seq, TimePoint now);
+    /// Another ground station asked for the parameter list: the answer (banner, parameters) goes out here
+    /// too.
+    void parameter_list_asked(TimePoint now);
 
     std::uint32_t mode() const { return mode_; }
     bool booted(TimePoint now) const { return now >= boot_done_; }

@@ -2,7 +2,9 @@
 // Two sans-IO parties joined by a simulated serial link, in virtual time that jumps to the next wake-up.
 // Each direction serialises frames at the link's byte rate (10 bits per byte), adds a latency, and drops
 // whole frames or single bytes with seeded probabilities. The drive loop is bounded so a livelock fails the
-// test instead of hanging it.
+// test instead of hanging it. stall_ground() models the ground's process stopped or starved: it is not
+// called until then, what comes for it waits, and when it runs again its timer is served before the bytes
+// that waited (the worst order; asio may serve a ready timer and a ready read either way).
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -81,6 +83,8 @@ class Harness {
           now_(start) {}
 
     TimePoint now() const { return now_; }
+    /// The ground does not run until `until` (SIGSTOP, starvation).
+    void stall_ground(TimePoint until) { ground_stalled_until_ = until; }
     Pipe& to_vehicle() { return to_vehicle_; }
     Pipe& to_ground() { return to_ground_; }
 
@@ -91,8 +95,10 @@ class Harness {
             if (done()) {
                 return true;
             }
-            const TimePoint t =
-                std::min({ground_.deadline(), vehicle_.deadline(), to_vehicle_.next(), to_ground_.next()});
+            const bool stalled = now_ < ground_stalled_until_;
+            const TimePoint ground_next =
+                stalled ? ground_stalled_until_ : std::min(ground_.deadline(), to_ground_.next());
+            const TimePoint t = std::min({ground_next, vehicle_.deadline(), to_vehicle_.next()});
             if (t > limit) {
                 now_ = std::max(now_, limit);
                 return done();
@@ -101,10 +107,16 @@ class Harness {
             while (auto f = to_vehicle_.pop_due(now_)) {
                 vehicle_.receive(*f, now_);
             }
-            while (auto f = to_ground_.pop_due(now_)) {
-                ground_.receive(*f, now_);
+            const bool resumed = stalled && now_ >= ground_stalled_until_;
+            if (resumed && ground_.deadline() <= now_) {
+                ground_.on_timeout(now_);
             }
-            if (ground_.deadline() <= now_) {
+            if (now_ >= ground_stalled_until_) {
+                while (auto f = to_ground_.pop_due(now_)) {
+                    ground_.receive(*f, now_);
+                }
+            }
+            if (now_ >= ground_stalled_until_ && ground_.deadline() <= now_) {
                 ground_.on_timeout(now_);
             }
             if (vehicle_.deadline() <= now_) {
@@ -120,7 +132,11 @@ class Harness {
 
   private:
     void flush() {
-        while (auto f = ground_.transmit()) {
+        while (now_ >= ground_stalled_until_) {
+            auto f = ground_.transmit();
+            if (!f) {
+                break;
+            }
             to_vehicle_.send(std::move(*f), now_);
         }
         while (auto f = vehicle_.transmit()) {
@@ -133,6 +149,7 @@ class Harness {
     Pipe to_vehicle_;
     Pipe to_ground_;
     TimePoint now_;
+    TimePoint ground_stalled_until_{};
 };
 
 }  // namespace airseg::autopilot::testing

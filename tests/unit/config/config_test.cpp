@@ -312,6 +312,8 @@ TEST(AutopilotStatus, SectionCarriesTheDocumentedKeys) {
     s.position = autopilot::Position{41.3, 2.1, 10};
     s.mission_current = 3;
     s.reboots = 1;
+    s.link_losses = 4;
+    s.syncs = 2;
     s.reconnects = 2;
     const auto j = autopilot_status_json(s);
     EXPECT_EQ(j["link"], "up");
@@ -323,6 +325,8 @@ TEST(AutopilotStatus, SectionCarriesTheDocumentedKeys) {
     EXPECT_DOUBLE_EQ(j["position"]["lon"].get<double>(), 2.1);
     EXPECT_EQ(j["mission_current"], 3);
     EXPECT_EQ(j["reboots"], 1);
+    EXPECT_EQ(j["link_losses"], 4);
+    EXPECT_EQ(j["syncs"], 2);
     EXPECT_EQ(j["reconnects"], 2);
     const auto down = autopilot_status_json(autopilot::AutopilotStatus{});
     EXPECT_EQ(down["link"], "down");
