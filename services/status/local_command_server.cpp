@@ -76,7 +76,8 @@ class LocalCommandServer::Session : public std::enable_shared_from_this<Session>
     }
 
     void send_line(const Json& value, bool close_after) {
-        outbox_.push_back(value.dump() + "\n");
+        // Texts from the autopilot (STATUSTEXT, parameter names) may be any bytes: shown, never thrown on.
+        outbox_.push_back(value.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n");
         close_after_ = close_after_ || close_after;
         if (outbox_.size() == 1) {
             do_write();
