@@ -210,8 +210,8 @@ class App::Impl {
         notifier_.reloading();
         auto result = load_config_file(options_.config_path, options_.overrides);
         if (!result.ok()) {
-            for (const auto& e : result.errors) {
-                spdlog::error("config: {}", e.to_string());
+            for (const auto& line : result.error_lines()) {
+                spdlog::error("config: {}", line);
             }
             spdlog::error("config: {} is invalid; keeping the running configuration", options_.config_path);
             notifier_.ready();
