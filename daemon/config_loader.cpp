@@ -69,25 +69,27 @@ class Errors {
     ConfigResult& result_;
 };
 
-/// The first scalar under `node` (itself included) holding a control character; defined and null if none.
-/// Escapes ("\0", "\x01") put them in a value although the file's text has none.
-YAML::Node scalar_with_control(const YAML::Node& node) {
+/// The first scalar of `node` (itself, or an item or key or value of it, as deep as a key's value is read: a
+/// list, a mapping) holding a control character; a null node if none. Escapes ("\0", "\x01") put them in a
+/// value although the file's text has none. Not deeper: a YAML alias bomb nests lists without end, and no key
+/// reads below that depth.
+YAML::Node scalar_with_control(const YAML::Node& node, int depth = 1) {
     if (node.IsScalar()) {
         for (const char c : node.Scalar()) {
             if (is_control(static_cast<unsigned char>(c))) {
                 return node;
             }
         }
-    } else if (node.IsSequence()) {
+    } else if (depth > 0 && node.IsSequence()) {
         for (const auto& item : node) {
-            if (auto found = scalar_with_control(item); !found.IsNull()) {
+            if (auto found = scalar_with_control(item, depth - 1); !found.IsNull()) {
                 return found;
             }
         }
-    } else if (node.IsMap()) {
+    } else if (depth > 0 && node.IsMap()) {
         for (const auto& entry : node) {
             for (const auto& part : {entry.first, entry.second}) {
-                if (auto found = scalar_with_control(part); !found.IsNull()) {
+                if (auto found = scalar_with_control(part, depth - 1); !found.IsNull()) {
                     return found;
                 }
             }

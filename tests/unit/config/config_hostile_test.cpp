@@ -109,6 +109,24 @@ TEST(ConfigHostile, InvalidUtf8AndControlCharactersAreErrorsAtTheirPlace) {
     EXPECT_EQ(r.errors[0].where, "--set");
 }
 
+// A billion laughs: nine levels of ten aliases. The check for control characters in values must not walk
+// them.
+TEST(ConfigHostile, AnAliasBombInAValueIsRefusedQuickly) {
+    std::string text = "groundlink:\n  ports: &l0 [\"/dev/ttyUSB0\", \"/dev/ttyUSB1\"]\n";
+    for (int level = 1; level <= 9; ++level) {
+        text += "  l" + std::to_string(level) + ": &l" + std::to_string(level) + " [";
+        for (int i = 0; i < 10; ++i) {
+            text += std::string(i ? ", " : "") + "*l" + std::to_string(level - 1);
+        }
+        text += "]\n";
+    }
+    text += "autopilot:\n  port: *l9\n";
+    const auto started = std::chrono::steady_clock::now();
+    const auto r = load_config_text(text, "bomb.yaml");
+    EXPECT_LT(std::chrono::steady_clock::now() - started, std::chrono::seconds(5));
+    EXPECT_FALSE(r.ok());
+}
+
 TEST(ConfigHostile, ASecondDocumentAndANonMappingRootAreErrors) {
     auto r = load_config_text("log_level: info\n---\nlog_level: debug\n", "two.yaml");
     ASSERT_EQ(r.errors.size(), 1u) << joined(r);
