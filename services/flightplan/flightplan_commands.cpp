@@ -12,6 +12,9 @@ namespace airseg::flightplan {
 
 namespace {
 
+/// The longest "source" or "path" of a plan request (PATH_MAX).
+constexpr std::size_t kMaxSourceBytes = 4096;
+
 struct PlanText {
     std::string text;
     std::string source;
@@ -38,13 +41,19 @@ PlanText plan_text_of(const Json& req) {
             source != req.end() && source->is_string() && !source->get_ref<const std::string&>().empty()
                 ? source->get<std::string>()
                 : std::string("<inline>");
+        if (out.source.size() > kMaxSourceBytes) {
+            // The source is shown in every status document while the plan runs.
+            out.error = "\"source\" longer than the " + std::to_string(kMaxSourceBytes) + " bytes allowed";
+            return out;
+        }
         if (out.text.size() > kMaxPlanTextBytes) {
             out.error = "plan larger than " + std::to_string(kMaxPlanTextBytes) + " bytes";
         }
         return out;
     }
-    if (!path->is_string() || path->get_ref<const std::string&>().empty()) {
-        out.error = "\"path\" must be a file name";
+    if (!path->is_string() || path->get_ref<const std::string&>().empty() ||
+        path->get_ref<const std::string&>().size() > kMaxSourceBytes) {
+        out.error = "\"path\" must be a file name of at most " + std::to_string(kMaxSourceBytes) + " bytes";
         return out;
     }
     out.source = path->get<std::string>();
