@@ -105,7 +105,7 @@ inline TextPosition position_of(std::string_view text, std::size_t offset) {
 /// Text from outside as it may appear in a message: malformed bytes and control characters written as \xNN
 /// (so a message is always valid UTF-8 and one line), and cut after `max_chars` characters with "…" and the
 /// whole length, so a 10 MB value is not echoed whole.
-inline std::string printable(std::string_view text, std::size_t max_chars = 80) {
+inline std::string excerpt(std::string_view text, std::size_t max_chars = 80) {
     constexpr char kHex[] = "0123456789abcdef";
     std::string out;
     std::size_t chars = 0;

@@ -227,7 +227,7 @@ class App::Impl {
         }
         for (const auto& c : changes) {
             // Values are cut as in the loader's errors: a long one is not logged whole.
-            const auto from = printable(c.from, 256), to = printable(c.to, 256);
+            const auto from = excerpt(c.from, 256), to = excerpt(c.to, 256);
             if (c.runtime) {
                 spdlog::info("config: {}: {} -> {} (applied)", c.key, from, to);
             } else {

@@ -51,7 +51,7 @@ std::string suggestion(const std::string& path) {
 }
 
 /// The errors of one load: the first kMaxListedConfigErrors listed, the rest only counted. A key echoed in an
-/// error is cut (printable), so a megabyte-long key is not printed whole.
+/// error is cut (excerpt), so a megabyte-long key is not printed whole.
 class Errors {
   public:
     explicit Errors(ConfigResult& result) : result_(result) {}
@@ -62,7 +62,7 @@ class Errors {
             ++result_.unlisted_errors;
             return;
         }
-        result_.errors.push_back({std::move(where), printable(key), std::move(message)});
+        result_.errors.push_back({std::move(where), excerpt(key), std::move(message)});
     }
 
   private:
@@ -102,7 +102,7 @@ std::string control_message(const YAML::Node& node) {
     for (const char c : node.Scalar()) {
         if (is_control(static_cast<unsigned char>(c))) {
             return fmt::format("a control character (0x{:02x}) in '{}': not allowed in a configuration value",
-                               static_cast<unsigned char>(c), printable(node.Scalar()));
+                               static_cast<unsigned char>(c), excerpt(node.Scalar()));
         }
     }
     return "a control character";
@@ -147,7 +147,7 @@ class Walker {
                 error(key_node.Mark(), path, "");  // counted, not listed: spare the suggestion's work
             } else {
                 error(key_node.Mark(), path,
-                      fmt::format("unknown key '{}'{}", printable(path), suggestion(path)));
+                      fmt::format("unknown key '{}'{}", excerpt(path), suggestion(path)));
             }
         }
     }
@@ -167,14 +167,14 @@ void apply_override(const std::string& text, Config& config, Errors& errors,
                     std::map<std::string, std::string>& where) {
     const auto eq = text.find('=');
     if (eq == std::string::npos || eq == 0) {
-        errors.add("--set", "", fmt::format("'{}' must be KEY=VALUE", printable(text)));
+        errors.add("--set", "", fmt::format("'{}' must be KEY=VALUE", excerpt(text)));
         return;
     }
     const std::string key = text.substr(0, eq);
     const std::string value = text.substr(eq + 1);
     const KeySpec* spec = find_key(key);
     if (spec == nullptr) {
-        errors.add("--set", key, fmt::format("unknown key '{}'{}", printable(key), suggestion(key)));
+        errors.add("--set", key, fmt::format("unknown key '{}'{}", excerpt(key), suggestion(key)));
         return;
     }
     where[key] = "--set " + key;

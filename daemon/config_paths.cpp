@@ -16,7 +16,7 @@ namespace fs = std::filesystem;
 
 /// A path in a message: long enough for /dev/serial/by-id/ names, cut before it drowns the message.
 std::string shown(const std::string& path) {
-    return printable(path, 256);
+    return excerpt(path, 256);
 }
 
 /// The device a path reaches, through symlinks such as /dev/serial/by-id/..., when it exists.

@@ -80,7 +80,7 @@ void CommandDispatcher::dispatch(const Json& request, Role caller, Reply reply) 
     // source, a name) would make every later dump of the status document throw.
     if (const auto where = invalid_text(request)) {
         reply(CommandResult::fail(CommandStatus::BadRequest,
-                                  "request text is not valid UTF-8 (at " + printable(*where) + ")"));
+                                  "request text is not valid UTF-8 (at " + excerpt(*where) + ")"));
         return;
     }
     const auto name = request["cmd"].get<std::string>();
@@ -94,7 +94,7 @@ void CommandDispatcher::dispatch(const Json& request, Role caller, Reply reply) 
     }
     if (!entry) {
         reply(
-            CommandResult::fail(CommandStatus::UnknownCommand, "unknown command '" + printable(name) + "'"));
+            CommandResult::fail(CommandStatus::UnknownCommand, "unknown command '" + excerpt(name) + "'"));
         return;
     }
     if (entry->required == Role::Control && caller != Role::Control) {

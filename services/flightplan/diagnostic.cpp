@@ -15,9 +15,9 @@ std::string Diagnostic::to_string() const {
     // A path holds the plan's own keys, a message may quote its names: cut, so that a megabyte-long key is
     // not echoed whole.
     if (!path.empty()) {
-        out += printable(path, 200) + ": ";
+        out += excerpt(path, 200) + ": ";
     }
-    out += printable(message, 400);
+    out += excerpt(message, 400);
     return out;
 }
 

@@ -552,7 +552,7 @@ void PlanController::skip(CommandId id, std::variant<std::uint64_t, std::string>
     } else {
         const auto& name = std::get<std::string>(target);
         if (!feeder_.jump_to(name, now)) {
-            reply(id, Status::BadRequest, "the plan has no element named '" + printable(name) + "'");
+            reply(id, Status::BadRequest, "the plan has no element named '" + excerpt(name) + "'");
             return;
         }
     }

@@ -643,7 +643,7 @@ PlanParser::ListTarget PlanParser::plan_head(const YRef& p) {
     return {plan_.main_list, path + ".elements", p};
 }
 
-void PlanParser::finish_geometry() {
+void PlanParser::finish_geometry(std::uint64_t max_scan_work) {
     plan_.frame = LocalFrame(reference_.value_or(first_coordinate_.value_or(LatLon{})));
     const LocalFrame& f = plan_.frame;
     auto to_local = [&](const std::vector<LatLon>& poly) {
@@ -674,7 +674,7 @@ void PlanParser::finish_geometry() {
         auto& scan = plan_.extra_for(id).scan;
         // Laying the scans out (counting their waypoints) crosses every line with every edge: a budget for
         // the whole plan, so that no plan keeps the service busy for long.
-        const std::uint64_t budget = kMaxScanWork - std::min(kMaxScanWork, scan_work_);
+        const std::uint64_t budget = max_scan_work - std::min(max_scan_work, scan_work_);
         scan.emplace(std::move(local), raw.spacing, raw.heading, raw.step, plan_.vehicle.min_spacing, budget);
         if (scan->too_many_lines()) {
             const bool lines = scan->work() / static_cast<double>(scan->polygon().size()) >
@@ -685,7 +685,7 @@ void PlanParser::finish_geometry() {
                         : "too small for this polygon: its lines times the polygon's edges (" +
                               std::to_string(std::llround(scan->work())) + ")" +
                               (scan_work_ > 0 ? ", with the plan's scans before it," : "") + " exceed the " +
-                              std::to_string(kMaxScanWork) +
+                              std::to_string(max_scan_work) +
                               " line-edge crossings a plan's scans may take to lay out");
             scan.reset();
         } else if (scan->total_count() == 0) {
@@ -820,7 +820,7 @@ LoadResult PlanParser::finish(const LoadOptions& options) {
                                                 " more position" + (out_of_frame_ > 2 ? "s" : "") + ")";
     }
     if (errors_.empty()) {
-        finish_geometry();
+        finish_geometry(options.max_scan_work);
         resolve_names();
         derive_counts(options);
     }

@@ -24,10 +24,6 @@ namespace airseg::flightplan {
 inline constexpr std::size_t kMaxTextBytes = 256;
 /// The most vertices of one polygon (a scan's area, a no-fly zone, the geofence).
 inline constexpr std::size_t kMaxPolygonVertices = 1000;
-/// The most line-edge crossings (scan lines x polygon vertices, all scans of a plan together) laying out a
-/// plan's scans may take, on the service's strand: 0.27 s for 36,000,000 on the 2-core development machine;
-/// as much as the largest single scan took before (10,000,000 lines of 4 edges), now for the whole plan.
-inline constexpr std::uint64_t kMaxScanWork = 40'000'000;
 
 class PlanParser {
   public:
@@ -103,7 +99,7 @@ class PlanParser {
     void parse_elements(const YRef& list, std::uint32_t parent, const std::string& path);
     void parse_leaf_common(const YRef& body, std::uint32_t id, const std::string& path);
 
-    void finish_geometry();
+    void finish_geometry(std::uint64_t max_scan_work);
     void resolve_names();
     void derive_counts(const LoadOptions& options);
 

@@ -59,15 +59,15 @@ TEST(Utf8, TextFaultsNameTheByteAndAllowTabsAndLineEnds) {
     EXPECT_EQ(at.column, 3u);
 }
 
-TEST(Utf8, PrintableEscapesAndCutsLongText) {
-    EXPECT_EQ(printable("ok \xc3\xa0"), "ok \xc3\xa0");
-    EXPECT_EQ(printable("a\xff\x01"
+TEST(Utf8, AnExcerptEscapesAndCutsLongText) {
+    EXPECT_EQ(excerpt("ok \xc3\xa0"), "ok \xc3\xa0");
+    EXPECT_EQ(excerpt("a\xff\x01"
                         "b"),
               "a\\xff\\x01b");
     const std::string huge(10'000'000, 'v');
-    const auto shown = printable(huge);
+    const auto shown = excerpt(huge);
     EXPECT_EQ(shown, std::string(80, 'v') + "… (10000000 bytes)");
-    EXPECT_TRUE(valid_utf8(printable("\xe2\x82\xac\xe2\x82", 1)));  // never cuts inside a character
+    EXPECT_TRUE(valid_utf8(excerpt("\xe2\x82\xac\xe2\x82", 1)));  // never cuts inside a character
 }
 
 }  // namespace

@@ -141,33 +141,30 @@ TEST(ConfigHostile, ASecondDocumentAndANonMappingRootAreErrors) {
     EXPECT_TRUE(load_config_text("log_level: info\n...\n", "end.yaml").ok());  // an end marker alone is fine
 }
 
-TEST(ConfigHostile, AHundredThousandUnknownKeysListFiftyErrorsAndCountTheRest) {
+// Ten thousand here (the system suite has the hundred thousand of the field report, against airsegd itself).
+TEST(ConfigHostile, TenThousandUnknownKeysListFiftyErrorsAndCountTheRest) {
     std::string text;
-    for (int i = 0; i < 100'000; ++i) {
+    for (int i = 0; i < 10'000; ++i) {
         text += "k" + std::to_string(i) + ": 1\n";
     }
-    ASSERT_LT(text.size(), kMaxConfigFileBytes);
-    const auto started = std::chrono::steady_clock::now();
     const auto r = load_config_text(text, "keys.yaml");
-    std::cout << "100000 unknown keys checked in "
-              << std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count() << " s\n";
     EXPECT_EQ(r.errors.size(), kMaxListedConfigErrors);
-    EXPECT_EQ(r.error_count(), 100'000u);
+    EXPECT_EQ(r.error_count(), 10'000u);
     const auto lines = r.error_lines();
     ASSERT_EQ(lines.size(), 51u);
-    EXPECT_EQ(lines.back(), "... and 99950 more errors");
+    EXPECT_EQ(lines.back(), "... and 9950 more errors");
 }
 
 TEST(ConfigHostile, ALongValueIsCutInItsError) {
-    const std::string value(900'000, 'v');
+    const std::string value(200'000, 'v');
     const auto r =
         load_config_text("threads: " + value + "\nautopilot:\n  baud: " + value + "\n", "long.yaml");
     ASSERT_EQ(r.errors.size(), 2u);
     for (const auto& e : r.errors) {
         EXPECT_LT(e.to_string().size(), 200u) << e.to_string().substr(0, 300);
-        EXPECT_NE(e.message.find(std::string(80, 'v') + "… (900000 bytes)"), std::string::npos);
+        EXPECT_NE(e.message.find(std::string(80, 'v') + "… (200000 bytes)"), std::string::npos);
     }
-    const std::string key(500'000, 'k');
+    const std::string key(100'000, 'k');
     const auto unknown = load_config_text(key + ": 1\n", "key.yaml");
     ASSERT_EQ(unknown.errors.size(), 1u);
     EXPECT_LT(unknown.errors[0].to_string().size(), 400u);
