@@ -6,6 +6,7 @@
 #include <csignal>
 #include <iostream>
 
+#include "client/json_text.hpp"
 #include "client/stick_input.hpp"
 #include "client/watch_view.hpp"
 
@@ -76,7 +77,7 @@ int run_radio_watch(VehicleLink& radio, const LiveOptions& o) {
         state.set_ground_link(radio.link_stats());
         const auto now = Clock::now();
         if (o.json) {
-            std::cout << state.to_json(now).dump() << "\n" << std::flush;
+            std::cout << dump_text(state.to_json(now)) << "\n" << std::flush;
         } else if (tty) {
             // Home, then each line cleared to its end, then the rest of the screen: no flicker.
             std::string screen = state.render(now) + notes_text(o);
@@ -107,7 +108,8 @@ int run_log(VehicleLink& radio, const LiveOptions& o) {
             const char* sev = e->severity == proto::Event::Severity::Error     ? "error"
                               : e->severity == proto::Event::Severity::Warning ? "warning"
                                                                                : "info";
-            std::cout << nlohmann::json{{"severity", sev}, {"text", e->text}}.dump() << "\n" << std::flush;
+            std::cout << dump_text(nlohmann::json{{"severity", sev}, {"text", e->text}}) << "\n"
+                      << std::flush;
         } else {
             std::cout << event_line(*e) << "\n" << std::flush;
         }
@@ -182,7 +184,7 @@ int run_joystick(VehicleLink& radio, const LiveOptions& o, const JoystickOptions
     radio.run_for(std::chrono::milliseconds(200), take);
     const std::string why = device_gone ? "the input device closed" : "stopped";
     if (o.json) {
-        std::cout << nlohmann::json{{"inputs_sent", sent}, {"ended", why}}.dump() << "\n";
+        std::cout << dump_text(nlohmann::json{{"inputs_sent", sent}, {"ended", why}}) << "\n";
     } else {
         std::cerr << "\r\n"
                   << why << " after " << sent

@@ -71,7 +71,15 @@ LocalAnswer LocalClient::request(const nlohmann::json& request) {
     if (!connect(out.error)) {
         return out;
     }
-    const std::string line = request.dump() + "\n";
+    std::string line;
+    try {
+        line = request.dump() + "\n";
+    } catch (const nlohmann::json::type_error&) {
+        // A word of the command line that is not UTF-8 (a plan element's name, a parameter's): refused here,
+        // as the daemon would refuse it.
+        out.error = "the request holds text that is not valid UTF-8";
+        return out;
+    }
     std::size_t sent = 0;
     while (sent < line.size()) {
         const ssize_t n = ::send(fd_, line.data() + sent, line.size() - sent, MSG_NOSIGNAL);

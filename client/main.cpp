@@ -19,6 +19,7 @@
 
 #include "cli/command_line.hpp"
 #include "client/hub_client.hpp"
+#include "client/json_text.hpp"
 #include "client/live_commands.hpp"
 #include "client/local_client.hpp"
 #include "client/mqtt_client.hpp"
@@ -187,7 +188,8 @@ int show_answer(const Options& o, const airseg::client::LocalAnswer& a,
                 const std::function<std::string(const nlohmann::json&)>& render) {
     if (!a.answer) {
         if (o.json) {
-            std::cout << nlohmann::json{{"ok", false}, {"status", "no_link"}, {"error", a.error}}.dump()
+            std::cout << airseg::client::dump_text(
+                             nlohmann::json{{"ok", false}, {"status", "no_link"}, {"error", a.error}})
                       << "\n";
         }
         std::cerr << "airsegctl: " << a.error << "\n";
@@ -196,7 +198,7 @@ int show_answer(const Options& o, const airseg::client::LocalAnswer& a,
     const auto& answer = *a.answer;
     const bool ok = answer.value("ok", false);
     if (o.json) {
-        std::cout << (ok ? answer["result"] : answer).dump() << "\n";
+        std::cout << airseg::client::dump_text(ok ? answer["result"] : answer) << "\n";
     } else if (ok) {
         std::cout << render(answer["result"]);
     } else {
@@ -218,7 +220,7 @@ int watch(const Options& o, const std::function<airseg::client::LocalAnswer(cons
         std::string screen;
         if (answer.answer && answer.answer->value("ok", false)) {
             const auto& doc = (*answer.answer)["result"];
-            screen = o.json ? doc.dump() + "\n" : airseg::client::render_status(doc);
+            screen = o.json ? airseg::client::dump_text(doc) + "\n" : airseg::client::render_status(doc);
         } else {
             screen = "airsegctl: " +
                      (answer.answer ? answer.answer->value("error", std::string("refused")) : answer.error) +
@@ -229,7 +231,7 @@ int watch(const Options& o, const std::function<airseg::client::LocalAnswer(cons
             const auto stats = radio->link_stats();
             for (const auto& [key, value] : stats.items()) {
                 screen += "  " + key + std::string(key.size() < 28 ? 28 - key.size() : 1, ' ') + " " +
-                          value.dump() + "\n";
+                          airseg::client::dump_text(value) + "\n";
             }
         }
         screen += airseg::client::notes_text(live);
@@ -375,11 +377,16 @@ int main(int argc, char** argv) {
         if (req.is_discarded() || !req.is_object()) {
             return usage_error("request: not a JSON object: " + o.positional[1]);
         }
-        return show_answer(o, client.request(req), [](const nlohmann::json& r) { return r.dump(2) + "\n"; });
+        return show_answer(o, client.request(req),
+                           [](const nlohmann::json& r) { return airseg::client::dump_text(r, 2) + "\n"; });
     }
     if (cmd == "plan") {
         auto plan =
             airseg::client::plan_command({o.positional.begin() + 1, o.positional.end()}, radio == nullptr);
+        if (!plan.request && plan.file_refused) {
+            std::cerr << "airsegctl: " << plan.error << "\n";  // nothing sent: the file cannot be a plan
+            return kRefused;
+        }
         if (!plan.request) {
             return usage_error(plan.error);
         }

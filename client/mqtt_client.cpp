@@ -5,6 +5,7 @@
 
 #include <random>
 
+#include "client/json_text.hpp"
 #include "client/mqtt_options.hpp"
 #include "client/watch_view.hpp"
 #include "services/autopilot/ardupilot/rover_modes.hpp"
@@ -163,7 +164,7 @@ LocalAnswer MqttClient::request(const Json& request, std::chrono::milliseconds t
     awaiting_ = fmt::format("{:08x}{:08x}", rd(), rd());
     answer_.reset();
     const Json message{{"id", awaiting_}, {"request", request}};
-    if (!session_->publish(vehicle_topic(vehicle_, "cmd"), message.dump(), 1, false)) {
+    if (!session_->publish(vehicle_topic(vehicle_, "cmd"), dump_text(message), 1, false)) {
         out.error = "the command could not be queued for the MQTT broker";
         return out;
     }

@@ -5,10 +5,11 @@
 
 #include <atomic>
 #include <charconv>
-#include <fstream>
 #include <mutex>
 #include <utility>
 #include <vector>
+
+#include "base/file_text.hpp"
 
 namespace airseg::client {
 
@@ -130,10 +131,11 @@ std::string MqttSession::start() {
     if (!o.username.empty()) {
         std::string password;
         if (!o.password_file.empty()) {
-            std::ifstream in(o.password_file);
-            if (!in || !std::getline(in, password)) {
-                return "cannot read the MQTT password from " + o.password_file;
+            const auto file = read_file_text(o.password_file, kMaxSmallFileBytes);
+            if (!file.ok()) {
+                return "cannot read the MQTT password from " + o.password_file + ": " + file.error;
             }
+            password = file.text.substr(0, file.text.find('\n'));
         }
         mosquitto_username_pw_set(m, o.username.c_str(),
                                   o.password_file.empty() ? nullptr : password.c_str());

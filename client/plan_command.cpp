@@ -1,9 +1,11 @@
 #include "client/plan_command.hpp"
 
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
+#include "base/file_text.hpp"
+#include "base/utf8.hpp"
+#include "client/json_text.hpp"
 #include "services/common/nearest_word.hpp"
 
 namespace airseg::client {
@@ -13,24 +15,29 @@ namespace {
 // The local socket takes requests up to 1 MiB; JSON escaping can grow a text a little.
 constexpr std::uintmax_t kInlineLimit = 900'000;
 // The radio carries a plan as one command; the daemon refuses plans over 16 MiB anyway.
-constexpr std::uintmax_t kMaxPlanFile = 16u << 20;
+constexpr std::size_t kMaxPlanFile = 16u << 20;
 
 std::string show_value(const nlohmann::json& v) {
-    return v.is_string() ? v.get<std::string>() : v.is_null() ? std::string("-") : v.dump();
+    return v.is_string() ? v.get<std::string>() : v.is_null() ? std::string("-") : dump_text(v);
 }
 
 std::optional<nlohmann::json> file_request(const std::string& cmd, const std::string& file, bool local,
                                            std::string& error) {
-    std::error_code ec;
-    const auto size = std::filesystem::file_size(file, ec);
-    if (ec) {
-        error = file + ": " + ec.message();
+    // A regular file only, read whole here (a FIFO or /dev/zero is refused at once).
+    auto read = read_file_text(file, kMaxPlanFile);
+    if (!read.ok()) {
+        error = file + ": " + read.error;
         return std::nullopt;
     }
-    if (size > kMaxPlanFile) {
-        error = file + ": larger than 16 MiB";
+    // The daemon refuses such a text as well; caught here, it is said with its place before anything is sent
+    // (a JSON request could not even carry its bytes).
+    if (const auto fault = first_text_fault(read.text)) {
+        const auto at = position_of(read.text, fault->offset);
+        error = file + ":" + std::to_string(at.line) + ":" + std::to_string(at.column) + ": " +
+                fault->what() + ": a plan is UTF-8 text without control characters";
         return std::nullopt;
     }
+    const auto size = read.text.size();
     if (size > kInlineLimit) {
         if (!local) {
             error = file + ": too large to send over the radio in one command (" + std::to_string(size) +
@@ -39,14 +46,7 @@ std::optional<nlohmann::json> file_request(const std::string& cmd, const std::st
         }
         return nlohmann::json{{"cmd", cmd}, {"path", std::filesystem::absolute(file).string()}};
     }
-    std::ifstream in(file, std::ios::binary);
-    std::ostringstream text;
-    text << in.rdbuf();
-    if (!in) {
-        error = file + ": cannot read";
-        return std::nullopt;
-    }
-    return nlohmann::json{{"cmd", cmd}, {"text", text.str()}, {"source", file}};
+    return nlohmann::json{{"cmd", cmd}, {"text", std::move(read.text)}, {"source", file}};
 }
 
 }  // namespace
@@ -110,12 +110,14 @@ PlanCommand plan_command(const std::vector<std::string>& args, bool local) {
             return out;
         }
         out.request = file_request("plan.load", files[0], local, out.error);
+        out.file_refused = !out.request;
         if (out.request && paused) {
             (*out.request)["paused"] = true;
         }
     } else if (sub == "append") {
         if (want(2, "append FILE")) {
             out.request = file_request("plan." + sub, args[1], local, out.error);
+            out.file_refused = !out.request;
         }
     } else if (sub == "show" || sub == "pause" || sub == "resume") {
         if (want(1, sub.c_str())) {

@@ -12,6 +12,7 @@ namespace airseg::client {
 struct PlanCommand {
     std::optional<nlohmann::json> request;  // empty: `error` says what is wrong with the arguments
     std::string error;
+    bool file_refused = false;  // the error is about the plan file (its kind, size or text), not the usage
     std::function<std::string(const nlohmann::json&)> render;  // text form of an ok result
 };
 

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "client/json_text.hpp"
 #include "services/common/text.hpp"
 
 namespace airseg::client {
@@ -14,7 +15,7 @@ std::string scalar(const nlohmann::json& v) {
     if (v.is_number_float()) {
         return fmt::format("{:.7g}", v.get<double>());
     }
-    return v.dump();
+    return dump_text(v);
 }
 
 void flatten(const nlohmann::json& v, const std::string& prefix, std::string& out) {

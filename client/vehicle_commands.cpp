@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <optional>
 
+#include "client/json_text.hpp"
 #include "services/common/text.hpp"
 
 namespace airseg::client {
@@ -36,8 +37,8 @@ std::string rates_text(const nlohmann::json& r) {
     const nlohmann::json requested = field("requested_hz");
     const nlohmann::json effective = field("effective_hz");
     for (const auto& [kind, hz] : requested.items()) {
-        out += fmt::format("{:<12} requested {:>6} Hz   effective {:>6} Hz\n", kind, hz.dump(),
-                           effective.value(kind, nlohmann::json()).dump());
+        out += fmt::format("{:<12} requested {:>6} Hz   effective {:>6} Hz\n", kind, dump_text(hz),
+                           dump_text(effective.value(kind, nlohmann::json())));
     }
     out += fmt::format("link budget {} B/s, weak-link factor {}{}\n", r.value("budget_bytes_per_s", 0.0),
                        r.value("factor", 1.0), r.value("weak_link", false) ? " (link weak)" : "");
@@ -62,7 +63,8 @@ BuiltCommand param_command(const std::vector<std::string>& a) {
     if (sub == "get" && a.size() == 3) {
         b.request = {{"cmd", "param.get"}, {"name", to_upper(a[2])}};
         b.render = [](const nlohmann::json& r) {
-            return fmt::format("{} = {}\n", r.value("name", "?"), r.value("value", nlohmann::json()).dump());
+            return fmt::format("{} = {}\n", r.value("name", "?"),
+                               dump_text(r.value("value", nlohmann::json())));
         };
     } else if (sub == "set" && a.size() == 4) {
         const auto v = number(a[3]);
@@ -72,7 +74,7 @@ BuiltCommand param_command(const std::vector<std::string>& a) {
         b.request = {{"cmd", "param.set"}, {"name", to_upper(a[2])}, {"value", *v}};
         b.render = [](const nlohmann::json& r) {
             return fmt::format("vehicle acknowledged: {} = {}\n", r.value("name", "?"),
-                               r.value("value", nlohmann::json()).dump());
+                               dump_text(r.value("value", nlohmann::json())));
         };
     } else if (sub == "list" && a.size() == 2) {
         b.request = {{"cmd", "param.list"}};
@@ -81,7 +83,7 @@ BuiltCommand param_command(const std::vector<std::string>& a) {
             const auto it = r.find("params");
             const nlohmann::json params = it != r.end() && it->is_object() ? *it : nlohmann::json::object();
             for (const auto& [name, value] : params.items()) {
-                out += fmt::format("{:<16} {}\n", name, value.dump());
+                out += fmt::format("{:<16} {}\n", name, dump_text(value));
             }
             return out + fmt::format("{} parameters\n", r.value("count", 0));
         };

@@ -9,6 +9,7 @@
 #include <thread>
 #include <vector>
 
+#include "base/utf8.hpp"
 #include "daemon/autopilot_commands.hpp"
 #include "daemon/autopilot_setup.hpp"
 #include "daemon/autopilot_status.hpp"
@@ -210,8 +211,8 @@ class App::Impl {
         notifier_.reloading();
         auto result = load_config_file(options_.config_path, options_.overrides);
         if (!result.ok()) {
-            for (const auto& e : result.errors) {
-                spdlog::error("config: {}", e.to_string());
+            for (const auto& line : result.error_lines()) {
+                spdlog::error("config: {}", line);
             }
             spdlog::error("config: {} is invalid; keeping the running configuration", options_.config_path);
             notifier_.ready();
@@ -225,10 +226,12 @@ class App::Impl {
             spdlog::info("config: reloaded {}, nothing changed", options_.config_path);
         }
         for (const auto& c : changes) {
+            // Values are cut as in the loader's errors: a long one is not logged whole.
+            const auto from = excerpt(c.from, 256), to = excerpt(c.to, 256);
             if (c.runtime) {
-                spdlog::info("config: {}: {} -> {} (applied)", c.key, c.from, c.to);
+                spdlog::info("config: {}: {} -> {} (applied)", c.key, from, to);
             } else {
-                spdlog::warn("config: {}: {} -> {} (takes effect after a restart)", c.key, c.from, c.to);
+                spdlog::warn("config: {}: {} -> {} (takes effect after a restart)", c.key, from, to);
             }
         }
         set_log_level(result.config.log_level);

@@ -6,11 +6,18 @@
 #include <filesystem>
 #include <system_error>
 
+#include "base/utf8.hpp"
+
 namespace airseg::daemon {
 
 namespace {
 
 namespace fs = std::filesystem;
+
+/// A path in a message: long enough for /dev/serial/by-id/ names, cut before it drowns the message.
+std::string shown(const std::string& path) {
+    return excerpt(path, 256);
+}
 
 /// The device a path reaches, through symlinks such as /dev/serial/by-id/..., when it exists.
 std::string device_of(const std::string& path) {
@@ -26,14 +33,14 @@ void check_port(const std::string& key, const std::string& path, std::vector<Key
     if (!fs::path(path).is_absolute()) {
         out.push_back({key, fmt::format("'{}' is a relative path; give the device's absolute path, e.g. "
                                         "/dev/ttyUSB0 (the service runs in /)",
-                                        path)});
+                                        shown(path))});
         return;
     }
     // A missing device is normal (a USB adapter unplugged): the service waits for it. One that exists
     // must be a character device; a pty slave counts, as the simulators use them.
     struct stat st {};
     if (::stat(path.c_str(), &st) == 0 && !S_ISCHR(st.st_mode)) {
-        out.push_back({key, fmt::format("'{}' is not a serial device ({})", path,
+        out.push_back({key, fmt::format("'{}' is not a serial device ({})", shown(path),
                                         S_ISDIR(st.st_mode) ? "a directory" : "not a character device")});
     }
 }
@@ -63,7 +70,7 @@ std::vector<KeyProblem> port_problems(const Config& c) {
             out.push_back({"groundlink.ports",
                            fmt::format("'{}' is the autopilot's device ({}): the autopilot and a radio "
                                        "need a port each",
-                                       port, autopilot)});
+                                       shown(port), shown(autopilot))});
         }
     }
     return out;
@@ -85,7 +92,7 @@ std::vector<KeyProblem> unwritable_path_warnings(const Config& c) {
         out.push_back({key, fmt::format("'{}' is outside the directories airsegd.service can write ({}); "
                                         "under systemd writing it fails unless a drop-in adds "
                                         "ReadWritePaths= (systemctl edit airsegd)",
-                                        path, fmt::join(unit_writable_dirs(), ", "))});
+                                        shown(path), fmt::join(unit_writable_dirs(), ", "))});
     };
     check("state_dir", c.state_dir);
     check("status.socket", c.status.socket);

@@ -6,13 +6,15 @@
 #include <cmath>
 #include <map>
 
+#include "base/utf8.hpp"
 #include "daemon/duration.hpp"
 
 namespace airseg::daemon {
 namespace {
 
+/// A value as an error message echoes it: cut, so that a 10 MB value is not repeated whole.
 std::string scalar_text(const YAML::Node& node) {
-    return node.IsScalar() ? node.Scalar() : std::string("(not a scalar)");
+    return node.IsScalar() ? excerpt(node.Scalar()) : std::string("(not a scalar)");
 }
 
 template <class Ref>
@@ -223,18 +225,19 @@ KeySpec number_map(std::string path, Ref ref, std::vector<std::string> names, bo
             }
             const std::string name = entry.first.Scalar();
             if (!names.empty() && std::find(names.begin(), names.end(), name) == names.end()) {
-                return fmt::format("unknown name '{}' (one of {})", name, fmt::join(names, ", "));
+                return fmt::format("unknown name '{}' (one of {})", excerpt(name), fmt::join(names, ", "));
             }
             double v = 0;
             if (!entry.second.IsScalar() || !YAML::convert<double>::decode(entry.second, v) ||
                 !std::isfinite(v)) {
-                return fmt::format("{}: expected a number, got '{}'", name, scalar_text(entry.second));
+                return fmt::format("{}: expected a number, got '{}'", excerpt(name),
+                                   scalar_text(entry.second));
             }
             if (whole && (v < 0 || v != std::floor(v))) {
-                return fmt::format("{}: expected a whole number >= 0, got {}", name, v);
+                return fmt::format("{}: expected a whole number >= 0, got {}", excerpt(name), v);
             }
             if (!out.emplace(name, v).second) {
-                return fmt::format("{} is given twice", name);
+                return fmt::format("{} is given twice", excerpt(name));
             }
         }
         ref(c) = std::move(out);

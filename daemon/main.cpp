@@ -24,10 +24,10 @@ int main(int argc, char** argv) {
     auto loaded = load_config_file(cli.options.config_path, cli.options.overrides);
     if (!loaded.ok()) {
         // Printed plainly (not through the logger) so they read the same in a terminal and in the journal.
-        for (const auto& e : loaded.errors) {
-            std::cerr << "airsegd: " << e.to_string() << "\n";
+        for (const auto& line : loaded.error_lines()) {
+            std::cerr << "airsegd: " << line << "\n";
         }
-        std::cerr << "airsegd: " << loaded.errors.size()
+        std::cerr << "airsegd: " << loaded.error_count()
                   << " error(s) in the configuration; nothing started\n";
         return kExitConfig;
     }

@@ -78,7 +78,9 @@ void FleetBridge::stop() {
 
 void FleetBridge::publish(std::string_view leaf, const Json& payload, int qos, bool retain) {
     if (!stopped_) {
-        session_.publish(topic(leaf), payload.dump(), qos, retain);
+        // The vehicle's texts (an autopilot's STATUSTEXT) may be any bytes: relayed, never thrown on.
+        session_.publish(topic(leaf), payload.dump(-1, ' ', false, Json::error_handler_t::replace), qos,
+                         retain);
     }
 }
 
@@ -150,12 +152,13 @@ void FleetBridge::on_command(const std::string& payload) {
         answer(id, bad_request("no \"request\" object"));
         return;
     }
-    const auto key = id.dump();
+    const auto key = id.dump(-1, ' ', false, Json::error_handler_t::replace);
     if (!first_time(key, id)) {
         spdlog::debug("fleet: command {} delivered again; not run twice", key);
         return;
     }
-    spdlog::info("fleet: command {} {}", key, request->value("cmd", Json()).dump());
+    spdlog::info("fleet: command {} {}", key,
+                 request->value("cmd", Json()).dump(-1, ' ', false, Json::error_handler_t::replace));
     hub_.command(*request, [this, key, id](Json reply) {
         if (stopped_) {
             return;

@@ -277,7 +277,8 @@ void Hub::on_frame(ClientConnection& connection, hub::Frame frame) {
             on_hello(client, j["hello"]);
             return;
         }
-        connection.close("unexpected hub message " + j.dump().substr(0, 80));
+        connection.close("unexpected hub message " +
+                         j.dump(-1, ' ', false, Json::error_handler_t::replace).substr(0, 80));
         return;
     }
     if (!client.welcomed) {

@@ -4,11 +4,11 @@
 #include <charconv>
 #include <deque>
 #include <filesystem>
-#include <fstream>
 #include <set>
 #include <utility>
 #include <variant>
 
+#include "base/file_text.hpp"
 #include "ground/map/http.hpp"
 #include "ground/map/plan_export.hpp"
 
@@ -65,20 +65,11 @@ bool safe_relative_path(std::string_view rest) {
 }
 
 std::optional<std::string> read_file(const std::filesystem::path& path) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) {
+    auto file = read_file_text(path.string(), kMaxFileBytes);  // a regular file only, never blocking
+    if (!file.ok()) {
         return std::nullopt;
     }
-    const auto size = std::filesystem::file_size(path, ec);
-    if (ec || size > kMaxFileBytes) {
-        return std::nullopt;
-    }
-    std::ifstream in(path, std::ios::binary);
-    std::string out(size, '\0');
-    if (!in.read(out.data(), static_cast<std::streamsize>(size))) {
-        return std::nullopt;
-    }
-    return out;
+    return std::move(file.text);
 }
 
 std::string error_response(int status, const std::string& why, const std::vector<std::string>& extra = {}) {

@@ -2,7 +2,39 @@
 
 #include <atomic>
 
+#include "base/utf8.hpp"
+
 namespace airseg {
+
+namespace {
+
+/// Where in `value` the first text (a string or a key) that is not UTF-8 is, as a JSON pointer; nullopt when
+/// there is none.
+std::optional<std::string> invalid_text(const Json& value, const std::string& at = "") {
+    if (value.is_string()) {
+        return valid_utf8(value.get_ref<const std::string&>()) ? std::nullopt
+                                                               : std::optional(at.empty() ? "/" : at);
+    }
+    if (value.is_object()) {
+        for (const auto& [key, item] : value.items()) {
+            if (!valid_utf8(key)) {
+                return at + "/" + key;
+            }
+            if (auto found = invalid_text(item, at + "/" + key)) {
+                return found;
+            }
+        }
+    } else if (value.is_array()) {
+        for (std::size_t i = 0; i < value.size(); ++i) {
+            if (auto found = invalid_text(value[i], at + "/" + std::to_string(i))) {
+                return found;
+            }
+        }
+    }
+    return std::nullopt;
+}
+
+}  // namespace
 
 const char* to_string(Role r) {
     return r == Role::Control ? "control" : "monitor";
@@ -44,6 +76,13 @@ void CommandDispatcher::dispatch(const Json& request, Role caller, Reply reply) 
                                   "request must be a JSON object with a string \"cmd\""));
         return;
     }
+    // The radio's CBOR does not check its texts as JSON's parser does; a text kept from a request (a plan's
+    // source, a name) would make every later dump of the status document throw.
+    if (const auto where = invalid_text(request)) {
+        reply(CommandResult::fail(CommandStatus::BadRequest,
+                                  "request text is not valid UTF-8 (at " + excerpt(*where) + ")"));
+        return;
+    }
     const auto name = request["cmd"].get<std::string>();
     std::shared_ptr<const Entry> entry;
     {
@@ -54,7 +93,8 @@ void CommandDispatcher::dispatch(const Json& request, Role caller, Reply reply) 
         }
     }
     if (!entry) {
-        reply(CommandResult::fail(CommandStatus::UnknownCommand, "unknown command '" + name + "'"));
+        reply(
+            CommandResult::fail(CommandStatus::UnknownCommand, "unknown command '" + excerpt(name) + "'"));
         return;
     }
     if (entry->required == Role::Control && caller != Role::Control) {

@@ -1,5 +1,9 @@
 #include "services/flightplan/diagnostic.hpp"
 
+#include <algorithm>
+
+#include "base/utf8.hpp"
+
 namespace airseg::flightplan {
 
 std::string Diagnostic::to_string() const {
@@ -8,17 +12,23 @@ std::string Diagnostic::to_string() const {
         out += ':' + std::to_string(line) + ':' + std::to_string(col);
     }
     out += ": ";
+    // A path holds the plan's own keys, a message may quote its names: cut, so that a megabyte-long key is
+    // not echoed whole.
     if (!path.empty()) {
-        out += path + ": ";
+        out += excerpt(path, 200) + ": ";
     }
-    out += message;
+    out += excerpt(message, 400);
     return out;
 }
 
 std::string to_string(const std::vector<Diagnostic>& diagnostics) {
     std::string out;
-    for (const auto& d : diagnostics) {
-        out += d.to_string() + '\n';
+    const std::size_t listed = std::min(diagnostics.size(), kMaxListedDiagnostics);
+    for (std::size_t i = 0; i < listed; ++i) {
+        out += diagnostics[i].to_string() + '\n';
+    }
+    if (diagnostics.size() > listed) {
+        out += "... and " + std::to_string(diagnostics.size() - listed) + " more errors\n";
     }
     return out;
 }

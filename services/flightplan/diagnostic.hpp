@@ -1,6 +1,7 @@
 #pragma once
 // One problem found in a plan, located as precisely as the source allows:
 // "plans/survey.yaml:12:9: plan.elements[3].scan.spacing: must be > 0".
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -15,7 +16,8 @@ struct Diagnostic {
     std::string to_string() const;
 };
 
-/// All diagnostics, one per line.
+/// The first kMaxListedDiagnostics, one per line, then "... and N more errors".
+inline constexpr std::size_t kMaxListedDiagnostics = 50;
 std::string to_string(const std::vector<Diagnostic>& diagnostics);
 
 }  // namespace airseg::flightplan

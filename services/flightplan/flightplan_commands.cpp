@@ -1,16 +1,19 @@
 // The flight plan commands of FlightplanService (see docs/flight-plan.md, "Commands").
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 
 #include <spdlog/spdlog.h>
 
+#include "base/file_text.hpp"
 #include "services/flightplan/flightplan_service.hpp"
 #include "services/flightplan/ground_mission.hpp"
 
 namespace airseg::flightplan {
 
 namespace {
+
+/// The longest "source" or "path" of a plan request (PATH_MAX).
+constexpr std::size_t kMaxSourceBytes = 4096;
 
 struct PlanText {
     std::string text;
@@ -38,45 +41,31 @@ PlanText plan_text_of(const Json& req) {
             source != req.end() && source->is_string() && !source->get_ref<const std::string&>().empty()
                 ? source->get<std::string>()
                 : std::string("<inline>");
+        if (out.source.size() > kMaxSourceBytes) {
+            // The source is shown in every status document while the plan runs.
+            out.error = "\"source\" longer than the " + std::to_string(kMaxSourceBytes) + " bytes allowed";
+            return out;
+        }
         if (out.text.size() > kMaxPlanTextBytes) {
             out.error = "plan larger than " + std::to_string(kMaxPlanTextBytes) + " bytes";
         }
         return out;
     }
-    if (!path->is_string() || path->get_ref<const std::string&>().empty()) {
-        out.error = "\"path\" must be a file name";
+    if (!path->is_string() || path->get_ref<const std::string&>().empty() ||
+        path->get_ref<const std::string&>().size() > kMaxSourceBytes) {
+        out.error = "\"path\" must be a file name of at most " + std::to_string(kMaxSourceBytes) + " bytes";
         return out;
     }
     out.source = path->get<std::string>();
-    std::ifstream in(out.source, std::ios::binary);
-    if (!in) {
-        out.error = out.source + ": cannot open the file";
+    // A FIFO, a device (/dev/zero) or a directory is refused at once: this runs on the service's strand.
+    auto file = read_file_text(out.source, kMaxPlanTextBytes);
+    if (!file.ok()) {
+        out.error = out.source + ": " + file.error;
         return out;
     }
-    // Sized to the file: the text is kept with the running plan (persistence, plan.append), and a buffer of
-    // the largest allowed plan would stay allocated, and resident, with it.
-    in.seekg(0, std::ios::end);
-    const std::streamoff size = in.tellg();
-    in.clear();
-    in.seekg(0, std::ios::beg);
-    std::size_t want = size >= 0 ? static_cast<std::size_t>(std::min<std::uint64_t>(
-                                       static_cast<std::uint64_t>(size), kMaxPlanTextBytes + 1))
-                                 : std::size_t{64} << 10;
-    // Not seekable (a pipe): read in growing steps, never more than one byte past the largest plan.
-    while (true) {
-        const std::size_t have = out.text.size();
-        out.text.resize(have + want);
-        in.read(out.text.data() + have, static_cast<std::streamsize>(want));
-        out.text.resize(have + static_cast<std::size_t>(in.gcount()));
-        if (!in || out.text.size() > kMaxPlanTextBytes || in.peek() == std::char_traits<char>::eof()) {
-            break;
-        }
-        want = std::min(out.text.size(), kMaxPlanTextBytes + 1 - out.text.size());
-    }
+    out.text = std::move(file.text);
+    // Sized to the file: the text is kept with the running plan (persistence, plan.append).
     out.text.shrink_to_fit();
-    if (out.text.size() > kMaxPlanTextBytes) {
-        out.error = out.source + ": plan larger than " + std::to_string(kMaxPlanTextBytes) + " bytes";
-    }
     return out;
 }
 

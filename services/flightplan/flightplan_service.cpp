@@ -105,7 +105,23 @@ void FlightplanService::on_start() {
             flush();
         }));
     if (store_) {
-        controller_.resume(resume_from(store_->load(), config_.load), SteadyClock::now());
+        // Whatever the stored state holds, the service comes up: a plan that cannot be resumed is set aside,
+        // never met again at the next start (no restart loop, no deaf daemon).
+        ResumeResult resumed;
+        try {
+            resumed = resume_from(store_->load(), config_.load);
+        } catch (const std::exception& e) {
+            resumed = ResumeResult{};
+            resumed.problems.push_back(std::string("stored plan cannot be resumed: ") + e.what() +
+                                       "; set aside");
+            resumed.set_aside = true;
+        }
+        if (resumed.set_aside) {
+            for (auto& problem : store_->set_aside_plan()) {
+                resumed.problems.push_back(std::move(problem));
+            }
+        }
+        controller_.resume(std::move(resumed), SteadyClock::now());
     }
     set_health(Health::Up);
     controller_.start(SteadyClock::now());

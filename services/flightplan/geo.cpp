@@ -18,6 +18,16 @@ bool on_segment(Enu p, Enu a, Enu b) {
 }
 }  // namespace
 
+double great_circle_distance(LatLon a, LatLon b) {
+    constexpr double kMeanRadius = 6'371'008.8;  // metres (IUGG)
+    const double dlat = (b.lat - a.lat) * kDegToRad;
+    const double dlon = (b.lon - a.lon) * kDegToRad;
+    const double h = std::sin(dlat / 2) * std::sin(dlat / 2) + std::cos(a.lat * kDegToRad) *
+                                                                   std::cos(b.lat * kDegToRad) *
+                                                                   std::sin(dlon / 2) * std::sin(dlon / 2);
+    return 2.0 * kMeanRadius * std::asin(std::min(1.0, std::sqrt(h)));
+}
+
 LocalFrame::LocalFrame(LatLon reference) : ref_(reference) {
     const double s = std::sin(reference.lat * kDegToRad);
     const double w = 1.0 - kWgs84EccentricitySq * s * s;

@@ -30,6 +30,18 @@ struct Enu {
     bool operator==(const Enu&) const = default;
 };
 
+/// How far a plan's positions may lie from its frame's reference, and how near the poles: beyond, the local
+/// frame stops being a map at all (longitudes wrap at ±180°, a degree of longitude shrinks to nothing at a
+/// pole), and a polygon around the globe shrank in it to a sliver of a few metres. Within the reach the
+/// frame is still off by up to tan(lat₀)·Δn²/R (the bound above): about 1.4 km at 41° and 100 km, 35 m at
+/// 16 km; a plan that spans more than a few kilometres should set its reference near its middle.
+inline constexpr double kMaxFrameReachMetres = 100'000.0;
+inline constexpr double kMaxFrameLatitude = 85.0;
+
+/// Great-circle distance on a sphere of the Earth's mean radius: the measure of kMaxFrameReachMetres,
+/// independent of the local frame it bounds.
+double great_circle_distance(LatLon a, LatLon b);
+
 /// Equirectangular projection around a reference point (see the error bound above).
 class LocalFrame {
   public:

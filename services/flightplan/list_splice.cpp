@@ -4,6 +4,8 @@
 #include <cctype>
 #include <cstdint>
 
+#include "base/utf8.hpp"
+
 namespace airseg::flightplan {
 
 namespace {
@@ -96,33 +98,11 @@ bool is_item(std::string_view line, std::size_t indent) {
 /// (malformed UTF-8, controls) in ways that depend on where they fall in its read buffer, so a batch could
 /// read them otherwise than the whole text does.
 bool plain_text(std::string_view text) {
-    std::size_t i = 0;
-    while (i < text.size()) {
-        const auto c = static_cast<unsigned char>(text[i]);
-        if (c < 0x80) {
-            if ((c < 0x20 && c != '\n' && c != '\t') || c == 0x7f) {
-                return false;
-            }
-            ++i;
-            continue;
-        }
-        const std::size_t length = c >= 0xf0 ? 4 : c >= 0xe0 ? 3 : c >= 0xc0 ? 2 : 0;
-        if (length == 0 || c > 0xf4 || c < 0xc2 || i + length > text.size()) {
+    for (std::size_t i = 0; i < text.size();) {
+        const auto c = utf8_next(text, i);
+        if (!c || (is_control(*c) && *c != '\n' && *c != '\t') || *c == 0xfeff) {
             return false;
         }
-        std::uint32_t code = c & (0x7fu >> length);
-        for (std::size_t k = 1; k < length; ++k) {
-            const auto next = static_cast<unsigned char>(text[i + k]);
-            if ((next & 0xc0) != 0x80) {
-                return false;
-            }
-            code = (code << 6) | (next & 0x3fu);
-        }
-        const std::uint32_t least[] = {0, 0, 0x80, 0x800, 0x10000};
-        if (code < least[length] || code > 0x10ffff || (code >= 0xd800 && code <= 0xdfff) || code == 0xfeff) {
-            return false;
-        }
-        i += length;
     }
     return true;
 }

@@ -6,8 +6,9 @@
 #include <cerrno>
 #include <charconv>
 #include <cstring>
-#include <fstream>
 #include <sstream>
+
+#include "base/file_text.hpp"
 
 namespace airseg::flightplan {
 
@@ -26,18 +27,6 @@ bool parse_u64(std::string_view s, std::uint64_t& out, int base = 10) {
     }
     auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), out, base);
     return ec == std::errc{} && ptr == s.data() + s.size();
-}
-
-/// Reads at most `limit` + 1 bytes, so an oversized file is noticed without being read whole.
-std::optional<std::string> read_bounded(const std::filesystem::path& path, std::size_t limit) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        return std::nullopt;
-    }
-    std::string data(limit + 1, '\0');
-    in.read(data.data(), static_cast<std::streamsize>(data.size()));
-    data.resize(static_cast<std::size_t>(in.gcount()));
-    return data;
 }
 
 const char* state_name(PlanState s) {
@@ -261,6 +250,19 @@ std::optional<std::string> StateStore::set_aside(const std::filesystem::path& pa
     return "too many corrupt copies of " + path.string();
 }
 
+std::vector<std::string> StateStore::set_aside_plan() {
+    std::vector<std::string> problems;
+    std::error_code ec;
+    for (const auto& p : {plan_path(), progress_path()}) {
+        if (std::filesystem::exists(std::filesystem::symlink_status(p, ec))) {
+            if (auto err = set_aside(p)) {
+                problems.push_back(std::move(*err));
+            }
+        }
+    }
+    return problems;
+}
+
 StoredState StateStore::load() {
     StoredState out;
     std::error_code ec;
@@ -272,11 +274,10 @@ StoredState StateStore::load() {
     std::string digest;
     if (std::filesystem::exists(plan_path(), ec)) {
         std::string why;
-        auto data = read_bounded(plan_path(), kMaxPlanBytes + 512);
-        if (!data) {
-            why = "cannot read";
-        } else if (data->size() > kMaxPlanBytes + 512) {
-            why = "too large";
+        auto file = read_file_text(plan_path().string(), kMaxPlanFileBytes);
+        const std::string* data = &file.text;
+        if (!file.ok()) {
+            why = file.error;
         } else if (data->compare(0, kPlanMagic.size(), kPlanMagic) != 0) {
             why = "missing header";
         } else {
@@ -311,11 +312,10 @@ StoredState StateStore::load() {
     if (std::filesystem::exists(progress_path(), ec)) {
         std::string why;
         std::optional<SavedProgress> p;
-        auto data = read_bounded(progress_path(), kMaxProgressBytes);
-        if (!data) {
-            why = "cannot read";
-        } else if (data->size() > kMaxProgressBytes) {
-            why = "too large";
+        auto file = read_file_text(progress_path().string(), kMaxProgressBytes);
+        const std::string* data = &file.text;
+        if (!file.ok()) {
+            why = file.error;
         } else {
             p = parse_progress(*data, why);
             if (p && p->plan_digest != digest) {

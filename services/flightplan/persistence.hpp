@@ -55,6 +55,7 @@ std::optional<std::string> write_file_atomically(const std::filesystem::path& pa
 class StateStore {
   public:
     static constexpr std::size_t kMaxPlanBytes = 16u << 20;
+    static constexpr std::size_t kMaxPlanFileBytes = kMaxPlanBytes + 512;  // the plan and its header line
     static constexpr std::size_t kMaxProgressBytes = 4096;
 
     explicit StateStore(std::filesystem::path directory, Durability durability = Durability::Fsync);
@@ -65,6 +66,9 @@ class StateStore {
     std::optional<std::string> clear();
     /// Reads both files, setting aside whatever is corrupt or does not belong to the stored plan.
     StoredState load();
+    /// Sets the plan and its progress aside (a stored plan that passed its checks but cannot be resumed);
+    /// what went wrong doing it, if anything.
+    std::vector<std::string> set_aside_plan();
 
     std::filesystem::path plan_path() const { return dir_ / "plan.yaml"; }
     std::filesystem::path progress_path() const { return dir_ / "progress.state"; }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "base/utf8.hpp"
 #include "services/flightplan/home_stream.hpp"
 #include "services/flightplan/plan_merge.hpp"
 
@@ -551,7 +552,7 @@ void PlanController::skip(CommandId id, std::variant<std::uint64_t, std::string>
     } else {
         const auto& name = std::get<std::string>(target);
         if (!feeder_.jump_to(name, now)) {
-            reply(id, Status::BadRequest, "the plan has no element named '" + name + "'");
+            reply(id, Status::BadRequest, "the plan has no element named '" + excerpt(name) + "'");
             return;
         }
     }

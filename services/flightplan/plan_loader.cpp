@@ -3,11 +3,12 @@
 #include <yaml-cpp/exceptions.h>
 #include <yaml-cpp/parser.h>
 
-#include <fstream>
 #include <istream>
 #include <memory>
 #include <streambuf>
 
+#include "base/file_text.hpp"
+#include "base/utf8.hpp"
 #include "services/flightplan/list_splice.hpp"
 #include "services/flightplan/plan_parser.hpp"
 #include "services/flightplan/plan_stream.hpp"
@@ -69,41 +70,55 @@ LoadResult load_from(Open open, std::string_view text, const std::string& source
 
 }  // namespace
 
+namespace {
+
+/// A text yaml-cpp would misread, refused at the edge with its place: malformed bytes would reach the plan's
+/// names (and make every JSON document that shows them throw), a NUL would silently end the plan.
+std::optional<Diagnostic> text_problem(std::string_view text, const std::string& source_name) {
+    const auto fault = first_text_fault(text);
+    if (!fault) {
+        return std::nullopt;
+    }
+    const auto where = position_of(text, fault->offset);
+    return Diagnostic{source_name, static_cast<int>(where.line), static_cast<int>(where.column), "",
+                      fault->what() + ": a plan is UTF-8 text without control characters"};
+}
+
+}  // namespace
+
 LoadResult load_plan_text(std::string_view text, const std::string& source_name, const LoadOptions& options) {
     if (text.size() > kMaxPlanTextBytes) {
         return one_error(source_name, 0, 0,
-                         "plan larger than " + std::to_string(kMaxPlanTextBytes) + " bytes");
+                         "plan larger than the " + size_text(kMaxPlanTextBytes) + " allowed (" +
+                             std::to_string(text.size()) + " bytes)");
+    }
+    if (auto problem = text_problem(text, source_name)) {
+        LoadResult r;
+        r.errors.push_back(std::move(*problem));
+        return r;
     }
     return load_from([&]() -> std::unique_ptr<std::istream> { return std::make_unique<TextStream>(text); },
                      text, source_name, options);
 }
 
 LoadResult load_plan_file(const std::string& path, const LoadOptions& options) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        return one_error(path, 0, 0, "cannot open the file");
+    // Only a regular file up to the cap: a FIFO, a directory or /dev/zero is refused at once.
+    const RegularFile file = RegularFile::open(path, kMaxPlanTextBytes);
+    if (!file.ok()) {
+        return one_error(path, 0, 0, file.error());
     }
-    in.seekg(0, std::ios::end);
-    const std::streamoff size = in.tellg();
-    if (size < 0) {
-        // Not seekable (a pipe): read it into memory, as much as a plan may be.
-        in.clear();
-        std::ifstream again(path, std::ios::binary);
-        std::string text(kMaxPlanTextBytes + 1, '\0');
-        again.read(text.data(), static_cast<std::streamsize>(text.size()));
-        text.resize(static_cast<std::size_t>(again.gcount()));
-        text.shrink_to_fit();
-        return load_plan_text(text, path, options);
+    // The file is read as it is parsed, never held whole; its main list is then not spliced (load_from). Its
+    // texts are checked as they are read (PlanEventReader).
+    bool grew = false;
+    auto result =
+        load_from([&]() -> std::unique_ptr<std::istream> { return std::make_unique<FileStream>(file, grew); },
+                  std::string_view(), path, options);
+    if (grew) {
+        return one_error(
+            path, 0, 0,
+            "larger than the " + size_text(kMaxPlanTextBytes) + " allowed (it grew while it was read)");
     }
-    if (static_cast<std::uint64_t>(size) > kMaxPlanTextBytes) {
-        return one_error(path, 0, 0, "plan larger than " + std::to_string(kMaxPlanTextBytes) + " bytes");
-    }
-    // The file is read as it is parsed, never held whole; its main list is then not spliced (load_from).
-    return load_from(
-        [&]() -> std::unique_ptr<std::istream> {
-            return std::make_unique<std::ifstream>(path, std::ios::binary);
-        },
-        std::string_view(), path, options);
+    return result;
 }
 
 }  // namespace airseg::flightplan

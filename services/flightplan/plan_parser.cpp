@@ -117,7 +117,43 @@ std::optional<std::string> PlanParser::text(const YRef& map, const char* key, co
         error(value, path + "." + key, "must be a non-empty string");
         return std::nullopt;
     }
+    if (value.Scalar().size() > kMaxTextBytes) {
+        // Names are shown in every status document and every reply about the plan.
+        error(value, path + "." + key,
+              "longer than the " + std::to_string(kMaxTextBytes) + " bytes allowed (" +
+                  std::to_string(value.Scalar().size()) + ")");
+        return std::nullopt;
+    }
     return value.Scalar();
+}
+
+void PlanParser::note_coordinate(LatLon p, const YRef& at, const std::string& path) {
+    if (!first_coordinate_) {
+        first_coordinate_ = p;
+    }
+    // The reference is known by now: plan.reference is read before any other position, and without it the
+    // first position is the reference.
+    const LatLon reference = reference_.value_or(*first_coordinate_);
+    const bool polar = std::abs(p.lat) > kMaxFrameLatitude;
+    const double reach = great_circle_distance(reference, p);
+    if (!polar && reach <= kMaxFrameReachMetres) {
+        return;
+    }
+    if (out_of_frame_++ > 0) {
+        return;  // the first one is located; finish() counts the rest
+    }
+    std::ostringstream msg;
+    msg.precision(7);
+    if (polar) {
+        msg << "latitude " << p.lat << " is beyond " << kMaxFrameLatitude
+            << " degrees: the plan's local frame does not reach the poles";
+    } else {
+        msg << "is " << std::llround(reach / 1000.0) << " km from the plan's reference (" << reference.lat
+            << ", " << reference.lon << "): every position must lie within " << kMaxFrameReachMetres / 1000.0
+            << " km of it, the reach of the plan's local frame (set plan.reference near the plan's middle)";
+    }
+    out_of_frame_error_ = errors_.size();
+    error(at, path, msg.str());
 }
 
 std::optional<LatLon> PlanParser::lat_lon_fields(const YRef& map, const std::string& path, bool required) {
@@ -130,7 +166,7 @@ std::optional<LatLon> PlanParser::lat_lon_fields(const YRef& map, const std::str
     if (!lat || !lon) {
         return std::nullopt;
     }
-    note_coordinate({*lat, *lon});
+    note_coordinate({*lat, *lon}, map, path);
     return LatLon{*lat, *lon};
 }
 
@@ -148,13 +184,20 @@ std::optional<LatLon> PlanParser::point(const YRef& node, const std::string& pat
         error(node[1], path + "[1]", "longitude must be a number between -180 and 180");
         return std::nullopt;
     }
-    note_coordinate({lat, lon});
+    note_coordinate({lat, lon}, node, path);
     return LatLon{lat, lon};
 }
 
 std::optional<std::vector<LatLon>> PlanParser::polygon(const YRef& node, const std::string& path) {
     if (!node.IsSequence() || node.size() < 3) {
         error(node, path, "must be a list of at least 3 [lat, lon] vertices");
+        return std::nullopt;
+    }
+    if (node.size() > kMaxPolygonVertices) {
+        // Every scan line and every leg checked against a zone crosses each edge.
+        error(node, path,
+              "has " + std::to_string(node.size()) + " vertices, more than the " +
+                  std::to_string(kMaxPolygonVertices) + " allowed");
         return std::nullopt;
     }
     std::vector<LatLon> out;
@@ -600,7 +643,7 @@ PlanParser::ListTarget PlanParser::plan_head(const YRef& p) {
     return {plan_.main_list, path + ".elements", p};
 }
 
-void PlanParser::finish_geometry() {
+void PlanParser::finish_geometry(std::uint64_t max_scan_work) {
     plan_.frame = LocalFrame(reference_.value_or(first_coordinate_.value_or(LatLon{})));
     const LocalFrame& f = plan_.frame;
     auto to_local = [&](const std::vector<LatLon>& poly) {
@@ -629,14 +672,27 @@ void PlanParser::finish_geometry() {
             continue;
         }
         auto& scan = plan_.extra_for(id).scan;
-        scan.emplace(std::move(local), raw.spacing, raw.heading, raw.step, plan_.vehicle.min_spacing);
+        // Laying the scans out (counting their waypoints) crosses every line with every edge: a budget for
+        // the whole plan, so that no plan keeps the service busy for long.
+        const std::uint64_t budget = max_scan_work - std::min(max_scan_work, scan_work_);
+        scan.emplace(std::move(local), raw.spacing, raw.heading, raw.step, plan_.vehicle.min_spacing, budget);
         if (scan->too_many_lines()) {
+            const bool lines = scan->work() / static_cast<double>(scan->polygon().size()) >
+                               static_cast<double>(ScanPattern::kMaxLines);
             error(mark, plan_.element_path(id) + ".scan.spacing",
-                  "too small for this polygon (more than " + std::to_string(ScanPattern::kMaxLines) +
-                      " lines)");
+                  lines ? "too small for this polygon (more than " + std::to_string(ScanPattern::kMaxLines) +
+                              " lines)"
+                        : "too small for this polygon: its lines times the polygon's edges (" +
+                              std::to_string(std::llround(scan->work())) + ")" +
+                              (scan_work_ > 0 ? ", with the plan's scans before it," : "") + " exceed the " +
+                              std::to_string(max_scan_work) +
+                              " line-edge crossings a plan's scans may take to lay out");
             scan.reset();
         } else if (scan->total_count() == 0) {
             error(mark, plan_.element_path(id) + ".scan.polygon", "polygon has no area");
+        }
+        if (scan) {
+            scan_work_ += static_cast<std::uint64_t>(scan->work());
         }
     }
     for (auto& [id, raw] : orbits_) {
@@ -759,8 +815,12 @@ LoadResult PlanParser::run(const YRef& doc, const LoadOptions& options) {
 }
 
 LoadResult PlanParser::finish(const LoadOptions& options) {
+    if (out_of_frame_ > 1) {
+        errors_[out_of_frame_error_].message += " (and " + std::to_string(out_of_frame_ - 1) +
+                                                " more position" + (out_of_frame_ > 2 ? "s" : "") + ")";
+    }
     if (errors_.empty()) {
-        finish_geometry();
+        finish_geometry(options.max_scan_work);
         resolve_names();
         derive_counts(options);
     }

@@ -19,6 +19,12 @@
 
 namespace airseg::flightplan {
 
+/// The longest text field of a plan (names, goto and reaction targets, types): names are shown in every
+/// status document and every reply about the plan.
+inline constexpr std::size_t kMaxTextBytes = 256;
+/// The most vertices of one polygon (a scan's area, a no-fly zone, the geofence).
+inline constexpr std::size_t kMaxPolygonVertices = 1000;
+
 class PlanParser {
   public:
     /// Where the items of an element list go: the container, the list's path, and the mapping that holds
@@ -78,11 +84,9 @@ class PlanParser {
     std::optional<LatLon> lat_lon_fields(const YRef& map, const std::string& path, bool required);
     std::optional<LatLon> point(const YRef& node, const std::string& path);
     std::optional<std::vector<LatLon>> polygon(const YRef& node, const std::string& path);
-    void note_coordinate(LatLon p) {
-        if (!first_coordinate_) {
-            first_coordinate_ = p;
-        }
-    }
+    /// Every position read: the first is the frame's reference unless plan.reference is given; one beyond the
+    /// frame's reach (geo.hpp) is an error.
+    void note_coordinate(LatLon p, const YRef& at, const std::string& path);
 
     std::uint32_t add_node(NodeKind kind, std::uint32_t parent, SourceMark mark);
     void set_name(std::uint32_t id, std::optional<std::string> name);
@@ -95,7 +99,7 @@ class PlanParser {
     void parse_elements(const YRef& list, std::uint32_t parent, const std::string& path);
     void parse_leaf_common(const YRef& body, std::uint32_t id, const std::string& path);
 
-    void finish_geometry();
+    void finish_geometry(std::uint64_t max_scan_work);
     void resolve_names();
     void derive_counts(const LoadOptions& options);
 
@@ -105,6 +109,9 @@ class PlanParser {
     Plan plan_;
     std::vector<Diagnostic> errors_;
     std::optional<LatLon> first_coordinate_;
+    std::uint64_t scan_work_ = 0;         // line-edge crossings of the scans laid out so far
+    std::uint64_t out_of_frame_ = 0;      // positions beyond the frame's reach
+    std::size_t out_of_frame_error_ = 0;  // the error that names the first of them
     std::optional<LatLon> reference_;
     std::map<std::uint32_t, RawScan> scans_;
     std::map<std::uint32_t, RawOrbit> orbits_;

@@ -5,6 +5,8 @@
 #include <istream>
 #include <utility>
 
+#include "base/utf8.hpp"
+
 namespace airseg::flightplan {
 
 // One level per list being streamed (level 0 is the document). A level's builder holds the trees of that
@@ -226,6 +228,11 @@ void PlanEventReader::OnScalar(const YAML::Mark& mark, const std::string&, YAML:
     Level& l = level();
     if (l.kind == Level::Kind::Skip) {
         return;
+    }
+    if (const auto bad = first_invalid_utf8(value)) {
+        // Every text of a plan reaches JSON documents (status, plan.show), whose dump would throw on it.
+        throw YAML::Exception(place(mark), "text that is not valid UTF-8 (byte " + std::to_string(*bad + 1) +
+                                               " of a " + (next_is_key() ? "key" : "value") + ")");
     }
     pending_ = Pending::None;
     const bool key = next_is_key();

@@ -11,7 +11,9 @@ ResumeResult resume_from(StoredState stored, const LoadOptions& options) {
     auto loaded = load_plan_text(*stored.plan_text, stored.plan_source, options);
     if (!loaded.ok()) {
         // The text passed its checksum, so it was accepted once: the loader or its options changed since.
-        out.problems.push_back("stored plan no longer loads: " + loaded.errors.front().to_string());
+        out.problems.push_back("stored plan no longer loads: " + loaded.errors.front().to_string() +
+                               "; set aside");
+        out.set_aside = true;
         return out;
     }
     ResumedPlan r;

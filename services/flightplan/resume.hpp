@@ -23,6 +23,9 @@ struct ResumedPlan {
 struct ResumeResult {
     std::optional<ResumedPlan> resumed;  // empty: nothing to resume (see problems)
     std::vector<std::string> problems;   // everything worth logging, including the store's own findings
+    /// The stored plan passed its checksum but no longer loads: its files are to be set aside
+    /// (StateStore::set_aside_plan), so that the next start does not meet it again.
+    bool set_aside = false;
 };
 
 /// Rebuilds the stream of a stored plan. A stored plan without progress starts from its beginning. Feed

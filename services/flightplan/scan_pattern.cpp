@@ -6,7 +6,7 @@
 namespace airseg::flightplan {
 
 ScanPattern::ScanPattern(std::vector<Enu> polygon, double spacing, double heading_deg, double step,
-                         double min_spacing)
+                         double min_spacing, std::uint64_t max_work)
     : polygon_(std::move(polygon)), spacing_(spacing), step_(step), min_spacing_(min_spacing) {
     const double h = heading_deg * kPi / 180.0;
     along_ = {std::sin(h), std::cos(h)};
@@ -24,7 +24,8 @@ ScanPattern::ScanPattern(std::vector<Enu> polygon, double spacing, double headin
         return;
     }
     const double lines = std::ceil((vmax_ - vmin_) / spacing_ - 1e-9);
-    if (lines > static_cast<double>(kMaxLines)) {
+    work_ = std::max(1.0, lines) * static_cast<double>(rotated_.size());
+    if (lines > static_cast<double>(kMaxLines) || work_ > static_cast<double>(max_work)) {
         too_many_lines_ = true;
         return;
     }

@@ -28,10 +28,14 @@ class ScanPattern {
     /// Beyond this many lines the pattern is refused (too_many_lines()) rather than computed.
     static constexpr std::uint64_t kMaxLines = 10'000'000;
 
-    ScanPattern(std::vector<Enu> polygon, double spacing, double heading_deg, double step,
-                double min_spacing);
+    /// `max_work`: the most line-edge crossings (lines x vertices) counting the waypoints may take; a pattern
+    /// that needs more is refused (too_many_lines()) rather than computed.
+    ScanPattern(std::vector<Enu> polygon, double spacing, double heading_deg, double step, double min_spacing,
+                std::uint64_t max_work = UINT64_MAX);
 
     bool too_many_lines() const { return too_many_lines_; }
+    /// Line-edge crossings the construction took (or would have taken, when refused): lines x vertices.
+    double work() const { return work_; }
     std::uint64_t line_count() const { return lines_; }
     /// Waypoints of the whole scan (computed once at construction, O(lines x vertices)).
     std::uint64_t total_count() const { return total_; }
@@ -54,6 +58,7 @@ class ScanPattern {
     double vmax_ = 0.0;
     std::uint64_t lines_ = 0;
     std::uint64_t total_ = 0;
+    double work_ = 0.0;
     bool too_many_lines_ = false;
 };
 

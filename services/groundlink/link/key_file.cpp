@@ -1,13 +1,12 @@
 #include "services/groundlink/link/key_file.hpp"
 
-#include <fcntl.h>
 #include <fmt/format.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <cctype>
 #include <cerrno>
 #include <system_error>
+
+#include "base/file_text.hpp"
 
 namespace airseg::groundlink {
 
@@ -29,36 +28,18 @@ std::string cannot_read(const std::string& path, int error) {
 
 KeyFileResult read_key_file(const std::string& path) {
     KeyFileResult out;
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY);
-    if (fd < 0) {
-        out.error = cannot_read(path, errno);
-        return out;
-    }
-    struct stat st {};
-    std::string content;
-    int read_error = ::fstat(fd, &st) == 0 ? 0 : errno;
     // A key is 32 bytes, or 64 hexadecimal characters with some whitespace: a few KiB is plenty.
-    char buffer[4096];
-    while (read_error == 0 && content.size() <= sizeof buffer) {
-        const auto n = ::read(fd, buffer, sizeof buffer);
-        if (n < 0 && errno == EINTR) {
-            continue;
-        }
-        if (n <= 0) {
-            read_error = n < 0 ? errno : 0;
-            break;
-        }
-        content.append(buffer, static_cast<std::size_t>(n));
-    }
-    ::close(fd);
-    if (read_error != 0) {
-        out.error = cannot_read(path, read_error);
+    const auto file = read_file_text(path, kMaxSmallFileBytes);
+    if (!file.ok()) {
+        out.error = file.errno_value != 0 ? cannot_read(path, file.errno_value)
+                                          : fmt::format("key file {}: {}", path, file.error);
         return out;
     }
-    if ((st.st_mode & 077) != 0) {
+    const std::string& content = file.text;
+    if ((file.mode & 077) != 0) {
         out.error =
             fmt::format("key file {} has mode {:04o}; it must be readable by its owner only (chmod 600 {})",
-                        path, st.st_mode & 07777, path);
+                        path, file.mode & 07777, path);
         return out;
     }
     std::array<std::uint8_t, 32> key{};

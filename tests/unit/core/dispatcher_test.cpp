@@ -51,6 +51,29 @@ TEST_F(DispatcherTest, UnknownAndMalformedRequestsAreNamed) {
     EXPECT_EQ(malformed->status, CommandStatus::BadRequest);
 }
 
+// The radio's CBOR carries any bytes in a text; a request holding one that is not UTF-8 is refused before any
+// handler keeps it (a plan's source, an element's name), so no later JSON dump can throw on it.
+TEST_F(DispatcherTest, ARequestWithTextThatIsNotUtf8IsRefusedBeforeItsHandler) {
+    bool ran = false;
+    dispatcher.add("plan.load", strand, Role::Control, [&](const Json&, CommandDispatcher::Reply reply) {
+        ran = true;
+        reply(CommandResult::ok());
+    });
+    for (const Json& request :
+         {Json{{"cmd", "plan.load"}, {"text", "plan: x"}, {"source", "n\xff.yaml"}},
+          Json{{"cmd", "plan.load"}, {"text", "plan: x"}, {"n\xe9", 1}},
+          Json{{"cmd", "plan.load"}, {"list", {"ok", "bad \xc3"}}}, Json{{"cmd", "\xff"}}}) {
+        auto r = call(request, Role::Control);
+        ASSERT_TRUE(r);
+        EXPECT_EQ(r->status, CommandStatus::BadRequest);
+        EXPECT_NE(r->error.find("not valid UTF-8"), std::string::npos) << r->error;
+        EXPECT_NO_THROW((void)r->to_json().dump()) << "the refusal itself must be valid JSON text";
+    }
+    EXPECT_FALSE(ran);
+    EXPECT_EQ(call({{"cmd", "plan.load"}, {"source", "caf\xc3\xa9.yaml"}}, Role::Control)->status,
+              CommandStatus::Ok);
+}
+
 TEST_F(DispatcherTest, MonitorCannotRunControlCommands) {
     bool ran = false;
     dispatcher.add("state", strand, Role::Control, [&](const Json&, CommandDispatcher::Reply reply) {
