@@ -128,7 +128,6 @@ void RoverSim::r2_send_heartbeat() {
         base |= mavlink::kModeFlagSafetyArmed;  // "we are armed if we are not initialising"
     }
     hb.base_mode = base | mavlink::kModeFlagCustomModeEnabled;
-    heartbeat_sent_this_boot_ = true;
     ++counters_.heartbeats_sent;
     out_.send(hb);
 }
