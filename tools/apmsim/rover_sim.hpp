@@ -174,6 +174,7 @@ class RoverSim {
     static constexpr std::uint8_t kCompid = 1;
     static constexpr std::size_t kMaxReachedLog = 4096;
     static constexpr std::size_t kMaxSpeedLog = 4096;
+    static constexpr std::size_t kMaxLegSamples = std::size_t{1} << 20;  // speed samples kept for one leg
 
     RoverSim(RoverSimConfig config, TimePoint now);
 
@@ -288,6 +289,7 @@ class RoverSim {
     void check_mission_change(TimePoint now);
     void continue_after(std::uint16_t seq, TimePoint now);
     void note_leg_speed(double speed);
+    void take_leg_stats(ReachedEvent& event);
     // rover_sim_telemetry.cpp
     void send_heartbeat(TimePoint now);
     void send_stream_message(std::uint32_t msgid, TimePoint now);

@@ -224,6 +224,9 @@ void RoverSim::physics_step(TimePoint at) {
         return;
     }
     vehicle_.drive_to(*target_, cruise_speed(), dt, lim);
+    if (mode_ == RoverMode::Auto) {
+        note_leg_speed(vehicle_.speed());
+    }
     if (rover2_mission()) {
         return;  // the 2.x navigate() task decides when a place is reached (r2_tick)
     }
@@ -257,14 +260,7 @@ void RoverSim::on_target_reached(double distance, bool passed, TimePoint now) {
     }
     const std::uint16_t seq = current_seq_;
     ReachedEvent event{now, seq, distance, passed, target_.value_or(GeoPoint{})};
-    if (!leg_speeds_.empty()) {
-        event.leg_s = static_cast<double>(leg_speeds_.size()) *
-                      std::chrono::duration<double>(config_.physics_step).count();
-        const auto middle = leg_speeds_.begin() + static_cast<std::ptrdiff_t>(leg_speeds_.size() / 2);
-        std::nth_element(leg_speeds_.begin(), middle, leg_speeds_.end());
-        event.median_speed = *middle;
-        leg_speeds_.clear();
-    }
+    take_leg_stats(event);
     char line[50];
     std::snprintf(line, sizeof line, "%s waypoint #%u dist %um", passed ? "Passed" : "Reached",
                   static_cast<unsigned>(seq), static_cast<unsigned>(std::lround(distance)));
@@ -430,8 +426,22 @@ void RoverSim::check_mission_change(TimePoint now) {
     load_item(current_seq_, now);
 }
 
+void RoverSim::take_leg_stats(ReachedEvent& event) {
+    if (leg_speeds_.empty()) {
+        return;
+    }
+    event.leg_s =
+        static_cast<double>(leg_speeds_.size()) * std::chrono::duration<double>(config_.physics_step).count();
+    const auto middle = leg_speeds_.begin() + static_cast<std::ptrdiff_t>(leg_speeds_.size() / 2);
+    std::nth_element(leg_speeds_.begin(), middle, leg_speeds_.end());
+    event.median_speed = *middle;
+    leg_speeds_.clear();
+}
+
 void RoverSim::note_leg_speed(double speed) {
-    leg_speeds_.push_back(static_cast<float>(speed));
+    if (leg_speeds_.size() < kMaxLegSamples) {  // about 5.8 hours of one leg: the median of those
+        leg_speeds_.push_back(static_cast<float>(speed));
+    }
 }
 
 bool RoverSim::guided_goto(const StoredItem& item) {

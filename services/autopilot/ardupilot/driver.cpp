@@ -436,6 +436,7 @@ void Driver::on_param_done(ParamCompletion c, TimePoint now) {
     if (c.id == sequence_fetch_) {
         sequence_fetch_ = 0;
         if (c.result == RequestResult::Ok) {
+            on_params_known();
             if (phase_ == Phase::Params) {
                 enter(Phase::Mission, now);
             }

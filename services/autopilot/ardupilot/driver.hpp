@@ -202,6 +202,7 @@ class Driver {
     bool on_speed_param_done(const ParamCompletion& c, TimePoint now);
     void forget_speed();
     void on_auto_entered();
+    void on_params_known();
     void restore_board_speed(TimePoint now);
 
     AutopilotConfig config_;

@@ -4,7 +4,8 @@
 // confirmed by COMMAND_ACK ACCEPTED) on boards that have the command, or the parameter the board drives AUTO
 // at (speed_param(): WP_SPEED on current Rover, CRUISE_SPEED on ArduRover 2.x; PARAM_SET, confirmed by the
 // PARAM_VALUE read back) on those that do not (2.x; also any board that answers the command UNSUPPORTED or
-// DENIED, or never answers it).
+// DENIED, or never answers it). A board with WP_SPEED gets the command even when configured as apm2: it
+// reads WP_SPEED only on entering AUTO.
 //  - Every entry into AUTO brings the board's own speed back (current Rover: ModeAuto::_enter() initialises
 //    AR_WPNav at WP_SPEED), and so does a reboot: the speed confirmed is then the board's own, and the plan's
 //    is sent again. A parameter, kept in the board's EEPROM, survives both and is sent only when it changes.
@@ -43,6 +44,15 @@ void Driver::forget_speed() {
     speed_set_.reset();
     speed_request_.reset();
     speed_refused_.reset();
+}
+
+// A board with WP_SPEED runs AR_WPNav (Rover 3.x and later), which has MAV_CMD_DO_CHANGE_SPEED, whatever
+// autopilot.board says: its WP_SPEED is read only when AUTO is entered, so the command is the way to set a
+// leg's speed while it drives.
+void Driver::on_params_known() {
+    if (params_.cached(kWpSpeed)) {
+        speed_by_param_ = false;
+    }
 }
 
 void Driver::on_auto_entered() {
