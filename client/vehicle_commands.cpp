@@ -52,7 +52,10 @@ BuiltCommand state_command(const std::vector<std::string>& a) {
     BuiltCommand b;
     b.request = {{"cmd", "state"}, {"state", to_upper(a[1])}};
     b.render = [](const nlohmann::json& r) {
-        return "vehicle acknowledged: state " + r.value("state", std::string("?")) + "\n";
+        const auto armed = r.find("armed");
+        const std::string arming =
+            armed != r.end() && armed->is_boolean() ? (armed->get<bool>() ? " (armed)" : " (disarmed)") : "";
+        return "vehicle acknowledged: state " + r.value("state", std::string("?")) + arming + "\n";
     };
     return b;
 }

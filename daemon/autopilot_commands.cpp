@@ -24,6 +24,11 @@ Json completed_result(const autopilot::RequestDone& done, Json result) {
                 result["value"] = *done.param_value;
             }
             break;
+        case autopilot::RequestKind::SetState:
+            if (done.armed) {
+                result["armed"] = *done.armed;
+            }
+            break;
         case autopilot::RequestKind::ListParams: {
             auto& params = result["params"] = Json::object();
             for (const auto& [name, value] : done.params) {

@@ -57,6 +57,7 @@ AutopilotSetup autopilot_setup(const Config& config) {
     ap.boot_timeout = a.boot_timeout;
     ap.heartbeat_timeout = a.heartbeat_timeout;
     ap.mode_timeout = a.mode_timeout;
+    ap.arming = a.arming == "never" ? autopilot::ArmingPolicy::Never : autopilot::ArmingPolicy::Auto;
     for (const auto& [name, value] : a.params) {
         ap.params.push_back({name, value});
     }

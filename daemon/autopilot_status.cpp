@@ -47,6 +47,8 @@ nlohmann::json autopilot_status_json(const autopilot::AutopilotStatus& s) {
     j["syncs"] = s.syncs;
     j["reconnects"] = s.reconnects;
     j["reset_pulses"] = s.reset_pulses;
+    j["armed"] = s.armed ? nlohmann::json(*s.armed) : nlohmann::json(nullptr);
+    j["arm_refusals"] = s.arm_refusals;
     j["speed"] = s.speed ? nlohmann::json(*s.speed) : nlohmann::json(nullptr);
     j["mission_items"] = s.mission_items;
     j["auto_restarts_corrected"] = s.auto_restarts_corrected;

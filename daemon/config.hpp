@@ -29,6 +29,7 @@ struct AutopilotConfig {
     milliseconds boot_timeout{30'000};      // autopilot.boot_timeout
     milliseconds heartbeat_timeout{3'000};  // autopilot.heartbeat_timeout
     milliseconds mode_timeout{1'500};       // autopilot.mode_timeout
+    std::string arming = "auto";            // autopilot.arming: auto | never
     std::map<std::string, double> params;   // autopilot.params: {NAME: value}
     std::map<std::string, double> streams;  // autopilot.streams: {position: 4, ...}; empty = board's
     std::map<std::string, double>

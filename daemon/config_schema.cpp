@@ -381,6 +381,11 @@ std::vector<KeySpec> build_schema() {
     s.push_back(duration(
         "autopilot.mode_timeout", [](Config& c) -> milliseconds& { return c.autopilot.mode_timeout; },
         milliseconds(0), hours(1), "wait for the autopilot to confirm a mode change, per attempt"));
+    s.push_back(choice(
+        "autopilot.arming", [](Config& c) -> std::string& { return c.autopilot.arming; }, {"auto", "never"},
+        "auto: a request for WAYPOINT_NAVIGATION (a plan starting or resuming) or MANUAL_NAVIGATION arms a "
+        "board that is not armed, never forcing; never: airsegd never arms (the RC transmitter or a ground "
+        "station does). airsegd never disarms"));
     s.push_back(number_map(
         "autopilot.params", [](Config& c) -> std::map<std::string, double>& { return c.autopilot.params; },
         {}, false, "autopilot parameters written (and read back) on every connection"));

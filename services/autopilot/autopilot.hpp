@@ -149,6 +149,7 @@ struct RequestDone {
     std::vector<MissionItem> items;                      // DownloadMission
     std::optional<double> param_value;                   // GetParam / SetParam (the value read back)
     std::vector<std::pair<std::string, double>> params;  // ListParams: the cached table, by name
+    std::optional<bool> armed;  // SetState: the board's heartbeat showed it armed at the end (when known)
 };
 
 using Event = std::variant<WaypointReached, MissionCurrentChanged, ModeChanged, LinkUp, LinkDown,
@@ -244,6 +245,8 @@ struct AutopilotStatus {
     unsigned syncs = 0;                          // autopilot.syncs: parameter + mission downloads started
     unsigned reconnects = 0;            // autopilot.reconnects (filled by the service from its port keeper)
     unsigned reset_pulses = 0;          // autopilot.reset_pulses
+    std::optional<bool> armed;          // autopilot.armed: the heartbeat's SAFETY_ARMED; empty before one
+    unsigned arm_refusals = 0;          // autopilot.arm_refusals: arming attempts the board refused
     std::optional<double> speed;        // autopilot.speed: the leg speed the board last confirmed, m/s
     std::string mission_items = "int";  // autopilot.mission_items: "int" (MISSION_ITEM_INT) or "float"
     unsigned auto_restarts_corrected = 0;  // autopilot.auto_restarts_corrected: slots set back after AUTO

@@ -17,6 +17,16 @@ const char* to_string(Board b) {
     return "?";
 }
 
+const char* to_string(ArmingPolicy p) {
+    switch (p) {
+        case ArmingPolicy::Auto:
+            return "auto";
+        case ArmingPolicy::Never:
+            return "never";
+    }
+    return "?";
+}
+
 std::optional<std::uint32_t> message_id(std::string_view name) {
     if (const auto* info = mavlink::find_message(name)) {
         return info->id;

@@ -70,6 +70,14 @@ struct MissionConfig {
     std::uint16_t max_items = 700;  // autopilot.mission.max_items
 };
 
+/// When the driver arms the autopilot (autopilot.arming). A board that needs arming (ArduPilot Rover 4.x:
+/// ARMING_REQUIRE 1) shows it by a heartbeat without MAV_MODE_FLAG_SAFETY_ARMED.
+enum class ArmingPolicy : std::uint8_t {
+    Auto,   // arm (never forced) on a request for WAYPOINT_NAVIGATION or MANUAL_NAVIGATION while disarmed
+    Never,  // never arm: someone else does (the RC transmitter, a ground station)
+};
+const char* to_string(ArmingPolicy p);
+
 /// MAV_TYPE values our own HEARTBEAT can carry.
 inline constexpr std::uint8_t kMavTypeGcs = 6;
 inline constexpr std::uint8_t kMavTypeOnboardController = 18;
@@ -97,6 +105,7 @@ struct AutopilotConfig {
     Duration param_list_timeout = seconds(60);      // autopilot.param_list_timeout: the whole download
     Duration mode_timeout = milliseconds(1500);     // autopilot.mode_timeout: per attempt
     unsigned mode_retries = 3;                      // autopilot.mode_retries
+    ArmingPolicy arming = ArmingPolicy::Auto;       // autopilot.arming: auto | never
     Duration unresponsive_timeout = seconds(20);    // autopilot.reset.unresponsive_timeout
     unsigned max_reset_pulses = 3;                  // autopilot.reset.max_pulses (0: never pulse)
     MissionConfig mission;

@@ -754,7 +754,7 @@ Json PlanController::progress_json() const {
     j["next_waypoint"] = optional_json(p.next_waypoint);
     j["window"] = p.window;
     j["reaction"] = last_reaction_.empty() ? Json(nullptr) : Json(last_reaction_);
-    j["interruption"] = p.interruption.empty() ? Json(nullptr) : Json(p.interruption);
+    j["interruption"] = shown_interruption(p).empty() ? Json(nullptr) : Json(shown_interruption(p));
     j["error"] = problem_.empty() ? Json(nullptr) : Json(problem_);
     return j;
 }
@@ -777,8 +777,15 @@ TimePoint PlanController::poll_timeout() const {
 }
 
 PlanController::StatusKey PlanController::status_key(const FeederProgress& p) const {
-    return {p.state,        p.plan_name,    p.element, p.waypoints_reached, p.next_waypoint, p.window,
-            last_reaction_, p.interruption, problem_};
+    return {p.state,        p.plan_name,           p.element, p.waypoints_reached, p.next_waypoint, p.window,
+            last_reaction_, shown_interruption(p), problem_};
+}
+
+// The last interruption is news while its plan runs (and kept after the plan continued); a plan that has
+// ended is done with it.
+const std::string& PlanController::shown_interruption(const FeederProgress& p) {
+    static const std::string kNone;
+    return p.state == PlanState::Done || p.state == PlanState::None ? kNone : p.interruption;
 }
 
 void PlanController::publish_status(bool force) {

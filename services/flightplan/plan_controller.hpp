@@ -161,6 +161,8 @@ class PlanController {
         std::tuple<PlanState, std::string, std::string, std::uint64_t, std::optional<std::uint64_t>,
                    std::size_t, std::string, std::string, std::string>;
     StatusKey status_key(const FeederProgress& p) const;
+    /// plan.interruption: the feeder's last interruption, none once the plan is done.
+    static const std::string& shown_interruption(const FeederProgress& p);
 
   private:
     struct Waiter {

@@ -605,6 +605,15 @@ void WindowFeeder::on_request_result(std::uint32_t id, autopilot::RequestResult 
                                  : std::string(detail));
         return;
     }
+    if (const auto* change = std::get_if<autopilot::RequestStateChange>(&request.op);
+        a == Answer::Refused && change != nullptr && change->state == VehicleState::WaypointNavigation) {
+        // The board will not drive the mission (it refused to arm, or refused AUTO) and says why: a plan
+        // that cannot start is failed with its reason rather than asked again every fault_backoff.
+        consecutive_failures_ = 0;
+        fail_plan(detail.empty() ? std::string("the autopilot refused to drive the mission")
+                                 : std::string(detail));
+        return;
+    }
     request_failed(now);
 }
 

@@ -23,7 +23,9 @@ struct Reached {
     std::uint64_t n = 0;  ///< the simulator's event number
     double t = 0;         ///< simulated seconds
     E7 at;
-    std::uint16_t seq = 0;  ///< the mission slot
+    std::uint16_t seq = 0;    ///< the mission slot
+    double leg_s = 0;         ///< seconds in AUTO on the leg that ended here
+    double median_speed = 0;  ///< the car's median speed over them, m/s
 };
 
 /// The flight plan's mission wraps through slot window+2, a point on the way from the last ring position to
@@ -52,7 +54,9 @@ inline std::vector<Reached> reached_log(ControlClient& sim, std::uint64_t from =
                 {r["n"].get<std::uint64_t>(),
                  r["t"].get<double>(),
                  {std::llround(r["lat"].get<double>() * 1e7), std::llround(r["lon"].get<double>() * 1e7)},
-                 static_cast<std::uint16_t>(r.value("seq", 0))});
+                 static_cast<std::uint16_t>(r.value("seq", 0)),
+                 r.value("leg_s", 0.0),
+                 r.value("median_speed", 0.0)});
         }
         if (page["reached"].size() < 500) {
             return out;

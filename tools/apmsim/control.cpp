@@ -45,6 +45,10 @@ nlohmann::json state_json(const RoverSim& sim, TimePoint now) {
         {"cruise_speed", s.cruise_speed},
         {"firmware", firmware_name(sim.config().firmware.firmware)},
         {"frozen", sim.frozen()},
+        {"gps_fix", s.gps_fix},
+        {"failing_check",
+         s.failing_check.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.failing_check)},
+        {"restarts", sim.counters().auto_restarts},
     };
     if (s.target) {
         j["target"] = {{"lat", s.target->lat}, {"lon", s.target->lon}, {"distance", s.target_distance}};
@@ -79,7 +83,9 @@ nlohmann::json reached_json(const RoverSim& sim, std::uint64_t from, std::uint64
                         {"lat", r.item.lat},
                         {"lon", r.item.lon},
                         {"distance", r.distance},
-                        {"passed", r.passed}});
+                        {"passed", r.passed},
+                        {"leg_s", r.leg_s},
+                        {"median_speed", r.median_speed}});
     }
     return {{"total", sim.reached_total()}, {"first_kept", first}, {"reached", list}};
 }
@@ -112,6 +118,8 @@ nlohmann::json stats_json(const RoverSim& sim) {
             {"mavlink2_ignored", c.mavlink2_ignored},
             {"heartbeats_sent", c.heartbeats_sent},
             {"heartbeats_stalled", c.heartbeats_stalled},
+            {"auto_restarts", c.auto_restarts},
+            {"arm_refused", c.arm_refused},
             {"uploads_completed", m.uploads_completed},
             {"uploads_cancelled", m.uploads_cancelled},
             {"mission_rerequests", m.rerequests},
@@ -243,6 +251,43 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
             sim.freeze(w[1] == "on", now);
             return "ok freeze " + w[1];
         }
+        if (verb == "arm") {
+            if (w.size() > 2 || (w.size() == 2 && w[1] != "force")) {
+                throw cli::UsageError("usage: arm [force]");
+            }
+            const auto result = sim.arm(true, w.size() == 2, now);
+            return result == 0 ? "ok armed"
+                               : "error: arm: refused (MAV_RESULT " + std::to_string(result) + ")";
+        }
+        if (verb == "disarm") {
+            need(1, "disarm");
+            sim.arm(false, false, now);
+            return "ok disarmed";
+        }
+        if (verb == "gps") {
+            need(2, "gps lose|fix");
+            if (w[1] != "lose" && w[1] != "fix") {
+                return "error: gps: expected lose or fix, got '" + w[1] + "'";
+            }
+            sim.set_gps_fix(w[1] == "fix", now);
+            return "ok gps " + w[1];
+        }
+        if (verb == "fail-check") {
+            if (w.size() < 2) {
+                throw cli::UsageError("usage: fail-check REASON...|off");
+            }
+            if (w.size() == 2 && w[1] == "off") {
+                sim.fail_check("", now);
+                return "ok fail-check off";
+            }
+            // The reason as the board would word it: the words after the verb, one space apart.
+            std::string reason = w[1];
+            for (std::size_t i = 2; i < w.size(); ++i) {
+                reason += " " + w[i];
+            }
+            sim.fail_check(reason, now);
+            return "ok fail-check " + reason;
+        }
         if (verb == "slow") {
             need(2, "slow MS");
             sim.faults().slow = cli::parse_milliseconds(verb, w[1]);
@@ -267,7 +312,8 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
             return "ok commands: state, modes [N], reached [FROM [COUNT]], speeds [FROM [COUNT]], stats, "
                    "rcpilot MODE, mode MODE, reboot [S], unplug, replug, hbstall S, loss P [BURST], corrupt "
                    "P, "
-                   "ignore-mission on|off, freeze on|off, slow MS, param NAME [VALUE]";
+                   "ignore-mission on|off, freeze on|off, slow MS, param NAME [VALUE], arm [force], disarm, "
+                   "gps lose|fix, fail-check REASON...|off";
         }
         return "error: unknown command '" + verb + "' (try help)";
     } catch (const cli::UsageError& e) {

@@ -42,6 +42,10 @@ FirmwareProfile FirmwareProfile::rover2() {
     p.commands = Dialect::Rover2;
     p.telemetry = Dialect::Rover2;
     p.change_speed_command = false;
+    p.arming_checks = false;
+    p.mission_change_restart = false;
+    p.auto_speed = AutoSpeed::CruiseSpeed;
+    p.cornering = false;
     return p;
 }
 

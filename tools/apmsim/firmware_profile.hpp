@@ -51,6 +51,27 @@ struct FirmwareProfile {
     Dialect telemetry = Dialect::Modern;
     /// COMMAND_LONG MAV_CMD_DO_CHANGE_SPEED served (2.x answers it UNSUPPORTED).
     bool change_speed_command = true;
+    /// ArduPilot 4.x arming (AP_Arming, AP_Arming_Rover): ARMING_REQUIRE defaults to 1, so the board boots
+    /// disarmed and does not move until armed; arming runs the checks (ARMING_CHECK) and a failure is said
+    /// as "Arm: <reason>" with MAV_RESULT_FAILED; "PreArm: <reason>" every 30 s while a check fails. false:
+    /// 2.x, armed from boot (ARMING_REQUIRE 0), no arming command.
+    bool arming_checks = true;
+    /// ModeAuto's mission change detector (AP_Mission_ChangeDetector): a change of the current navigation
+    /// command or of the next two (DO_JUMP followed) restarts the current one in the WP submode.
+    bool mission_change_restart = true;
+    /// Where the speed in AUTO comes from.
+    enum class AutoSpeed : std::uint8_t {
+        /// AR_WPNav: WP_SPEED at every entry into AUTO (and GUIDED, RTL); DO_CHANGE_SPEED changes it in
+        /// those modes only; CRUISE_SPEED is not the AUTO speed.
+        WpSpeed,
+        /// 2.x: CRUISE_SPEED, a new value applying at once; DO_CHANGE_SPEED writes it.
+        CruiseSpeed,
+    };
+    AutoSpeed auto_speed = AutoSpeed::WpSpeed;
+    /// S-curve cornering (AR_WPNav since 4.2): the car slows for a turn by its angle and the lateral
+    /// acceleration limit, stops where the next leg has no length, at the last waypoint and at a waypoint
+    /// with a hold time (which it then holds), and re-plans from standstill when a command restarts.
+    bool cornering = true;
 
     static FirmwareProfile modern();
     static FirmwareProfile rover2();

@@ -4,9 +4,9 @@
 //
 //  - Idle, it skips every byte but the MAVLink 1 start byte 0xFE. A MAVLink 2 frame (0xFD ...) is line
 //    noise: its bytes are skipped, unless one of them is 0xFE, which starts a candidate that swallows the
-//    bytes after it (possibly the start of the next good frame). Each 0xFD met while idle is counted: normally
-//    one per MAVLink 2 frame that reached the board and was not understood (a 0xFD inside the frame, as the
-//    message id of STATUSTEXT, 253, counts as well).
+//    bytes after it (possibly the start of the next good frame). Each 0xFD met while idle is counted:
+//    normally one per MAVLink 2 frame that reached the board and was not understood (a 0xFD inside the frame,
+//    as the message id of STATUSTEXT, 253, counts as well).
 //  - It reads length, sequence, system, component, message id and payload, then checks the checksum with the
 //    message's CRC_EXTRA from the firmware's table. An id missing from the table has CRC_EXTRA 0 there, so
 //    its frames fail (bad_crc), as MISSION_REQUEST_INT and MISSION_ITEM_INT do on a 2.x board.

@@ -62,24 +62,31 @@ class MissionStore {
         } else {
             items_[seq] = item;
         }
+        ++changes_;
         return true;
     }
     /// Makes the mission exactly `count` items (at least home): keeps the first ones, fills new slots with
     /// `blank`.
     void resize(std::size_t count, const StoredItem& blank) {
         items_.resize(std::max<std::size_t>(1, std::min(count, capacity_)), blank);
+        ++changes_;
     }
     /// Keeps the first `count` items (home always stays).
     void truncate(std::size_t count) {
         if (count >= 1 && count < items_.size()) {
             items_.resize(count);
+            ++changes_;
         }
     }
     void set_home(const StoredItem& home) { items_[0] = home; }
+    /// Counts every write (AP_Mission's last change time: an item written, even with the same content, or
+    /// the mission cut shorter).
+    std::uint64_t changes() const { return changes_; }
 
   private:
     std::size_t capacity_;
     std::vector<StoredItem> items_;
+    std::uint64_t changes_ = 0;
 };
 
 }  // namespace airseg::apmsim

@@ -17,8 +17,9 @@ it as you would open /dev/ttyACM0. The board speaks MAVLink as system 1, compone
 (MAV_TYPE_GROUND_ROVER, MAV_AUTOPILOT_ARDUPILOTMEGA) to any ground station.
 
 Like an APM on USB, the board reboots when a program opens the port (DTR): it goes silent for the boot
-delay, then sends "Initialising APM..." and heartbeats in MAV_STATE_BOOT/CALIBRATING (mode INITIALISING)
-for the calibration time, then "Ready to drive." in STANDBY/ACTIVE and mode INITIAL_MODE (MANUAL).
+delay, then sends "Initialising APM..." and heartbeats in MAV_STATE_CALIBRATING (mode INITIALISING)
+for the calibration time, then "Ready to drive." and mode INITIAL_MODE (MANUAL). The modern board then
+waits to be armed (ARMING_REQUIRE 1); the rover2 board is armed from the start.
 
 )";
 
@@ -31,8 +32,9 @@ Control commands (one per datagram; the reply goes to the sender's bound address
   modes [N]                mode history (the last N changes) as JSON: [{"t":s,"from":..,"to":..,"cause":..,"seq":..,"count":..}]
                            causes: power on, reboot, command, rc pilot, mission end, rtl end
   reached [FROM [COUNT]]   reached items number FROM on (at most COUNT, 500 by default) as JSON:
-                           {"total":N,"first_kept":K,"reached":[{"n":..,"seq":..,"lat":..,"lon":..,..}]}
-  stats                    byte, frame and mission counters as JSON
+                           {"total":N,"first_kept":K,"reached":[{"n":..,"seq":..,"lat":..,"lon":..,..,
+                           "leg_s":..,"median_speed":..}]}
+  stats                    byte, frame, mission, restarted-command and arming counters as JSON
   speeds [FROM [COUNT]]    changes of the navigation speed number FROM on as JSON:
                            {"total":N,"first_kept":K,"speeds":[{"n":..,"t":s,"speed":..,"cause":..,"seq":..}]}
   rcpilot MODE             the RC pilot flips the mode switch (MANUAL, HOLD, AUTO, ... or a number)
@@ -45,6 +47,9 @@ Control commands (one per datagram; the reply goes to the sender's bound address
   ignore-mission on|off    ignore mission protocol messages
   slow MS                  answer requests MS milliseconds late (0: at once)
   param NAME [VALUE]       read or set a parameter
+  arm [force] | disarm     arm (the checks run unless forced) or disarm, as MAV_CMD_COMPONENT_ARM_DISARM
+  gps lose|fix             the GPS loses or gets its fix (arming in AUTO then fails: no position estimate)
+  fail-check REASON...|off an arming check fails with REASON ("PreArm: REASON", "Arm: REASON") / passes
   help
 )";
 
@@ -124,19 +129,21 @@ void fill_table(cli::OptionTable& table, ApmSimOptions& o,
         .flag("mavlink1", "speak MAVLink 1 (default MAVLink 2; rover2 always does)",
               later_flag([&o] { o.sim.version = mavlink::Version::V1; }))
         .value("param", "NAME=VALUE", "set a parameter before boot (repeatable), e.g. WP_RADIUS=3",
-               [&o](std::string_view option, std::string_view text) {
+               later([&o](std::string_view option, std::string_view text) {
                    const std::string v(text);
                    const auto eq = v.find('=');
                    if (eq == std::string::npos || eq == 0) {
                        throw UsageError(std::string(option) + ": expected NAME=VALUE, got '" + v + "'");
                    }
                    const std::string name = v.substr(0, eq);
-                   if (!ParamTable::rover_defaults().index_of(name)) {
-                       throw UsageError(std::string(option) + ": unknown parameter '" + name + "'");
+                   if (!ParamTable::for_profile(o.sim.firmware).index_of(name)) {
+                       throw UsageError(std::string(option) + ": unknown parameter '" + name +
+                                        "' (firmware " + std::string(firmware_name(o.sim.firmware.firmware)) +
+                                        ")");
                    }
                    o.params.emplace_back(
                        name, static_cast<float>(parse_double(option, v.substr(eq + 1), -1e9, 1e9)));
-               })
+               }))
         .value("seed", "N", "seed of the fault generators (deterministic) [1]",
                later(number(o.sim.seed, 0, UINT64_MAX)))
         .value("speedup", "N", "simulated time runs N times faster than real time [1]",

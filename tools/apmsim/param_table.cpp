@@ -263,6 +263,21 @@ ParamTable ParamTable::rover_defaults() {
     return t;
 }
 
+ParamTable ParamTable::for_profile(const FirmwareProfile& profile) {
+    ParamTable t = rover_defaults();
+    if (profile.arming_checks) {
+        t.set("ARMING_REQUIRE", 1);  // AP_Arming: Required::YES_MIN_PWM
+    }
+    if (profile.auto_speed == FirmwareProfile::AutoSpeed::WpSpeed) {
+        t.add("WP_SPEED", Real32, 2);  // AR_WPNAV_SPEED_DEFAULT
+    }
+    if (profile.cornering) {
+        t.add("ATC_ACCEL_MAX", Real32, 1);      // AR_ATTCONTROL_THR_ACCEL_MAX
+        t.add("ATC_TURN_MAX_G", Real32, 0.6F);  // AR_AttitudeControl _TURN_MAX_G
+    }
+    return t;
+}
+
 void ParamTable::add(std::string name, ParamType type, float value) {
     params_.push_back(Param{std::move(name), type, value});
 }

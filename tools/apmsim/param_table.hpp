@@ -8,6 +8,8 @@
 #include <string_view>
 #include <vector>
 
+#include "tools/apmsim/firmware_profile.hpp"
+
 namespace airseg::apmsim {
 
 /// MAV_PARAM_TYPE values ArduPilot uses.
@@ -23,6 +25,10 @@ class ParamTable {
   public:
     /// The table of a freshly flashed APM:Rover (a little over 250 parameters).
     static ParamTable rover_defaults();
+    /// The table of a board running `profile`: rover_defaults(), and on a board with ArduPilot 4.x arming
+    /// ARMING_REQUIRE 1, with AR_WPNav speeds WP_SPEED (2 m/s), with S-curve cornering ATC_ACCEL_MAX
+    /// (1 m/s²) and ATC_TURN_MAX_G (0.6 g), the defaults of AR_WPNav.cpp and AR_AttitudeControl.cpp.
+    static ParamTable for_profile(const FirmwareProfile& profile);
 
     std::size_t size() const { return params_.size(); }
     const Param& at(std::size_t index) const { return params_.at(index); }

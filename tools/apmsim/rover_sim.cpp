@@ -75,7 +75,7 @@ RoverSim::RoverSim(RoverSimConfig config, TimePoint now)
       started_(now),
       now_(now),
       rng_(config_.seed),
-      params_(ParamTable::rover_defaults()),
+      params_(ParamTable::for_profile(config_.firmware)),
       store_(config_.mission_capacity, home_item(config_)),
       out_(config_.version),
       server_(store_, out_,
@@ -143,6 +143,14 @@ void RoverSim::reboot(TimePoint now) {
     guided_target_.reset();
     rc_override_.fill(0);
     r2_ = Rover2Nav{};
+    planned_speed_ = 0;
+    wait_until_.reset();
+    change_detector_.reset();
+    leg_speeds_.clear();
+    // AP_Arming::update() after a boot: no report for 30 s, the checks taken as failing until they run.
+    last_prearm_display_ = now;
+    prearm_failing_ = true;
+    report_immediately_ = false;
     // What was set without saving (a 2.x DO_CHANGE_SPEED) is lost; a DO_CHANGE_SPEED's speed is forgotten.
     for (const auto& [name, saved] : unsaved_params_) {
         params_.set(name, saved);
@@ -173,7 +181,6 @@ void RoverSim::enter_phase(BootPhase phase, TimePoint now) {
             break;
         case BootPhase::Calibrating:
             phase_until_ = now + config_.calib_time;
-            heartbeat_sent_this_boot_ = false;
             next_heartbeat_ = now;
             if (rover2_telemetry()) {
                 // system.pde startup_ground() and startup_INS_ground(), with the 2.x severities; the
@@ -254,6 +261,7 @@ void RoverSim::handle_timeout(TimePoint now) {
     }
     if (next_heartbeat_ <= now) {
         send_heartbeat(now);
+        arming_update(now);  // AP_Arming::update() runs at 1 Hz too
         next_heartbeat_ = std::max(next_heartbeat_ + seconds(1), now);
     }
     if (phase_ == BootPhase::Ready) {
@@ -436,7 +444,7 @@ SimState RoverSim::state() const {
     SimState s;
     s.phase = phase_;
     s.mode = mode_;
-    s.armed = armed_;
+    s.armed = is_armed();
     s.position = vehicle_.position();
     s.heading_deg = vehicle_.heading() * 180.0 / 3.14159265358979323846;
     s.speed = vehicle_.speed();
@@ -450,12 +458,16 @@ SimState RoverSim::state() const {
     s.battery_remaining = std::clamp(100.0 * (1.0 - consumed_mah_ / capacity), 0.0, 100.0);
     s.odometer = vehicle_.odometer();
     s.cruise_speed = cruise_speed();
+    s.gps_fix = gps_fix_;
+    s.failing_check = failing_check_;
     return s;
 }
 
 double RoverSim::cruise_speed() const {
     // A parameter set to nonsense must not fling the car off the planet.
-    const double param = std::clamp(static_cast<double>(params_.get("CRUISE_SPEED", 2)), 0.0, 50.0);
+    const bool wp_speed = config_.firmware.auto_speed == FirmwareProfile::AutoSpeed::WpSpeed;
+    const double param =
+        std::clamp(static_cast<double>(params_.get(wp_speed ? "WP_SPEED" : "CRUISE_SPEED", 2)), 0.0, 50.0);
     return std::clamp(speed_override_.value_or(param), 0.0, 50.0);
 }
 

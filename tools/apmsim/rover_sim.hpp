@@ -38,6 +38,7 @@
 #include "tools/apmsim/firmware_profile.hpp"
 #include "tools/apmsim/legacy_mission_server.hpp"
 #include "tools/apmsim/legacy_parser.hpp"
+#include "tools/apmsim/mission_change_detector.hpp"
 #include "tools/apmsim/mission_server.hpp"
 #include "tools/apmsim/mission_store.hpp"
 #include "tools/apmsim/outbox.hpp"
@@ -115,14 +116,19 @@ struct ReachedEvent {
     double distance = 0;  // metres from the item when it counted as reached
     bool passed = false;  // went past it rather than inside WP_RADIUS
     GeoPoint item;        // where the reached item was
+    // The leg that ended here, timed in AUTO only (from the item before being reached, the mission started
+    // or a HOLD ended): its seconds and the median of the car's speed over them, m/s (0 for no time).
+    double leg_s = 0;
+    double median_speed = 0;
 };
 
-/// A change of the speed the rover drives at in AUTO, RTL and GUIDED (CRUISE_SPEED, or a DO_CHANGE_SPEED).
+/// A change of the speed the rover drives at in AUTO, RTL and GUIDED (modern: WP_SPEED as AUTO was entered,
+/// or a DO_CHANGE_SPEED; rover2: CRUISE_SPEED).
 struct SpeedChange {
     TimePoint at{};
     double speed = 0;       // m/s
     std::string cause;      // "power on", "reboot", "param" (PARAM_SET), "control", "command line",
-                            // "command" (COMMAND_LONG), "mission", "mode" (AUTO entered)
+                            // "command" (COMMAND_LONG), "mission", "mode" (AUTO, GUIDED or RTL entered)
     std::uint16_t seq = 0;  // current mission item then (for "mission": the DO_CHANGE_SPEED item)
 };
 
@@ -142,6 +148,8 @@ struct SimState {
     double battery_remaining = 100;  // percent
     double odometer = 0;             // metres
     double cruise_speed = 0;         // m/s the rover drives at when navigating
+    bool gps_fix = true;             // the GPS has a fix (control: gps)
+    std::string failing_check;       // an arming check made to fail (control: fail-check), "" if none
 };
 
 struct SimCounters {
@@ -156,6 +164,8 @@ struct SimCounters {
     std::uint64_t mavlink2_ignored = 0;  // MAVLink 2 frames a MAVLink 1 only board met (its 0xFD start bytes)
     std::uint64_t heartbeats_sent = 0;
     std::uint64_t heartbeats_stalled = 0;
+    std::uint64_t auto_restarts = 0;  // "Auto mission changed, restarted command" (the change detector)
+    std::uint64_t arm_refused = 0;    // arming attempts that failed their checks
 };
 
 class RoverSim {
@@ -164,6 +174,7 @@ class RoverSim {
     static constexpr std::uint8_t kCompid = 1;
     static constexpr std::size_t kMaxReachedLog = 4096;
     static constexpr std::size_t kMaxSpeedLog = 4096;
+    static constexpr std::size_t kMaxLegSamples = std::size_t{1} << 20;  // speed samples kept for one leg
 
     RoverSim(RoverSimConfig config, TimePoint now);
 
@@ -185,6 +196,15 @@ class RoverSim {
     /// Sets (and saves) a parameter from outside MAVLink: the control socket, the command line. A speed
     /// change is logged with `cause`.
     bool set_param(const std::string& name, float value, TimePoint now, const std::string& cause = "control");
+    /// Arms (as MAV_CMD_COMPONENT_ARM_DISARM would; `force`: the checks skipped, as param2 21196 does) or
+    /// disarms. Returns the MAV_RESULT the command gets.
+    std::uint8_t arm(bool on, bool force, TimePoint now);
+    /// The GPS gets (true) or loses its fix: without one the board has no position estimate, which an
+    /// arming check in the modes that need a position refuses ("Need Position Estimate").
+    void set_gps_fix(bool fix, TimePoint now);
+    /// An arming check that fails with `reason` (as "PreArm: <reason>" and "Arm: <reason>") until cleared
+    /// with "".
+    void fail_check(std::string reason, TimePoint now);
     /// Heartbeats stop for `d` from `now` (everything else goes on).
     void stall_heartbeats(Duration d, TimePoint now) { hb_stall_until_ = now + d; }
     /// Stops (true) or restarts the vehicle's motion (its physics clock): while frozen it keeps its place,
@@ -260,6 +280,18 @@ class RoverSim {
     void on_request_data_stream(const mavlink::Frame& f, TimePoint now);
     void on_rc_override(const mavlink::Frame& f, TimePoint now);
     void load_stream_rates(TimePoint now);
+    // rover_sim_arming.cpp: the arming checks and their reports
+    bool is_armed() const;
+    std::uint8_t arm_disarm(bool on, bool force);
+    std::vector<std::string> failing_checks() const;
+    void arming_update(TimePoint now);
+    // rover_sim_nav.cpp: the modern navigation (S-curve speeds, the change detector, timed waypoints)
+    void nav_modern_step(double dt, const DriveLimits& lim, TimePoint at);
+    double corner_speed_here(double cruise, const DriveLimits& lim, bool& stop) const;
+    void check_mission_change(TimePoint now);
+    void continue_after(std::uint16_t seq, TimePoint now);
+    void note_leg_speed(double speed);
+    void take_leg_stats(ReachedEvent& event);
     // rover_sim_telemetry.cpp
     void send_heartbeat(TimePoint now);
     void send_stream_message(std::uint32_t msgid, TimePoint now);
@@ -321,10 +353,15 @@ class RoverSim {
     TimePoint hb_stall_until_{};
     TimePoint last_step_{};
     bool frozen_ = false;
-    bool heartbeat_sent_this_boot_ = false;
 
     RoverMode mode_ = RoverMode::Initialising;
     bool armed_ = false;
+    // Arming (modern): what fails, and AP_Arming::update()'s reporting state.
+    bool gps_fix_ = true;
+    std::string failing_check_;
+    bool prearm_failing_ = false;
+    bool report_immediately_ = false;
+    TimePoint last_prearm_display_{};
     std::vector<ModeChange> mode_history_;
 
     // Navigation: the target is a copy of the item's location, taken when the item became current.
@@ -338,14 +375,21 @@ class RoverSim {
     std::uint64_t reached_total_ = 0;       // ever logged, including those dropped from reached_
     std::vector<std::int32_t> jumps_done_;  // per item: DO_JUMP repeats taken (reset by a new mission)
     bool loitering_ = false;                // arrived at a NAV_LOITER_UNLIM item: stay there
+    // Modern navigation: the S-curve's planned speed (restarts from 0 when the leg is re-planned from where
+    // the car is), a waypoint's hold time being held, the change detector, the leg's speed samples.
+    double planned_speed_ = 0;
+    std::optional<TimePoint> wait_until_;
+    MissionChangeDetector change_detector_;
+    std::vector<float> leg_speeds_;  // the car's speed at each physics step of the leg, in AUTO
 
     std::array<std::uint16_t, 8> rc_override_{};  // 0: not overridden
     TimePoint rc_override_at_{};
     double consumed_mah_ = 0;
 
-    // Speed. Modern: a DO_CHANGE_SPEED sets the speed until AUTO is entered again (AR_WPNav's desired
-    // speed); CRUISE_SPEED applies otherwise. Rover2: DO_CHANGE_SPEED writes CRUISE_SPEED in RAM only, so a
-    // reboot brings the saved value back (unsaved_params_).
+    // Speed. Modern: AR_WPNav's speed, WP_SPEED as it was when AUTO, GUIDED or RTL was last entered, or what
+    // a DO_CHANGE_SPEED set since (speed_override_; WP_SPEED itself before any of them). Rover2:
+    // CRUISE_SPEED; DO_CHANGE_SPEED writes it in RAM only, so a reboot brings the saved value back
+    // (unsaved_params_).
     std::optional<double> speed_override_;
     std::map<std::string, float> unsaved_params_;  // name -> value saved in EEPROM
     std::deque<SpeedChange> speed_log_;

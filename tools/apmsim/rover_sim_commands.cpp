@@ -87,9 +87,12 @@ void RoverSim::apply_param_side_effects(const std::string& name, const std::stri
     if (name.rfind("SR0_", 0) == 0 && phase_ == BootPhase::Ready) {
         load_stream_rates(now);
     }
-    if (name == "CRUISE_SPEED") {
-        // The new value applies at once, also over an earlier DO_CHANGE_SPEED (modern).
-        speed_override_.reset();
+    if (name == "CRUISE_SPEED" && config_.firmware.auto_speed == FirmwareProfile::AutoSpeed::CruiseSpeed) {
+        note_speed(cause, now);  // 2.x: the new value applies at once
+    }
+    if (name == "WP_SPEED") {
+        // AR_WPNav reads WP_SPEED when it is initialised (entering AUTO, GUIDED or RTL): the speed changes
+        // now only if none of them was entered since the boot.
         note_speed(cause, now);
     }
 }
@@ -166,12 +169,18 @@ void RoverSim::on_command_long(const mv::Frame& f, TimePoint now) {
             }
             break;
         }
-        case kCmdDoChangeSpeed:
-            // Rover's handle of MAV_CMD_DO_CHANGE_SPEED: param2 is the new speed (m/s), param1 (speed type)
-            // and param3 (throttle) are not used; a negative speed fails (Mode::set_desired_speed()).
+        case kCmdDoChangeSpeed: {
+            // GCS_MAVLINK_Rover::handle_command_int_packet(): param2 is the new speed (m/s), param3
+            // (throttle) is not used; a climb or descent speed type (param1 2, 3) is DENIED. The mode sets
+            // the speed (Mode::set_desired_speed()): AUTO, GUIDED and RTL take it (AR_WPNav::set_speed_max():
+            // at least 0.05 m/s), the others (HOLD, MANUAL...) fail.
+            const auto type = std::lround(c.param1);
+            const bool takes_speed = is_navigating(mode_);
             if (!config_.firmware.change_speed_command) {
                 result = mavlink::kResultUnsupported;
-            } else if (!(c.param2 >= 0)) {
+            } else if (type == 2 || type == 3) {
+                result = mavlink::kResultDenied;
+            } else if (!takes_speed || !(c.param2 >= 0.05F)) {
                 result = mavlink::kResultFailed;
             } else {
                 speed_override_ = c.param2;
@@ -179,6 +188,7 @@ void RoverSim::on_command_long(const mv::Frame& f, TimePoint now) {
                 result = mavlink::kResultAccepted;
             }
             break;
+        }
         case mavlink::kCmdMissionStart:
             result = !ready                                      ? mavlink::kResultTemporarilyRejected
                      : set_mode(RoverMode::Auto, "command", now) ? mavlink::kResultAccepted
@@ -189,14 +199,19 @@ void RoverSim::on_command_long(const mv::Frame& f, TimePoint now) {
                      : set_mode(RoverMode::Rtl, "command", now) ? mavlink::kResultAccepted
                                                                 : mavlink::kResultFailed;
             break;
-        case mavlink::kCmdComponentArmDisarm:
-            if (!ready) {
+        case mavlink::kCmdComponentArmDisarm: {
+            // GCS_MAVLINK::handle_command_component_arm_disarm(): param1 1 arms, 0 disarms, anything else is
+            // UNSUPPORTED; param2 21196 or 2989 forces (the checks are skipped).
+            const auto force = std::lround(c.param2);
+            if (!config_.firmware.arming_checks && !ready) {
                 result = mavlink::kResultTemporarilyRejected;
+            } else if (c.param1 == 1.0F || c.param1 == 0.0F) {
+                result = arm_disarm(c.param1 == 1.0F, force == 21196 || force == 2989);
             } else {
-                armed_ = c.param1 >= 0.5F;
-                result = mavlink::kResultAccepted;
+                result = mavlink::kResultUnsupported;
             }
             break;
+        }
         case mavlink::kCmdDoSetMissionCurrent: {
             const auto seq = static_cast<std::uint16_t>(std::clamp(c.param1, 0.0F, 65535.0F));
             result = seq < store_.count() && set_current(seq, now) ? mavlink::kResultAccepted

@@ -2,9 +2,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 
 #include "services/autopilot/mavlink/enums.hpp"
 #include "services/autopilot/mavlink/messages.hpp"
+#include "tools/apmsim/corner_speed.hpp"
 #include "tools/apmsim/rover_sim.hpp"
 
 namespace airseg::apmsim {
@@ -13,16 +15,42 @@ namespace mv = mavlink;
 
 namespace {
 
+constexpr double kGravity = 9.80665;
+constexpr double kStopped = 0.1;            // m/s: a car going slower than this has stopped at its waypoint
+constexpr double kSamePoint = 0.01;         // m: a leg shorter than this has no length
+constexpr float kMinWaypointSpeed = 0.05F;  // AR_WPNAV_SPEED_MIN
+
 bool is_manual(RoverMode m) {
     return m == RoverMode::Manual || m == RoverMode::Learning || m == RoverMode::Steering ||
            m == RoverMode::Acro;
+}
+
+/// Seconds a navigation item holds the car where it is reached (ModeAuto::do_nav_wp(): p1 of a waypoint, a
+/// negative one counting 0; LOITER_TIME's time).
+double hold_seconds(const StoredItem& item) {
+    if (item.command == kCmdNavWaypoint || item.command == kCmdNavLoiterTime) {
+        return std::max(0.0, std::floor(static_cast<double>(item.param1)));
+    }
+    return 0.0;
+}
+
+/// A navigation command the car always stops at (loiters, a held waypoint).
+bool stops_at(const StoredItem& item) {
+    return item.command == kCmdNavLoiterUnlimited || item.command == kCmdNavLoiterTurns ||
+           item.command == kCmdNavLoiterTime || hold_seconds(item) > 0;
+}
+
+double wrap_pi(double a) {
+    return std::remainder(a, 2 * std::numbers::pi);
 }
 
 }  // namespace
 
 DriveLimits RoverSim::limits() const {
     DriveLimits l;
-    l.lateral_accel = std::max(0.1F, params_.get("TURN_MAX_G", 2)) * 9.80665;
+    const float g =
+        config_.firmware.cornering ? params_.get("ATC_TURN_MAX_G", 0.6F) : params_.get("TURN_MAX_G", 2);
+    l.lateral_accel = std::max(0.1F, g) * kGravity;
     return l;
 }
 
@@ -40,7 +68,7 @@ bool RoverSim::physics_active() const {
     if (vehicle_.speed() != 0) {
         return true;
     }
-    if (phase_ != BootPhase::Ready || !armed_) {
+    if (phase_ != BootPhase::Ready || !is_armed()) {
         return false;
     }
     if (is_navigating(mode_)) {
@@ -65,13 +93,23 @@ bool RoverSim::set_mode(RoverMode mode, const std::string& cause, TimePoint now)
     mode_ = mode;
     target_.reset();
     leg_start_ = vehicle_.position();
+    wait_until_.reset();
     if (from != mode_) {
         mode_history_.push_back(ModeChange{now, from, mode_, cause, current_seq_, store_.count()});
+        if (is_navigating(mode_)) {
+            // AR_WPNav::init(): the speed is WP_SPEED again and the S-curve starts from rest (modern).
+            planned_speed_ = 0;
+            if (config_.firmware.auto_speed == FirmwareProfile::AutoSpeed::WpSpeed) {
+                speed_override_ = std::max(kMinWaypointSpeed, params_.get("WP_SPEED", 2));
+                note_speed("mode", now);
+            }
+        }
     }
     // Entering AUTO may end the mission at once (nothing left to drive to), which switches to HOLD.
     switch (mode) {
         case RoverMode::Auto:
-            if (from != RoverMode::Auto) {
+            if (from != RoverMode::Auto &&
+                config_.firmware.auto_speed == FirmwareProfile::AutoSpeed::CruiseSpeed) {
                 // ModeAuto::_enter() initialises the waypoint controller: a DO_CHANGE_SPEED of an earlier
                 // run is forgotten and CRUISE_SPEED applies.
                 speed_override_.reset();
@@ -79,10 +117,14 @@ bool RoverSim::set_mode(RoverMode mode, const std::string& cause, TimePoint now)
             }
             if (mission_complete_ || current_seq_ == 0 || current_seq_ >= store_.count()) {
                 current_seq_ = 1;  // start from the first item after home
+                leg_speeds_.clear();
             }
             mission_complete_ = false;
             mission_running_ = true;
             load_item(current_seq_, now);
+            // ModeAuto primes its change detector right after mission.start_or_resume().
+            change_detector_.reset();
+            check_mission_change(now);
             break;
         case RoverMode::Rtl:
         case RoverMode::SmartRtl:
@@ -110,8 +152,10 @@ void RoverSim::load_item(std::uint16_t seq, TimePoint now) {
         if (item.command == kCmdDoChangeSpeed) {
             // Run while heading to the next place, as AP_Mission starts the do-commands after a nav command.
             // param2 is the speed (m/s); the speed type of param1 is not looked at (Rover's
-            // do_change_speed()); zero or less leaves the speed.
-            if (item.param2 > 0) {
+            // do_change_speed()); below AR_WPNav's 0.05 m/s (-1: no change) it leaves the speed.
+            const float least =
+                config_.firmware.auto_speed == FirmwareProfile::AutoSpeed::WpSpeed ? kMinWaypointSpeed : 0.0F;
+            if (item.param2 > least) {
                 speed_override_ = item.param2;
                 note_speed("mission", now, seq);
             }
@@ -156,7 +200,7 @@ void RoverSim::physics_step(TimePoint at) {
     // The motor's share of the battery (the electronics' share is counted in advance()).
     consumed_mah_ += 10.0 * std::abs(vehicle_.throttle()) * dt * 1000.0 / 3600.0;
 
-    if (phase_ != BootPhase::Ready || !armed_) {
+    if (phase_ != BootPhase::Ready || !is_armed()) {
         vehicle_.stop(dt, lim);
         return;
     }
@@ -175,7 +219,14 @@ void RoverSim::physics_step(TimePoint at) {
         vehicle_.stop(dt, lim);
         return;
     }
+    if (config_.firmware.cornering && !rover2_mission()) {
+        nav_modern_step(dt, lim, at);
+        return;
+    }
     vehicle_.drive_to(*target_, cruise_speed(), dt, lim);
+    if (mode_ == RoverMode::Auto) {
+        note_leg_speed(vehicle_.speed());
+    }
     if (rover2_mission()) {
         return;  // the 2.x navigate() task decides when a place is reached (r2_tick)
     }
@@ -208,6 +259,8 @@ void RoverSim::on_target_reached(double distance, bool passed, TimePoint now) {
         return;
     }
     const std::uint16_t seq = current_seq_;
+    ReachedEvent event{now, seq, distance, passed, target_.value_or(GeoPoint{})};
+    take_leg_stats(event);
     char line[50];
     std::snprintf(line, sizeof line, "%s waypoint #%u dist %um", passed ? "Passed" : "Reached",
                   static_cast<unsigned>(seq), static_cast<unsigned>(std::lround(distance)));
@@ -220,7 +273,7 @@ void RoverSim::on_target_reached(double distance, bool passed, TimePoint now) {
     if (reached_.size() >= kMaxReachedLog) {
         reached_.pop_front();
     }
-    reached_.push_back(ReachedEvent{now, seq, distance, passed, target_.value_or(GeoPoint{})});
+    reached_.push_back(event);
     ++reached_total_;
     if (store_.at(seq).command == kCmdNavLoiterUnlimited) {
         loitering_ = true;  // stays here; the mission does not advance past it
@@ -230,14 +283,27 @@ void RoverSim::on_target_reached(double distance, bool passed, TimePoint now) {
         load_item(static_cast<std::uint16_t>(store_.count()), now);  // RTL ends the mission
         return;
     }
+    if (config_.firmware.cornering && hold_seconds(store_.at(seq)) > 0) {
+        // ModeAuto::verify_nav_wp(): held there for the item's seconds, then on (nav_modern_step()).
+        wait_until_ = now + std::chrono::duration_cast<Duration>(
+                                std::chrono::duration<double>(hold_seconds(store_.at(seq))));
+        return;
+    }
+    continue_after(seq, now);
+}
+
+void RoverSim::continue_after(std::uint16_t seq, TimePoint now) {
     const GeoPoint here = target_.value_or(GeoPoint{});
     load_item(static_cast<std::uint16_t>(seq + 1), now);
+    if (config_.firmware.cornering && target_ && mode_ == RoverMode::Auto) {
+        leg_start_ = here;  // the S-curve's next leg starts at the destination just reached
+    }
     // The next item at the very point just reached is a leg of no length: ArduPilot takes it as passed at
     // once (Location::line_path_proportion() gives the end of the line for two points closer than a
     // millimetre), it does not turn round to drive back into WP_RADIUS.
     if (target_ && mode_ == RoverMode::Auto && !loitering_ && distance_m(here, *target_) < 0.001 &&
         current_seq_ != seq) {
-        on_target_reached(distance, true, now);
+        on_target_reached(distance_m(vehicle_.position(), *target_), true, now);
     }
 }
 
@@ -252,9 +318,130 @@ bool RoverSim::set_current(std::uint16_t seq, TimePoint now) {
     mission_complete_ = false;
     if (mode_ == RoverMode::Auto) {
         mission_running_ = true;
+        wait_until_.reset();
+        leg_speeds_.clear();
+        planned_speed_ = 0;   // the new leg is planned from where the car is, from rest (AR_WPNav)
         load_item(seq, now);  // retarget at once
     }
     return true;
+}
+
+// The modern waypoint controller (AR_WPNav, ModeAuto), one physics step: the change detector, a timed
+// waypoint's wait, the S-curve's planned speed (corner_speed.hpp) and when a waypoint counts as reached.
+void RoverSim::nav_modern_step(double dt, const DriveLimits& lim, TimePoint at) {
+    check_mission_change(at);
+    if (!target_ || loitering_) {
+        vehicle_.stop(dt, lim);
+        return;
+    }
+    if (wait_until_) {
+        vehicle_.stop(dt, lim);
+        if (at >= *wait_until_) {
+            wait_until_.reset();
+            continue_after(current_seq_, at);
+        }
+        return;
+    }
+    const double cruise = cruise_speed();
+    bool stop = false;
+    const double corner = corner_speed_here(cruise, lim, stop);
+    const double radius = std::max(0.1F, params_.get("WP_RADIUS", 2));
+    const double accel = std::max(0.1F, params_.get("ATC_ACCEL_MAX", 1));
+    const double limit =
+        approach_speed_limit(corner, distance_m(vehicle_.position(), *target_), stop ? 0.0 : radius, accel);
+    planned_speed_ = std::min({planned_speed_ + accel * dt, cruise, limit});
+    vehicle_.drive_to(*target_, planned_speed_, dt, lim);
+    if (mode_ == RoverMode::Auto) {
+        note_leg_speed(vehicle_.speed());
+    }
+    const double distance = distance_m(vehicle_.position(), *target_);
+    // A waypoint the car stops at counts once it has stopped there (the S-curve ends at rest on it).
+    const bool must_stop = stop && mode_ == RoverMode::Auto;
+    if (distance <= radius && (!must_stop || vehicle_.speed() <= kStopped)) {
+        on_target_reached(distance, false, at);
+        return;
+    }
+    if (leg_start_ && distance_m(*leg_start_, *target_) > radius) {
+        const double leg = bearing_rad(*leg_start_, *target_);
+        const double to_vehicle = bearing_rad(*target_, vehicle_.position());
+        if (std::cos(to_vehicle - leg) > 0 && distance < 4 * radius) {
+            on_target_reached(distance, true, at);
+        }
+    }
+}
+
+// The speed the car leaves its target at (ModeAuto::do_nav_wp() and AR_WPNav::set_desired_location()): a
+// stop (`stop` set, 0) at a loiter or a held waypoint, with no next navigation command (DO_JUMP followed),
+// before a next leg of no length (a next command without a place counts as one: Location::sanitize()) and
+// in the modes that drive to one point; otherwise the corner's speed.
+double RoverSim::corner_speed_here(double cruise, const DriveLimits& lim, bool& stop) const {
+    stop = true;
+    if (mode_ != RoverMode::Auto || current_seq_ == 0 || current_seq_ >= store_.count()) {
+        return 0.0;
+    }
+    const StoredItem& item = store_.at(current_seq_);
+    if (stops_at(item) || item.command == kCmdNavReturnToLaunch) {
+        return 0.0;
+    }
+    const auto next = next_nav_cmd(store_, static_cast<std::uint16_t>(current_seq_ + 1), jumps_done_);
+    if (!next) {
+        return 0.0;
+    }
+    const StoredItem& after = store_.at(*next);
+    if (after.lat_e7 == 0 && after.lon_e7 == 0) {
+        return 0.0;
+    }
+    const GeoPoint next_point = point_of(after);
+    if (distance_m(*target_, next_point) < kSamePoint) {
+        return 0.0;
+    }
+    double turn = 0.0;
+    if (leg_start_ && distance_m(*leg_start_, *target_) >= kSamePoint) {
+        turn = wrap_pi(bearing_rad(*target_, next_point) - bearing_rad(*leg_start_, *target_));
+    }
+    const double radius = std::max(0.1F, params_.get("WP_RADIUS", 2));
+    const double v = corner_speed(turn, cruise, lim.lateral_accel, radius);
+    stop = v <= 0.0;
+    return v;
+}
+
+// ModeAuto::update(): a change of the current navigation command or of the next two restarts the current
+// one in the WP submode (driving to a place; not while holding at a waypoint, loitering or returning home):
+// it is read again and re-planned from where the car is, from rest.
+void RoverSim::check_mission_change(TimePoint now) {
+    if (!config_.firmware.mission_change_restart || mode_ != RoverMode::Auto || !mission_running_) {
+        return;
+    }
+    jumps_done_.resize(store_.count(), 0);
+    if (!change_detector_.check(store_, current_seq_, jumps_done_)) {
+        return;
+    }
+    if (!target_ || loitering_ || wait_until_ || current_seq_ >= store_.count() ||
+        store_.at(current_seq_).command == kCmdNavReturnToLaunch) {
+        return;
+    }
+    ++counters_.auto_restarts;
+    text(mavlink::kSeverityCritical, "Auto mission changed, restarted command");
+    planned_speed_ = 0;
+    load_item(current_seq_, now);
+}
+
+void RoverSim::take_leg_stats(ReachedEvent& event) {
+    if (leg_speeds_.empty()) {
+        return;
+    }
+    event.leg_s =
+        static_cast<double>(leg_speeds_.size()) * std::chrono::duration<double>(config_.physics_step).count();
+    const auto middle = leg_speeds_.begin() + static_cast<std::ptrdiff_t>(leg_speeds_.size() / 2);
+    std::nth_element(leg_speeds_.begin(), middle, leg_speeds_.end());
+    event.median_speed = *middle;
+    leg_speeds_.clear();
+}
+
+void RoverSim::note_leg_speed(double speed) {
+    if (leg_speeds_.size() < kMaxLegSamples) {  // about 5.8 hours of one leg: the median of those
+        leg_speeds_.push_back(static_cast<float>(speed));
+    }
 }
 
 bool RoverSim::guided_goto(const StoredItem& item) {

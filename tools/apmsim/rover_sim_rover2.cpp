@@ -128,7 +128,6 @@ void RoverSim::r2_send_heartbeat() {
         base |= mavlink::kModeFlagSafetyArmed;  // "we are armed if we are not initialising"
     }
     hb.base_mode = base | mavlink::kModeFlagCustomModeEnabled;
-    heartbeat_sent_this_boot_ = true;
     ++counters_.heartbeats_sent;
     out_.send(hb);
 }
@@ -477,7 +476,9 @@ void RoverSim::r2_reached(bool passed, double distance, TimePoint now) {
     if (reached_.size() >= kMaxReachedLog) {
         reached_.pop_front();
     }
-    reached_.push_back(ReachedEvent{now, r2_.nav_index, distance, passed, r2_.next_wp});
+    ReachedEvent event{now, r2_.nav_index, distance, passed, r2_.next_wp};
+    take_leg_stats(event);
+    reached_.push_back(event);
     ++reached_total_;
 }
 

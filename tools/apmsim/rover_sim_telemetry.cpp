@@ -61,15 +61,17 @@ void RoverSim::send_heartbeat(TimePoint now) {
         case RoverMode::Initialising:
             break;
     }
-    if (armed_) {
+    // GCS_MAVLINK_Rover::base_mode() and vehicle_system_status(): armed is never shown while initialising;
+    // the status follows the mode, not the arming (CALIBRATING while initialising, STANDBY in HOLD, ACTIVE
+    // otherwise, disarmed or not).
+    if (is_armed() && mode_ != RoverMode::Initialising) {
         hb.base_mode |= mavlink::kModeFlagSafetyArmed;
     }
-    if (phase_ == BootPhase::Calibrating) {
-        hb.system_status = heartbeat_sent_this_boot_ ? mavlink::kMavStateCalibrating : mavlink::kMavStateBoot;
+    if (phase_ == BootPhase::Calibrating || mode_ == RoverMode::Initialising) {
+        hb.system_status = mavlink::kMavStateCalibrating;
     } else {
-        hb.system_status = armed_ ? mavlink::kMavStateActive : mavlink::kMavStateStandby;
+        hb.system_status = mode_ == RoverMode::Hold ? mavlink::kMavStateStandby : mavlink::kMavStateActive;
     }
-    heartbeat_sent_this_boot_ = true;
     ++counters_.heartbeats_sent;
     out_.send(hb);
 }
@@ -157,7 +159,7 @@ void RoverSim::send_stream_message(std::uint32_t msgid, TimePoint now) {
         case mv::GpsRawInt::kId: {
             mv::GpsRawInt g;
             g.time_usec = unix_us(now);
-            g.fix_type = 3;
+            g.fix_type = gps_fix_ ? 3 : 1;  // 1: GPS_FIX_TYPE_NO_FIX
             g.lat = e7(pos.lat);
             g.lon = e7(pos.lon);
             g.alt = static_cast<std::int32_t>(std::lround(config_.home_alt * 1000.0));
@@ -165,7 +167,7 @@ void RoverSim::send_stream_message(std::uint32_t msgid, TimePoint now) {
             g.epv = 200;
             g.vel = static_cast<std::uint16_t>(std::lround(std::abs(speed) * 100));
             g.cog = static_cast<std::uint16_t>(std::lround(heading_deg * 100) % 36000);
-            g.satellites_visible = 10;
+            g.satellites_visible = gps_fix_ ? 10 : 0;
             out_.send(g);
             return;
         }

@@ -66,7 +66,8 @@ Driver::Driver(AutopilotConfig config)
       link_(LinkWatchConfig{config_.bauds, config_.baud_probe, config_.reset_on_open, config_.boot_timeout,
                             config_.heartbeat_timeout, config_.unresponsive_timeout,
                             config_.max_reset_pulses}),
-      modes_(config_.mode_timeout, config_.mode_retries) {}
+      modes_(config_.mode_timeout, config_.mode_retries),
+      arming_(config_.mode_timeout, config_.mode_retries) {}
 
 // --- port lifecycle ----------------------------------------------------------------------------------------
 
@@ -80,6 +81,7 @@ void Driver::on_port_open(TimePoint now) {
     stop_hold_sent_.reset();
     auto_check_.cancel();
     forget_speed();
+    armed_seen_ = false;
     speed_by_param_ = config_.board == Board::Apm2;  // ArduRover 2.x has no MAV_CMD_DO_CHANGE_SPEED command
     next_gcs_heartbeat_ = config_.gcs_heartbeat ? now : kNever;
     enter(Phase::WaitBoot, now);
@@ -162,6 +164,10 @@ void Driver::handle_timeout(TimePoint now) {
         finish_mode(std::move(*o), now);
     }
     send_due_modes();
+    if (auto o = arming_.handle_timeout(now)) {
+        state_done(o->id, o->result, std::move(o->detail));
+    }
+    send_due_arming();
     if (due.baud) {
         actions_.push_back(SwitchBaud{*due.baud});
     }
@@ -191,10 +197,10 @@ void Driver::handle_timeout(TimePoint now) {
 }
 
 TimePoint Driver::poll_timeout() const {
-    TimePoint t =
-        std::min({missions_.poll_timeout(), params_.poll_timeout(), phase_deadline_, rc_.poll_timeout(),
-                  next_gcs_heartbeat_ == kNever ? kNever : next_gcs_heartbeat_ + kGcsHeartbeatSlack,
-                  auto_check_.poll_timeout(), link_.poll_timeout(), modes_.poll_timeout()});
+    TimePoint t = std::min(
+        {missions_.poll_timeout(), params_.poll_timeout(), phase_deadline_, rc_.poll_timeout(),
+         next_gcs_heartbeat_ == kNever ? kNever : next_gcs_heartbeat_ + kGcsHeartbeatSlack,
+         auto_check_.poll_timeout(), link_.poll_timeout(), modes_.poll_timeout(), arming_.poll_timeout()});
     if (speed_request_) {
         t = std::min(t, speed_request_->deadline);
     }
@@ -384,13 +390,14 @@ void Driver::on_mission_done(MissionCompletion c, TimePoint now) {
                 break;
             case RequestKind::ClearMission:
                 mission_.clear();
+                restore_board_speed(now);  // no plan any more: the board's own speed again
                 break;
             case RequestKind::DownloadMission: {
                 mission_.clear();
                 for (std::size_t i = 1; i < c.items.size(); ++i) {
                     mission_.push_back(decode_item(c.items[i]));
                 }
-                RequestDone d{op.id, op.kind, r, {}, mission_, std::nullopt, {}};
+                RequestDone d{op.id, op.kind, r, {}, mission_, std::nullopt, {}, std::nullopt};
                 emit(std::move(d));
                 return;
             }
@@ -435,6 +442,7 @@ void Driver::on_param_done(ParamCompletion c, TimePoint now) {
     if (c.id == sequence_fetch_) {
         sequence_fetch_ = 0;
         if (c.result == RequestResult::Ok) {
+            on_params_known();
             if (phase_ == Phase::Params) {
                 enter(Phase::Mission, now);
             }
@@ -461,7 +469,7 @@ void Driver::on_param_done(ParamCompletion c, TimePoint now) {
     if (it == param_ops_.end()) {
         return;
     }
-    RequestDone d{it->second.id, it->second.kind, c.result, c.detail, {}, std::nullopt, {}};
+    RequestDone d{it->second.id, it->second.kind, c.result, c.detail, {}, std::nullopt, {}, std::nullopt};
     if (c.value) {
         d.param_value = *c.value;
     }
@@ -476,6 +484,9 @@ void Driver::cancel_everything(const std::string& why, TimePoint now) {
     sequence_sets_.clear();
     if (auto o = modes_.cancel(why)) {
         finish_mode(std::move(*o), now);
+    }
+    if (auto o = arming_.cancel(why)) {
+        state_done(o->id, o->result, std::move(o->detail));
     }
     override_active_ = false;
 }
@@ -617,17 +628,25 @@ std::uint32_t Driver::request_state(VehicleState target, TimePoint now) {
         return id;
     }
     const auto mode = static_cast<std::uint32_t>(*mode_for(target));
-    if (auto o = modes_.cancel(std::string("superseded by a request for ") + to_string(target))) {
+    const std::string superseded = std::string("superseded by a request for ") + to_string(target);
+    if (auto o = modes_.cancel(superseded)) {
         finish_mode(std::move(*o), now);
     }
+    if (auto o = arming_.cancel(superseded)) {
+        state_done(o->id, o->result, std::move(o->detail));
+    }
     if (mode_ && *mode_ == mode) {
-        // Same autopilot mode (MANUAL for DIRECTED, MANUAL_NAVIGATION and failsafe MANUAL): only our side
-        // changes.
+        // Same autopilot mode (MANUAL for DIRECTED, MANUAL_NAVIGATION and failsafe MANUAL; AUTO, which may
+        // still need arming): only our side changes.
         override_active_ = target == VehicleState::ManualNavigation;
         failsafe_latched_ = failsafe_latched_ || target == VehicleState::Manual;
         update_state(now, true);
         flush_rc(now);
-        done(id, RequestKind::SetState, RequestResult::Ok);
+        if (arms_for(target) && needs_arming()) {
+            start_arming(id, now);
+            return id;
+        }
+        state_done(id, RequestResult::Ok, {});
         return id;
     }
     // Nothing is running after the cancel above (which words why); an outcome here still gets reported.
@@ -681,8 +700,55 @@ void Driver::finish_mode(ModeOutcome o, TimePoint now) {
         failsafe_latched_ = failsafe_latched_ || o.target == VehicleState::Manual;
         update_state(now, true);
         flush_rc(now);
+        if (arms_for(o.target) && needs_arming()) {
+            start_arming(o.id, now);  // in the new mode: the request is done once the board is armed
+            return;
+        }
     }
-    done(o.id, RequestKind::SetState, o.result, std::move(o.detail));
+    state_done(o.id, o.result, std::move(o.detail));
+}
+
+void Driver::state_done(std::uint32_t id, RequestResult result, std::string detail) {
+    RequestDone d;
+    d.id = id;
+    d.kind = RequestKind::SetState;
+    d.result = result;
+    d.detail = std::move(detail);
+    d.armed = armed();
+    emit(std::move(d));
+}
+
+// ArduPilot Rover 4.x boots disarmed (ARMING_REQUIRE 1) and drives nothing until armed; a board that needs
+// no arming (2.x, ARMING_REQUIRE 0) always reports SAFETY_ARMED. The states in which this system drives the
+// vehicle (the mission, the ground joystick) are armed for; DIRECTED is the RC pilot's, who arms with the
+// sticks. Arming comes after the mode is confirmed: entering AUTO disarmed skips the position checks
+// (Mode::enter()), while arming in AUTO runs them, so a board that could not drive the mission says so now,
+// in its own words.
+bool Driver::arms_for(VehicleState target) {
+    return target == VehicleState::WaypointNavigation || target == VehicleState::ManualNavigation;
+}
+
+bool Driver::needs_arming() const {
+    return config_.arming == ArmingPolicy::Auto && armed_seen_ && !armed_;
+}
+
+void Driver::start_arming(std::uint32_t id, TimePoint now) {
+    if (auto o = arming_.start(id, now)) {
+        state_done(o->id, o->result, std::move(o->detail));
+    }
+    send_due_arming();
+}
+
+void Driver::send_due_arming() {
+    while (arming_.poll_send()) {
+        mav::CommandLong m;
+        m.target_system = config_.target_sysid;
+        m.target_component = config_.target_compid;
+        m.command = mavlink::kCmdComponentArmDisarm;
+        m.confirmation = static_cast<std::uint8_t>(std::min(arming_.attempt(), 255u));
+        m.param1 = 1.0F;  // arm; param2 0: the checks run (21196 would force)
+        out_.send(m);
+    }
 }
 
 void Driver::update_state(TimePoint now, bool requested) {
@@ -720,6 +786,8 @@ AutopilotStatus Driver::status() const {
     s.link_losses = link_.link_losses();
     s.syncs = syncs_;
     s.reset_pulses = link_.reset_pulses();
+    s.armed = armed();
+    s.arm_refusals = arming_.refusals();
     s.speed = speed_set_;
     s.mission_items = missions_.answers_int() ? "int" : "float";
     s.auto_restarts_corrected = auto_check_.corrections();

@@ -15,18 +15,22 @@
 //
 // Afterwards it keeps: telemetry; the vehicle state derived from each heartbeat (mode changes made by the RC
 // pilot or the autopilot itself are published as External ModeChanged events); requested state changes,
-// confirmed by the heartbeat, retried, refused or timed out (never dropped); mission operations through
+// confirmed by the heartbeat, retried, refused or timed out (never dropped), a change to WAYPOINT_NAVIGATION
+// on a board whose heartbeat says it is disarmed going on, with autopilot.arming auto, to arm it
+// (ArmControl: done once armed, refused with the board's "Arm:"/"PreArm:" reason); mission operations through
 // MissionClient; parameters through ParamClient; RC override from joystick input; waypoint-reached events
 // from MISSION_ITEM_REACHED or the "Reached waypoint #N" text; after every entry into AUTO the mission slot
 // the board was at (AutoEntryCheck: 2.x firmware restarts at item 1); the speed of the mission item being
-// driven to (its MissionItem::speed: MAV_CMD_DO_CHANGE_SPEED, or the CRUISE_SPEED parameter on a board
-// without the command, APM 2.x); link DOWN after heartbeat_timeout of silence (judged once the input
-// waiting in the port has been read: a stall of the daemon itself is not the autopilot's silence);
-// unexpected reboots (time_boot_ms going back and running on from there, or a heartbeat gap ended by a
-// heartbeat saying BOOT/CALIBRATING/INITIALISING; never a text: LinkWatch) trigger a resync of parameters
-// and mission and an AutopilotRebooted event; an autopilot silent for unresponsive_timeout while its port is
-// open makes the driver ask for a reset pulse (at most max_reset_pulses times until it is READY again). The
-// link's timers and reboot evidence are LinkWatch's, a requested mode change from request to outcome is
+// driven to (its MissionItem::speed: MAV_CMD_DO_CHANGE_SPEED, set again after every entry into AUTO, or the
+// parameter the board drives AUTO at on a board without the command: CRUISE_SPEED on APM 2.x, WP_SPEED on
+// current Rover; its own value restored at the plan's end); link DOWN after heartbeat_timeout of silence
+// (judged once the input waiting in the port has been read: a stall of the daemon itself is not the
+// autopilot's silence); unexpected reboots (time_boot_ms going back and running on from there, or a
+// heartbeat gap ended by a heartbeat saying BOOT/CALIBRATING/INITIALISING; never a text: LinkWatch) trigger a
+// resync of parameters and mission and an AutopilotRebooted event; an autopilot silent for
+// unresponsive_timeout while its port is open makes the driver ask for a reset pulse (at most
+// max_reset_pulses times until it is READY again). The link's timers and reboot evidence are LinkWatch's, a
+// requested mode change from request to outcome is
 // ModeControl's; the driver feeds them and acts on what they report (events, frames, port actions).
 //
 // Contract (the service, on its strand): on_port_open/on_port_closed/on_reset_pulsed for the port; every byte
@@ -43,6 +47,7 @@
 #include <vector>
 
 #include "base/time.hpp"
+#include "services/autopilot/ardupilot/arm_control.hpp"
 #include "services/autopilot/ardupilot/auto_entry_check.hpp"
 #include "services/autopilot/ardupilot/link_watch.hpp"
 #include "services/autopilot/ardupilot/mission_client.hpp"
@@ -124,10 +129,15 @@ class Driver {
     const AutoEntryCheck& auto_entry_check() const { return auto_check_; }
     /// The speed the board last confirmed for the leg it drives (m/s), if any was set.
     std::optional<double> commanded_speed() const { return speed_set_; }
+    /// The heartbeat's SAFETY_ARMED; empty before the first heartbeat of this connection.
+    std::optional<bool> armed() const { return armed_seen_ ? std::optional<bool>(armed_) : std::nullopt; }
+    const ArmControl& arm_control() const { return arming_; }
     /// Speed changes the board confirmed, ever.
     unsigned speed_changes() const { return speed_changes_; }
-    /// True when speeds go by the CRUISE_SPEED parameter (the board lacks MAV_CMD_DO_CHANGE_SPEED).
+    /// True when speeds go by a parameter (the board lacks MAV_CMD_DO_CHANGE_SPEED): speed_param().
     bool speed_by_param() const { return speed_by_param_; }
+    /// The parameter the board drives AUTO at: WP_SPEED when it has one (current Rover), else CRUISE_SPEED.
+    const char* speed_param() const;
     /// True when Stop items go as waypoints and the driver holds the vehicle on arrival.
     bool stops_as_waypoints() const { return stop_as_waypoint_; }
     bool link_up() const { return link_.up(); }
@@ -163,6 +173,11 @@ class Driver {
     void send_mode(std::uint32_t mode);
     void send_due_modes();
     void finish_mode(ModeOutcome o, TimePoint now);
+    void state_done(std::uint32_t id, RequestResult result, std::string detail);
+    static bool arms_for(VehicleState target);
+    bool needs_arming() const;
+    void start_arming(std::uint32_t id, TimePoint now);
+    void send_due_arming();
     void update_state(TimePoint now, bool requested);
     void emit(Event e) { events_.push_back(std::move(e)); }
     void flush_rc(TimePoint now);
@@ -195,6 +210,9 @@ class Driver {
     void speed_timeout(TimePoint now);
     bool on_speed_param_done(const ParamCompletion& c, TimePoint now);
     void forget_speed();
+    void on_auto_entered();
+    void on_params_known();
+    void restore_board_speed(TimePoint now);
 
     AutopilotConfig config_;
     Outbox out_;
@@ -204,6 +222,7 @@ class Driver {
     RcOverride rc_;
     LinkWatch link_;
     ModeControl modes_;
+    ArmControl arming_;
     FrameTap tap_;
 
     Phase phase_ = Phase::Closed;
@@ -221,6 +240,8 @@ class Driver {
     std::optional<std::uint32_t> mode_;
     std::uint8_t system_status_ = 0;
     bool override_active_ = false;
+    bool armed_ = false;       // the last heartbeat's SAFETY_ARMED
+    bool armed_seen_ = false;  // a heartbeat came since the port opened or the board rebooted
     bool failsafe_latched_ = false;
     VehicleState state_ = VehicleState::Unknown;
     std::string mode_name_;
@@ -235,7 +256,8 @@ class Driver {
     bool stop_as_waypoint_ = false;            // the board lacks NAV_LOITER_UNLIM: Stop items go as waypoints
     std::optional<TimePoint> stop_hold_sent_;  // HOLD sent on reaching such a Stop, until the board holds
     std::optional<double> speed_set_;
-    std::optional<double> board_speed_;  // CRUISE_SPEED before the first change
+    std::optional<double> board_speed_;    // speed_param() before the first change: restored at the end
+    std::optional<double> speed_refused_;  // not asked again until AUTO is entered again or it changes
     std::optional<SpeedRequest> speed_request_;
     bool speed_by_param_ = false;
     unsigned speed_changes_ = 0;

@@ -165,6 +165,8 @@ void Driver::refuse_value(std::string why) {
 
 void Driver::on_heartbeat(const mav::Heartbeat& hb, TimePoint now) {
     system_status_ = hb.system_status;
+    armed_ = (hb.base_mode & mavlink::kModeFlagSafetyArmed) != 0;
+    armed_seen_ = true;
     // APM:Rover 2.x reports MAV_STATE_UNINIT in HOLD (send_heartbeat() of its GCS_Mavlink.pde): in a running
     // mode UNINIT is that quirk, not a board starting up.
     const bool uninit_booting = hb.system_status == mavlink::kMavStateUninit &&
@@ -189,6 +191,9 @@ void Driver::on_heartbeat(const mav::Heartbeat& hb, TimePoint now) {
     } else if (mode_changed) {
         override_active_ = false;  // the RC pilot or the autopilot took over
     }
+    if (auto o = arming_.on_heartbeat(armed_)) {
+        state_done(o->id, o->result, std::move(o->detail));
+    }
     if (phase_ == Phase::WaitBoot && !booting && hb.system_status != mavlink::kMavStatePoweroff) {
         enter(Phase::Params, now);
     }
@@ -209,6 +214,7 @@ void Driver::on_heartbeat(const mav::Heartbeat& hb, TimePoint now) {
                 auto_check_.arm(board_slot(), now);  // entered AUTO without our asking
             }
             auto_check_.on_auto(now);
+            on_auto_entered();  // the board's speed is its own again
             update_speed(now);
         }
     } else if (mode_changed) {
@@ -275,6 +281,7 @@ void Driver::on_statustext(const mav::Statustext& t, TimePoint now) {
     // Escaped here, at the edge: the text goes on to logs, events for the ground and JSON.
     const std::string text = printable(mav::text_of(t.text));
     emit(StatusText{t.severity, text});
+    arming_.on_text(text, now);
     const std::string l = lower(text);
     if (const auto pos = l.find("reached waypoint #"); pos != std::string::npos) {
         const char* digits = l.c_str() + pos + 18;
@@ -300,6 +307,10 @@ void Driver::on_command_ack(const mav::CommandAck& ack, TimePoint now) {
         on_speed_ack(ack.result, now);
         return;
     }
+    if (ack.command == mavlink::kCmdComponentArmDisarm) {
+        arming_.on_ack(ack.result, now);  // the heartbeat confirms, or the refusal's texts follow
+        return;
+    }
     if (ack.command != mavlink::kCmdDoSetMode) {
         return;
     }
@@ -316,6 +327,9 @@ void Driver::on_reached(std::uint16_t seq, TimePoint now) {
     auto_check_.on_reached(seq);
     current_reached_ = seq == reported_current_;
     hold_at_stop(seq, now);
+    if (seq >= 1 && seq <= mission_.size() && mission_[seq - 1u].kind == MissionItem::Kind::Stop) {
+        restore_board_speed(now);  // the plan's end
+    }
     emit(WaypointReached{seq});
 }
 
@@ -323,6 +337,7 @@ void Driver::reboot_detected(const std::string& evidence, TimePoint now) {
     ++reboots_;
     auto_check_.cancel();
     forget_speed();
+    armed_seen_ = false;
     emit(AutopilotRebooted{evidence});
     cancel_everything("autopilot rebooted", now);
     last_error_ = "autopilot rebooted: " + evidence;

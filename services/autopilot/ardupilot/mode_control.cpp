@@ -1,20 +1,13 @@
 #include "services/autopilot/ardupilot/mode_control.hpp"
 
-#include <iterator>
-
 #include "services/autopilot/ardupilot/rover_modes.hpp"
+#include "services/autopilot/mavlink/enums.hpp"
 
 namespace airseg::autopilot::ardupilot {
 
 namespace {
-constexpr std::uint8_t kMavResultAccepted = 0;
-constexpr std::uint8_t kMavResultInProgress = 5;
-
-const char* mav_result_name(std::uint8_t r) {
-    static const char* const kNames[] = {"ACCEPTED", "TEMPORARILY_REJECTED", "DENIED",   "UNSUPPORTED",
-                                         "FAILED",   "IN_PROGRESS",          "CANCELLED"};
-    return r < std::size(kNames) ? kNames[r] : "unknown";
-}
+constexpr std::uint8_t kMavResultAccepted = mavlink::kResultAccepted;
+constexpr std::uint8_t kMavResultInProgress = mavlink::kResultInProgress;
 }  // namespace
 
 std::optional<ModeOutcome> ModeControl::start(std::uint32_t id, VehicleState target, std::uint32_t mode,
@@ -37,7 +30,7 @@ std::optional<ModeOutcome> ModeControl::on_ack(std::uint8_t result) {
         return std::nullopt;  // accepted / in progress: the heartbeat confirms
     }
     return finish(RequestResult::Refused, std::string("autopilot answered MAV_RESULT_") +
-                                              mav_result_name(result) + " to mode " +
+                                              mavlink::result_name(result) + " to mode " +
                                               rover_mode_name(request_->mode));
 }
 

@@ -36,6 +36,12 @@ inline constexpr std::uint8_t kResultDenied = 2;
 inline constexpr std::uint8_t kResultUnsupported = 3;
 inline constexpr std::uint8_t kResultFailed = 4;
 inline constexpr std::uint8_t kResultInProgress = 5;
+/// MAV_RESULT_<name> without the prefix ("ACCEPTED", "FAILED"...), "unknown" past CANCELLED.
+inline const char* result_name(std::uint8_t r) {
+    constexpr const char* kNames[] = {"ACCEPTED", "TEMPORARILY_REJECTED", "DENIED",   "UNSUPPORTED",
+                                      "FAILED",   "IN_PROGRESS",          "CANCELLED"};
+    return r < sizeof kNames / sizeof kNames[0] ? kNames[r] : "unknown";
+}
 
 // MAV_MISSION_RESULT (MISSION_ACK)
 inline constexpr std::uint8_t kMissionAccepted = 0;

@@ -95,7 +95,7 @@ TEST(ApmsimBinary, GroundStationSessionUploadsHundredItemsAndDrivesThemToHold) {
     EXPECT_GE(gcs.heard[0].at - gcs.opened_at(), 80ms);
     auto hb = gcs.wait_for<mv::Heartbeat>(kGenerous, 0);
     ASSERT_TRUE(hb);
-    EXPECT_EQ(hb->system_status, 1) << "MAV_STATE_BOOT";
+    EXPECT_EQ(hb->system_status, 2) << "MAV_STATE_CALIBRATING while initialising";
     EXPECT_EQ(hb->custom_mode, 16u);
     EXPECT_EQ(ask_json(ctl, "state")["boots"], 2);
     ASSERT_TRUE(gcs.wait_for<mv::Statustext>(
@@ -104,7 +104,18 @@ TEST(ApmsimBinary, GroundStationSessionUploadsHundredItemsAndDrivesThemToHold) {
                                      0);
     ASSERT_TRUE(hb);
     EXPECT_EQ(hb->custom_mode, 0u) << "MANUAL";
-    EXPECT_TRUE(hb->base_mode & 128) << "armed";
+    EXPECT_FALSE(hb->base_mode & 128) << "disarmed: ARMING_REQUIRE 1";
+    mv::CommandLong arm;
+    arm.command = 400;  // MAV_CMD_COMPONENT_ARM_DISARM
+    arm.param1 = 1;
+    std::size_t arm_from = gcs.heard.size();
+    ASSERT_TRUE(gcs.send(arm));
+    const auto armed = gcs.wait_for<mv::CommandAck>([](const mv::CommandAck& a) { return a.command == 400; },
+                                                    kGenerous, arm_from);
+    ASSERT_TRUE(armed);
+    EXPECT_EQ(armed->result, 0);
+    ASSERT_TRUE(gcs.wait_for<mv::Heartbeat>([](const mv::Heartbeat& h) { return (h.base_mode & 128) != 0; },
+                                            kGenerous, arm_from));
 
     // Parameters: the whole list, then one set with its echo.
     std::size_t from = gcs.heard.size();

@@ -18,7 +18,7 @@ TEST(ApmsimBoot, SilentThenCalibratingThenReady) {
     ASSERT_TRUE(hb);
     EXPECT_EQ(hb->type, 10);
     EXPECT_EQ(hb->autopilot, 3);
-    EXPECT_EQ(hb->system_status, 1) << "first heartbeat: MAV_STATE_BOOT";
+    EXPECT_EQ(hb->system_status, 2) << "initialising: MAV_STATE_CALIBRATING (Rover sends no BOOT)";
     EXPECT_EQ(hb->custom_mode, 16u) << "INITIALISING";
     EXPECT_EQ(h.received.front().frame.sysid, 1);
     EXPECT_EQ(h.received.front().frame.compid, 1);
@@ -28,16 +28,18 @@ TEST(ApmsimBoot, SilentThenCalibratingThenReady) {
 
     hb = h.wait_for<mv::Heartbeat>(seconds(2));
     ASSERT_TRUE(hb);
-    EXPECT_EQ(hb->system_status, 2) << "then MAV_STATE_CALIBRATING";
+    EXPECT_EQ(hb->system_status, 2) << "still MAV_STATE_CALIBRATING";
+    EXPECT_FALSE(hb->base_mode & 128) << "never armed while initialising";
 
     ASSERT_TRUE(h.wait_text("Ready to drive.", seconds(3)));
     EXPECT_GE(h.now - kStart, seconds(5));
     hb = h.wait_for<mv::Heartbeat>(seconds(2));
     ASSERT_TRUE(hb);
     EXPECT_EQ(hb->custom_mode, 0u) << "INITIAL_MODE is MANUAL";
-    EXPECT_EQ(hb->system_status, 4) << "armed (ARMING_REQUIRE 0): ACTIVE";
+    EXPECT_EQ(hb->system_status, 4) << "MANUAL: ACTIVE, armed or not";
     EXPECT_TRUE(hb->base_mode & 1) << "custom mode enabled";
-    EXPECT_TRUE(hb->base_mode & 128) << "armed";
+    EXPECT_FALSE(hb->base_mode & 128) << "ARMING_REQUIRE 1: disarmed until armed";
+    EXPECT_FALSE(h.sim.state().armed);
 }
 
 TEST(ApmsimBoot, HeartbeatsAtOneHertz) {
@@ -241,7 +243,7 @@ TEST(ApmsimModes, SetModeCommandAndHistory) {
 
 TEST(ApmsimModes, RcOverrideDrivesInManual) {
     SimHarness h;
-    h.boot();
+    h.boot_armed();
     const GeoPoint start = h.sim.state().position;
     mv::RcChannelsOverride o;
     o.chan1_raw = 1500;

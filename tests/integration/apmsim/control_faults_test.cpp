@@ -22,7 +22,10 @@ TEST(ApmsimControl, QueriesAndFaults) {
     const auto state = nlohmann::json::parse(apply_control(h.sim, "state", h.now, link));
     EXPECT_EQ(state["mode"], "MANUAL");
     EXPECT_EQ(state["phase"], "ready");
-    EXPECT_EQ(state["armed"], true);
+    EXPECT_EQ(state["armed"], false) << "ARMING_REQUIRE 1: disarmed until armed";
+    EXPECT_EQ(state["gps_fix"], true);
+    EXPECT_TRUE(state["failing_check"].is_null());
+    EXPECT_EQ(state["restarts"], 0);
     EXPECT_EQ(state["mission_count"], 1);
     EXPECT_NEAR(state["lat"].get<double>(), h.sim.config().home.lat, 1e-9);
 
@@ -96,7 +99,7 @@ TEST(ApmsimControl, OptionsParse) {
 
 TEST(ApmsimGuided, GoToHereOnlyInGuided) {
     SimHarness h;
-    h.boot();
+    h.boot_armed();
     auto go = waypoint(h.sim.config().home, 0, 30);
     go.current = 2;
     std::size_t from = h.received.size();
@@ -173,14 +176,20 @@ TEST(ApmsimCommands, HomeVersionArmRebootAndUnknown) {
     ASSERT_TRUE(version);
     EXPECT_TRUE(version->capabilities & 0x4) << "MISSION_INT";
 
-    c.command = 400;  // disarm
+    c.command = 400;  // arm, then disarm
+    c.param1 = 1;
+    h.send(c);
+    EXPECT_TRUE(h.sim.state().armed);
+    auto hb = h.wait_for<mv::Heartbeat>(seconds(2));
+    ASSERT_TRUE(hb);
+    EXPECT_EQ(hb->base_mode & 128, 128);
     c.param1 = 0;
     h.send(c);
     EXPECT_FALSE(h.sim.state().armed);
-    auto hb = h.wait_for<mv::Heartbeat>(seconds(2));
+    hb = h.wait_for<mv::Heartbeat>(seconds(2));
     ASSERT_TRUE(hb);
     EXPECT_EQ(hb->base_mode & 128, 0);
-    EXPECT_EQ(hb->system_status, 3) << "STANDBY when disarmed";
+    EXPECT_EQ(hb->system_status, 4) << "MANUAL: ACTIVE, armed or not";
 
     c.command = 31000;
     from = h.received.size();

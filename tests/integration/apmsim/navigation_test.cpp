@@ -1,6 +1,8 @@
 // RoverSim driving missions in simulated time: reached events, HOLD at the end, retargeting, mode history.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "tests/integration/apmsim/sim_harness.hpp"
 
 namespace airseg::apmsim::test {
@@ -16,7 +18,7 @@ std::vector<std::uint16_t> reached_seqs(const SimHarness& h, std::size_t from = 
 
 TEST(ApmsimNav, DrivesTheMissionInOrderThenHolds) {
     SimHarness h;
-    h.boot();
+    h.boot_armed();
     ASSERT_EQ(h.upload(line_mission(h.sim.config().home, 5, 20)), 0);
     h.set_mode(RoverMode::Auto);
     ASSERT_EQ(h.last<mv::CommandAck>()->result, 0);
@@ -45,7 +47,7 @@ TEST(ApmsimNav, TextOnlyStyleSendsNoReachedMessage) {
     RoverSimConfig c;
     c.reached_style = ReachedStyle::TextOnly;
     SimHarness h(c);
-    h.boot();
+    h.boot_armed();
     ASSERT_EQ(h.upload(line_mission(h.sim.config().home, 2, 10)), 0);
     h.set_mode(RoverMode::Auto);
     ASSERT_TRUE(h.run_until([&] { return h.sim.state().mode == RoverMode::Hold; }, seconds(60)));
@@ -60,7 +62,7 @@ TEST(ApmsimNav, TextOnlyStyleSendsNoReachedMessage) {
 
 TEST(ApmsimNav, SetCurrentRetargetsAtOnce) {
     SimHarness h;
-    h.boot();
+    h.boot_armed();
     ASSERT_EQ(h.upload(line_mission(h.sim.config().home, 5, 30)), 0);
     h.set_mode(RoverMode::Auto);
     h.run_for(seconds(3));
@@ -80,9 +82,13 @@ TEST(ApmsimNav, SetCurrentRetargetsAtOnce) {
     EXPECT_EQ(reached_seqs(h, from), (std::vector<std::uint16_t>{4, 5}));
 }
 
+// A board without the mission change detector (FirmwareProfile::mission_change_restart off) keeps driving to
+// the copy of its target; the current one restarts the command instead (the next test).
 TEST(ApmsimNav, NewMissionKeepsTheTargetBeingDrivenTo) {
-    SimHarness h;
-    h.boot();
+    RoverSimConfig c;
+    c.firmware.mission_change_restart = false;
+    SimHarness h(c);
+    h.boot_armed();
     ASSERT_EQ(h.upload(line_mission(h.sim.config().home, 3, 40)), 0);
     h.set_mode(RoverMode::Auto);
     h.run_for(seconds(5));
@@ -106,11 +112,36 @@ TEST(ApmsimNav, NewMissionKeepsTheTargetBeingDrivenTo) {
     (void)from;
 }
 
+// ModeAuto's change detector: the new mission rewrites the current command, which restarts at its new place
+// ("Auto mission changed, restarted command"), re-planned from where the car is.
+TEST(ApmsimNav, NewMissionUnderAutoRestartsTheCurrentCommandAtItsNewPlace) {
+    SimHarness h;
+    h.boot_armed();
+    ASSERT_EQ(h.upload(line_mission(h.sim.config().home, 3, 40)), 0);
+    h.set_mode(RoverMode::Auto);
+    h.run_for(seconds(5));
+    ASSERT_EQ(h.sim.state().current_seq, 1);
+    std::vector<mv::MissionItemInt> east{waypoint(h.sim.config().home, 0, 0)};
+    for (int i = 1; i <= 3; ++i) {
+        east.push_back(waypoint(h.sim.config().home, 0, 40.0 * i));
+    }
+    const std::size_t from = h.received.size();
+    ASSERT_EQ(h.upload(east), 0);
+    h.run_for(milliseconds(100));
+    EXPECT_GE(h.sim.counters().auto_restarts, 1u);
+    const auto texts = h.texts(from);
+    EXPECT_NE(std::find(texts.begin(), texts.end(), "Auto mission changed, restarted command"), texts.end());
+    ASSERT_TRUE(h.sim.state().target);
+    EXPECT_NEAR(distance_m(*h.sim.state().target, waypoint_point(east[1])), 0, 0.5);
+    ASSERT_TRUE(h.run_until([&] { return !h.sim.reached().empty(); }, seconds(60)));
+    EXPECT_NEAR(distance_m(h.sim.state().position, waypoint_point(east[1])), 0, 3.0);
+}
+
 // A frozen vehicle stays where it is however much time passes, while the board still talks (heartbeats, the
 // mission protocol); released, it carries on from the same place to the same target without catching up.
 TEST(ApmsimNav, AFrozenVehicleKeepsItsPlaceWhileTheLinkGoesOnAndCarriesOnWhenReleased) {
     SimHarness h;
-    h.boot();
+    h.boot_armed();
     ASSERT_EQ(h.upload(line_mission(h.sim.config().home, 4, 40)), 0);
     h.set_mode(RoverMode::Auto);
     ASSERT_TRUE(h.run_until([&] { return !h.sim.reached().empty(); }, seconds(60)));
@@ -135,7 +166,7 @@ TEST(ApmsimNav, AFrozenVehicleKeepsItsPlaceWhileTheLinkGoesOnAndCarriesOnWhenRel
 
 TEST(ApmsimNav, RebootStopsTheMissionAndResumesNothing) {
     SimHarness h;
-    h.boot();
+    h.boot_armed();
     ASSERT_EQ(h.upload(line_mission(h.sim.config().home, 3, 30)), 0);
     h.set_mode(RoverMode::Auto);
     h.run_for(seconds(5));
@@ -153,7 +184,7 @@ TEST(ApmsimNav, RebootStopsTheMissionAndResumesNothing) {
 
 TEST(ApmsimNav, RtlDrivesHomeThenHolds) {
     SimHarness h;
-    h.boot();
+    h.boot_armed();
     ASSERT_EQ(h.upload(line_mission(h.sim.config().home, 1, 30)), 0);
     h.set_mode(RoverMode::Auto);
     ASSERT_TRUE(h.run_until([&] { return h.sim.state().mode == RoverMode::Hold; }, seconds(60)));
@@ -211,7 +242,7 @@ namespace {
 // each reached event appends one more item with a partial write; the rover never stops until the feed does.
 TEST(ApmsimNav, FeedingItemsWhileDrivingNeverHoldsEarly) {
     SimHarness h;
-    h.boot();
+    h.boot_armed();
     const GeoPoint home = h.sim.config().home;
     ASSERT_EQ(h.upload(line_mission(home, 3, 15)), 0);
     h.set_mode(RoverMode::Auto);
@@ -257,7 +288,7 @@ namespace {
 // NAV_LOITER_UNLIM where the vehicle stays once it gets there.
 TEST(ApmsimNav, DoJumpForeverLoopsTheRingAndLoiterUnlimitedStaysPut) {
     SimHarness h;
-    h.boot();
+    h.boot_armed();
     auto items = line_mission(h.sim.config().home, 3, 15);
     mv::MissionItemInt jump;
     jump.command = kCmdDoJump;

@@ -128,6 +128,25 @@ class SimHarness {
     void boot() {
         ASSERT_TRUE(run_until([&] { return sim.state().phase == BootPhase::Ready; }, seconds(30)));
     }
+    /// MAV_CMD_COMPONENT_ARM_DISARM as a ground station sends it; the COMMAND_ACK's result (nothing if none).
+    std::optional<std::uint8_t> arm(bool on = true, float param2 = 0) {
+        mv::CommandLong c;
+        c.command = 400;
+        c.param1 = on ? 1.0F : 0.0F;
+        c.param2 = param2;
+        const std::size_t from = received.size();
+        send(c);
+        const auto ack = last<mv::CommandAck>(from);
+        return ack ? std::optional<std::uint8_t>(ack->result) : std::nullopt;
+    }
+    /// Boots and, on a board that waits to be armed (modern: ARMING_REQUIRE 1), arms it: ready to drive.
+    void boot_armed() {
+        boot();
+        if (!sim.state().armed) {
+            ASSERT_EQ(arm(), std::optional<std::uint8_t>(0));
+        }
+        ASSERT_TRUE(sim.state().armed);
+    }
 
     /// Uploads `items` (home first) with the plain protocol; returns the final MISSION_ACK type.
     std::optional<std::uint8_t> upload(const std::vector<mv::MissionItemInt>& items) {

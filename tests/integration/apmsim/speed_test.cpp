@@ -1,6 +1,6 @@
-// The speed the simulated rover drives at: CRUISE_SPEED (PARAM_SET applies at once), MAV_CMD_DO_CHANGE_SPEED
-// as a command and as a mission item, the speed log, and a HOLD forced by the board mid-plan; for both
-// firmware profiles, in simulated time.
+// The speed the simulated rover drives at: modern, WP_SPEED as it was when AUTO was entered; rover2,
+// CRUISE_SPEED (PARAM_SET applies at once); MAV_CMD_DO_CHANGE_SPEED as a command and as a mission item, the
+// speed log, and a HOLD forced by the board mid-plan; for both firmware profiles, in simulated time.
 #include <gtest/gtest.h>
 
 #include <memory>
@@ -16,7 +16,7 @@ std::unique_ptr<SimHarness> booted(Firmware f) {
     if (f == Firmware::Rover2) {
         h->gcs.set_version(mv::Version::V1);
     }
-    h->boot();
+    h->boot_armed();
     return h;
 }
 
@@ -72,8 +72,31 @@ void cruise_speed_is_followed(Firmware f) {
     EXPECT_EQ(json["speeds"][1]["speed"], 5.0);
 }
 
-TEST(ApmsimSpeed, AutoFollowsCruiseSpeedAndParamSetAppliesAtOnceModern) {
-    cruise_speed_is_followed(Firmware::Modern);
+// Current Rover: AR_WPNav takes WP_SPEED when AUTO is entered (ModeAuto::_enter() → AR_WPNav::init()); a
+// later WP_SPEED waits for the next entry, and CRUISE_SPEED is not the AUTO speed at all.
+TEST(ApmsimSpeed, ModernAutoDrivesAtWpSpeedAsItWasWhenAutoWasEntered) {
+    auto h = booted(Firmware::Modern);
+    ASSERT_EQ(h->sim.speed_log().size(), 1u);
+    EXPECT_EQ(h->sim.speed_log().front().speed, 2.0);
+    param_set(*h, "WP_SPEED", 3);
+    param_set(*h, "CRUISE_SPEED", 5);
+    ASSERT_EQ(h->upload_float(long_leg(*h, 600)), 0);
+    h->set_mode(RoverMode::Auto);
+    h->run_for(seconds(10));
+    EXPECT_NEAR(h->sim.state().speed, 3.0, 0.05) << "WP_SPEED, not CRUISE_SPEED";
+    param_set(*h, "WP_SPEED", 4);
+    h->run_for(seconds(3));
+    EXPECT_NEAR(h->sim.state().speed, 3.0, 0.05) << "read when AUTO is entered, not while in it";
+    h->set_mode(RoverMode::Hold);
+    h->set_mode(RoverMode::Auto);
+    h->run_for(seconds(10));
+    EXPECT_NEAR(h->sim.state().speed, 4.0, 0.05);
+    const auto log = log_of(h->sim);
+    ASSERT_EQ(log.size(), 3u) << speeds_json(h->sim, 0, 10).dump();
+    EXPECT_EQ(log[1].speed, 3.0);
+    EXPECT_EQ(log[1].cause, "param") << "before any AUTO, WP_SPEED is what AUTO will take";
+    EXPECT_EQ(log[2].speed, 4.0);
+    EXPECT_EQ(log[2].cause, "mode");
 }
 
 TEST(ApmsimSpeed, AutoFollowsCruiseSpeedAndParamSetAppliesAtOnceRover2) {
@@ -101,10 +124,25 @@ TEST(ApmsimSpeed, ModernDoChangeSpeedCommandHoldsUntilAutoIsEnteredAgain) {
     from = h->received.size();
     h->send(c);
     EXPECT_EQ(h->last<mv::CommandAck>(from)->result, 4) << "a negative speed fails";
+    c.param2 = 0.04F;
+    from = h->received.size();
+    h->send(c);
+    EXPECT_EQ(h->last<mv::CommandAck>(from)->result, 4) << "below AR_WPNav's 0.05 m/s fails";
+    c.param1 = 2;  // climb speed
+    c.param2 = 3;
+    from = h->received.size();
+    h->send(c);
+    EXPECT_EQ(h->last<mv::CommandAck>(from)->result, 2) << "DENIED";
+    EXPECT_NEAR(h->sim.cruise_speed(), 4.0, 1e-6);
 
     h->set_mode(RoverMode::Hold);
+    c.param1 = 1;
+    c.param2 = 3;
+    from = h->received.size();
+    h->send(c);
+    EXPECT_EQ(h->last<mv::CommandAck>(from)->result, 4) << "HOLD takes no speed (Mode::set_desired_speed())";
     h->set_mode(RoverMode::Auto);
-    EXPECT_EQ(h->sim.cruise_speed(), 2.0) << "entering AUTO forgets the command's speed";
+    EXPECT_EQ(h->sim.cruise_speed(), 2.0) << "entering AUTO forgets the command's speed: WP_SPEED";
     EXPECT_EQ(h->sim.speed_log().back().cause, "mode");
 }
 

@@ -95,7 +95,8 @@ struct Rig {
         auto r = result_of(id);
         return r ? *r
                  : RequestDone{
-                       id, RequestKind::SetState, RequestResult::Cancelled, "no result in time", {}, {}, {}};
+                       id, RequestKind::SetState, RequestResult::Cancelled, "no result in time", {}, {}, {},
+                       {}};
     }
     void bring_up() {
         open_with_reset();
@@ -860,6 +861,138 @@ TEST(Driver, TheLegSpeedGoesByCommandOnBoardsThatHaveItAndByCruiseSpeedOnOthers)
     odd.harness.run_for(seconds(3));
     EXPECT_FLOAT_EQ(odd.rover.params()["CRUISE_SPEED"], 1.5F);
     EXPECT_TRUE(odd.driver.speed_by_param());
+}
+
+}  // namespace
+}  // namespace airseg::autopilot::ardupilot
+
+namespace airseg::autopilot::ardupilot {
+namespace {
+
+// ---- arming (ArduPilot Rover 4.x boots disarmed: ARMING_REQUIRE 1) ---------------------------------------
+
+FakeRover::Options needs_arming() {
+    FakeRover::Options o;
+    o.arming_required = true;
+    return o;
+}
+
+TEST(Driver, ABoardThatNeedsArmingIsArmedOnceAutoIsConfirmedAndStaysArmedInHold) {
+    Rig rig(pixhawk_config(), needs_arming());
+    rig.bring_up();
+    EXPECT_EQ(rig.driver.status().armed, std::optional<bool>(false));
+    ASSERT_EQ(rig.wait_result(rig.driver.upload_mission(plan(4), rig.now())).result, RequestResult::Ok);
+    const auto id = rig.driver.request_state(VehicleState::WaypointNavigation, rig.now());
+    const auto r = rig.wait_result(id);
+    ASSERT_EQ(r.result, RequestResult::Ok) << r.detail;
+    EXPECT_EQ(r.armed, std::optional<bool>(true));
+    EXPECT_TRUE(rig.rover.armed());
+    EXPECT_EQ(rig.rover.mode(), testing::kAuto);
+    EXPECT_EQ(rig.rover.arm_commands(), 1u);
+    EXPECT_EQ(rig.driver.status().armed, std::optional<bool>(true));
+    // PARKING and AUTO again: nothing disarms, nothing arms twice.
+    ASSERT_EQ(rig.wait_result(rig.driver.request_state(VehicleState::Parking, rig.now())).result,
+              RequestResult::Ok);
+    ASSERT_EQ(rig.wait_result(rig.driver.request_state(VehicleState::WaypointNavigation, rig.now())).result,
+              RequestResult::Ok);
+    EXPECT_TRUE(rig.rover.armed());
+    EXPECT_EQ(rig.rover.arm_commands(), 1u);
+}
+
+TEST(Driver, ArmingRefusedEndsTheRequestRefusedInTheBoardsOwnWords) {
+    auto opts = needs_arming();
+    opts.arm_refusal = "Need Position Estimate";
+    Rig rig(pixhawk_config(), opts);
+    rig.bring_up();
+    ASSERT_EQ(rig.wait_result(rig.driver.upload_mission(plan(4), rig.now())).result, RequestResult::Ok);
+    const auto r = rig.wait_result(rig.driver.request_state(VehicleState::WaypointNavigation, rig.now()));
+    EXPECT_EQ(r.result, RequestResult::Refused);
+    EXPECT_NE(r.detail.find("Arm: Need Position Estimate"), std::string::npos) << r.detail;
+    EXPECT_NE(r.detail.find("MAV_RESULT_FAILED"), std::string::npos) << r.detail;
+    EXPECT_EQ(r.armed, std::optional<bool>(false));
+    EXPECT_EQ(rig.driver.status().arm_refusals, 1u);
+    EXPECT_EQ(rig.driver.arm_control().last_refusal(), "Arm: Need Position Estimate");
+    EXPECT_EQ(rig.rover.arm_commands(), 1u) << "a refusal is not asked again";
+}
+
+TEST(Driver, WithArmingNeverTheBoardIsLeftAsItIsAndAnUnansweredArmTimesOut) {
+    auto never = pixhawk_config();
+    never.arming = ArmingPolicy::Never;
+    Rig rig(never, needs_arming());
+    rig.bring_up();
+    ASSERT_EQ(rig.wait_result(rig.driver.upload_mission(plan(4), rig.now())).result, RequestResult::Ok);
+    EXPECT_EQ(rig.wait_result(rig.driver.request_state(VehicleState::WaypointNavigation, rig.now())).result,
+              RequestResult::Ok);
+    EXPECT_EQ(rig.rover.arm_commands(), 0u);
+    EXPECT_FALSE(rig.rover.armed());
+
+    auto silent = needs_arming();
+    silent.arm_acks = false;
+    Rig mute(pixhawk_config(), silent);
+    mute.bring_up();
+    ASSERT_EQ(mute.wait_result(mute.driver.upload_mission(plan(4), mute.now())).result, RequestResult::Ok);
+    const auto r = mute.wait_result(mute.driver.request_state(VehicleState::WaypointNavigation, mute.now()));
+    EXPECT_EQ(r.result, RequestResult::Timeout) << r.detail;
+    EXPECT_EQ(mute.rover.arm_commands(), 1u + pixhawk_config().mode_retries);
+}
+
+TEST(Driver, AJoystickSessionArmsTooButTheRcPilotsDirectedStateDoesNot) {
+    Rig rig(pixhawk_config(), needs_arming());
+    rig.bring_up();
+    ASSERT_EQ(rig.wait_result(rig.driver.request_state(VehicleState::Directed, rig.now())).result,
+              RequestResult::Ok);
+    EXPECT_FALSE(rig.rover.armed());
+    ASSERT_EQ(rig.wait_result(rig.driver.request_state(VehicleState::ManualNavigation, rig.now())).result,
+              RequestResult::Ok);
+    EXPECT_TRUE(rig.rover.armed());
+}
+
+// ---- speeds on current Rover: the board forgets the command's speed at every entry into AUTO
+// ---------------
+
+TEST(Driver, ThePlansSpeedIsSetAgainAfterEveryEntryIntoAutoAndStatusShowsWhatTheBoardConfirmed) {
+    FakeRover::Options current;
+    current.current_rover_speed = true;
+    Rig rig(pixhawk_config(), current);
+    rig.bring_up();
+    ASSERT_EQ(rig.wait_result(rig.driver.upload_mission(plan_with_speeds(), rig.now())).result,
+              RequestResult::Ok);
+    ASSERT_EQ(rig.wait_result(rig.driver.set_current(1, rig.now())).result, RequestResult::Ok);
+    ASSERT_EQ(rig.wait_result(rig.driver.request_state(VehicleState::WaypointNavigation, rig.now())).result,
+              RequestResult::Ok);
+    rig.harness.run_for(seconds(2));
+    ASSERT_EQ(rig.rover.speed_commands(), std::vector<float>{1.5F});
+    EXPECT_EQ(rig.driver.status().speed, 1.5);
+    EXPECT_STREQ(rig.driver.speed_param(), "WP_SPEED");
+
+    // HOLD and back (a forced HOLD, a pause): the board drives at WP_SPEED again; the plan's speed follows.
+    rig.rover.pilot_sets_mode(testing::kHold, rig.now());
+    rig.harness.run_for(seconds(2));
+    rig.rover.pilot_sets_mode(testing::kAuto, rig.now());
+    rig.harness.run_until([&] { return rig.driver.status().mode == "AUTO"; }, rig.now() + seconds(5));
+    EXPECT_EQ(rig.driver.status().speed, std::optional<double>(2.0)) << "WP_SPEED until confirmed";
+    rig.harness.run_for(seconds(2));
+    EXPECT_EQ(rig.rover.speed_commands(), (std::vector<float>{1.5F, 1.5F}));
+    EXPECT_EQ(rig.driver.status().speed, 1.5);
+    EXPECT_FALSE(rig.driver.speed_by_param()) << "FAILED outside AUTO is not a board without the command";
+}
+
+TEST(Driver, OnABoardSetByParameterItsOwnSpeedIsWrittenBackWhenThePlanEnds) {
+    Rig old(apm2_config(), apm2_rover());
+    old.bring_up();
+    ASSERT_FLOAT_EQ(old.rover.params()["CRUISE_SPEED"], 3.0F);
+    ASSERT_EQ(old.wait_result(old.driver.upload_mission(plan_with_speeds(), old.now())).result,
+              RequestResult::Ok);
+    ASSERT_EQ(old.wait_result(old.driver.set_current(5, old.now())).result, RequestResult::Ok);
+    ASSERT_EQ(old.wait_result(old.driver.request_state(VehicleState::WaypointNavigation, old.now())).result,
+              RequestResult::Ok);
+    old.harness.run_for(seconds(3));
+    ASSERT_FLOAT_EQ(old.rover.params()["CRUISE_SPEED"], 2.5F);
+    // The last waypoint reached: the board heads for the plan's final Stop.
+    ASSERT_EQ(old.wait_result(old.driver.set_current(8, old.now())).result, RequestResult::Ok);
+    old.harness.run_for(seconds(3));
+    EXPECT_FLOAT_EQ(old.rover.params()["CRUISE_SPEED"], 3.0F) << "the board's own value, back";
+    EXPECT_EQ(old.driver.status().speed, 3.0);
 }
 
 }  // namespace

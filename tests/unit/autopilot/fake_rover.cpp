@@ -28,6 +28,10 @@ FakeRover::FakeRover(Options options, TimePoint now)
     param_order_.push_back("CRUISE_SPEED");
     params_["WP_RADIUS"] = 2.0f;
     param_order_.push_back("WP_RADIUS");
+    if (options_.current_rover_speed) {
+        params_["WP_SPEED"] = 2.0f;
+        param_order_.push_back("WP_SPEED");
+    }
     mav::MissionItemInt home;
     home.frame = 0;
     home.command = 16;
@@ -43,6 +47,7 @@ void FakeRover::reboot(TimePoint now) {
     boot_texts_sent_ = false;
     receiving_ = false;
     mode_ = kHold;
+    armed_ = false;
     current_ = 0;
     last_override_.reset();
     out_.clear();
@@ -76,6 +81,9 @@ void FakeRover::send_heartbeat(TimePoint now) {
     hb.type = 10;
     hb.autopilot = 3;
     hb.base_mode = 1;
+    if ((armed_ || !options_.arming_required) && now >= boot_done_) {
+        hb.base_mode |= 128;  // MAV_MODE_FLAG_SAFETY_ARMED
+    }
     hb.custom_mode = mode_;
     hb.system_status = now < boot_done_ ? kGcsMavStateCalibrating : kMavStateStandby;
     if (options_.uninit_in_hold && mode_ == kHold && now >= boot_done_) {
@@ -413,11 +421,25 @@ void FakeRover::on_frame(const mav::Frame& f, TimePoint now) {
                     set_mode(mode, now);
                 }
             } else if (m.command == 178) {  // MAV_CMD_DO_CHANGE_SPEED
-                ack.result = options_.change_speed_command ? 0 : 3;
+                ack.result = !options_.change_speed_command                   ? 3
+                             : options_.current_rover_speed && mode_ != kAuto ? 4
+                                                                              : 0;
                 if (ack.result == 0) {
                     speed_commands_.push_back(m.param2);
                 }
                 send(ack);
+            } else if (m.command == 400 && m.param1 == 1.0F) {  // MAV_CMD_COMPONENT_ARM_DISARM: arm
+                ++arm_commands_;
+                if (!options_.arm_acks) {
+                    return;
+                }
+                ack.result = options_.arm_refusal.empty() ? 0 : 4;
+                send(ack);  // ArduPilot's texts leave through a queue: the refusal's reason after the ack
+                if (ack.result == 0) {
+                    armed_ = true;
+                } else {
+                    text(2, "Arm: " + options_.arm_refusal);
+                }
             } else {
                 ack.result = 0;
                 send(ack);

@@ -44,6 +44,10 @@ class FakeRover {
         bool loiter_unlim = true;              // stores NAV_LOITER_UNLIM (else MAV_MISSION_UNSUPPORTED)
         bool uninit_in_hold = false;           // heartbeats say MAV_STATE_UNINIT in HOLD (APM:Rover 2.x)
         bool banner_on_param_list = false;     // the banner texts before the parameters (ArduPilot 4.x)
+        bool arming_required = false;  // boots disarmed (no SAFETY_ARMED) until MAV_CMD_COMPONENT_ARM_DISARM
+        std::string arm_refusal{};     // when set, arming fails: "Arm: <refusal>" after the ack FAILED
+        bool arm_acks = true;          // the arm command is acknowledged (else silently ignored)
+        bool current_rover_speed = false;  // WP_SPEED 2; DO_CHANGE_SPEED FAILED outside AUTO (Rover 4.x)
     };
 
     explicit FakeRover(Options options, TimePoint now);
@@ -66,6 +70,8 @@ class FakeRover {
     void parameter_list_asked(TimePoint now);
 
     std::uint32_t mode() const { return mode_; }
+    bool armed() const { return armed_; }
+    unsigned arm_commands() const { return arm_commands_; }
     bool booted(TimePoint now) const { return now >= boot_done_; }
     const std::vector<mav::MissionItemInt>& mission() const { return mission_; }
     std::uint16_t mission_current() const { return current_; }
@@ -106,6 +112,8 @@ class FakeRover {
     TimePoint next_heartbeat_;
     bool boot_texts_sent_;
     std::uint32_t mode_ = kHold;
+    bool armed_ = false;
+    unsigned arm_commands_ = 0;
     std::set<std::uint32_t> refused_modes_;
     std::vector<float> speed_commands_;
     std::vector<std::pair<std::uint32_t, std::uint8_t>> item_frames_;  // (message id, frame)

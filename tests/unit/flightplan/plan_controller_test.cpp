@@ -2,6 +2,8 @@
 // the link-loss reaction, an autopilot that reboots or reconnects mid-plan, pause and resume.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <string>
 #include <vector>
 
@@ -59,6 +61,8 @@ struct Rig {
                 pending.push_back(*call);
             } else if (auto* t = std::get_if<ReactionTrigger>(&*o)) {
                 triggers.push_back(*t);
+            } else if (auto* e = std::get_if<FeederEvent>(&*o)) {
+                events.push_back(*e);
             }
         }
         while (auto r = c.poll_reply()) {
@@ -162,6 +166,7 @@ struct Rig {
     std::vector<AutopilotCall> pending;
     std::vector<CommandReply> replies;
     std::vector<ReactionTrigger> triggers;
+    std::vector<FeederEvent> events;
     std::vector<ProgressSave> saves;
     std::optional<std::string> save_error;  // what the state store answers
 };
@@ -535,6 +540,51 @@ TEST(FlightplanController, StopFailsTheWaitingCommands) {
     const auto replies = rig.replies_to(id);
     ASSERT_EQ(replies.size(), 1u);
     EXPECT_EQ(replies.front().error, "plan.load: the daemon is stopping");
+}
+
+// A board that will not arm (ArduPilot Rover 4.x, ARMING_REQUIRE 1, a check failing): the driver's request
+// for WAYPOINT_NAVIGATION ends Refused with the board's words, and the plan fails with them.
+TEST(FlightplanController, AnAutopilotThatRefusesToArmFailsThePlanWithItsReasonAndHoldsTheVehicle) {
+    Rig rig;
+    rig.ready();
+    const auto id = rig.load(plan_text());
+    for (int guard = 0; guard < 100 && !rig.pending.empty(); ++guard) {
+        const auto call = rig.pending.front();
+        rig.pending.erase(rig.pending.begin());
+        rig.now += milliseconds(50);
+        autopilot::RequestDone done;
+        if (is_auto(call.request)) {
+            done.kind = autopilot::RequestKind::SetState;
+            done.result = autopilot::RequestResult::Refused;
+            done.detail = "the autopilot refused to arm (MAV_RESULT_FAILED): Arm: Need Position Estimate";
+        }
+        rig.c.on_request_done(call.id, done, rig.now);
+        rig.drain();
+    }
+    EXPECT_EQ(rig.state(), "failed");
+    const auto plan = rig.c.progress_json();
+    ASSERT_TRUE(plan["error"].is_string()) << plan.dump();
+    EXPECT_NE(plan["error"].get<std::string>().find("Arm: Need Position Estimate"), std::string::npos)
+        << plan.dump();
+    EXPECT_EQ(std::count_if(rig.events.begin(), rig.events.end(),
+                            [](const FeederEvent& e) { return e.kind == FeederEvent::Kind::PlanFailed; }),
+              1);
+    const auto replies = rig.replies_to(id);
+    ASSERT_EQ(replies.size(), 1u);
+    EXPECT_NE(replies.front().status, Status::Ok);
+    EXPECT_EQ(rig.count(is_auto), 1u) << "not asked again";
+    EXPECT_EQ(last_state_asked(rig), autopilot::VehicleState::Parking);
+}
+
+TEST(FlightplanController, ADonePlanShowsNoInterruptionARunningOneShowsTheLast) {
+    FeederProgress p;
+    p.interruption = "the autopilot left AUTO for HOLD by itself";
+    p.state = PlanState::Running;
+    EXPECT_EQ(PlanController::shown_interruption(p), p.interruption);
+    p.state = PlanState::Interrupted;
+    EXPECT_EQ(PlanController::shown_interruption(p), p.interruption);
+    p.state = PlanState::Done;
+    EXPECT_EQ(PlanController::shown_interruption(p), "");
 }
 
 }  // namespace
