@@ -397,6 +397,10 @@ void PlanController::handle_event(const FeederEvent& e) {
             log(Level::Warn,
                 fmt::format("window starved at waypoint {}: holding until it is written", e.plan_index));
             break;
+        case FeederEvent::Kind::HeldAtFrontier:
+            log(Level::Warn,
+                fmt::format("waiting for waypoint {} to reach the autopilot: {}", e.plan_index, e.detail));
+            break;
         case FeederEvent::Kind::Interrupted:
             log(Level::Warn, fmt::format("plan interrupted at waypoint {}: {}", e.plan_index, e.detail));
             break;
@@ -755,6 +759,9 @@ Json PlanController::progress_json() const {
     j["reaction"] = last_reaction_.empty() ? Json(nullptr) : Json(last_reaction_);
     j["interruption"] = p.interruption.empty() ? Json(nullptr) : Json(p.interruption);
     j["error"] = problem_.empty() ? Json(nullptr) : Json(problem_);
+    j["held_at_frontier"] = p.held_at_frontier;
+    j["frontier_stops"] = p.frontier_stops;
+    j["frontier_wait_s"] = std::round(std::chrono::duration<double>(p.frontier_wait).count() * 10.0) / 10.0;
     return j;
 }
 
@@ -776,8 +783,9 @@ TimePoint PlanController::poll_timeout() const {
 }
 
 PlanController::StatusKey PlanController::status_key(const FeederProgress& p) const {
-    return {p.state,        p.plan_name,    p.element, p.waypoints_reached, p.next_waypoint, p.window,
-            last_reaction_, p.interruption, problem_};
+    return {p.state,         p.plan_name,        p.element,        p.waypoints_reached,
+            p.next_waypoint, p.window,           last_reaction_,   p.interruption,
+            problem_,        p.held_at_frontier, p.frontier_stops, p.frontier_wait};
 }
 
 void PlanController::publish_status(bool force) {

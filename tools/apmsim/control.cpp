@@ -79,7 +79,8 @@ nlohmann::json reached_json(const RoverSim& sim, std::uint64_t from, std::uint64
                         {"lat", r.item.lat},
                         {"lon", r.item.lon},
                         {"distance", r.distance},
-                        {"passed", r.passed}});
+                        {"passed", r.passed},
+                        {"command", r.command}});
     }
     return {{"total", sim.reached_total()}, {"first_kept", first}, {"reached", list}};
 }

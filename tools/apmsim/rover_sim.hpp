@@ -112,9 +112,10 @@ struct ModeChange {
 struct ReachedEvent {
     TimePoint at{};
     std::uint16_t seq = 0;
-    double distance = 0;  // metres from the item when it counted as reached
-    bool passed = false;  // went past it rather than inside WP_RADIUS
-    GeoPoint item;        // where the reached item was
+    double distance = 0;        // metres from the item when it counted as reached
+    bool passed = false;        // went past it rather than inside WP_RADIUS
+    GeoPoint item;              // where the reached item was
+    std::uint16_t command = 0;  // its MAV_CMD (NAV_WAYPOINT, or NAV_LOITER_UNLIM where the rover stays)
 };
 
 /// A change of the speed the rover drives at in AUTO, RTL and GUIDED (CRUISE_SPEED, or a DO_CHANGE_SPEED).

@@ -220,7 +220,8 @@ void RoverSim::on_target_reached(double distance, bool passed, TimePoint now) {
     if (reached_.size() >= kMaxReachedLog) {
         reached_.pop_front();
     }
-    reached_.push_back(ReachedEvent{now, seq, distance, passed, target_.value_or(GeoPoint{})});
+    reached_.push_back(
+        ReachedEvent{now, seq, distance, passed, target_.value_or(GeoPoint{}), store_.at(seq).command});
     ++reached_total_;
     if (store_.at(seq).command == kCmdNavLoiterUnlimited) {
         loitering_ = true;  // stays here; the mission does not advance past it

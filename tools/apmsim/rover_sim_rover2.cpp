@@ -477,7 +477,7 @@ void RoverSim::r2_reached(bool passed, double distance, TimePoint now) {
     if (reached_.size() >= kMaxReachedLog) {
         reached_.pop_front();
     }
-    reached_.push_back(ReachedEvent{now, r2_.nav_index, distance, passed, r2_.next_wp});
+    reached_.push_back(ReachedEvent{now, r2_.nav_index, distance, passed, r2_.next_wp, r2_.next_nav.command});
     ++reached_total_;
 }
 
