@@ -15,9 +15,8 @@
 # Work directories: build-pkg-ARCH/. AIRSEG_SOURCE_DIR packages another tree. Missing build tools
 # are installed with apt-get (as root). AIRSEG_INTEROP_MODULES: a node_modules directory filled by
 # tests/integration/mavlink_interop/setup.sh, so that mavlink_interop runs too (no network here).
-# AIRSEG_CTEST_ARGS: ctest options (default: a failed test is rerun up to twice: under qemu-arm a few real-time
-# tests - READY within 1 s, a 400 ms mission timeout at speedup 20 - run 5-10 times slower than on the hardware;
-# every failure is still printed).
+# AIRSEG_CTEST_ARGS: more ctest options. The suite runs through tools/run-ctest.sh: every case once, a failure
+# fails the build (no case is rerun unless tests/ci-rerun.txt names it with its cause; each rerun is printed).
 # AIRSEG_EXTRA_CMAKE_ARGS: more cmake options (CI: -DAIRSEG_TEST_HANG_INJECTION=ON, so that the
 # stuck-service test runs on ARM too; packages to ship leave the test-only hook out).
 # AIRSEG_TEST_JOBS: test cases run at once (default: AIRSEG_JOBS, the build's parallel level).
@@ -117,10 +116,10 @@ build_one() {
   fi
   rm -f "$work"/*.deb "$work"/*.ddeb "$work"/*.buildinfo "$work"/*.changes
   local start=$SECONDS
-  # debhelper gives the build a HOME of its own inside debian/, which would start ccache empty.
-  export CCACHE_DIR=${CCACHE_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/ccache}
+  # debhelper gives the build a HOME of its own inside debian/: lib.sh has exported the compiler cache's
+  # directory and base (tools/ci-lib.sh), so the package builds share the cache of every other build here.
   (cd "$src" && env "${env[@]}" AIRSEG_SYSROOT="$sysroot" DEB_BUILD_OPTIONS="$opts" \
-     AIRSEG_CMAKE_ARGS="$(ccache_launcher_args) ${AIRSEG_EXTRA_CMAKE_ARGS:-}" AIRSEG_CTEST_ARGS="${AIRSEG_CTEST_ARGS---repeat until-pass:3}" \
+     AIRSEG_CMAKE_ARGS="$(ccache_launcher_args) ${AIRSEG_EXTRA_CMAKE_ARGS:-}" AIRSEG_CTEST_ARGS="${AIRSEG_CTEST_ARGS:-}" \
      dpkg-buildpackage "${dpkg_args[@]}") \
      >"$work/build.log" 2>&1 || { tail -n 60 "$work/build.log"; die "build for $arch failed (log: $work/build.log)"; }
   echo "$key" >"$obj/.airseg-build-options"

@@ -2,7 +2,16 @@
 # shellcheck shell=bash
 
 AIRSEG_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-AIRSEG_SYSROOTS=${AIRSEG_SYSROOTS:-$AIRSEG_ROOT/sysroots}
+# The sysroots live outside the tree, in this user's cache, so that every clone on the machine (a CI run's
+# fresh one included) uses the same ones: made once (packaging/ensure-sysroot.sh remakes one whose package
+# list changed, or that is more than a week old), and the same paths in every compile command, which the
+# compiler cache needs.
+AIRSEG_SYSROOTS=${AIRSEG_SYSROOTS:-${XDG_CACHE_HOME:-$HOME/.cache}/airseg/sysroots}
+# Logs, the compiler cache's per-stage statistics and the closing table (tools/ci-lib.sh).
+export AIRSEG_CI_LOGS=${AIRSEG_CI_LOGS:-$AIRSEG_ROOT/build-logs}
+# shellcheck source=../tools/ci-lib.sh
+. "$AIRSEG_ROOT/tools/ci-lib.sh"
+airseg_ccache_env "$AIRSEG_ROOT"
 
 log() { printf '%s: %s\n' "$(basename "$0")" "$*" >&2; }
 die() { log "error: $*"; exit 1; }

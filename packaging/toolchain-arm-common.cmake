@@ -3,17 +3,29 @@
 # AIRSEG_TARGET_TRIPLET and AIRSEG_TARGET_ARCH first (arm64 also AIRSEG_TARGET_PROCESSOR and AIRSEG_QEMU).
 #
 # AIRSEG_SYSROOT (cache variable or environment) names the sysroot; default: sysroots/<arch> at
-# the top of the tree. Test executables run through qemu-arm-static (qemu-aarch64-static) -L <sysroot>.
+# the top of the tree if there is one, else the user's cache where packaging/lib.sh keeps them
+# (AIRSEG_SYSROOTS, default ~/.cache/airseg/sysroots/<arch>). Test executables run through qemu-arm-static (qemu-aarch64-static) -L <sysroot>.
 
 if(NOT AIRSEG_SYSROOT)
   if(DEFINED ENV{AIRSEG_SYSROOT} AND NOT "$ENV{AIRSEG_SYSROOT}" STREQUAL "")
     set(AIRSEG_SYSROOT "$ENV{AIRSEG_SYSROOT}")
   else()
+    # packaging/lib.sh keeps the sysroots in the user's cache (AIRSEG_SYSROOTS); sysroots/ in the tree is
+    # still looked at first.
     get_filename_component(AIRSEG_SYSROOT "${CMAKE_CURRENT_LIST_DIR}/../sysroots/${AIRSEG_TARGET_ARCH}" ABSOLUTE)
+    if(NOT EXISTS "${AIRSEG_SYSROOT}/usr/include")
+      if(DEFINED ENV{AIRSEG_SYSROOTS} AND NOT "$ENV{AIRSEG_SYSROOTS}" STREQUAL "")
+        set(AIRSEG_SYSROOT "$ENV{AIRSEG_SYSROOTS}/${AIRSEG_TARGET_ARCH}")
+      elseif(DEFINED ENV{XDG_CACHE_HOME} AND NOT "$ENV{XDG_CACHE_HOME}" STREQUAL "")
+        set(AIRSEG_SYSROOT "$ENV{XDG_CACHE_HOME}/airseg/sysroots/${AIRSEG_TARGET_ARCH}")
+      else()
+        set(AIRSEG_SYSROOT "$ENV{HOME}/.cache/airseg/sysroots/${AIRSEG_TARGET_ARCH}")
+      endif()
+    endif()
   endif()
 endif()
 if(NOT EXISTS "${AIRSEG_SYSROOT}/usr/include")
-  message(FATAL_ERROR "No ${AIRSEG_TARGET_ARCH} sysroot in ${AIRSEG_SYSROOT}: run packaging/make-sysroot.sh ${AIRSEG_TARGET_ARCH}")
+  message(FATAL_ERROR "No ${AIRSEG_TARGET_ARCH} sysroot in ${AIRSEG_SYSROOT}: run packaging/ensure-sysroot.sh ${AIRSEG_TARGET_ARCH} ${AIRSEG_SYSROOT}")
 endif()
 # try_compile() projects re-read this file; pass the sysroot on to them.
 list(APPEND CMAKE_TRY_COMPILE_PLATFORM_VARIABLES AIRSEG_SYSROOT)

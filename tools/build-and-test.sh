@@ -21,9 +21,20 @@
 #   native    GCC build as shipped (build/, the one tools/demo.sh runs) and the whole ctest suite
 # Default: "sanitize tidy fuzz tsan cross". The shipped GCC build is tested by the cross stage on the two ARM
 # targets; "native" repeats that on amd64 and is the quickest check while developing.
+# Every compile goes through ccache when it is installed, in the cache this user's ccache uses
+# (~/.cache/ccache unless configured), with paths relative to the top of the tree (tools/ci-lib.sh): a second
+# run, in this clone or in a fresh one elsewhere on the same machine, compiles almost nothing. Each stage
+# says how many of its compiles the cache served. Test suites run through tools/run-ctest.sh (every case
+# once; no rerun unless tests/ci-rerun.txt names the case with its cause). The log ends with a table of the
+# stages (build-logs/stages.tsv): wall time, tests passed / failed / skipped, ccache hits, reruns.
 # docs/operations.md ("CI") has the figures for each stage.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. tools/ci-lib.sh
+export AIRSEG_CI_LOGS=$PWD/build-logs
+mkdir -p "$AIRSEG_CI_LOGS"
+rm -f "$AIRSEG_CI_LOGS/stages.tsv"
+airseg_ccache_env "$PWD"
 stages=${AIRSEG_STAGES:-sanitize tidy fuzz tsan cross}
 jobs=$(nproc)
 # Test cases at once: most of them wait on real time (the simulated radios and autopilot run at real speed),
@@ -32,20 +43,48 @@ test_jobs=${AIRSEG_TEST_JOBS:-$((4 * jobs))}
 export AIRSEG_TEST_JOBS=$test_jobs
 total=$SECONDS
 
-launcher=()
+# The CI builds map the tree's path to . in their objects (AIRSEG_RELATIVE_PATHS), so that a clone elsewhere
+# shares their cache entries.
+launcher=(-DAIRSEG_RELATIVE_PATHS=ON)
 if command -v ccache >/dev/null; then
-  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  launcher+=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 fi
 
 has_stage() { [[ " $stages " == *" $1 "* ]]; }
-elapsed() { echo "build-and-test: $1 in $((SECONDS - $2)) s"; }
+# elapsed WHAT START [SUMMARY_FILE] [CCACHE_STAGE]: says how long WHAT took and records it for the closing table.
+elapsed() {
+  echo "build-and-test: $1 in $((SECONDS - $2)) s"
+  [ -z "${4:-}" ] || echo "build-and-test: $1: ccache served $(ccache_stage_rate "$4") compiles"
+  record_stage "$1" "$((SECONDS - $2))" "${3:-}" "${4:-}"
+}
+# A process started here in the background, with everything it started.
+kill_tree() {
+  local child
+  for child in $(ps -o pid= --ppid "$1" 2>/dev/null); do
+    kill_tree "$child"
+  done
+  kill "$1" 2>/dev/null || true
+}
+# The table ends the log however the run ends; a stage that failed is its last row, and what it left running
+# in the background (fuzzers, the TSan build, the cross preparation) is stopped.
+finish() {
+  local code=$? pid
+  if [ "$code" != 0 ]; then
+    for pid in ${fuzz_pid:-} ${tsan_build_pid:-} ${prepare_pid:-}; do
+      kill_tree "$pid"
+    done
+    record_stage "FAILED (exit $code) after the stages above" "-" "" ""
+  fi
+  print_stage_table "$((SECONDS - total))"
+}
+trap finish EXIT
 
 # The MAVLink interoperability test needs node-mavlink (pinned by its lock file) in each build directory.
 run_ctest() {
   local dir=$1
   shift
   tests/integration/mavlink_interop/setup.sh "$dir"
-  ctest --test-dir "$dir" -j"$test_jobs" --output-on-failure --timeout 600 "$@"
+  tools/run-ctest.sh "$dir" -j"$test_jobs" --timeout 600 "$@"
 }
 
 for s in $stages; do
@@ -67,13 +106,14 @@ fi
 
 if has_stage sanitize || has_stage fuzz; then
   start=$SECONDS
+  ccache_stage_begin sanitize-build
   # The same configuration tests/fuzz/run.sh makes, so the fuzz stage reuses this build.
   CC=clang CXX=clang++ cmake -S . -B build-san -G Ninja "${launcher[@]}" \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" \
     -DAIRSEG_BUILD_FUZZ=ON -DAIRSEG_BUILD_TESTS=ON -DAIRSEG_BUILD_BENCH=ON \
     -DAIRSEG_SANITIZE=fuzzer-no-link,address,undefined
   cmake --build build-san -j"$jobs"
-  elapsed "sanitizer build" "$start"
+  elapsed "sanitize: build (clang, ASan+UBSan)" "$start" "" sanitize-build
 fi
 
 # Each libFuzzer target for $seconds from its seeds, $1 at a time; each log ends with libFuzzer's statistics.
@@ -108,18 +148,38 @@ if has_stage fuzz && has_stage sanitize; then
   fuzz_pid=$!
 fi
 
+# The ThreadSanitizer build of the concurrency tests: in batches like every other build (the tidy stage
+# parses each changed source on its own, which is where a missing #include that a batch-mate provides shows).
+mapfile -t tsan_targets < <(grep '^[a-z]' tests/concurrency-tests.txt)
+tsan_build() {
+  ccache_stage_begin tsan-build
+  cmake -S . -B build-tsan -G Ninja "${launcher[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" -DAIRSEG_BUILD_BENCH=OFF -DAIRSEG_SANITIZE=thread
+  cmake --build build-tsan -j"$jobs" --target "${tsan_targets[@]}"
+}
+
+# The TSan build compiles at nice 19 beside the ASan+UBSan suite, which mostly waits on real time: a core is
+# idle there (the fuzzers, also at nice 19, share it). Its log is printed at the tsan stage.
+tsan_build_pid=""
+if has_stage tsan && has_stage sanitize && [ "${AIRSEG_TSAN_BESIDE_SUITE:-1}" = 1 ]; then
+  tsan_start=$SECONDS
+  ( renice -n 19 -p "$BASHPID" >/dev/null; tsan_build ) >build-logs/tsan-build.log 2>&1 &
+  tsan_build_pid=$!
+fi
+
 if has_stage sanitize; then
   start=$SECONDS
   # Any sanitizer report ends the process with an error, in the tests and in the programs they start.
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=0:halt_on_error=1 \
-    UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 run_ctest build-san
-  elapsed "tests under ASan+UBSan" "$start"
+    UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 run_ctest build-san || suite=$?
+  elapsed "sanitize: whole suite under ASan+UBSan" "$start" build-san/ctest-summary.txt
+  [ "${suite:-0}" = 0 ] || exit 1
 fi
 
 if has_stage tidy; then
   start=$SECONDS
   tools/clang-tidy-check.sh build-tidy
-  elapsed "clang-tidy" "$start"
+  elapsed "tidy: clang-tidy on the changed sources" "$start"
 fi
 
 if [ -n "$fuzz_pid" ]; then
@@ -127,21 +187,26 @@ if [ -n "$fuzz_pid" ]; then
   wait "$fuzz_pid" || code=$?
   cat build-logs/fuzz.log
   [ "$code" = 0 ] || { echo "build-and-test: fuzzing found a problem" >&2; exit 1; }
-  elapsed "fuzzing, beside the ASan+UBSan suite" "$fuzz_start"
+  elapsed "fuzz: every target, beside the ASan+UBSan suite" "$fuzz_start"
 elif has_stage fuzz; then
   start=$SECONDS
   fuzz_targets "$jobs"  # one per core
-  elapsed "fuzzing" "$start"
+  elapsed "fuzz: every target" "$start"
 fi
 
 if has_stage tsan; then
   start=$SECONDS
-  # In batches like every other build: the tidy stage parses each changed source on its own, which is where a
-  # missing #include that a batch-mate provides shows up.
-  cmake -S . -B build-tsan -G Ninja "${launcher[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" -DAIRSEG_BUILD_BENCH=OFF -DAIRSEG_SANITIZE=thread
-  mapfile -t tsan_targets < <(grep '^[a-z]' tests/concurrency-tests.txt)
-  cmake --build build-tsan -j"$jobs" --target "${tsan_targets[@]}"
+  if [ -n "$tsan_build_pid" ]; then
+    code=0
+    wait "$tsan_build_pid" || code=$?
+    cat build-logs/tsan-build.log
+    [ "$code" = 0 ] || { echo "build-and-test: the ThreadSanitizer build failed" >&2; exit 1; }
+    start=$tsan_start
+  else
+    tsan_build
+  fi
+  elapsed "tsan: build of the concurrency tests (GCC, TSan)${tsan_build_pid:+, at nice 19 beside the suite}" "$start" "" tsan-build
+  start=$SECONDS
   # Each executable runs whole and directly (ctest's label list cannot carry a second label through
   # gtest_discover_tests), all at once: they mostly wait on real time. Each log is printed when it ends.
   mkdir -p build-tsan/logs
@@ -153,16 +218,23 @@ if has_stage tsan; then
       >"build-tsan/logs/$t.log" 2>&1 &
     pids+=($!)
   done
-  failed=0
+  failed=0 t_passed=0 t_failed=0 t_skipped=0
   for i in "${!pids[@]}"; do
     code=0
     wait "${pids[$i]}" || code=$?
     echo "tsan: ${tsan_targets[$i]} (exit $code)"
-    cat "build-tsan/logs/${tsan_targets[$i]}.log"
+    log="build-tsan/logs/${tsan_targets[$i]}.log"
+    cat "$log"
     [ "$code" = 0 ] || failed=1
+    # GoogleTest's closing lines: "[  PASSED  ] N tests.", "[  FAILED  ] N tests, listed below:", "[  SKIPPED ] N ..."
+    n=$(sed -n 's/^\[  PASSED  \] \([0-9]*\) test.*/\1/p' "$log" | tail -n1); t_passed=$((t_passed + ${n:-0}))
+    n=$(sed -n 's/^\[  FAILED  \] \([0-9]*\) test.*/\1/p' "$log" | tail -n1); t_failed=$((t_failed + ${n:-0}))
+    n=$(sed -n 's/^\[  SKIPPED \] \([0-9]*\) test.*/\1/p' "$log" | tail -n1); t_skipped=$((t_skipped + ${n:-0}))
+    [ "$code" = 0 ] || [ -n "$(sed -n 's/^\[  FAILED  \] \([0-9]*\) test.*/\1/p' "$log")" ] || t_failed=$((t_failed + 1))
   done
+  echo "passed=$t_passed failed=$t_failed skipped=$t_skipped reruns=" >build-tsan/logs/summary.txt
+  elapsed "tsan: the concurrency tests, whole, at once" "$start" build-tsan/logs/summary.txt
   [ "$failed" = 0 ] || { echo "build-and-test: a ThreadSanitizer run failed" >&2; exit 1; }
-  elapsed "ThreadSanitizer build and tests" "$start"
 fi
 
 if has_stage cross; then
@@ -178,21 +250,25 @@ if has_stage cross; then
   # shellcheck disable=SC2086
   AIRSEG_INTEROP_MODULES="$(cd "$modules_dir" && pwd)/mavlink_interop/node_modules" \
     packaging/ci-cross.sh ${AIRSEG_CROSS:-amd64 armhf armel arm64}
-  elapsed "packages (amd64, and ARM with their tests under qemu-arm)" "$start"
+  elapsed "cross: the whole package stage (rows above)" "$start"
 fi
 
 if has_stage native; then
   start=$SECONDS
   # build/ as the README's first command made it is reused as it is: adding a compiler launcher (or any
   # other option) to a configured tree makes CMake rebuild every step.
+  ccache_stage_begin native-build
   if [ -f build/CMakeCache.txt ]; then
     cmake build >/dev/null
   else
     cmake -S . -B build -G Ninja "${launcher[@]}"
   fi
   cmake --build build -j"$jobs"
-  run_ctest build
-  elapsed "native build and tests" "$start"
+  elapsed "native: build" "$start" "" native-build
+  start=$SECONDS
+  run_ctest build || suite=$?
+  elapsed "native: whole suite" "$start" build/ctest-summary.txt
+  [ "${suite:-0}" = 0 ] || exit 1
 fi
 
 echo "build-and-test: stages '$stages' passed in $((SECONDS - total)) s"

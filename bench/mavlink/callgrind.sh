@@ -10,8 +10,9 @@
 #   bench/mavlink/callgrind.sh [BUILD_DIR] [C_LIBRARY_DIR]
 #
 # BUILD_DIR defaults to build (bench_mavlink_callgrind must be built there). The C library is not part of the
-# tree: give its directory (the one with protocol.h and common/) as the second argument or in
-# MAVLINK_C_LIBRARY; without it its columns are skipped. Instruction counts are exact and repeatable.
+# tree: give its directory (the one with protocol.h; the messages in minimal/, standard/ and common/ as
+# published today, or all in common/ as in older checkouts) as the second argument or in MAVLINK_C_LIBRARY;
+# without it its columns are skipped. Instruction counts are exact and repeatable.
 set -eu
 
 build=${1:-build}
@@ -37,13 +38,35 @@ per() {  # instructions / units, two decimals
     awk -v a="$1" -v b="$2" 'BEGIN { printf "%.2f", a / b }'
 }
 
+# The message headers clib_parse.c decodes, each from the folder the library's layout puts it in: today's
+# c_library_v2 spreads them over minimal/ (HEARTBEAT), standard/ (GLOBAL_POSITION_INT) and common/; older
+# checkouts (and the single-folder dialects) have all of them in common/. Writes clib_messages.h into $work.
+clib_messages() {
+    local msg dir found
+    : >"$work/clib_messages.h"
+    for msg in attitude battery_status global_position_int gps_raw_int heartbeat mission_current \
+        nav_controller_output radio_status rc_channels servo_output_raw statustext sys_status system_time vfr_hud; do
+        found=
+        for dir in minimal standard common; do
+            if [ -f "$clib/$dir/mavlink_msg_$msg.h" ]; then
+                found=$dir
+                break
+            fi
+        done
+        [ -n "$found" ] || { echo "no mavlink_msg_$msg.h in $clib/minimal, standard or common" >&2; return 1; }
+        echo "#include \"$found/mavlink_msg_$msg.h\"" >>"$work/clib_messages.h"
+    done
+}
+
 have_clib=no
 if [ -n "$clib" ]; then
     if [ -f "$clib/protocol.h" ]; then
         "$bench" write-stream "$work/stream.bin"
         "$bench" write-crcs "$work/crcs.h"
-        ${CC:-cc} -O2 -g -w -include "$work/crcs.h" -I"$clib" "$here/clib_parse.c" -o "$work/clib_parse"
+        clib_messages
+        ${CC:-cc} -O2 -g -w -include "$work/crcs.h" -I"$clib" -I"$work" "$here/clib_parse.c" -o "$work/clib_parse"
         have_clib=yes
+        echo "C library: $clib ($(sed 's/^#include "\(.*\)\/mavlink_msg_.*/\1/' "$work/clib_messages.h" | sort | uniq -c | awk '{printf "%s%s in %s", (NR > 1 ? ", " : ""), $1, $2}'))"
     else
         echo "no protocol.h in $clib: C library columns skipped" >&2
     fi

@@ -1,7 +1,7 @@
 #include "tests/support/process.hpp"
+#include "tests/support/tree_paths.hpp"
 
 #include <fcntl.h>
-#include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
 #include <spawn.h>
@@ -60,10 +60,10 @@ void write_file(const std::string& path, const std::string& text) {
 }
 
 std::string binary(const std::string& relative) {
-    return std::string(AIRSEG_BINARY_DIR) + "/" + relative;
+    return binary_dir() + "/" + relative;
 }
 std::string source_path(const std::string& relative) {
-    return std::string(AIRSEG_SOURCE_DIR) + "/" + relative;
+    return source_dir() + "/" + relative;
 }
 
 Subprocess::Subprocess(std::vector<std::string> argv, std::map<std::string, std::string> env,
@@ -244,18 +244,6 @@ std::size_t NotifyListener::count(const std::string& needle, std::size_t from_in
         n += messages_[i].text.find(needle) != std::string::npos ? 1 : 0;
     }
     return n;
-}
-
-int free_udp_port() {
-    const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-    sockaddr_in addr{};
-    addr.sin_family = AF_INET;
-    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    ::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
-    socklen_t len = sizeof addr;
-    ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
-    ::close(fd);
-    return ntohs(addr.sin_port);
 }
 
 }  // namespace airseg::test

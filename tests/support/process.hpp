@@ -12,6 +12,9 @@
 #include <thread>
 #include <vector>
 
+#include "tests/support/ports.hpp"
+#include "tests/support/tree_paths.hpp"
+
 namespace airseg::test {
 
 using namespace std::chrono_literals;
@@ -44,8 +47,6 @@ void write_file(const std::string& path, const std::string& text);
 
 /// Path of a binary built in this tree, e.g. binary("daemon/airsegd").
 std::string binary(const std::string& relative);
-/// A loopback UDP port free at the moment of asking (the kernel picks it).
-int free_udp_port();
 std::string source_path(const std::string& relative);
 
 class Subprocess {

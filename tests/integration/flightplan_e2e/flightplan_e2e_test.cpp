@@ -151,7 +151,7 @@ class FlightplanE2e : public ::testing::TestWithParam<std::string> {
     /// add noise.
     void start_daemon(int window) {
         window_ = window;
-        const int udp_port = 20000 + static_cast<int>(::getpid() % 20000);
+        const int udp_port = free_udp_port();
         daemon_ = std::make_unique<Subprocess>(
             std::vector<std::string>{binary("daemon/airsegd"),
                                      "--config",

@@ -25,7 +25,7 @@ constexpr double kHomeLon = GroundChain::kHomeLon;
 class GroundHubE2e : public ::testing::Test {
   protected:
     /// `mavlink_udp`: where the hub sends the vehicle's MAVLink; off but for the test that plays the ground
-    /// station on 14550, so that no other hub's vehicle reaches it.
+    /// station (on a reserved port), so that no other hub's vehicle reaches it.
     void start_chain(const std::string& mavlink_udp = "off") {
         chain = std::make_unique<GroundChain>(
             dir.path(), std::vector<std::string>{"--map", "127.0.0.1:0", "--tcp", "127.0.0.1:0",
@@ -253,9 +253,11 @@ TEST_F(GroundHubE2e, TheMapShowsThePlanAndTheVehicleDrivingIt) {
 // on connect: heartbeats and position at 1 Hz or more, every parameter, the mission, a mode change (LOITER).
 // Meanwhile airseg's own telemetry keeps its rate on the same 57600-baud link.
 TEST_F(GroundHubE2e, AGroundStationGetsTheAutopilotsMavlinkThroughTheHub) {
-    // The hub's default: the vehicle's MAVLink to UDP 14550, where the ground station listens, as
-    // QGroundControl does; it answers to the port the frames came from.
-    start_chain("127.0.0.1:14550");
+    // As with the hub's default (UDP 14550, where QGroundControl listens), the vehicle's MAVLink goes to
+    // the port the ground station listens on, and it answers to the port the frames came from. A port of this
+    // test's own: 14550 may be taken by a demo or by another suite's run of this case on the machine.
+    const std::string gcs_port = std::to_string(free_udp_port());
+    start_chain("127.0.0.1:" + gcs_port);
     const auto node = run({"/bin/sh", "-c", "command -v node"});
     ASSERT_EQ(node.exit_code, 0) << "node is not installed: sudo apt-get install nodejs";
     // A paused plan: the autopilot's mission holds its window, and nothing drives while the mode changes.
@@ -264,7 +266,7 @@ TEST_F(GroundHubE2e, AGroundStationGetsTheAutopilotsMavlinkThroughTheHub) {
     Subprocess watcher(ctl_argv({"watch", "--duration", "40000"}, false), {}, dir.path());
     auto gcs = run(
         {node.out.substr(0, node.out.find('\n')), source_path("tests/integration/ground_hub/gcs_client.js"),
-         "listen:14550", binary("mavlink_interop/node_modules"), "5"},
+         "listen:" + gcs_port, binary("mavlink_interop/node_modules"), "5"},
         {}, 240s);
     const auto summary = Json::parse(gcs.out, nullptr, false);
     ASSERT_TRUE(summary.is_object()) << gcs.out << gcs.err << "\nhub:\n" << hub->err();

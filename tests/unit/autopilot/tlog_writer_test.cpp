@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "services/autopilot/ardupilot/driver.hpp"
+#include "tests/support/tree_paths.hpp"
 #include "tests/unit/autopilot/fake_rover.hpp"
 #include "tests/unit/autopilot/sim_harness.hpp"
 
@@ -98,7 +99,8 @@ TEST(TlogWriter, ARecordedSessionDecodesWithMavdump) {
         EXPECT_EQ(tlog.stats().dropped_frames, 0u);
     }
     ASSERT_GT(frames, 50u);
-    const std::string out = run(std::string(AIRSEG_MAVDUMP_EXE) + " --tlog " + config.path + " 2>/dev/null");
+    const std::string out = run(::airseg::test::binary_dir() + "/" AIRSEG_MAVDUMP_IN_BUILD " --tlog " +
+                                config.path + " 2>/dev/null");
     std::istringstream lines(out);
     std::size_t decoded = 0, heartbeats = 0, params = 0;
     for (std::string line; std::getline(lines, line);) {

@@ -8,6 +8,7 @@
 #include "daemon/config_loader.hpp"
 #include "daemon/config_schema.hpp"
 #include "daemon/duration.hpp"
+#include "tests/support/tree_paths.hpp"
 
 namespace airseg::daemon {
 namespace {
@@ -110,7 +111,7 @@ TEST(Config, SetOverridesAreValidatedLikeTheFile) {
 }
 
 TEST(Config, ShippedExampleIsValidAndDocumentsEveryKey) {
-    const std::string path = std::string(AIRSEG_SOURCE_DIR) + "/config/airseg.yaml";
+    const std::string path = ::airseg::test::source_dir() + "/config/airseg.yaml";
     auto r = load_config_file(path);
     ASSERT_TRUE(r.ok()) << r.errors[0].to_string();
     const YAML::Node root = YAML::LoadFile(path);

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "services/flightplan/plan_loader.hpp"
+#include "tests/support/tree_paths.hpp"
 #include "tests/unit/flightplan/plan_text.hpp"
 
 namespace airseg::flightplan {
@@ -14,7 +15,8 @@ using test::messages;
 
 TEST(FlightplanLoader, ExamplePlansLoad) {
     int loaded = 0;
-    for (const auto& entry : std::filesystem::directory_iterator(AIRSEG_SOURCE_DIR "/config/plans")) {
+    for (const auto& entry :
+         std::filesystem::directory_iterator(::airseg::test::source_dir() + "/config/plans")) {
         if (entry.path().extension() != ".yaml") {
             continue;
         }
@@ -26,7 +28,7 @@ TEST(FlightplanLoader, ExamplePlansLoad) {
 }
 
 TEST(FlightplanLoader, ExampleSurveyHasTheExpectedShape) {
-    const auto r = load_plan_file(AIRSEG_SOURCE_DIR "/config/plans/rover-survey.yaml");
+    const auto r = load_plan_file(::airseg::test::source_dir() + "/config/plans/rover-survey.yaml");
     ASSERT_TRUE(r.ok()) << to_string(r.errors);
     const Plan& p = *r.plan;
     EXPECT_EQ(p.name, "campus-survey");
@@ -249,7 +251,7 @@ namespace airseg::flightplan {
 namespace {
 
 TEST(FlightplanLoader, MutatedPlansNeverCrash) {
-    std::ifstream in(AIRSEG_SOURCE_DIR "/config/plans/rover-survey.yaml", std::ios::binary);
+    std::ifstream in(::airseg::test::source_dir() + "/config/plans/rover-survey.yaml", std::ios::binary);
     const std::string original((std::istreambuf_iterator<char>(in)), {});
     ASSERT_FALSE(original.empty());
     const std::string alphabet = "{}[]:,-&*#!|>'\"\n 0123456789.e-+~";

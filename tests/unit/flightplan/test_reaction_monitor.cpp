@@ -4,6 +4,7 @@
 
 #include "services/flightplan/plan_loader.hpp"
 #include "services/flightplan/reaction_monitor.hpp"
+#include "tests/support/tree_paths.hpp"
 
 namespace airseg::flightplan {
 namespace {
@@ -73,7 +74,7 @@ TEST(FlightplanReactions, LowBatteryFiresOnceWithHysteresis) {
 }
 
 TEST(FlightplanReactions, GeofenceFromALoadedPlan) {
-    const auto r = load_plan_file(AIRSEG_SOURCE_DIR "/config/plans/rover-survey.yaml");
+    const auto r = load_plan_file(::airseg::test::source_dir() + "/config/plans/rover-survey.yaml");
     ASSERT_TRUE(r.ok()) << to_string(r.errors);
     ReactionMonitor m(ReactionSettings::from_plan(*r.plan));
     const TimePoint t{};

@@ -7,6 +7,7 @@
 #include <numeric>
 #include <random>
 
+#include "tests/support/tree_paths.hpp"
 #include "tests/unit/flightplan/sim_autopilot.hpp"
 
 namespace airseg::flightplan {
@@ -629,7 +630,7 @@ namespace airseg::flightplan {
 namespace {
 
 TEST(FlightplanFeeder, ExampleSurveyPlanElementsStartAndFinishInOrder) {
-    const auto r = load_plan_file(AIRSEG_SOURCE_DIR "/config/plans/rover-survey.yaml");
+    const auto r = load_plan_file(::airseg::test::source_dir() + "/config/plans/rover-survey.yaml");
     ASSERT_TRUE(r.ok()) << to_string(r.errors);
     std::vector<Waypoint> expected;
     {

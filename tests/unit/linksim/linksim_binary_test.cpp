@@ -25,7 +25,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-const std::string kBinary = std::string(AIRSEG_BINARY_DIR) + "/tools/linksim/airseg-linksim";
+const std::string kBinary = ::airseg::test::binary_dir() + "/tools/linksim/airseg-linksim";
 
 using airseg::test::wait_until;
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/support/tree_paths.hpp"
 #include "tests/unit/mavlink/golden_frames.hpp"
 
 namespace {
@@ -30,8 +31,8 @@ class MavdumpCli : public ::testing::Test {
     }
     // Runs the tool with `args`, stdout and stderr to files; returns the exit status.
     int run(const std::string& args) const {
-        const std::string cmd =
-            std::string(AIRSEG_MAVDUMP_EXE) + " " + args + " >" + path("out") + " 2>" + path("err");
+        const std::string cmd = ::airseg::test::binary_dir() + "/" AIRSEG_MAVDUMP_IN_BUILD " " + args + " >" +
+                                path("out") + " 2>" + path("err");
         const int status = std::system(cmd.c_str());
         return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     }

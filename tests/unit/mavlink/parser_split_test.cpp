@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "services/autopilot/mavlink/parser.hpp"
+#include "tests/support/tree_paths.hpp"
 #include "tests/unit/mavlink/ardupilot_stream.hpp"
 
 namespace airseg::mavlink {
@@ -91,7 +92,8 @@ TEST(MavlinkParserSplit, CleanArdupilotStreamGivesTheSameFramesHoweverRead) {
 }
 
 TEST(MavlinkParserSplit, FuzzSeedsGiveTheSameFramesAndCountersHoweverRead) {
-    const std::filesystem::path dir = std::filesystem::path(AIRSEG_SOURCE_DIR) / "tests/fuzz/corpus/mavlink";
+    const std::filesystem::path dir =
+        std::filesystem::path(::airseg::test::source_dir()) / "tests/fuzz/corpus/mavlink";
     std::size_t seeds = 0;
     for (const auto& entry : std::filesystem::directory_iterator(dir)) {
         if (entry.path().extension() != ".bin") {

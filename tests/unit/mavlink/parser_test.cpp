@@ -12,6 +12,7 @@
 #include "services/autopilot/mavlink/encoder.hpp"
 #include "services/autopilot/mavlink/messages.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
+#include "tests/support/tree_paths.hpp"
 #include "tests/unit/mavlink/golden_frames.hpp"
 
 namespace airseg::mavlink {
@@ -184,7 +185,7 @@ TEST(MavlinkParser, VerifiedFrameInsideAnUnknownFrameWinsWholeAndInPieces) {
 // The input the fuzz target found (tests/fuzz/corpus/mavlink/), replayed here with its chunk size and others.
 TEST(MavlinkParser, FuzzFoundStreamCountsTheSameWholeAndInPieces) {
     std::ifstream in(
-        std::string(AIRSEG_SOURCE_DIR) + "/tests/fuzz/corpus/mavlink/counters_resync_inside_open_damage.bin",
+        ::airseg::test::source_dir() + "/tests/fuzz/corpus/mavlink/counters_resync_inside_open_damage.bin",
         std::ios::binary);
     const Bytes stream{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
     ASSERT_EQ(stream.size(), 585u);

@@ -1,0 +1,87 @@
+# Shared by tools/build-and-test.sh and the packaging scripts: the compiler cache's settings, its hit rate per
+# stage, and the table of stages that ends CI's log. Sourced, never run.
+# shellcheck shell=bash
+
+# airseg_ccache_env TOP: exports the compiler cache's settings for builds of the tree at TOP, so that they
+# reach every compile, the package builds' included (debhelper gives a package build a HOME of its own, where
+# ccache would start empty and without the user's configuration):
+#   CCACHE_DIR      the cache this user's ccache uses anyway (`ccache -k cache_dir`: ~/.cache/ccache unless
+#                   configured), so a developer's builds and a CI run on the same machine share it;
+#   CCACHE_BASEDIR  TOP: paths under it are rewritten relative to the compile's directory, so a clone of the
+#                   tree in another directory hits what this one stored (with -ffile-prefix-map, which the CI
+#                   builds use, AIRSEG_RELATIVE_PATHS and Debian's default flags, the objects are identical);
+#   CCACHE_MAXSIZE  at least 10 GB: one CI run stores about 1.5 GB (5 build configurations), and developers'
+#                   builds share the cache.
+airseg_ccache_env() {
+  command -v ccache >/dev/null || return 0
+  local size
+  CCACHE_DIR=${CCACHE_DIR:-$(ccache -k cache_dir)}
+  export CCACHE_DIR
+  export CCACHE_BASEDIR=$1
+  size=$(ccache -k max_size)
+  case "$size" in
+    *G) [ "${size%%[.G]*}" -ge 10 ] || export CCACHE_MAXSIZE=10G ;;
+    *) export CCACHE_MAXSIZE=10G ;;
+  esac
+}
+
+# ccache_stage_begin NAME: this stage's compiles are counted apart (CCACHE_STATSLOG, one line per result), so
+# other users of the cache (developers building meanwhile) do not blur its hit rate.
+ccache_stage_begin() {
+  command -v ccache >/dev/null || return 0
+  mkdir -p "$AIRSEG_CI_LOGS"
+  export CCACHE_STATSLOG="$AIRSEG_CI_LOGS/ccache-$1.log"
+  : >"$CCACHE_STATSLOG"
+}
+
+# ccache_stage_rate NAME: "H/N (P %)" for the stage's compiles: hits over cacheable compiles; "-" for none.
+ccache_stage_rate() {
+  local log="$AIRSEG_CI_LOGS/ccache-$1.log" hits misses
+  [ -f "$log" ] || { echo "-"; return; }
+  hits=$(grep -cE '^(direct|preprocessed)_cache_hit$' "$log" || true)
+  misses=$(grep -cx 'cache_miss' "$log" || true)
+  if [ $((hits + misses)) = 0 ]; then
+    echo "-"
+  else
+    echo "$hits/$((hits + misses)) ($((100 * hits / (hits + misses))) %)"
+  fi
+}
+
+# record_stage NAME WALL_SECONDS [SUMMARY_FILE] [CCACHE_STAGE]: one row of the closing table. SUMMARY_FILE is
+# a ctest-summary.txt from tools/run-ctest.sh ("passed=N failed=N skipped=N reruns=A,B").
+record_stage() {
+  local name=$1 wall=$2 summary=${3:-} cstage=${4:-} passed=- failed=- skipped=- reruns=- rate=-
+  if [ -n "$summary" ] && [ -f "$summary" ]; then
+    passed=$(sed -n 's/.*passed=\([0-9?]*\).*/\1/p' "$summary")
+    failed=$(sed -n 's/.*failed=\([0-9?]*\).*/\1/p' "$summary")
+    skipped=$(sed -n 's/.*skipped=\([0-9?]*\).*/\1/p' "$summary")
+    reruns=$(sed -n 's/.*reruns=\(.*\)$/\1/p' "$summary")
+    reruns=${reruns:-none}
+  elif [ -n "$summary" ]; then
+    failed="?"
+  fi
+  [ -z "$cstage" ] || rate=$(ccache_stage_rate "$cstage")
+  mkdir -p "$AIRSEG_CI_LOGS"
+  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "$wall" "$passed" "$failed" "$skipped" "$rate" "$reruns" \
+    >>"$AIRSEG_CI_LOGS/stages.tsv"
+}
+
+# print_stage_table TOTAL_SECONDS: the table of every recorded stage, then one plain line of test counts.
+print_stage_table() {
+  local table="$AIRSEG_CI_LOGS/stages.tsv" p=0 f=0 s=0
+  [ -f "$table" ] || return 0
+  echo
+  echo "== CI stages (wall seconds; tests passed / failed / skipped; compiles served by ccache; reruns)"
+  {
+    printf 'stage\twall s\tpassed\tfailed\tskipped\tccache hits\treruns\n'
+    cat "$table"
+    printf 'total\t%s\t\t\t\t\t\n' "$1"
+  } | awk -F'\t' '{ printf "%-44s %7s %7s %7s %8s  %-18s %s\n", $1, $2, $3, $4, $5, $6, $7 }'
+  while IFS=$'\t' read -r _ _ passed failed skipped _ _; do
+    [[ "$passed" =~ ^[0-9]+$ ]] && p=$((p + passed))
+    [[ "$failed" =~ ^[0-9]+$ ]] && f=$((f + failed))
+    [[ "$failed" == "?" ]] && f=$((f + 1))
+    [[ "$skipped" =~ ^[0-9]+$ ]] && s=$((s + skipped))
+  done <"$table"
+  echo "tests: $p passed, $f failed, $s skipped"
+}

@@ -1,0 +1,100 @@
+#!/usr/bin/env bash
+# run-ctest.sh BUILD_DIR [CTEST_ARGS...]
+#
+# Runs a build's ctest suite the way CI does (tools/build-and-test.sh, and debian/rules inside the package
+# builds), and says in one line what happened:
+#   - Every case runs once. A case that fails is a failure, unless tests/ci-rerun.txt names it (with its cause,
+#     recorded in docs/reliability.md): such a case runs again, at most twice, and every failure before its pass
+#     is printed as "ctest: RERUN NAME: failed, passed at attempt K". No flight-plan, autopilot or system-suite
+#     case is ever rerun, whatever the file says.
+#   - With AIRSEG_TEST_LOCK set, it waits for that lock first and runs at nice 0 (CI's side-by-side ARM
+#     builds: one suite at a time, or AIRSEG_SUITES_AT_ONCE, never behind a compile).
+#   - BUILD_DIR/ctest-summary.txt gets "passed=N failed=N skipped=N reruns=NAME,NAME", read by the table at
+#     the end of CI's log.
+# CTEST_ARGS go to every ctest run (e.g. -j8 --timeout 600 --exclude-regex ...). Exit status: 0 when every case
+# passed (a rerun one included), 1 otherwise.
+set -euo pipefail
+top=$(cd "$(dirname "$0")/.." && pwd)
+dir=$(cd "${1:?usage: run-ctest.sh BUILD_DIR [CTEST_ARGS...]}" && pwd)
+shift
+
+# AIRSEG_TEST_LOCK (CI's ARM package builds, which compile side by side): one suite at a time, and at nice 0
+# whatever the build around it was started at, so that no compile ever comes before a suite's cases.
+# AIRSEG_SUITES_AT_ONCE (default 1) suites may hold one of its slots at a time.
+if [ -n "${AIRSEG_TEST_LOCK:-}" ]; then
+  echo "ctest: waiting for one of ${AIRSEG_SUITES_AT_ONCE:-1} slot(s) of $AIRSEG_TEST_LOCK"
+  while :; do
+    for ((slot = 0; slot < ${AIRSEG_SUITES_AT_ONCE:-1}; slot++)); do
+      exec 9>>"$AIRSEG_TEST_LOCK.$slot"
+      flock -n 9 && break 2
+      exec 9>&-
+    done
+    sleep 2
+  done
+  renice -n 0 -p $$ >/dev/null 2>&1 || echo "ctest: cannot run at nice 0 (not root): staying at nice $(nice)"
+fi
+
+# junit_field FILE ATTRIBUTE: an attribute of the <testsuite> element.
+junit_field() { sed -n "s/^[[:space:]]*$2=\"\([0-9]*\)\".*/\1/p" "$1" | head -n1; }
+# junit_failed FILE: the names of the cases that failed, one per line.
+junit_failed() { sed -n 's/^[[:space:]]*<testcase name="\([^"]*\)".* status="fail".*/\1/p' "$1"; }
+regex_quote() { sed 's/[][\.*^$+?(){}|]/\\&/g'; }
+
+first="$dir/ctest-attempt-1.xml"
+rm -f "$dir"/ctest-attempt-*.xml "$dir/ctest-summary.txt"
+code=0
+# A suite that finds no test at all is a failure, not a pass.
+ctest --test-dir "$dir" --output-on-failure --no-tests=error --output-junit "$first" "$@" || code=$?
+if [ ! -f "$first" ]; then
+  echo "ctest: no result file (ctest exit $code)" >&2
+  echo "passed=0 failed=? skipped=0 reruns=" >"$dir/ctest-summary.txt"
+  exit 1
+fi
+total=$(junit_field "$first" tests)
+skipped=$(($(junit_field "$first" skipped) + $(junit_field "$first" disabled)))
+mapfile -t failed < <(junit_failed "$first")
+
+# Cases tests/ci-rerun.txt allows a rerun ("REGEX: cause" per line), never one of the three suites whose
+# failures must show at their first run.
+allowed=$(sed -n 's/^\([^#][^:]*\):.*/\1/p' "$top/tests/ci-rerun.txt" 2>/dev/null | paste -sd'|' -)
+never='Flightplan|Autopilot|GcsEndpoint|System'
+rerun=() final_failed=()
+for name in "${failed[@]}"; do
+  if [ -n "$allowed" ] && [[ "$name" =~ $allowed ]] && ! [[ "$name" =~ $never ]]; then
+    rerun+=("$name")
+  else
+    final_failed+=("$name")
+  fi
+done
+
+reruns=()
+attempt=1
+while [ ${#rerun[@]} -gt 0 ] && [ $attempt -lt 3 ]; do
+  attempt=$((attempt + 1))
+  pattern="^($(printf '%s\n' "${rerun[@]}" | regex_quote | paste -sd'|' -))\$"
+  echo "ctest: attempt $attempt of ${#rerun[@]} case(s) tests/ci-rerun.txt allows to rerun: ${rerun[*]}"
+  ctest --test-dir "$dir" --output-on-failure --output-junit "$dir/ctest-attempt-$attempt.xml" "$@" \
+    -R "$pattern" || true
+  mapfile -t still < <(junit_failed "$dir/ctest-attempt-$attempt.xml")
+  for name in "${rerun[@]}"; do
+    if ! printf '%s\n' "${still[@]}" | grep -qxF -- "$name"; then
+      echo "ctest: RERUN $name: failed, passed at attempt $attempt"
+      reruns+=("$name")
+    fi
+  done
+  rerun=("${still[@]}")
+done
+final_failed+=("${rerun[@]}")
+# ctest failed without a failing case: no test found, or a case that could not run.
+[ "$code" = 0 ] || [ ${#failed[@]} -gt 0 ] || final_failed+=("(ctest exit $code: no test found, or a case not run)")
+
+n_failed=${#final_failed[@]}
+passed=$((total - skipped - n_failed))
+[ "$passed" -ge 0 ] || passed=0
+echo "passed=$passed failed=$n_failed skipped=$skipped reruns=$(IFS=,; echo "${reruns[*]}")" >"$dir/ctest-summary.txt"
+echo "ctest: $passed passed, $n_failed failed, $skipped skipped"
+[ ${#reruns[@]} = 0 ] || echo "ctest: ${#reruns[@]} of them passed only on a rerun: ${reruns[*]}"
+for name in "${final_failed[@]}"; do
+  echo "ctest: FAILED $name"
+done
+[ "$n_failed" = 0 ]
