@@ -505,7 +505,11 @@ TEST_P(FlightplanE2e, SkipPauseResumeAndAppendAreConfirmedByTheBoard) {
     rest.insert(rest.end(), extra.begin(), extra.end());
     for (std::size_t k = 0; k < rest.size(); ++k, ++i) {
         ASSERT_LT(i, reached.size());
-        ASSERT_PRED2(same_place, reached[i].at, rest[k]) << "after the skip, #" << k;
+        ASSERT_PRED2(same_place, reached[i].at, rest[k])
+            << "after the skip, #" << k << "\n"
+            << describe_reached_around(
+                   std::vector<Reached>(reached.begin() + static_cast<long>(i - k), reached.end()), rest, k)
+            << daemon_->err();
     }
 }
 
@@ -851,7 +855,8 @@ TEST_P(FlightplanStarvedE2e, AStarvedDaemonStopsTheVehicleAtTheFrontierAndNeverL
         ASSERT_EQ(load.exit_code, 0) << load.json.dump() << load.err;
         Starver starver(daemon_->pid(), seed);
         ASSERT_TRUE(wait_until(
-            [&] { return control_->json("reached 0 1").value("total", 0ull) >= first + expected.size(); }, 240s, kPoll))
+            [&] { return control_->json("reached 0 1").value("total", 0ull) >= first + expected.size(); },
+            240s, kPoll))
             << "seed " << seed << "\n"
             << show().dump() << daemon_->err();
         starver.stop();
@@ -860,7 +865,8 @@ TEST_P(FlightplanStarvedE2e, AStarvedDaemonStopsTheVehicleAtTheFrontierAndNeverL
         const auto all = reached_log(*control_, first);
         const auto reached = plan_waypoints_of(all);
         std::size_t same = 0;
-        while (same < reached.size() && same < expected.size() && same_place(reached[same].at, expected[same])) {
+        while (same < reached.size() && same < expected.size() &&
+               same_place(reached[same].at, expected[same])) {
             ++same;
         }
         ASSERT_EQ(reached.size(), expected.size())
