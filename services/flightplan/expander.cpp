@@ -288,6 +288,15 @@ bool Expander::seek(std::uint64_t index) {
     if (index < origin_.index) {
         return false;
     }
+    Expander before = *this;  // restored when the index is past the end
+    if (!seek_from_here(index)) {
+        *this = std::move(before);
+        return false;
+    }
+    return true;
+}
+
+bool Expander::seek_from_here(std::uint64_t index) {
     if (index < position_ || error_) {
         reset_to_origin();
     }

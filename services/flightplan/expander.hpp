@@ -53,6 +53,7 @@ class Expander final : public WaypointStream {
         const NodeExtra* box = nullptr;  // the container's children and repeat count, looked up once
     };
 
+    bool seek_from_here(std::uint64_t index);
     void reset_to_origin();
     void place_at(std::uint32_t node);
     /// Walks the element tree until a leaf with waypoints is active. False at the end of the plan.

@@ -40,6 +40,8 @@ const char* to_string(FeederEvent::Kind kind) {
             return "request-failed";
         case FeederEvent::Kind::WindowStarved:
             return "window-starved";
+        case FeederEvent::Kind::HeldAtFrontier:
+            return "held-at-frontier";
         case FeederEvent::Kind::Interrupted:
             return "interrupted";
         case FeederEvent::Kind::Continued:

@@ -10,6 +10,7 @@
 #include <variant>
 #include <vector>
 
+#include "base/time.hpp"
 #include "services/autopilot/autopilot.hpp"
 #include "services/flightplan/waypoint.hpp"
 
@@ -44,12 +45,14 @@ struct FeederEvent {
         HoldStarted,
         HoldEnded,
         PlanDone,
-        PlanBlocked,    // the stream stopped on an error (detail); the vehicle stops after the last good one
-        RequestFailed,  // a request exhausted its retry budget (detail); the vehicle is held
-        WindowStarved,  // the next target was not on the autopilot in time; the vehicle is held
-        Interrupted,    // the vehicle left AUTO without the feeder asking (detail: why and what follows)
-        Continued,      // back in AUTO after an interruption
-        PlanFailed,     // the autopilot refused the plan's items (detail: its answer); the vehicle is held
+        PlanBlocked,     // the stream stopped on an error (detail); the vehicle stops after the last good one
+        RequestFailed,   // a request exhausted its retry budget (detail); the vehicle is held
+        WindowStarved,   // the autopilot headed for a slot whose content was not confirmed; it is held
+        HeldAtFrontier,  // the vehicle stopped at the window's barrier: the next waypoint was not written in
+                         // time (once per stop); it goes on once the write lands
+        Interrupted,     // the vehicle left AUTO without the feeder asking (detail: why and what follows)
+        Continued,       // back in AUTO after an interruption
+        PlanFailed,      // the autopilot refused the plan's items (detail: its answer); the vehicle is held
     };
     Kind kind = Kind::WaypointReached;
     std::uint32_t generation = 0;  // which plan (replace_plan increments it)
@@ -77,7 +80,9 @@ struct FeederProgress {
     std::string failure{};       // why the plan failed, "" unless state is Failed
     std::uint64_t interruptions = 0;
     std::uint64_t starvation_holds = 0;
-    std::uint64_t retargets = 0;  // the vehicle reached its target while the next slot's write was in flight
+    bool held_at_frontier = false;      // plan.held_at_frontier: waiting at the barrier for a write now
+    std::uint64_t frontier_stops = 0;   // plan.frontier_stops: times the vehicle waited at the barrier
+    Duration frontier_wait{};           // plan.frontier_wait_s: time spent waiting there (ended waits)
     std::uint64_t ignored_reached = 0;  // duplicate or late reached reports
     std::uint64_t retries = 0;
     std::uint64_t failures = 0;

@@ -398,6 +398,10 @@ void PlanController::handle_event(const FeederEvent& e) {
             log(Level::Warn,
                 fmt::format("window starved at waypoint {}: holding until it is written", e.plan_index));
             break;
+        case FeederEvent::Kind::HeldAtFrontier:
+            log(Level::Warn,
+                fmt::format("waiting for waypoint {} to reach the autopilot: {}", e.plan_index, e.detail));
+            break;
         case FeederEvent::Kind::Interrupted:
             log(Level::Warn, fmt::format("plan interrupted at waypoint {}: {}", e.plan_index, e.detail));
             break;
@@ -756,6 +760,9 @@ Json PlanController::progress_json() const {
     j["reaction"] = last_reaction_.empty() ? Json(nullptr) : Json(last_reaction_);
     j["interruption"] = shown_interruption(p).empty() ? Json(nullptr) : Json(shown_interruption(p));
     j["error"] = problem_.empty() ? Json(nullptr) : Json(problem_);
+    j["held_at_frontier"] = p.held_at_frontier;
+    j["frontier_stops"] = p.frontier_stops;
+    j["frontier_wait_s"] = std::round(std::chrono::duration<double>(p.frontier_wait).count() * 10.0) / 10.0;
     return j;
 }
 
@@ -777,8 +784,9 @@ TimePoint PlanController::poll_timeout() const {
 }
 
 PlanController::StatusKey PlanController::status_key(const FeederProgress& p) const {
-    return {p.state,        p.plan_name,           p.element, p.waypoints_reached, p.next_waypoint, p.window,
-            last_reaction_, shown_interruption(p), problem_};
+    return {p.state,         p.plan_name,        p.element,          p.waypoints_reached,
+            p.next_waypoint, p.window,           last_reaction_,     shown_interruption(p),
+            problem_,        p.held_at_frontier, p.frontier_stops,   p.frontier_wait};
 }
 
 // The last interruption is news while its plan runs (and kept after the plan continued); a plan that has

@@ -49,7 +49,8 @@ class WaypointStream {
     virtual ~WaypointStream() = default;
     /// The next waypoint, or nothing at the end of the plan (or when the stream stopped on an error).
     virtual std::optional<Waypoint> next() = 0;
-    /// Restart the stream so that next() returns the waypoint with this index. False if it does not exist.
+    /// Restart the stream so that next() returns the waypoint with this index. False if it does not exist,
+    /// and then the stream is where it was (a skip past the end must not lose what comes next).
     virtual bool seek(std::uint64_t index) = 0;
     /// Continue the stream at the named element; indices keep counting. False if no such element.
     virtual bool jump_to(std::string_view element_name) = 0;

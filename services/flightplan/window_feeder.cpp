@@ -54,16 +54,25 @@ std::optional<std::string> FeederConfig::validate() const {
 }
 
 WindowFeeder::WindowFeeder(FeederConfig config)
-    : config_(config), confirmed_(config.window + 1u + kWrapSlots) {}
+    : config_(config),
+      confirmed_(config.window + 1u + kWrapSlots),
+      written_over_stop_(config.window + 1u + kWrapSlots, false) {}
 
 std::vector<MissionItem> WindowFeeder::slot_items(std::uint16_t slot, const MissionItem& item) const {
     if (slot != wrap_slot()) {
         return {item};
     }
+    // [item, JumpTo(2), place]: a board that runs the do-commands after a waypoint once it is reached
+    // (APM:Rover 2.42-2.45) runs them only when a place follows them; AP_Mission follows the jump when it
+    // gets to it and looks ahead through it, so the leg from W to slot 2 is planned as one corner, not a
+    // stop.
     MissionItem jump;
     jump.kind = MissionItem::Kind::JumpTo;
     jump.jump_slot = kFirstRingSlot;
-    return {item, item, jump, item};
+    MissionItem place = item;
+    place.kind = MissionItem::Kind::Waypoint;
+    place.hold_s.reset();
+    return {item, jump, place};
 }
 
 MissionItem WindowFeeder::Entry::item() const {
@@ -83,15 +92,49 @@ MissionItem WindowFeeder::Entry::item() const {
     return m;
 }
 
+MissionItem WindowFeeder::Entry::barrier() const {
+    MissionItem m = item();
+    m.kind = MissionItem::Kind::Stop;
+    return m;
+}
+
 bool WindowFeeder::confirmed(const Entry& e) const {
     return holds(e.slot, e.item());
 }
 
+bool WindowFeeder::holds_stop(std::uint16_t slot) const {
+    return mission_ok_ && slot < confirmed_.size() && confirmed_[slot] &&
+           confirmed_[slot]->kind == MissionItem::Kind::Stop;
+}
+
+WindowFeeder::Chain WindowFeeder::chain_from(std::size_t first) const {
+    Chain c{first, false};
+    for (; c.entries < queue_.size(); ++c.entries) {
+        const Entry& e = queue_[c.entries];
+        if (!confirmed(e)) {
+            // The head's own slot is the set-current's and the starvation guard's business.
+            c.broken = c.entries > 0 && !holds(e.slot, queue_[c.entries - 1].barrier());
+            return c;
+        }
+        if (e.stop) {
+            ++c.entries;
+            return c;
+        }
+    }
+    c.broken = !queue_.empty() && !holds(ring_next(queue_.back().slot), queue_.back().barrier());
+    return c;
+}
+
+std::size_t WindowFeeder::capacity() const {
+    const bool target_outside = need_set_current_ && !repoint_only_;
+    return config_.window - 1u - (target_outside ? 1u : 0u);
+}
+
 bool WindowFeeder::holds(std::uint16_t slot, const MissionItem& item) const {
-    if (!mission_ok_ || static_cast<std::size_t>(slot) + kWrapSlots > confirmed_.size()) {
+    const auto want = slot_items(slot, item);
+    if (!mission_ok_ || static_cast<std::size_t>(slot) + want.size() > confirmed_.size()) {
         return false;
     }
-    const auto want = slot_items(slot, item);
     for (std::size_t i = 0; i < want.size(); ++i) {
         if (confirmed_[slot + i] != want[i]) {
             return false;
@@ -138,7 +181,7 @@ void WindowFeeder::replace_plan(PlanFeed feed, TimePoint now) {
         refill(now);
         check_done();
     } else {
-        start_fresh(queue_.empty() ? kFirstRingSlot : ring_next(queue_[0].slot), now);
+        start_fresh(now);
     }
 }
 
@@ -172,11 +215,29 @@ void WindowFeeder::restart(TimePoint now) {
     hold_wp_.reset();
     stream_ended_ = false;
     done_ = false;
-    // The new head goes in a slot the vehicle is not heading for; a set-current then points it there.
-    start_fresh(queue_.empty() ? kFirstRingSlot : ring_next(queue_[0].slot), now);
+    start_fresh(now);
 }
 
-void WindowFeeder::start_fresh(std::uint16_t first_slot, TimePoint now) {
+// The new head goes where the vehicle cannot get by itself: after the slot following its target T, which
+// gets a barrier at T's point (a vehicle that reaches T before the set-current waits there). A vehicle
+// parked on a Stop at T goes nowhere by itself: the head follows T at once. A set-current then points the
+// vehicle at the head, and until then nothing it reports is the new window's doing.
+void WindowFeeder::start_fresh(TimePoint now) {
+    std::uint16_t t = 0;  // none known
+    if (ap_target_ && *ap_target_ < confirmed_.size()) {
+        t = ring_position(*ap_target_);
+    } else if (!queue_.empty()) {
+        t = queue_[0].slot;
+    }
+    std::uint16_t first_slot = kFirstRingSlot;
+    old_target_.reset();
+    if (t >= kFirstRingSlot && mission_ok_) {
+        first_slot = holds_stop(t) ? ring_next(t) : ring_next(ring_next(t));
+        if (!holds_stop(t)) {
+            old_target_ = t;
+        }
+    }
+    left_frontier(now);
     queue_.clear();
     fresh_slot_ = first_slot;
     need_set_current_ = true;
@@ -204,7 +265,10 @@ void WindowFeeder::continue_with(PlanFeed feed, TimePoint now) {
     }
     if (queue_.empty()) {
         // Parked on the Stop item: the continuation goes into the next slot, then set-current points there.
-        start_fresh(stop_slot ? ring_next(*stop_slot) : kFirstRingSlot, now);
+        if (stop_slot) {
+            ap_target_ = *stop_slot;
+        }
+        start_fresh(now);
         return;
     }
     refill(now);
@@ -249,7 +313,7 @@ void WindowFeeder::release_hold(TimePoint now) {
 // ---- window bookkeeping --------------------------------------------------------------------------------
 
 void WindowFeeder::refill(TimePoint now) {
-    while (stream_ && !stream_ended_ && queue_.size() < config_.window) {
+    while (stream_ && !stream_ended_ && queue_.size() < capacity()) {
         auto w = stream_->next();
         const std::uint16_t slot = queue_.empty() ? fresh_slot_ : ring_next(queue_.back().slot);
         if (!w) {
@@ -320,6 +384,15 @@ void WindowFeeder::complete_through(std::size_t position, TimePoint now) {
     refill(now);
     announce_head();
     check_starvation();
+    if (!frontier_since_ && !starving_ && !queue_.empty() && !queue_[0].stop && !confirmed(queue_[0]) &&
+        holds_stop(queue_[0].slot)) {
+        // The vehicle drives on from the waypoint just reached into the barrier: it stops at that point and
+        // waits for the next write.
+        at_frontier(now);
+    }
+    if (!queue_.empty() && queue_[0].stop) {
+        left_frontier(now);  // the plan's end: the vehicle waits for nothing
+    }
     check_done();
 }
 
@@ -392,30 +465,39 @@ void WindowFeeder::check_done() {
 }
 
 void WindowFeeder::check_starvation() {
-    if (!mission_ok_ || need_set_current_ || queue_.empty() || starving_) {
+    if (!mission_ok_ || need_set_current_ || queue_.empty() || starving_ || confirmed(queue_[0]) ||
+        holds_stop(queue_[0].slot)) {
         return;
     }
-    if (!confirmed(queue_[0])) {
-        const auto* in_flight =
-            outstanding_ ? std::get_if<autopilot::WriteMissionItems>(&outstanding_->request.op) : nullptr;
-        if (in_flight && mode_ == Mode::Auto && in_flight->first_slot <= queue_[0].slot &&
-            static_cast<std::size_t>(queue_[0].slot) < in_flight->first_slot + in_flight->items.size()) {
-            // The vehicle reached its target while the write of the slot after it was on its way (a plan
-            // replaced near the end of a leg): it heads for that slot's old content for one round trip. No
-            // HOLD for that: once the write lands, set-current retargets it (reached reports until then say
-            // nothing about the plan). Should the write fail, the vehicle is held (request_failed).
-            need_set_current_ = true;
-            repoint_only_ = false;
-            ++counters_.retargets;
-            return;
-        }
-        // The autopilot took its target from a slot not yet rewritten: what it reaches there is stale. Hold,
-        // write, then point it at the head again; reached reports until then say nothing about the plan.
-        starving_ = true;
-        need_set_current_ = true;
-        repoint_only_ = false;
-        ++counters_.starvation_holds;
-        emit(FeederEvent::Kind::WindowStarved, &queue_[0].wp, queue_[0].generation, queue_[0].element_path);
+    // The head's slot holds neither the head nor a barrier: what the autopilot takes from it is not the
+    // plan's (the ring's invariant keeps this from happening; a board that lost a write could). Hold, write,
+    // then point it at the head again; reached reports until then say nothing about the plan.
+    starving_ = true;
+    need_set_current_ = true;
+    repoint_only_ = false;
+    ++counters_.starvation_holds;
+    emit(FeederEvent::Kind::WindowStarved, &queue_[0].wp, queue_[0].generation, queue_[0].element_path);
+}
+
+void WindowFeeder::at_frontier(TimePoint now) {
+    if (frontier_since_) {
+        return;
+    }
+    frontier_since_ = now;
+    ++counters_.frontier_stops;
+    // Once the head is written the board is pointed at it again: a vehicle parked on a Stop does not leave it
+    // because its slot changed (ArduPilot restarts only a waypoint leg when its mission changes).
+    need_set_current_ = true;
+    repoint_only_ = true;
+    ap_target_ = queue_[0].slot;
+    emit(FeederEvent::Kind::HeldAtFrontier, &queue_[0].wp, queue_[0].generation, queue_[0].element_path,
+         "the next waypoint was not on the autopilot in time: the vehicle waits at the last one written");
+}
+
+void WindowFeeder::left_frontier(TimePoint now) {
+    if (frontier_since_) {
+        counters_.frontier_wait += now - *frontier_since_;
+        frontier_since_.reset();
     }
 }
 
@@ -423,10 +505,13 @@ void WindowFeeder::check_starvation() {
 
 void WindowFeeder::on_reached(std::uint16_t slot, TimePoint now) {
     slot = ring_position(slot);
-    if (need_set_current_ && !repoint_only_) {
-        ++counters_.ignored_reached;  // the autopilot's target is not (yet) the window's head
+    if (starving_ || queue_.empty()) {
+        ++counters_.ignored_reached;  // the autopilot's target was not the plan's
         return;
     }
+    // By the ring's invariant every slot the vehicle can reach from its target holds the entry the window
+    // put there or a barrier, so a report of an entry's confirmed slot is that entry reached, whether or not
+    // a set-current is still due (the vehicle may have driven on into the window by itself).
     const std::size_t limit = std::min<std::size_t>(queue_.size(), config_.lost_reached_tolerance + 1);
     for (std::size_t p = 0; p < limit; ++p) {
         const Entry& e = queue_[p];
@@ -434,11 +519,19 @@ void WindowFeeder::on_reached(std::uint16_t slot, TimePoint now) {
             break;
         }
         if (e.slot == slot && confirmed(e)) {
+            written_over_stop_[ring_next(slot)] = false;  // it moves on to what the slot holds now
+            left_frontier(now);
+            need_set_current_ = false;
+            repoint_only_ = false;
             ap_target_ = ring_next(slot);
             current_mismatches_ = 0;
             complete_through(p, now);
             return;
         }
+    }
+    if (slot == queue_[0].slot && !confirmed(queue_[0]) && holds_stop(slot)) {
+        at_frontier(now);  // arrived at the barrier
+        return;
     }
     ++counters_.ignored_reached;
 }
@@ -448,27 +541,64 @@ void WindowFeeder::on_current(std::uint16_t slot, TimePoint now) {
         return;
     }
     slot = ring_position(slot);
-    if (need_set_current_) {
+    if (slot >= confirmed_.size()) {
+        // Past the mission's end: a board whose Stop is a jump there ran it, which it does only once the
+        // waypoint before the Stop is reached. The first Stop on the vehicle's way ends the chain: every
+        // entry before it was reached, whatever became of their reports. Once known to wait there, the same
+        // report says nothing new (the chain has grown since).
+        const Chain c = chain_from(0);
+        const std::size_t waypoints = c.entries > 0 && queue_[c.entries - 1].stop ? c.entries - 1 : c.entries;
+        if (!c.broken && waypoints > 0 && !starving_ && !frontier_since_ &&
+            (!need_set_current_ || repoint_only_)) {
+            ap_target_.reset();
+            complete_through(waypoints - 1, now);
+        }
+        return;
+    }
+    if (slot < 1) {
+        return;
+    }
+    if (slot == queue_[0].slot && !confirmed(queue_[0]) && holds_stop(slot) && !starving_) {
         ap_target_ = slot;
+        at_frontier(now);
         return;
     }
     if (slot == queue_[0].slot) {
         ap_target_ = slot;
-        current_mismatches_ = 0;
+        if (!need_set_current_) {
+            current_mismatches_ = 0;
+        }
         return;
     }
     const std::size_t limit = std::min<std::size_t>(queue_.size(), config_.lost_reached_tolerance + 2);
-    for (std::size_t p = 1; p < limit; ++p) {
-        if (queue_[p - 1].stop) {
-            break;
+    if (!starving_) {
+        for (std::size_t p = 1; p < limit; ++p) {
+            if (queue_[p - 1].stop) {
+                break;
+            }
+            if (queue_[p].slot == slot && (confirmed(queue_[p]) || holds(slot, queue_[p - 1].barrier()))) {
+                // The autopilot moved past entries whose reached reports were lost (or are still on the way).
+                ap_target_ = slot;
+                current_mismatches_ = 0;
+                need_set_current_ = false;
+                repoint_only_ = false;
+                const bool retake = written_over_stop_[slot];
+                complete_through(p - 1, now);
+                if (retake && !frontier_since_) {
+                    // The slot held a barrier until lately, and nothing says whether the board got there
+                    // before or after the write: pointing it at the slot it reports takes what the slot
+                    // holds now (it drives nothing twice: it has not left the slot).
+                    written_over_stop_[slot] = false;
+                    need_set_current_ = true;
+                    repoint_only_ = true;
+                }
+                return;
+            }
         }
-        if (queue_[p].slot == slot && confirmed(queue_[p])) {
-            // The autopilot moved past entries whose reached reports were lost (or are still on the way).
-            ap_target_ = slot;
-            current_mismatches_ = 0;
-            complete_through(p - 1, now);
-            return;
-        }
+    }
+    if (need_set_current_) {
+        ap_target_ = slot;
+        return;
     }
     // Anything else twice in a row: point the autopilot back at the head.
     if (++current_mismatches_ >= 2) {
@@ -549,6 +679,16 @@ void WindowFeeder::on_mode(VehicleState state, autopilot::ModeChangeCause cause,
         interrupt("the RC pilot took the vehicle (MANUAL); plan resume continues", true);
         return;
     }
+    if (mode_ == Mode::Hold && old_target_ && need_set_current_ && !repoint_only_) {
+        // After a skip or a new plan, a board whose Stop ends its mission holds by itself at the barrier
+        // after its old target: the set-current and AUTO that follow take it to the new head.
+        return;
+    }
+    if (frontier_since_ && mode_ == Mode::Hold) {
+        // A board whose Stop ends its mission (APM:Rover 2.x) holds at the barrier by itself: the head's
+        // write, a set-current and AUTO take it on, as for a vehicle parked there in AUTO.
+        return;
+    }
     // The board's own HOLD: a failsafe, a mode switch, a DO_JUMP taken its own way, or the end of its
     // mission. Every slot still holds what it held. If the board's target is the head (or the one after it,
     // whose reached report may still be on its way) AUTO is all it needs: the board goes on from its own
@@ -568,7 +708,8 @@ void WindowFeeder::on_mode(VehicleState state, autopilot::ModeChangeCause cause,
         false);
 }
 
-void WindowFeeder::on_autopilot_rebooted(TimePoint) {
+void WindowFeeder::on_autopilot_rebooted(TimePoint now) {
+    left_frontier(now);
     mission_ok_ = false;
     std::fill(confirmed_.begin(), confirmed_.end(), std::nullopt);
     ap_target_.reset();
@@ -592,7 +733,7 @@ void WindowFeeder::on_request_result(std::uint32_t id, autopilot::RequestResult 
     const Answer a = answer(result);
     if (a == Answer::Done) {
         consecutive_failures_ = 0;
-        request_succeeded(request);
+        request_succeeded(request, now);
         return;
     }
     const bool writes_items = std::holds_alternative<autopilot::UploadMission>(request.op) ||
@@ -618,13 +759,6 @@ void WindowFeeder::on_request_result(std::uint32_t id, autopilot::RequestResult 
 }
 
 void WindowFeeder::request_failed(TimePoint now) {
-    if (need_set_current_ && !starving_ && mode_ == Mode::Auto && !queue_.empty() && !confirmed(queue_[0]) &&
-        ap_target_ == queue_[0].slot) {
-        // A retarget waited for this write: the vehicle drives to stale content until it lands. Hold now.
-        starving_ = true;
-        ++counters_.starvation_holds;
-        emit(FeederEvent::Kind::WindowStarved, &queue_[0].wp, queue_[0].generation, queue_[0].element_path);
-    }
     // The reconciliation in poll_request() regenerates the same request: retrying needs no copy of it.
     if (++consecutive_failures_ <= config_.retries) {
         ++counters_.retries;
@@ -639,9 +773,10 @@ void WindowFeeder::request_failed(TimePoint now) {
          "autopilot request failed after retries");
 }
 
-void WindowFeeder::request_succeeded(const FeederRequest& request) {
+void WindowFeeder::request_succeeded(const FeederRequest& request, TimePoint now) {
     if (const auto* up = std::get_if<autopilot::UploadMission>(&request.op)) {
         std::fill(confirmed_.begin(), confirmed_.end(), std::nullopt);
+        std::fill(written_over_stop_.begin(), written_over_stop_.end(), false);
         for (std::size_t i = 0; i < up->items.size() && i + 1 < confirmed_.size(); ++i) {
             confirmed_[i + 1] = up->items[i];
         }
@@ -661,6 +796,9 @@ void WindowFeeder::request_succeeded(const FeederRequest& request) {
         if (!queue_.empty() && queue_[0].slot == sc->slot) {
             need_set_current_ = false;
             repoint_only_ = false;
+            old_target_.reset();
+            left_frontier(now);  // pointed at what it waited for (a board held there: AUTO follows)
+            refill(now);         // the vehicle is on the window: the slot it left is the window's again
         }
         current_mismatches_ = 0;
     } else if (const auto* change = std::get_if<autopilot::RequestStateChange>(&request.op)) {
@@ -701,8 +839,12 @@ std::optional<WindowFeeder::Mode> WindowFeeder::desired_mode() const {
 }
 
 bool WindowFeeder::ready_for_auto() const {
-    return mission_ok_ && !need_set_current_ && !queue_.empty() && confirmed(queue_[0]) &&
-           (queue_.size() < 2 || confirmed(queue_[1]));
+    if (!mission_ok_ || need_set_current_ || queue_.empty() || !confirmed(queue_[0])) {
+        return false;
+    }
+    // The head and what follows it on board: the next entry, or the barrier when the head is the last one.
+    const Chain c = chain_from(0);
+    return !c.broken && c.entries >= std::min<std::size_t>(2, queue_.size());
 }
 
 FeederRequest WindowFeeder::issue(decltype(FeederRequest::op) op, TimePoint now) {
@@ -711,30 +853,58 @@ FeederRequest WindowFeeder::issue(decltype(FeederRequest::op) op, TimePoint now)
     return r;
 }
 
-std::optional<FeederRequest> WindowFeeder::next_write(std::size_t from, std::size_t to, TimePoint now) {
-    to = std::min(to, queue_.size());
-    auto writable = [&](std::size_t i) {
-        // Never rewrite the item the vehicle is driving to, unless it is the head (then it is wrong anyway)
-        // or the vehicle is held and a set-current is due (it makes the autopilot take its target afresh).
-        const bool held_for_set_current = mode_ == Mode::Hold && need_set_current_;
-        return !confirmed(queue_[i]) && (i == 0 || held_for_set_current || ap_target_ != queue_[i].slot);
-    };
-    for (std::size_t i = from; i < to; ++i) {
-        if (!writable(i)) {
-            continue;
-        }
-        autopilot::WriteMissionItems w;
-        w.first_slot = queue_[i].slot;
-        w.items = slot_items(queue_[i].slot, queue_[i].item());
-        for (std::size_t j = i + 1;
-             j < queue_.size() && queue_[j].slot == queue_[j - 1].slot + 1 && writable(j); ++j) {
-            for (const auto& m : slot_items(queue_[j].slot, queue_[j].item())) {
-                w.items.push_back(m);
-            }
-        }
-        return issue(std::move(w), now);
+std::optional<FeederRequest> WindowFeeder::write(std::uint16_t slot, const MissionItem& item, TimePoint now) {
+    // Never rewrite the slot the vehicle is driving to, but for the head (wrong anyway, or the barrier it
+    // waits at) or while it is held for a set-current (which makes the autopilot take its target afresh).
+    const bool held_for_set_current = mode_ == Mode::Hold && need_set_current_;
+    if (ap_target_ == slot && slot != queue_[0].slot && !held_for_set_current) {
+        return std::nullopt;
     }
-    return std::nullopt;
+    autopilot::WriteMissionItems w;
+    w.first_slot = slot;
+    w.items = slot_items(slot, item);
+    return issue(std::move(w), now);
+}
+
+// One write at a time, each keeping the invariant: a slot the vehicle can reach gets an entry only once the
+// slot after it holds that entry's barrier, and a reachable slot holding anything else gets a barrier first.
+// A write is one transfer, so a daemon stopped in the middle of one leaves no half-sealed ring behind.
+std::optional<FeederRequest> WindowFeeder::next_write(TimePoint now) {
+    if (old_target_ && need_set_current_ && !repoint_only_ && confirmed_[*old_target_] &&
+        confirmed_[*old_target_]->kind != MissionItem::Kind::Stop) {
+        // Until the set-current, the vehicle may still reach its old target T: the slot after T stops it
+        // there.
+        MissionItem stop = *confirmed_[*old_target_];
+        stop.kind = MissionItem::Kind::Stop;
+        stop.hold_s.reset();
+        const std::uint16_t after = ring_next(*old_target_);
+        if (!holds(after, stop)) {
+            return write(after, stop, now);
+        }
+    }
+    const Chain c = chain_from(0);
+    if (c.broken) {
+        const Entry& good = queue_[c.entries - 1];
+        return write(ring_next(good.slot), good.barrier(), now);
+    }
+    if (c.entries >= queue_.size()) {
+        return std::nullopt;
+    }
+    const Entry& e = queue_[c.entries];
+    if (!e.stop) {
+        const std::uint16_t after = ring_next(e.slot);
+        const bool sealed =
+            holds(after, e.barrier()) || (c.entries + 1 < queue_.size() && confirmed(queue_[c.entries + 1]) &&
+                                          !chain_from(c.entries + 1).broken);
+        if (!sealed) {
+            return write(after, e.barrier(), now);
+        }
+    }
+    auto w = write(e.slot, e.item(), now);
+    if (w && c.entries > 0 && holds_stop(e.slot)) {
+        written_over_stop_[e.slot] = true;
+    }
+    return w;
 }
 
 std::optional<FeederRequest> WindowFeeder::poll_request(TimePoint now) {
@@ -751,82 +921,46 @@ std::optional<FeederRequest> WindowFeeder::poll_request(TimePoint now) {
         return std::nullopt;
     }
     if (!mission_ok_) {
-        // Slots the window does not use (slot 1 among them) get a Stop at the last position: harmless if
-        // ever reached.
-        MissionItem filler = queue_.back().item();
-        filler.kind = MissionItem::Kind::Stop;
+        // Every ring position not holding an entry gets the last entry's barrier, the slot after it included.
+        // Slot 1 is where a board that restarts its mission on entering AUTO begins before the driver points
+        // it on: a place (a 2.x board ends its mission at once on a Stop there).
+        const MissionItem filler = queue_.back().barrier();
         std::vector<MissionItem> at(wrap_slot() + 1u, filler);  // by ring position; [0] unused
         for (const auto& e : queue_) {
             at[e.slot] = e.item();
         }
         autopilot::UploadMission up;
-        for (std::uint16_t s = 1; s <= wrap_slot(); ++s) {
+        MissionItem start = filler;
+        start.kind = MissionItem::Kind::Waypoint;
+        up.items.push_back(start);
+        for (std::uint16_t s = kFirstRingSlot; s <= wrap_slot(); ++s) {
             for (const auto& m : slot_items(s, at[s])) {
                 up.items.push_back(m);
             }
         }
         return issue(std::move(up), now);
     }
-    if (auto w = next_write(0, 2, now)) {
-        return w;
+    if (need_set_current_ && queue_[0].stop) {
+        need_set_current_ = false;  // the plan is at its end: nothing to point the vehicle at
+        repoint_only_ = false;
     }
-    if (need_set_current_ && confirmed(queue_[0]) && (queue_.size() < 2 || confirmed(queue_[1]))) {
-        return issue(autopilot::SetMissionCurrent{queue_[0].slot}, now);
+    if (need_set_current_ && confirmed(queue_[0])) {
+        const Chain c = chain_from(0);
+        if (!c.broken && c.entries >= std::min<std::size_t>(2, queue_.size())) {
+            return issue(autopilot::SetMissionCurrent{queue_[0].slot}, now);
+        }
     }
-    if (auto w = next_write(2, queue_.size(), now)) {
+    if (auto w = next_write(now)) {
         return w;
     }
     if (ready_for_auto()) {
         starving_ = false;
-        if (fault_ &&
-            std::all_of(queue_.begin(), queue_.end(), [&](const Entry& e) { return confirmed(e); })) {
+        if (fault_ && !chain_from(0).broken && chain_from(0).entries == queue_.size()) {
             fault_ = false;
         }
     }
     if (desired_mode() == Mode::Auto && mode_ != Mode::Auto && ready_for_auto()) {
         return issue(autopilot::RequestStateChange{VehicleState::WaypointNavigation}, now);
-    }
-    return next_stop_filler(now);
-}
-
-// Once the plan has ended, the ring slots after the Stop item still hold waypoints already driven. A board
-// that stores the Stop as a plain waypoint drives on to the next slot by itself until the HOLD it is sent
-// on arrival takes effect; with the Stop copied into the free slots, driving on keeps it where it is.
-// The slots the vehicle left last are copied into only once it holds: a reached report for one of them may
-// still be on its way (the feeder also moves on by MISSION_CURRENT), and found naming a Stop it would hold
-// the vehicle there, short of the end.
-std::optional<FeederRequest> WindowFeeder::next_stop_filler(TimePoint now) {
-    if (!stream_ended_ || queue_.empty() || !queue_.back().stop || need_set_current_) {
-        return std::nullopt;
-    }
-    if (!std::all_of(queue_.begin(), queue_.end(), [&](const Entry& e) { return confirmed(e); })) {
-        return std::nullopt;
-    }
-    const MissionItem stop = queue_.back().item();
-    const int ring = wrap_slot() - kFirstRingSlot + 1;
-    const int settled =
-        done_ && mode_ == Mode::Hold ? 0 : static_cast<int>(config_.lost_reached_tolerance) + 2;
-    auto free_slot = [&](std::uint16_t slot) {
-        const int behind_head = (queue_[0].slot - slot + ring) % ring;
-        return std::none_of(queue_.begin(), queue_.end(), [&](const Entry& e) { return e.slot == slot; }) &&
-               ap_target_ != slot && behind_head > settled;
-    };
-    // From the slot after the Stop round the ring: the slot the board reaches first is written first.
-    std::uint16_t slot = ring_next(queue_.back().slot);
-    for (std::uint16_t n = 0; n < wrap_slot(); ++n, slot = ring_next(slot)) {
-        if (!free_slot(slot) || holds(slot, stop)) {
-            continue;
-        }
-        autopilot::WriteMissionItems w;
-        w.first_slot = slot;
-        w.items = slot_items(slot, stop);
-        for (std::uint16_t next = slot + 1; next <= wrap_slot() && free_slot(next) && !holds(next, stop);
-             ++next) {
-            for (const auto& m : slot_items(next, stop)) {
-                w.items.push_back(m);
-            }
-        }
-        return issue(std::move(w), now);
     }
     return std::nullopt;
 }
@@ -871,7 +1005,12 @@ FeederProgress WindowFeeder::progress() const {
     } else {
         p.state = interrupted_ ? PlanState::Interrupted : PlanState::Running;
     }
-    p.interruption = last_interruption_;
+    // The last interruption stays in view while the plan goes on; a finished plan has none left.
+    p.interruption = done_ ? std::string{} : last_interruption_;
+    p.held_at_frontier = frontier_since_.has_value();
+    if (p.held_at_frontier) {
+        p.interruption = "waiting at the last waypoint written to the autopilot for the next one";
+    }
     const Entry* first_of_plan = nullptr;
     for (const auto& e : queue_) {
         if (e.stop) {

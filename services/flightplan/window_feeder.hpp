@@ -3,16 +3,20 @@
 // of its mission while the plan has more (the circular waypoint queue of APM:Rover navigation, made
 // robust). Sans-IO: no autopilot protocol, no clock, no thread.
 //
-// Mission layout (see docs/flight-plan.md): slot 0 home (the driver's), slot 1 unused (a Stop), then a ring
-// of K positions: slots 2..K, and the wrap W = slots K+1..K+4, written together as [wp, wp, JumpTo(2), wp].
-// After slot K the vehicle drives to W's waypoint as slot K+1; K+2, at the same point, is passed at once and
-// the jump takes it on to slot 2. The layout works with both ways ArduPilot has run a DO_JUMP: when the
-// mission gets to it (AP_Mission), and as soon as the waypoint before it becomes the target (APM:Rover 2.x,
-// where the do-commands after a waypoint also need a waypoint after them to run at all). Reports of slots
-// K+2..K+4 count as K+1. The current target is the window's head; the ring holds the next K entries in ring
-// order. When the vehicle reaches slot s, slot s is rewritten with the entry K ahead, so the
-// successor of the current target, in mission order, is always the next plan waypoint. When the plan ends,
-// the slot after the last waypoint holds a Stop item at the last position, so the vehicle stays there.
+// Mission layout (see docs/flight-plan.md): slot 0 home (the driver's), slot 1 where a board that restarts
+// its mission on entering AUTO begins (a waypoint the driver points it on from at once), then a ring of K
+// positions: slots 2..K, and the wrap W = slots K+1..K+3, written together as [wp, JumpTo(2), wp]. From
+// W's waypoint the jump takes the vehicle on to slot 2 (both ways ArduPilot has run a DO_JUMP find the
+// waypoint after it); K+3 is never driven. Reports of slots K+2..K+3 count as W.
+//
+// The safety invariant: every slot the autopilot can reach without another write from here holds either
+// the plan's entry for that position or a Stop at the point of the entry before it (the barrier). The
+// window holds up to K-1 entries from the head in ring order, and the slot after the last holds its
+// barrier; a slot is written with an entry only once the slot after it holds that entry's barrier, so a
+// vehicle whose feeder fell behind stops at the frontier and waits (HeldAtFrontier) instead of driving a
+// slot left from an earlier round. The writes after a reached waypoint land three or more waypoints ahead
+// of the vehicle's target, outside the look-ahead of ArduPilot's mission change detector (the current
+// navigation command and the next two), so they never restart the leg being driven.
 //
 // Contract (the driver, on the service's strand):
 //   inputs   replace_plan(), skip_to(), jump_to(), pause(), resume(), release_hold(),
@@ -109,16 +113,25 @@ class WindowFeeder {
         std::string element_path;
         bool announced = false;  // ElementStarted considered (once, when it became the head)
         autopilot::MissionItem item() const;
+        /// The Stop that ends the drivable part of the ring after this entry: at its point.
+        autopilot::MissionItem barrier() const;
     };
     struct Outstanding {
         FeederRequest request;
         TimePoint deadline;
     };
+    /// How far the vehicle can drive on what the autopilot holds, from the head: `entries` queue entries on
+    /// board in ring order, then either their barrier (or a Stop entry) ends it, or a slot holding anything
+    /// else — content the vehicle must never reach — breaks it at `entries`.
+    struct Chain {
+        std::size_t entries = 0;
+        bool broken = false;
+    };
     enum class Mode : std::uint8_t { Unknown, Auto, Hold, Manual };
 
     static constexpr std::uint16_t kFirstRingSlot = 2;
-    static constexpr std::uint16_t kWrapSlots = 4;
-    /// W, the last ring position: slots K+1..K+4.
+    static constexpr std::uint16_t kWrapSlots = 3;
+    /// W, the last ring position: slots K+1..K+3.
     std::uint16_t wrap_slot() const { return static_cast<std::uint16_t>(config_.window + 1); }
     std::uint16_t ring_next(std::uint16_t slot) const {
         return slot >= wrap_slot() ? kFirstRingSlot : slot + 1;
@@ -133,7 +146,13 @@ class WindowFeeder {
     bool confirmed(const Entry& e) const;
     /// The autopilot is known to hold `item` at ring position `slot`.
     bool holds(std::uint16_t slot, const autopilot::MissionItem& item) const;
-    void start_fresh(std::uint16_t first_slot, TimePoint now);
+    /// The autopilot is known to hold a Stop at ring position `slot` (a barrier, or the plan's end).
+    bool holds_stop(std::uint16_t slot) const;
+    Chain chain_from(std::size_t first) const;
+    /// Entries the window keeps: K-1, one less while the vehicle still heads for a slot outside it (the
+    /// slot after the last entry must stay writable for its barrier).
+    std::size_t capacity() const;
+    void start_fresh(TimePoint now);
     void restart(TimePoint now);
     void refill(TimePoint now);
     void complete_through(std::size_t position, TimePoint now);
@@ -144,6 +163,9 @@ class WindowFeeder {
     std::string stream_path(const Waypoint& wp) const;
     void request_failed(TimePoint now);
     void check_starvation();
+    /// The vehicle stands at a barrier: the head's slot holds a Stop, and the board reports being there.
+    void at_frontier(TimePoint now);
+    void left_frontier(TimePoint now);
     bool plan_active() const;
     void interrupt(std::string why, bool wait_for_operator);
     void fail_plan(std::string why);
@@ -151,10 +173,11 @@ class WindowFeeder {
               std::string detail = {});
     std::optional<Mode> desired_mode() const;
     bool ready_for_auto() const;
-    std::optional<FeederRequest> next_write(std::size_t from, std::size_t to, TimePoint now);
-    std::optional<FeederRequest> next_stop_filler(TimePoint now);
+    /// The next write that brings the ring closer to the window without ever breaking the invariant.
+    std::optional<FeederRequest> next_write(TimePoint now);
+    std::optional<FeederRequest> write(std::uint16_t slot, const autopilot::MissionItem& item, TimePoint now);
     FeederRequest issue(decltype(FeederRequest::op) op, TimePoint now);
-    void request_succeeded(const FeederRequest& request);
+    void request_succeeded(const FeederRequest& request, TimePoint now);
 
     FeederConfig config_;
     std::unique_ptr<WaypointStream> stream_;
@@ -168,10 +191,15 @@ class WindowFeeder {
 
     // What the autopilot is known to hold.
     bool mission_ok_ = false;
-    std::vector<std::optional<autopilot::MissionItem>> confirmed_;  // by slot, 0..K+1
+    std::vector<std::optional<autopilot::MissionItem>> confirmed_;  // by slot, 0..K+3
+    // Slots where an entry replaced a barrier while the entry before it was not yet seen reached: a board
+    // that got there first drives (or waits at) its copy of the Stop, whatever the slot holds now.
+    std::vector<bool> written_over_stop_;
     std::optional<std::uint16_t> ap_target_;  // the slot the autopilot is believed to head for
     bool need_set_current_ = false;
-    bool repoint_only_ = false;  // set-current due after the board's own HOLD: its reports still count
+    std::optional<std::uint16_t> old_target_;  // after a fresh start: the target the vehicle had, kept apart
+    bool repoint_only_ =
+        false;  // set-current due while the board's reports still count (its target is sound)
     Mode mode_ = Mode::Unknown;
     std::uint32_t current_mismatches_ = 0;
 
@@ -181,6 +209,7 @@ class WindowFeeder {
     std::string last_interruption_;
     std::optional<std::string> failed_;  // why the autopilot refused the plan
     bool starving_ = false;
+    std::optional<TimePoint> frontier_since_;  // the vehicle waits at a barrier for the next write
     bool fault_ = false;
     TimePoint retry_not_before_ = TimePoint::min();
     std::uint32_t consecutive_failures_ = 0;

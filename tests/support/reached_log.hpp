@@ -26,17 +26,16 @@ struct Reached {
     std::uint16_t seq = 0;    ///< the mission slot
     double leg_s = 0;         ///< seconds in AUTO on the leg that ended here
     double median_speed = 0;  ///< the car's median speed over them, m/s
+    std::uint16_t command = 16;  ///< the item's MAV_CMD
 };
 
-/// The flight plan's mission wraps through slot window+2, a point on the way from the last ring position to
-/// the first (docs/flight-plan.md, "Mission layout"): a board drives through it, and its arrival there is no
-/// plan waypoint.
 /// flightplan.window in config/airseg.yaml, which the system suite runs with.
 inline constexpr int kDefaultWindow = 5;
 
-inline std::vector<Reached> plan_waypoints_of(std::vector<Reached> log, int window) {
-    const auto pass_through = static_cast<std::uint16_t>(window + 2);
-    std::erase_if(log, [&](const Reached& r) { return r.seq == pass_through; });
+/// The waypoints in a board's reached log: without its arrivals at a Stop (NAV_LOITER_UNLIM, 17), the barrier
+/// after the last waypoint written (docs/flight-plan.md, "Mission layout"), which is no plan waypoint.
+inline std::vector<Reached> plan_waypoints_of(std::vector<Reached> log) {
+    std::erase_if(log, [](const Reached& r) { return r.command == 17; });
     return log;
 }
 
@@ -56,7 +55,8 @@ inline std::vector<Reached> reached_log(ControlClient& sim, std::uint64_t from =
                  {std::llround(r["lat"].get<double>() * 1e7), std::llround(r["lon"].get<double>() * 1e7)},
                  static_cast<std::uint16_t>(r.value("seq", 0)),
                  r.value("leg_s", 0.0),
-                 r.value("median_speed", 0.0)});
+                 r.value("median_speed", 0.0),
+                 static_cast<std::uint16_t>(r.value("command", 16))});
         }
         if (page["reached"].size() < 500) {
             return out;

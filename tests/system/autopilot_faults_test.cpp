@@ -47,7 +47,7 @@ class SystemPlan : public ::testing::Test {
         EXPECT_EQ(plan_section(*bench).value("waypoints_reached", 0u), expected.size());
         if (whole_log) {
             expect_reached_in_order(
-                plan_waypoints_of(reached_log(bench->sim(), first_reached), kDefaultWindow), expected);
+                plan_waypoints_of(reached_log(bench->sim(), first_reached)), expected);
             if (HasFailure()) {
                 std::cout << bench->logs();
             }
@@ -94,7 +94,7 @@ TEST_F(SystemPlan, AutopilotUnpluggedAndReplugedMidPlan) {
             booted = m["t"].get<double>();
         }
     }
-    const auto log = plan_waypoints_of(reached_log(bench->sim(), first_reached), kDefaultWindow);
+    const auto log = plan_waypoints_of(reached_log(bench->sim(), first_reached));
     std::size_t unseen = 0;
     for (const auto& r : log) {
         unseen += r.t >= unplugged_t && r.t <= booted ? 1 : 0;
@@ -151,7 +151,7 @@ TEST_F(SystemPlan, AutopilotHeartbeatStall) {
     // waypoint it had seen unreached: 7 waypoints driven twice here). KNOWN LIMITATION (docs/reliability.md):
     // while the heartbeats are missing the daemon sends the board nothing, so a board that runs through its
     // window follows the ring's jump into slots not yet rewritten and drives those waypoints again (2 here).
-    const auto log = plan_waypoints_of(reached_log(bench->sim(), first_reached), kDefaultWindow);
+    const auto log = plan_waypoints_of(reached_log(bench->sim(), first_reached));
     const auto replays = expect_no_skip(log, expected);
     EXPECT_LT(replays, 5u) << "at most the stale ring slots, never a rewind: " << as_indices(log, expected);
     const auto stats = bench->sim().json("stats");
@@ -235,14 +235,14 @@ TEST_F(SystemPlan, DaemonKilledMidPlanResumesAtTheFirstUnreachedWaypoint) {
         }
     }
     std::vector<Reached> after;
-    for (const auto& r : plan_waypoints_of(reached_log(bench->sim(), first_reached), kDefaultWindow)) {
+    for (const auto& r : plan_waypoints_of(reached_log(bench->sim(), first_reached))) {
         if (r.t > booted) {
             after.push_back(r);
         }
     }
     expect_reached_in_order(after, expected, saved_next);
     // The board drove on alone between the kill and the reopen: those waypoints are driven again after it.
-    const auto whole = plan_waypoints_of(reached_log(bench->sim(), first_reached), kDefaultWindow);
+    const auto whole = plan_waypoints_of(reached_log(bench->sim(), first_reached));
     const auto replays = expect_no_skip(whole, expected);
     end_checks(expected, false);
     std::cout << "[ figures ] SIGKILL mid-plan at next_index " << saved_next << ": ready " << ready_s
@@ -289,7 +289,7 @@ TEST_F(SystemPlan, InvalidPlanRejectedNamingWhatAndWhereAndAValidOneReplacesTheR
         << bench->sim().json("reached 0 100").dump() << bench->logs();
 
     // On the board: A from its start without a gap, at most the target it was heading for, then all of B.
-    const auto log = plan_waypoints_of(reached_log(bench->sim(), first_reached), kDefaultWindow);
+    const auto log = plan_waypoints_of(reached_log(bench->sim(), first_reached));
     std::size_t i = 0;
     while (i < log.size() && i < a.size() && same_place(log[i].at, a[i])) {
         ++i;

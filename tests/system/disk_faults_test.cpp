@@ -126,7 +126,7 @@ TEST(SystemDisk, DiskFullWhileWritingTheTlogAndTheStateFileKeepsTheDaemonUpAndTh
     ASSERT_TRUE(
         wait_until([&] { return plan_section(bench).value("state", "") == "done"; }, kGenerous, kPoll))
         << plan_section(bench).dump();
-    expect_reached_in_order(plan_waypoints_of(reached_log(bench.sim(), first), kDefaultWindow), expected);
+    expect_reached_in_order(plan_waypoints_of(reached_log(bench.sim(), first)), expected);
     send_unique(bench, serial++, tally);
     expect_each_answered_once(tally, commands_at_start, ground_commands(bench));
     expect_daemon_alive(bench);

@@ -85,7 +85,8 @@ nlohmann::json reached_json(const RoverSim& sim, std::uint64_t from, std::uint64
                         {"distance", r.distance},
                         {"passed", r.passed},
                         {"leg_s", r.leg_s},
-                        {"median_speed", r.median_speed}});
+                        {"median_speed", r.median_speed},
+                        {"command", r.command}});
     }
     return {{"total", sim.reached_total()}, {"first_kept", first}, {"reached", list}};
 }

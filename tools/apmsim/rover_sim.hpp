@@ -120,6 +120,7 @@ struct ReachedEvent {
     // or a HOLD ended): its seconds and the median of the car's speed over them, m/s (0 for no time).
     double leg_s = 0;
     double median_speed = 0;
+    std::uint16_t command = 0;  // its MAV_CMD (NAV_WAYPOINT, or NAV_LOITER_UNLIM where the rover stays)
 };
 
 /// A change of the speed the rover drives at in AUTO, RTL and GUIDED (modern: WP_SPEED as AUTO was entered,

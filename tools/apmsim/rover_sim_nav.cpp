@@ -260,6 +260,7 @@ void RoverSim::on_target_reached(double distance, bool passed, TimePoint now) {
     }
     const std::uint16_t seq = current_seq_;
     ReachedEvent event{now, seq, distance, passed, target_.value_or(GeoPoint{})};
+    event.command = store_.at(seq).command;
     take_leg_stats(event);
     char line[50];
     std::snprintf(line, sizeof line, "%s waypoint #%u dist %um", passed ? "Passed" : "Reached",

@@ -477,6 +477,7 @@ void RoverSim::r2_reached(bool passed, double distance, TimePoint now) {
         reached_.pop_front();
     }
     ReachedEvent event{now, r2_.nav_index, distance, passed, r2_.next_wp};
+    event.command = r2_.next_nav.command;
     take_leg_stats(event);
     reached_.push_back(event);
     ++reached_total_;

@@ -77,8 +77,7 @@ void Driver::on_port_open(TimePoint now) {
     ready_s_.reset();
     parser_ = mav::Parser{};
     missions_.forget_board();  // another board may be behind the port now
-    stop_as_waypoint_ = false;
-    stop_hold_sent_.reset();
+    stop_as_jump_ = false;
     auto_check_.cancel();
     forget_speed();
     armed_seen_ = false;
@@ -371,7 +370,7 @@ void Driver::on_mission_done(MissionCompletion c, TimePoint now) {
     }
     PendingOp op = std::move(it->second);
     mission_ops_.erase(it);
-    if (retry_with_stops_as_waypoints(op, c, now)) {
+    if (retry_with_stops_as_jumps(op, c, now)) {
         return;
     }
     const RequestResult r = from_mission(c.result);
@@ -410,17 +409,17 @@ void Driver::on_mission_done(MissionCompletion c, TimePoint now) {
 }
 
 // A board that does not store NAV_LOITER_UNLIM (APM:Rover 2.x: MAV_MISSION_UNSUPPORTED) gets Stop items as
-// waypoints from now on, and the same write once more; the driver then holds the vehicle on arrival.
-bool Driver::retry_with_stops_as_waypoints(const PendingOp& op, const MissionCompletion& c, TimePoint now) {
+// jumps past the mission's end from now on (encode_item()), and the same write once more.
+bool Driver::retry_with_stops_as_jumps(const PendingOp& op, const MissionCompletion& c, TimePoint now) {
     constexpr std::uint8_t kMissionUnsupported = 3;
     const bool writes = op.kind == RequestKind::UploadMission || op.kind == RequestKind::WriteItems;
     const bool has_stop = std::any_of(op.items.begin(), op.items.end(),
                                       [](const MissionItem& m) { return m.kind == MissionItem::Kind::Stop; });
-    if (!writes || !has_stop || stop_as_waypoint_ || c.result != MissionResult::Denied ||
+    if (!writes || !has_stop || stop_as_jump_ || c.result != MissionResult::Denied ||
         c.refusal != kMissionUnsupported) {
         return false;
     }
-    stop_as_waypoint_ = true;
+    stop_as_jump_ = true;
     std::vector<mav::MissionItemInt> wire;
     if (op.kind == RequestKind::UploadMission) {
         wire.push_back(home_slot_ ? *home_slot_ : home_item(telemetry_.home.value_or(Position{})));
@@ -520,7 +519,7 @@ std::uint32_t Driver::upload_mission(std::vector<MissionItem> items, TimePoint n
     wire.reserve(items.size() + 1);
     wire.push_back(home_slot_ ? *home_slot_ : home_item(telemetry_.home.value_or(Position{})));
     for (const auto& it : items) {
-        wire.push_back(encode_item(it, stop_as_waypoint_));
+        wire.push_back(encode_item(it, stop_as_jump_));
     }
     const std::uint32_t id = next_id_++;
     mission_ops_[missions_.upload(std::move(wire), now)] = {id, RequestKind::UploadMission, std::move(items),
@@ -540,7 +539,7 @@ std::uint32_t Driver::write_items(std::uint16_t first_slot, std::vector<MissionI
     }
     std::vector<mav::MissionItemInt> wire;
     for (const auto& it : items) {
-        wire.push_back(encode_item(it, stop_as_waypoint_));
+        wire.push_back(encode_item(it, stop_as_jump_));
     }
     mission_ops_[missions_.write_partial(first_slot, std::move(wire), now)] = {id, RequestKind::WriteItems,
                                                                                std::move(items), first_slot};

@@ -139,7 +139,7 @@ class Driver {
     /// The parameter the board drives AUTO at: WP_SPEED when it has one (current Rover), else CRUISE_SPEED.
     const char* speed_param() const;
     /// True when Stop items go as waypoints and the driver holds the vehicle on arrival.
-    bool stops_as_waypoints() const { return stop_as_waypoint_; }
+    bool stops_as_jumps() const { return stop_as_jump_; }
     bool link_up() const { return link_.up(); }
     bool ready() const { return phase_ == Phase::Ready && link_.up(); }
 
@@ -164,8 +164,7 @@ class Driver {
     void sequence_failed(const std::string& why, TimePoint now);
     void drain_clients(TimePoint now);
     void on_mission_done(MissionCompletion c, TimePoint now);
-    bool retry_with_stops_as_waypoints(const PendingOp& op, const MissionCompletion& c, TimePoint now);
-    void hold_at_stop(std::uint16_t slot, TimePoint now);
+    bool retry_with_stops_as_jumps(const PendingOp& op, const MissionCompletion& c, TimePoint now);
     void on_param_done(ParamCompletion c, TimePoint now);
     void cancel_everything(const std::string& why, TimePoint now);
     void done(std::uint32_t id, RequestKind kind, RequestResult result, std::string detail = {});
@@ -253,8 +252,7 @@ class Driver {
     std::uint16_t reported_current_ = 0;  // the mission slot last reported (MissionCurrentChanged)
     bool current_reached_ = false;        // the board reported reported_current_ reached since
     AutoEntryCheck auto_check_;
-    bool stop_as_waypoint_ = false;            // the board lacks NAV_LOITER_UNLIM: Stop items go as waypoints
-    std::optional<TimePoint> stop_hold_sent_;  // HOLD sent on reaching such a Stop, until the board holds
+    bool stop_as_jump_ = false;  // the board lacks NAV_LOITER_UNLIM: Stop items go as DO_JUMP past the end
     std::optional<double> speed_set_;
     std::optional<double> board_speed_;    // speed_param() before the first change: restored at the end
     std::optional<double> speed_refused_;  // not asked again until AUTO is entered again or it changes

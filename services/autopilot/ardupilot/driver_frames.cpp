@@ -198,16 +198,6 @@ void Driver::on_heartbeat(const mav::Heartbeat& hb, TimePoint now) {
         enter(Phase::Params, now);
     }
     update_state(now, false);
-    if (stop_hold_sent_ && hb.custom_mode == static_cast<std::uint32_t>(RoverMode::Auto) &&
-        !modes_.pending()) {
-        if (now - *stop_hold_sent_ < config_.mode_timeout * config_.mode_retries) {
-            send_mode(static_cast<std::uint32_t>(RoverMode::Hold));  // the first was lost
-        } else {
-            stop_hold_sent_.reset();
-        }
-    } else if (hb.custom_mode != static_cast<std::uint32_t>(RoverMode::Auto)) {
-        stop_hold_sent_.reset();
-    }
     if (hb.custom_mode == static_cast<std::uint32_t>(RoverMode::Auto)) {
         if (mode_changed) {
             if (!auto_check_.active()) {
@@ -237,18 +227,6 @@ void Driver::on_mission_current(std::uint16_t seq, TimePoint now) {
             (void)missions_.set_current(*auto_check_.expected(), now);
             break;
     }
-}
-
-// A Stop sent as a waypoint was reached: the board drives on to the next slot by itself; HOLD keeps the
-// vehicle where the Stop is, as NAV_LOITER_UNLIM would have. The change is the driver's own (External for
-// the flight plan manager, whose plan has ended there).
-void Driver::hold_at_stop(std::uint16_t slot, TimePoint now) {
-    if (!stop_as_waypoint_ || slot < 1 || static_cast<std::size_t>(slot) > mission_.size() ||
-        mission_[slot - 1].kind != MissionItem::Kind::Stop || state_ != VehicleState::WaypointNavigation) {
-        return;
-    }
-    send_mode(static_cast<std::uint32_t>(RoverMode::Hold));
-    stop_hold_sent_ = now;
 }
 
 // The slot the board heads for: its last MISSION_CURRENT, or, when it has since reported that slot reached
@@ -326,7 +304,6 @@ void Driver::on_reached(std::uint16_t seq, TimePoint now) {
     last_reached_ = std::pair{seq, now};
     auto_check_.on_reached(seq);
     current_reached_ = seq == reported_current_;
-    hold_at_stop(seq, now);
     if (seq >= 1 && seq <= mission_.size() && mission_[seq - 1u].kind == MissionItem::Kind::Stop) {
         restore_board_speed(now);  // the plan's end
     }

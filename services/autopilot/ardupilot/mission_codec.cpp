@@ -12,15 +12,21 @@ std::int32_t to_e7(double degrees) {
 }
 }  // namespace
 
-mavlink::MissionItemInt encode_item(const MissionItem& item, bool stop_as_waypoint) {
+mavlink::MissionItemInt encode_item(const MissionItem& item, bool stop_as_jump) {
     mavlink::MissionItemInt m;
     m.autocontinue = 1;
+    if (item.kind == MissionItem::Kind::Stop && stop_as_jump) {
+        m.command = mavlink::kCmdDoJump;
+        m.frame = mavlink::kFrameMission;
+        m.param1 = static_cast<float>(kJumpPastTheEnd);
+        m.param2 = -1.0f;
+        return m;
+    }
     switch (item.kind) {
         case MissionItem::Kind::Waypoint:
         case MissionItem::Kind::Stop:
-            m.command = item.kind == MissionItem::Kind::Waypoint || stop_as_waypoint
-                            ? mavlink::kCmdNavWaypoint
-                            : mavlink::kCmdNavLoiterUnlim;
+            m.command = item.kind == MissionItem::Kind::Waypoint ? mavlink::kCmdNavWaypoint
+                                                                 : mavlink::kCmdNavLoiterUnlim;
             m.frame = mavlink::kFrameGlobalRelativeAltInt;
             m.x = to_e7(item.lat);
             m.y = to_e7(item.lon);
@@ -43,6 +49,10 @@ mavlink::MissionItemInt encode_item(const MissionItem& item, bool stop_as_waypoi
 MissionItem decode_item(const mavlink::MissionItemInt& m) {
     MissionItem item;
     if (m.command == mavlink::kCmdDoJump) {
+        if (std::lround(m.param1) == kJumpPastTheEnd) {
+            item.kind = MissionItem::Kind::Stop;  // a Stop as a board without NAV_LOITER_UNLIM holds it
+            return item;
+        }
         item.kind = MissionItem::Kind::JumpTo;
         item.jump_slot = static_cast<std::uint16_t>(std::lround(m.param1));
         return item;

@@ -11,15 +11,22 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <random>
 #include <sstream>
+#include <thread>
 
 #include "services/flightplan/expander.hpp"
 #include "services/flightplan/plan_loader.hpp"
@@ -226,7 +233,7 @@ class FlightplanE2e : public ::testing::TestWithParam<std::string> {
     }
     /// The board's reached log from event `from` on, without the wrap's pass-through point.
     std::vector<Reached> board_log(std::uint64_t from) {
-        return plan_waypoints_of(reached_log(*control_, from), window_);
+        return plan_waypoints_of(reached_log(*control_, from));
     }
     /// Where a finished plan leaves the vehicle: on NAV_LOITER_UNLIM in AUTO, or (a 2.x board, which has no
     /// such command) held by the daemon at the last waypoint.
@@ -499,7 +506,11 @@ TEST_P(FlightplanE2e, SkipPauseResumeAndAppendAreConfirmedByTheBoard) {
     rest.insert(rest.end(), extra.begin(), extra.end());
     for (std::size_t k = 0; k < rest.size(); ++k, ++i) {
         ASSERT_LT(i, reached.size());
-        ASSERT_PRED2(same_place, reached[i].at, rest[k]) << "after the skip, #" << k;
+        ASSERT_PRED2(same_place, reached[i].at, rest[k])
+            << "after the skip, #" << k << "\n"
+            << describe_reached_around(
+                   std::vector<Reached>(reached.begin() + static_cast<long>(i - k), reached.end()), rest, k)
+            << daemon_->err();
     }
 }
 
@@ -872,9 +883,131 @@ TEST_P(FlightplanE2e, EveryLegIsDrivenAtItsPlannedSpeedBeforeAndAfterAHoldTheBoa
     std::cout << " m/s (planned " << kSpeed << ")\n";
 }
 
+/// Stops and continues a process at random, as a starved board's scheduler would: pauses of 0.05-5 s (real
+/// time), each after 0.1-2 s of running, until stopped. Seeded, so a failing run can be replayed.
+class Starver {
+  public:
+    Starver(pid_t pid, unsigned seed) : pid_(pid), rng_(seed) {
+        thread_ = std::thread([this] { run(); });
+    }
+    ~Starver() { stop(); }
+    void stop() {
+        {
+            std::lock_guard lock(mutex_);
+            stopping_ = true;
+        }
+        wake_.notify_all();
+        if (thread_.joinable()) {
+            thread_.join();
+        }
+        ::kill(pid_, SIGCONT);
+    }
+    int pauses() const { return pauses_; }
+    double paused_s() const { return paused_s_; }
+
+  private:
+    void run() {
+        std::uniform_real_distribution<double> running(0.1, 2.0);
+        // Pause lengths log-uniform from 50 ms to 5 s: short stalls are common, long ones rare but there.
+        std::uniform_real_distribution<double> log_pause(std::log(0.05), std::log(5.0));
+        while (!wait_for(running(rng_))) {
+            const double pause = std::exp(log_pause(rng_));
+            ::kill(pid_, SIGSTOP);
+            ++pauses_;
+            paused_s_ += pause;
+            const bool stopping = wait_for(pause);
+            ::kill(pid_, SIGCONT);
+            if (stopping) {
+                return;
+            }
+        }
+    }
+    /// Waits `s` seconds; true when asked to stop meanwhile.
+    bool wait_for(double s) {
+        std::unique_lock lock(mutex_);
+        return wake_.wait_for(lock, std::chrono::duration<double>(s), [&] { return stopping_; });
+    }
+    pid_t pid_;
+    std::mt19937 rng_;
+    std::thread thread_;
+    std::mutex mutex_;
+    std::condition_variable wake_;
+    bool stopping_ = false;
+    std::atomic<int> pauses_{0};
+    double paused_s_ = 0;
+};
+
+// The ring's invariant under CPU starvation (docs/flight-plan.md, "Mission layout"): airsegd is stopped for
+// 0.05-5 s at random (up to 250 simulated seconds, a hundred waypoints of travel: far more than the window
+// holds) while the board drives a scan. The vehicle waits at the last waypoint written and goes on once the
+// writes land: every plan waypoint reached once and in order, and nothing else reached, ever.
+// AIRSEG_STARVE_RUNS repeats the case (default 1) and AIRSEG_STARVE_SEED picks the first seed.
+class FlightplanStarvedE2e : public FlightplanE2e {};
+
+TEST_P(FlightplanStarvedE2e, AStarvedDaemonStopsTheVehicleAtTheFrontierAndNeverLetsItDriveAStalePoint) {
+    const char* runs_env = std::getenv("AIRSEG_STARVE_RUNS");
+    const char* seed_env = std::getenv("AIRSEG_STARVE_SEED");
+    const int runs = runs_env != nullptr ? std::max(1, std::atoi(runs_env)) : 1;
+    const unsigned first_seed = seed_env != nullptr ? static_cast<unsigned>(std::atoi(seed_env)) : 1u;
+    // 96 m x 96 m, a waypoint every 8 m: 168 of them.
+    const auto file = write_plan("scan.yaml", scan_plan("starved-scan", 96, 96, 8));
+    const auto expected = expected_positions(file);
+    ASSERT_GE(expected.size(), 150u);
+    start_daemon(5);
+    for (int run = 0; run < runs; ++run) {
+        const unsigned seed = first_seed + static_cast<unsigned>(run);
+        const auto first = reached_total(*control_);
+        const auto before = show();
+        auto load = ctl({"plan", "load", file});
+        ASSERT_EQ(load.exit_code, 0) << load.json.dump() << load.err;
+        Starver starver(daemon_->pid(), seed);
+        ASSERT_TRUE(wait_until(
+            [&] { return control_->json("reached 0 1").value("total", 0ull) >= first + expected.size(); },
+            240s, kPoll))
+            << "seed " << seed << "\n"
+            << show().dump() << daemon_->err();
+        starver.stop();
+        ASSERT_TRUE(wait_until([&] { return show().value("state", "") == "done"; }, kGenerous, kPoll))
+            << "seed " << seed << " " << show().dump();
+        const auto all = reached_log(*control_, first);
+        const auto reached = plan_waypoints_of(all);
+        std::size_t same = 0;
+        while (same < reached.size() && same < expected.size() &&
+               same_place(reached[same].at, expected[same])) {
+            ++same;
+        }
+        ASSERT_EQ(reached.size(), expected.size())
+            << "seed " << seed << ": every waypoint once, nothing else; the first that is not:\n"
+            << describe_reached_around(reached, expected, same) << daemon_->err();
+        for (std::size_t i = 0; i < expected.size(); ++i) {
+            ASSERT_PRED2(same_place, reached[i].at, expected[i])
+                << "seed " << seed << ": reached #" << i << " is not plan waypoint " << i << "\n"
+                << describe_reached_around(reached, expected, i);
+        }
+        // Where it waited (a Stop reached), it waited at a plan waypoint.
+        for (const auto& r : all) {
+            if (r.command == 17) {
+                EXPECT_TRUE(std::any_of(expected.begin(), expected.end(),
+                                        [&](const E7& e) { return same_place(r.at, e); }))
+                    << "seed " << seed << ": stopped at " << r.at.first << "," << r.at.second;
+            }
+        }
+        const auto plan = show();
+        const auto stops = plan.value("frontier_stops", 0) - before.value("frontier_stops", 0);
+        const double waited = plan.value("frontier_wait_s", 0.0) - before.value("frontier_wait_s", 0.0);
+        std::cout << "[ figures ] " << GetParam() << " seed " << seed << ": " << starver.pauses()
+                  << " pauses of the daemon, " << starver.paused_s() << " s stopped; " << stops
+                  << " stops at the frontier, " << waited << " s waited there\n";
+        EXPECT_GT(starver.pauses(), 0);
+        EXPECT_EQ(plan.value("starvation_holds", 0), 0) << plan.dump();
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(Firmware, FlightplanE2e, ::testing::Values("modern", "rover2"),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
 INSTANTIATE_TEST_SUITE_P(Firmware, FlightplanSurveyE2e, ::testing::Values("modern", "rover2"),
+                         [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
+INSTANTIATE_TEST_SUITE_P(Firmware, FlightplanStarvedE2e, ::testing::Values("modern", "rover2"),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
 
 }  // namespace

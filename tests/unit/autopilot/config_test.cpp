@@ -111,6 +111,11 @@ TEST(MissionCodec, RoundTripsEveryKind) {
     }
     EXPECT_EQ(ardupilot::encode_item(jump).param2, -1.0f);  // forever
     EXPECT_EQ(ardupilot::encode_item(stop).command, 17);
+    // A board without NAV_LOITER_UNLIM: a jump past the end, read back as a Stop.
+    const auto as_jump = ardupilot::encode_item(stop, true);
+    EXPECT_EQ(as_jump.command, 177);
+    EXPECT_EQ(as_jump.param1, 255.0f);
+    EXPECT_EQ(ardupilot::decode_item(as_jump).kind, MissionItem::Kind::Stop);
 }
 
 TEST(RcOverride, ScalesAndClampsAndNeverSendsWithoutInput) {

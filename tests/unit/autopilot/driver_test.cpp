@@ -765,27 +765,26 @@ TEST(Driver, EnteringAutoOnABoardThatRestartsAtItemOneGoesBackToTheSlotItWasAt) 
     EXPECT_EQ(modern.driver.status().auto_restarts_corrected, 0u);
 }
 
-TEST(Driver, ABoardWithoutLoiterUnlimGetsStopsAsWaypointsAndIsHeldOnArrival) {
+TEST(Driver, ABoardWithoutLoiterUnlimGetsStopsAsJumpsPastTheEnd) {
     FakeRover::Options o = apm2_rover();
     o.loiter_unlim = false;
     Rig rig(apm2_config(), o);
     rig.bring_up();
     const auto r = rig.wait_result(rig.driver.upload_mission(plan(6), rig.now()));  // slot 6 is a Stop
     ASSERT_EQ(r.result, RequestResult::Ok) << r.detail;
-    EXPECT_TRUE(rig.driver.stops_as_waypoints());
-    EXPECT_EQ(rig.rover.mission()[6].command, 16);
+    EXPECT_TRUE(rig.driver.stops_as_jumps());
+    EXPECT_EQ(rig.rover.mission()[6].command, 177) << "MAV_CMD_DO_JUMP";
+    EXPECT_EQ(rig.rover.mission()[6].param1, 255.0f) << "past the end of any mission the board holds";
     EXPECT_EQ(rig.driver.mission()[5].kind, MissionItem::Kind::Stop)
         << "still a Stop to the rest of the daemon";
+    // The board holds there by itself: the driver sends no HOLD of its own on arrival.
     ASSERT_EQ(rig.wait_result(rig.driver.set_current(5, rig.now())).result, RequestResult::Ok);
     ASSERT_EQ(rig.wait_result(rig.driver.request_state(VehicleState::WaypointNavigation, rig.now())).result,
               RequestResult::Ok);
     rig.harness.run_for(seconds(2));
     rig.rover.reach(5, rig.now());
-    rig.harness.run_for(seconds(1));
-    EXPECT_EQ(rig.rover.mode(), testing::kAuto) << "a waypoint is driven through";
-    rig.rover.reach(6, rig.now());
     rig.harness.run_for(seconds(2));
-    EXPECT_EQ(rig.rover.mode(), testing::kHold) << "arrived at the Stop: held there";
+    EXPECT_EQ(rig.rover.mode(), testing::kAuto) << "no HOLD from the driver";
 }
 
 TEST(Driver, HoldReportedAsUninitByA2xBoardIsNoReboot) {

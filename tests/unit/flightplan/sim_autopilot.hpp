@@ -1,9 +1,16 @@
 #pragma once
 // A small simulated autopilot for WindowFeeder tests: mission slots (0 = home), a current target, reaches one
-// target per step while in auto, follows JumpTo items, passes a waypoint at the point just reached at once,
-// parks on Stop items and falls into HOLD when it passes
+// target per step while in auto, follows JumpTo items, parks on Stop items and falls into HOLD when it passes
 // the last slot (ArduPilot Rover behaviour at the end of a mission). Reboots lose the mission. Every mode
 // change is reported, with its cause, as the autopilot driver reports it (mode_changes()).
+//
+// Two command processors, as ArduPilot Rover has had: AP_Mission (the default: the target is a copy taken
+// when it became current; a rewritten waypoint leg restarts when the current navigation command or the next
+// two change, counted in restarts(), while a Stop being driven to stays until a set-current) and APM:Rover
+// 2.42-2.45 (`legacy`): once a place is reached the do-commands between it and the next place run, a JumpTo
+// continues at its slot, a Stop ends the mission there (the driver writes it as a DO_JUMP past the end, after
+// which the board holds by itself), and a do-command with no place after it never runs.
+#include <algorithm>
 #include <cstdint>
 #include <deque>
 #include <map>
@@ -26,9 +33,8 @@ using autopilot::VehicleState;
 class SimAutopilot {
   public:
     SimAutopilot() { reboot(); }
-    /// APM:Rover 2.x: a DO_JUMP runs as soon as the waypoint before it becomes the target (and only if a
-    /// waypoint follows it), so that waypoint is skipped.
-    bool early_jumps = false;
+    /// APM:Rover 2.42-2.45's command processor (see above).
+    bool legacy = false;
 
     RequestResult apply(const FeederRequest& r) {
         if (const auto* up = std::get_if<autopilot::UploadMission>(&r.op)) {
@@ -39,24 +45,36 @@ class SimAutopilot {
             if (current_ == 0 || current_ >= slots_.size()) {
                 current_ = 1;
             }
+            take_target();
             return RequestResult::Ok;
         }
         if (const auto* w = std::get_if<autopilot::WriteMissionItems>(&r.op)) {
             if (w->first_slot == 0 || w->first_slot + w->items.size() > slots_.size()) {
                 return RequestResult::Timeout;
             }
+            const auto watched = legacy ? std::vector<std::uint16_t>{} : look_ahead();
+            bool watched_changed = false;
             for (std::size_t i = 0; i < w->items.size(); ++i) {
-                slots_[w->first_slot + i] = w->items[i];
+                const auto slot = static_cast<std::uint16_t>(w->first_slot + i);
+                if (slots_[slot] != w->items[i] &&
+                    std::find(watched.begin(), watched.end(), slot) != watched.end()) {
+                    watched_changed = true;
+                }
+                slots_[slot] = w->items[i];
+            }
+            if (watched_changed && auto_ && target_.kind == MissionItem::Kind::Waypoint) {
+                ++restarts_;  // "Auto mission changed, restarted command": the leg is planned afresh
+                take_target();
             }
             ++writes_;
             return RequestResult::Ok;
         }
         if (const auto* s = std::get_if<autopilot::SetMissionCurrent>(&r.op)) {
-            if (s->slot == 0 || s->slot >= slots_.size()) {
-                return RequestResult::Timeout;
+            if (s->slot == 0 || s->slot >= slots_.size() || (legacy && !is_place(slots_[s->slot]))) {
+                return RequestResult::Timeout;  // 2.x: "Bad Request - cannot change to non-Nav cmd"
             }
             current_ = s->slot;
-            parked_ = false;
+            take_target();
             return RequestResult::Ok;
         }
         const auto& change = std::get<autopilot::RequestStateChange>(r.op);
@@ -81,34 +99,26 @@ class SimAutopilot {
         if (!auto_ || current_ == 0 || current_ >= slots_.size()) {
             return std::nullopt;
         }
-        const MissionItem& item = slots_[current_];
-        if (item.kind == MissionItem::Kind::Stop) {
-            parked_ = true;
+        if (target_.kind != MissionItem::Kind::Waypoint) {
+            parked_ = true;  // at a Stop: it stays there
             return std::nullopt;
         }
-        visited_.push_back({item.lat, item.lon});
+        visited_.push_back({target_.lat, target_.lon});
         const std::uint16_t reached = current_;
-        std::size_t next = current_ + 1u;
-        if (early_jumps && next + 2u < slots_.size() && slots_[next + 1u].kind == MissionItem::Kind::JumpTo) {
-            next = slots_[next + 1u].jump_slot;  // the waypoint before the jump is skipped
-            ++early_jumps_taken_;
+        if (legacy) {
+            legacy_advance(reached);
+            return reached;
         }
-        for (int guard = 0; !early_jumps && next < slots_.size() && guard < 8; ++guard) {
-            if (slots_[next].kind == MissionItem::Kind::JumpTo) {
-                next = slots_[next].jump_slot;
-            } else if (slots_[next].kind == MissionItem::Kind::Waypoint && slots_[next].lat == item.lat &&
-                       slots_[next].lon == item.lon) {
-                ++next;  // a waypoint where the vehicle already is: passed at once (inside its radius)
-            } else {
-                break;
-            }
+        std::size_t next = current_ + 1u;
+        for (int guard = 0;
+             next < slots_.size() && slots_[next].kind == MissionItem::Kind::JumpTo && guard < 8; ++guard) {
+            next = slots_[next].jump_slot;
         }
         if (next >= slots_.size()) {
-            set_mode(VehicleState::Parking,
-                     ModeChangeCause::External);  // mission complete: ArduPilot Rover goes HOLD
-            ++end_of_mission_holds_;
+            end_of_mission();
         } else {
             current_ = static_cast<std::uint16_t>(next);
+            take_target();
         }
         return reached;
     }
@@ -119,6 +129,7 @@ class SimAutopilot {
         auto_ = false;
         mode_ = VehicleState::Unknown;
         parked_ = false;
+        target_ = home();
     }
 
     /// The RC pilot takes the vehicle out of AUTO (the transmitter's MANUAL switch).
@@ -135,11 +146,76 @@ class SimAutopilot {
     /// The mission as stored, slot 0 (home) first.
     const std::vector<MissionItem>& slots() const { return slots_; }
     int end_of_mission_holds() const { return end_of_mission_holds_; }
+    /// Times a legacy board ended its mission at a Stop (a barrier, or the plan's end) and held.
+    int stop_holds() const { return stop_holds_; }
     int hold_requests() const { return hold_requests_; }
     int writes() const { return writes_; }
-    int early_jumps_taken() const { return early_jumps_taken_; }
+    /// Waypoint legs restarted because the current navigation command or the next two changed.
+    int restarts() const { return restarts_; }
 
   private:
+    static constexpr std::uint16_t kPastTheEnd = 254;
+    static bool is_place(const MissionItem& m) { return m.kind == MissionItem::Kind::Waypoint; }
+
+    void take_target() {
+        target_ = current_ < slots_.size() ? slots_[current_] : home();
+        parked_ = false;
+    }
+
+    /// AP_Mission's change detector: the current navigation command and the next two, through jumps.
+    std::vector<std::uint16_t> look_ahead() const {
+        std::vector<std::uint16_t> out;
+        std::size_t i = current_;
+        for (int guard = 0; out.size() < 3 && i > 0 && i < slots_.size() && guard < 16; ++guard) {
+            if (slots_[i].kind == MissionItem::Kind::JumpTo) {
+                i = slots_[i].jump_slot;
+                continue;
+            }
+            out.push_back(static_cast<std::uint16_t>(i));
+            ++i;
+        }
+        return out;
+    }
+
+    // process_next_command() once `from` is reached: the next place, and the do-commands before it.
+    void legacy_advance(std::size_t from) {
+        for (int guard = 0; guard < 8; ++guard) {
+            std::size_t place = from + 1;
+            while (place < slots_.size() && !is_place(slots_[place])) {
+                ++place;
+            }
+            if (place >= slots_.size()) {
+                end_of_mission();  // "No commands - setting HOLD"
+                return;
+            }
+            std::optional<std::size_t> jump;
+            for (std::size_t i = from + 1; i < place; ++i) {
+                if (slots_[i].kind == MissionItem::Kind::Stop) {
+                    ++stop_holds_;  // a DO_JUMP past the end: no commands left, HOLD where it is
+                    set_mode(VehicleState::Parking, ModeChangeCause::External);
+                    parked_ = true;
+                    current_ = kPastTheEnd;  // MISSION_CURRENT carries the jump's target, less one
+                    return;
+                }
+                if (slots_[i].kind == MissionItem::Kind::JumpTo) {
+                    jump = slots_[i].jump_slot;
+                    break;
+                }
+            }
+            if (!jump) {
+                current_ = static_cast<std::uint16_t>(place);
+                take_target();
+                return;
+            }
+            from = *jump - 1;  // do_jump(): the processor carries on at the jump's target
+        }
+    }
+
+    void end_of_mission() {
+        set_mode(VehicleState::Parking, ModeChangeCause::External);  // mission complete: Rover goes HOLD
+        ++end_of_mission_holds_;
+    }
+
     void set_mode(VehicleState mode, ModeChangeCause cause) {
         auto_ = mode == VehicleState::WaypointNavigation;
         if (mode != mode_) {
@@ -150,15 +226,17 @@ class SimAutopilot {
     static MissionItem home() { return MissionItem{}; }
     std::vector<MissionItem> slots_;
     std::uint16_t current_ = 0;
+    MissionItem target_;
     bool auto_ = false;
     VehicleState mode_ = VehicleState::Unknown;
     std::vector<ModeReport> changes_;
     bool parked_ = false;
     std::vector<LatLon> visited_;
     int end_of_mission_holds_ = 0;
+    int stop_holds_ = 0;
     int hold_requests_ = 0;
     int writes_ = 0;
-    int early_jumps_taken_ = 0;
+    int restarts_ = 0;
 };
 
 /// A lazily generated straight-line plan of n waypoints; selected indices can carry hold actions.
@@ -225,6 +303,11 @@ struct Impairments {
     bool refuse_missions = false;    // every upload and write is refused (a board that takes none of them)
     int requests_per_step = 2;       // link budget
     bool report_current = true;      // MISSION_CURRENT every step
+    // The feeder's own stalls (a starved daemon): at each step a stall starts with this probability and lasts
+    // 1..stall_steps steps, during which the vehicle drives on and its reports wait in the port.
+    double stall = 0.0;
+    int stall_steps = 6;
+    bool fail_next_set_current = false;  // the next set-current times out (one-shot)
 };
 
 /// Drives a feeder against the simulated autopilot in simulated time, one second per step.
@@ -234,14 +317,37 @@ class Harness {
         : feeder(config), imp_(imp), rng_(seed) {}
 
     void step() {
+        if (stall_left_ == 0 && chance(imp_.stall)) {
+            stall_left_ = std::uniform_int_distribution<int>(1, imp_.stall_steps)(rng_);
+            ++stalls;
+        }
+        if (stall_left_ > 0) {
+            --stall_left_;
+            if (const auto reached = ap.step()) {
+                waiting_.push_back(*reached);  // read from the port once the daemon runs again
+            }
+            now += seconds(1);
+            return;
+        }
         report_modes();  // what the vehicle did between steps (the RC pilot, the board itself)
+        if (!waiting_.empty()) {
+            // Back from a stall: what the port holds is read before anything is decided.
+            for (auto s : std::exchange(waiting_, {})) {
+                feeder.on_reached(s, now);
+                drain();
+            }
+            feeder.on_current(ap.current(), now);
+            drain();
+        }
         int budget = imp_.requests_per_step;
         while (budget-- > 0) {
             auto r = feeder.poll_request(now);
             if (!r) {
                 break;
             }
+            const bool set_current = std::holds_alternative<autopilot::SetMissionCurrent>(r->op);
             const bool fail =
+                (set_current && std::exchange(imp_.fail_next_set_current, false)) ||
                 chance(imp_.fail_request) ||
                 (imp_.fail_writes && std::holds_alternative<autopilot::WriteMissionItems>(r->op));
             const bool refuse =
@@ -322,10 +428,13 @@ class Harness {
     }
 
     Impairments& impairments() { return imp_; }
+    /// The feeder is stalled, or has not yet read what came meanwhile (nothing reaches a stopped daemon).
+    bool stalled() const { return stall_left_ > 0 || !waiting_.empty(); }
 
     WindowFeeder feeder;
     SimAutopilot ap;
     TimePoint now{};
+    int stalls = 0;
     std::vector<std::uint64_t> reached;
     std::vector<FeederEvent> events;
 
@@ -334,6 +443,8 @@ class Harness {
     Impairments imp_;
     std::mt19937 rng_;
     std::deque<std::uint16_t> late_;
+    std::deque<std::uint16_t> waiting_;
+    int stall_left_ = 0;
 };
 
 inline PlanFeed synthetic(std::uint64_t n, double base_lat = 41.0,

@@ -217,6 +217,25 @@ TEST(FlightplanExpander, SeekAndRestoreMatchAFullExpansion) {
     EXPECT_EQ(fresh.next()->local, all[17].local);
 }
 
+// A skip past the end is refused and loses nothing: the stream gives what it would have given next (it
+// had moved to its end, and a window fed from it then never drove the waypoints it had not yet read).
+TEST(FlightplanExpander, ASeekPastTheEndLeavesTheStreamWhereItWas) {
+    auto plan = load(kMixedPlan);
+    ASSERT_TRUE(plan);
+    const auto all = expand_all(plan);
+    ASSERT_GT(all.size(), 12u);
+    Expander e(plan);
+    for (int i = 0; i < 10; ++i) {
+        e.next();
+    }
+    EXPECT_FALSE(e.seek(all.size() + 5000));
+    EXPECT_EQ(e.position(), 10u);
+    auto w = e.next();
+    ASSERT_TRUE(w);
+    EXPECT_EQ(w->index, 10u);
+    EXPECT_EQ(w->local, all[10].local);
+}
+
 TEST(FlightplanExpander, JumpIntoDetachedBlockThenGotoBackIntoLoop) {
     auto plan = load(kMixedPlan);
     ASSERT_TRUE(plan);
