@@ -621,6 +621,14 @@ std::uint32_t Driver::request_state(VehicleState target, TimePoint now) {
              link_.up() ? "autopilot not ready" : "autopilot link down");
         return id;
     }
+    if (state_ == VehicleState::ConfigureCheck && target != VehicleState::Manual) {
+        // A board that says it is booting (a reboot whose evidence is still coming in, a calibration) will
+        // take the mode once it is up: asked again then, never a refusal that ends a plan.
+        done(id, RequestKind::SetState, RequestResult::NotReady,
+             std::string(to_string(state_)) + " -> " + to_string(target) + ": " +
+                 *transition_refusal(state_, target));
+        return id;
+    }
     if (auto why = transition_refusal(state_, target)) {
         done(id, RequestKind::SetState, RequestResult::Refused,
              std::string(to_string(state_)) + " -> " + to_string(target) + ": " + *why);
