@@ -994,5 +994,24 @@ TEST(Driver, OnABoardSetByParameterItsOwnSpeedIsWrittenBackWhenThePlanEnds) {
     EXPECT_EQ(old.driver.status().speed, 3.0);
 }
 
+// A board whose heartbeat says INITIALISING while the daemon holds it ready (the first heartbeats of a reboot
+// whose clock evidence has not come in yet) will take a mode once it is up: the request is "not ready", asked again later, never a refusal (the flight plan fails a plan whose AUTO
+// is refused).
+TEST(Driver, AModeAskedWhileTheBoardSaysItIsBootingIsNotReadyRatherThanRefused) {
+    Rig rig(apm2_config(), apm2_rover());
+    rig.bring_up();
+    rig.harness.run_for(seconds(10));
+    rig.rover.report_initialising(rig.now() + seconds(3));
+    ASSERT_TRUE(rig.harness.run_until(
+        [&] { return rig.driver.status().state == VehicleState::ConfigureCheck; }, rig.now() + seconds(5)));
+    const auto asked = rig.wait_result(rig.driver.request_state(VehicleState::WaypointNavigation, rig.now()));
+    EXPECT_EQ(asked.result, RequestResult::NotReady) << asked.detail;
+    EXPECT_EQ(rig.driver.status().reboots, 0u);
+    ASSERT_TRUE(rig.harness.run_until(
+        [&] { return rig.driver.status().state != VehicleState::ConfigureCheck; }, rig.now() + seconds(10)));
+    EXPECT_EQ(rig.wait_result(rig.driver.request_state(VehicleState::WaypointNavigation, rig.now())).result,
+              RequestResult::Ok);
+}
+
 }  // namespace
 }  // namespace airseg::autopilot::ardupilot

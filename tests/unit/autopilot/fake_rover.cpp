@@ -84,7 +84,7 @@ void FakeRover::send_heartbeat(TimePoint now) {
     if ((armed_ || !options_.arming_required) && now >= boot_done_) {
         hb.base_mode |= 128;  // MAV_MODE_FLAG_SAFETY_ARMED
     }
-    hb.custom_mode = mode_;
+    hb.custom_mode = now < initialising_until_ ? 16u : mode_;  // 16: Rover's INITIALISING
     hb.system_status = now < boot_done_ ? kGcsMavStateCalibrating : kMavStateStandby;
     if (options_.uninit_in_hold && mode_ == kHold && now >= boot_done_) {
         hb.system_status = 0;  // APM:Rover 2.x's HOLD

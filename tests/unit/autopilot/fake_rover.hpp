@@ -59,6 +59,9 @@ class FakeRover {
 
     /// Power cycle / reset line: silent for boot_delay, then booting heartbeats, then standby.
     void reboot(TimePoint now);
+    /// Heartbeats say mode INITIALISING (16) until `until` while the clock runs on: what a board reports
+    /// first after a reset, before its clock samples show the reset.
+    void report_initialising(TimePoint until) { initialising_until_ = until; }
     /// No output at all (and input ignored) until `until`.
     void stall(TimePoint until) { stall_until_ = until; }
     /// The RC pilot flips the mode switch.
@@ -109,6 +112,7 @@ class FakeRover {
     TimePoint boot_start_;
     TimePoint boot_done_;
     TimePoint stall_until_{};
+    TimePoint initialising_until_{};
     TimePoint next_heartbeat_;
     bool boot_texts_sent_;
     std::uint32_t mode_ = kHold;
