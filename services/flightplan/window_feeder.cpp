@@ -542,10 +542,19 @@ void WindowFeeder::on_current(std::uint16_t slot, TimePoint now) {
     }
     slot = ring_position(slot);
     if (slot >= confirmed_.size()) {
+        if (queue_[0].slot == kFirstRingSlot && !queue_[0].stop && confirmed(queue_[0]) && !starving_ &&
+            !frontier_since_) {
+            // Heading for slot 2, the wrap's jump target: the 2.x command processor runs the do-commands
+            // after the place a jump lands on at once, on the way to it (process_non_nav_command() clears the
+            // WAIT_COMMAND the jump's own process_next_command() set, commands_process.pde), so a barrier in
+            // slot 3 holds the vehicle short of slot 2. Pointed at slot 2 again, it drives there.
+            at_frontier(now);
+            return;
+        }
         // Past the mission's end: a board whose Stop is a jump there ran it, which it does only once the
-        // waypoint before the Stop is reached. The first Stop on the vehicle's way ends the chain: every
-        // entry before it was reached, whatever became of their reports. Once known to wait there, the same
-        // report says nothing new (the chain has grown since).
+        // waypoint before the Stop is reached (slot 2 aside, above). The first Stop on the vehicle's way ends
+        // the chain: every entry before it was reached, whatever became of their reports. Once known to wait
+        // there, the same report says nothing new (the chain has grown since).
         const Chain c = chain_from(0);
         const std::size_t waypoints = c.entries > 0 && queue_[c.entries - 1].stop ? c.entries - 1 : c.entries;
         if (!c.broken && waypoints > 0 && !starving_ && !frontier_since_ &&

@@ -8,8 +8,9 @@
 // when it became current; a rewritten waypoint leg restarts when the current navigation command or the next
 // two change, counted in restarts(), while a Stop being driven to stays until a set-current) and APM:Rover
 // 2.42-2.45 (`legacy`): once a place is reached the do-commands between it and the next place run, a JumpTo
-// continues at its slot, a Stop ends the mission there (the driver writes it as a DO_JUMP past the end, after
-// which the board holds by itself), and a do-command with no place after it never runs.
+// continues at its slot (and the do-commands after the place it lands on run at once, on the way to that place),
+// a Stop ends the mission there (the driver writes it as a DO_JUMP past the end, after which the board holds
+// by itself), and a do-command with no place after it never runs.
 #include <algorithm>
 #include <cstdint>
 #include <deque>
@@ -179,6 +180,7 @@ class SimAutopilot {
 
     // process_next_command() once `from` is reached: the next place, and the do-commands before it.
     void legacy_advance(std::size_t from) {
+        bool jumped = false;
         for (int guard = 0; guard < 8; ++guard) {
             std::size_t place = from + 1;
             while (place < slots_.size() && !is_place(slots_[place])) {
@@ -191,10 +193,7 @@ class SimAutopilot {
             std::optional<std::size_t> jump;
             for (std::size_t i = from + 1; i < place; ++i) {
                 if (slots_[i].kind == MissionItem::Kind::Stop) {
-                    ++stop_holds_;  // a DO_JUMP past the end: no commands left, HOLD where it is
-                    set_mode(VehicleState::Parking, ModeChangeCause::External);
-                    parked_ = true;
-                    current_ = kPastTheEnd;  // MISSION_CURRENT carries the jump's target, less one
+                    hold_past_the_end();
                     return;
                 }
                 if (slots_[i].kind == MissionItem::Kind::JumpTo) {
@@ -205,10 +204,29 @@ class SimAutopilot {
             if (!jump) {
                 current_ = static_cast<std::uint16_t>(place);
                 take_target();
+                if (jumped) {
+                    // After a jump the do-commands that follow the target's place run at once, on the way to
+                    // it: process_non_nav_command() clears the WAIT_COMMAND that the jump's own
+                    // process_next_command() had set (commands_process.pde), so the next call steps on.
+                    for (std::size_t i = place + 1; i < slots_.size() && !is_place(slots_[i]); ++i) {
+                        if (slots_[i].kind == MissionItem::Kind::Stop) {
+                            hold_past_the_end();
+                            return;
+                        }
+                    }
+                }
                 return;
             }
             from = *jump - 1;  // do_jump(): the processor carries on at the jump's target
+            jumped = true;
         }
+    }
+
+    void hold_past_the_end() {
+        ++stop_holds_;  // a DO_JUMP past the end: no commands left, HOLD where it is
+        set_mode(VehicleState::Parking, ModeChangeCause::External);
+        parked_ = true;
+        current_ = kPastTheEnd;  // MISSION_CURRENT carries the jump's target, less one
     }
 
     void end_of_mission() {
