@@ -217,7 +217,11 @@ void Driver::on_mission_current(std::uint16_t seq, TimePoint now) {
     switch (auto_check_.on_current(seq, now)) {
         case AutoEntryCheck::Verdict::Report:
             report_current(seq);
-            update_speed(now);
+            if (!mission_.empty() && seq > mission_.size()) {
+                restore_board_speed(now);  // a Stop sent as a jump past the end has run: the plan's end
+            } else {
+                update_speed(now);
+            }
             break;
         case AutoEntryCheck::Verdict::Suppress:
             break;
