@@ -93,8 +93,7 @@ void CommandDispatcher::dispatch(const Json& request, Role caller, Reply reply) 
         }
     }
     if (!entry) {
-        reply(
-            CommandResult::fail(CommandStatus::UnknownCommand, "unknown command '" + excerpt(name) + "'"));
+        reply(CommandResult::fail(CommandStatus::UnknownCommand, "unknown command '" + excerpt(name) + "'"));
         return;
     }
     if (entry->required == Role::Control && caller != Role::Control) {

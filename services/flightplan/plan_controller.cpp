@@ -784,9 +784,9 @@ TimePoint PlanController::poll_timeout() const {
 }
 
 PlanController::StatusKey PlanController::status_key(const FeederProgress& p) const {
-    return {p.state,         p.plan_name,        p.element,          p.waypoints_reached,
-            p.next_waypoint, p.window,           last_reaction_,     shown_interruption(p),
-            problem_,        p.held_at_frontier, p.frontier_stops,   p.frontier_wait};
+    return {p.state,         p.plan_name,        p.element,        p.waypoints_reached,
+            p.next_waypoint, p.window,           last_reaction_,   shown_interruption(p),
+            problem_,        p.held_at_frontier, p.frontier_stops, p.frontier_wait};
 }
 
 // The last interruption is news while its plan runs (and kept after the plan continued); a plan that has

@@ -23,9 +23,9 @@ struct Reached {
     std::uint64_t n = 0;  ///< the simulator's event number
     double t = 0;         ///< simulated seconds
     E7 at;
-    std::uint16_t seq = 0;    ///< the mission slot
-    double leg_s = 0;         ///< seconds in AUTO on the leg that ended here
-    double median_speed = 0;  ///< the car's median speed over them, m/s
+    std::uint16_t seq = 0;       ///< the mission slot
+    double leg_s = 0;            ///< seconds in AUTO on the leg that ended here
+    double median_speed = 0;     ///< the car's median speed over them, m/s
     std::uint16_t command = 16;  ///< the item's MAV_CMD
 };
 

@@ -46,8 +46,7 @@ class SystemPlan : public ::testing::Test {
             << bench->sim().json("reached 0 100").dump() << bench->logs();
         EXPECT_EQ(plan_section(*bench).value("waypoints_reached", 0u), expected.size());
         if (whole_log) {
-            expect_reached_in_order(
-                plan_waypoints_of(reached_log(bench->sim(), first_reached)), expected);
+            expect_reached_in_order(plan_waypoints_of(reached_log(bench->sim(), first_reached)), expected);
             if (HasFailure()) {
                 std::cout << bench->logs();
             }

@@ -58,7 +58,8 @@ double slowest_near(SimHarness& h, GeoPoint point, double radius, const std::fun
     return slowest;
 }
 
-// ---- arming ------------------------------------------------------------------------------------------------
+// ---- arming
+// ------------------------------------------------------------------------------------------------
 
 TEST(CurrentRoverArming, BootsDisarmedAndAutoStartsTheMissionButDrivesNothingUntilArmed) {
     SimHarness h;
@@ -295,7 +296,8 @@ TEST(CurrentRoverCornering, AZeroLengthNextLegStopsTheCarAtTheWaypointAStraightO
               0);
     h.set_mode(RoverMode::Auto);
     const double straight = slowest_near(
-        h, waypoint_point(waypoint(home, 80, 0)), 2.0, [&] { return h.sim.reached().size() >= 2; }, seconds(60));
+        h, waypoint_point(waypoint(home, 80, 0)), 2.0, [&] { return h.sim.reached().size() >= 2; },
+        seconds(60));
     EXPECT_NEAR(straight, 2.0, 0.05) << "straight on: no slowing";
 
     // The ring's wrap: the waypoint twice, then the jump back. The next leg after the first copy has no
@@ -307,7 +309,8 @@ TEST(CurrentRoverCornering, AZeroLengthNextLegStopsTheCarAtTheWaypointAStraightO
               0);
     r.set_mode(RoverMode::Auto);
     const double wrap = slowest_near(
-        r, waypoint_point(waypoint(home, 80, 0)), 2.0, [&] { return r.sim.reached().size() >= 3; }, seconds(60));
+        r, waypoint_point(waypoint(home, 80, 0)), 2.0, [&] { return r.sim.reached().size() >= 3; },
+        seconds(60));
     EXPECT_LT(wrap, 0.15) << "a full stop at the duplicated point";
     EXPECT_EQ(r.sim.state().current_seq, 1) << "then on through the jump";
     // Through the jump as well: the last item of the ring followed by a jump to an item at its place.
@@ -318,7 +321,8 @@ TEST(CurrentRoverCornering, AZeroLengthNextLegStopsTheCarAtTheWaypointAStraightO
               0);
     j.set_mode(RoverMode::Auto);
     const double through_jump = slowest_near(
-        j, waypoint_point(waypoint(home, 80, 0)), 2.0, [&] { return j.sim.reached().size() >= 3; }, seconds(60));
+        j, waypoint_point(waypoint(home, 80, 0)), 2.0, [&] { return j.sim.reached().size() >= 3; },
+        seconds(60));
     EXPECT_LT(through_jump, 0.15);
 }
 
@@ -333,11 +337,13 @@ TEST(CurrentRoverCornering, CornersAreTakenAtTheSpeedOfTheirArcAndAUturnOrTheLas
     h.set_mode(RoverMode::Auto);
     // 90°: an arc of WP_RADIUS / tan(45°) = 2 m at ATC_TURN_MAX_G 0.6 g: sqrt(5.88 * 2) = 3.4 m/s.
     const double corner = slowest_near(
-        h, waypoint_point(waypoint(home, 60, 0)), 2.5, [&] { return h.sim.reached().size() >= 1; }, seconds(60));
+        h, waypoint_point(waypoint(home, 60, 0)), 2.5, [&] { return h.sim.reached().size() >= 1; },
+        seconds(60));
     EXPECT_NEAR(corner, std::sqrt(0.6 * 9.80665 * 2.0), 0.2);
     // Back the way it came: a stop.
     const double uturn = slowest_near(
-        h, waypoint_point(waypoint(home, 60, 60)), 2.0, [&] { return h.sim.reached().size() >= 2; }, seconds(60));
+        h, waypoint_point(waypoint(home, 60, 60)), 2.0, [&] { return h.sim.reached().size() >= 2; },
+        seconds(60));
     EXPECT_LT(uturn, 0.15);
     ASSERT_TRUE(h.run_until([&] { return h.sim.state().mode == RoverMode::Hold; }, seconds(120)));
     EXPECT_LT(distance_m(h.sim.state().position, waypoint_point(waypoint(home, 120, 0))), 0.5)
@@ -384,7 +390,8 @@ TEST(CurrentRoverCornering, Rover2KeepsDrivingThroughAZeroLengthLeg) {
               0);
     h.set_mode_message(RoverMode::Auto);
     const double slowest = slowest_near(
-        h, waypoint_point(waypoint(home, 80, 0)), 2.0, [&] { return h.sim.reached().size() >= 3; }, seconds(60));
+        h, waypoint_point(waypoint(home, 80, 0)), 2.0, [&] { return h.sim.reached().size() >= 3; },
+        seconds(60));
     EXPECT_GT(slowest, 1.5);
 }
 

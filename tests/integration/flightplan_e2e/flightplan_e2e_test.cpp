@@ -505,13 +505,11 @@ TEST_P(FlightplanE2e, SkipPauseResumeAndAppendAreConfirmedByTheBoard) {
     std::vector<E7> rest(route.begin() + 20, route.end());
     rest.insert(rest.end(), extra.begin(), extra.end());
     for (std::size_t k = 0; k < rest.size(); ++k, ++i) {
-        ASSERT_LT(i, reached.size()) << "after the skip, #" << k << " of " << rest.size()
-                                     << " was never reached\n"
-                                     << describe_reached_around(
-                                            std::vector<Reached>(reached.begin() + static_cast<long>(i - k),
-                                                                 reached.end()),
-                                            rest, k)
-                                     << daemon_->err();
+        ASSERT_LT(i, reached.size())
+            << "after the skip, #" << k << " of " << rest.size() << " was never reached\n"
+            << describe_reached_around(
+                   std::vector<Reached>(reached.begin() + static_cast<long>(i - k), reached.end()), rest, k)
+            << daemon_->err();
         ASSERT_PRED2(same_place, reached[i].at, rest[k])
             << "after the skip, #" << k << "\n"
             << describe_reached_around(

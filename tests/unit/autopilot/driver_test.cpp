@@ -995,8 +995,8 @@ TEST(Driver, OnABoardSetByParameterItsOwnSpeedIsWrittenBackWhenThePlanEnds) {
 }
 
 // A board whose heartbeat says INITIALISING while the daemon holds it ready (the first heartbeats of a reboot
-// whose clock evidence has not come in yet) will take a mode once it is up: the request is "not ready", asked again later, never a refusal (the flight plan fails a plan whose AUTO
-// is refused).
+// whose clock evidence has not come in yet) will take a mode once it is up: the request is "not ready", asked
+// again later, never a refusal (the flight plan fails a plan whose AUTO is refused).
 TEST(Driver, AModeAskedWhileTheBoardSaysItIsBootingIsNotReadyRatherThanRefused) {
     Rig rig(apm2_config(), apm2_rover());
     rig.bring_up();

@@ -62,7 +62,7 @@ TEST(Utf8, TextFaultsNameTheByteAndAllowTabsAndLineEnds) {
 TEST(Utf8, AnExcerptEscapesAndCutsLongText) {
     EXPECT_EQ(excerpt("ok \xc3\xa0"), "ok \xc3\xa0");
     EXPECT_EQ(excerpt("a\xff\x01"
-                        "b"),
+                      "b"),
               "a\\xff\\x01b");
     const std::string huge(10'000'000, 'v');
     const auto shown = excerpt(huge);

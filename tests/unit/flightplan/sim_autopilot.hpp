@@ -8,9 +8,9 @@
 // when it became current; a rewritten waypoint leg restarts when the current navigation command or the next
 // two change, counted in restarts(), while a Stop being driven to stays until a set-current) and APM:Rover
 // 2.42-2.45 (`legacy`): once a place is reached the do-commands between it and the next place run, a JumpTo
-// continues at its slot (and the do-commands after the place it lands on run at once, on the way to that place),
-// a Stop ends the mission there (the driver writes it as a DO_JUMP past the end, after which the board holds
-// by itself), and a do-command with no place after it never runs.
+// continues at its slot (and the do-commands after the place it lands on run at once, on the way to that
+// place), a Stop ends the mission there (the driver writes it as a DO_JUMP past the end, after which the
+// board holds by itself), and a do-command with no place after it never runs.
 #include <algorithm>
 #include <cstdint>
 #include <deque>
