@@ -1,5 +1,6 @@
 #include "services/flightplan/plan_stream.hpp"
 
+#include <yaml-cpp/exceptions.h>
 #include <yaml-cpp/parser.h>
 
 #include <istream>

@@ -331,13 +331,13 @@ TEST_F(GcsEndpointE2e, ParameterListsFromAnotherStationBringBannersButNoReboot) 
     // Everything the station hears is read as it comes (the parameters follow each banner, and the board's
     // telemetry all the time), the banners counted.
     int banners = 0;
-    const auto listen = [&](std::chrono::milliseconds for_) {
+    const auto listen = [&](std::chrono::milliseconds span) {
         hear(
             [&](const mavlink::Frame& f) {
                 banners += banner(f) ? 1 : 0;
                 return false;
             },
-            for_);
+            span);
     };
     const double start = board_t();
     for (int request = 0; request < 20; ++request) {
