@@ -817,8 +817,15 @@ void WindowFeeder::request_succeeded(const FeederRequest& request, TimePoint now
 
 void WindowFeeder::handle_timeout(TimePoint now) {
     if (outstanding_ && now >= outstanding_->deadline) {
-        outstanding_.reset();
-        request_failed(now);
+        if (now - outstanding_->deadline > kLateWake && !outstanding_->read_grace) {
+            outstanding_->read_grace = true;
+            // Woken this late, the daemon itself was not running: the answer may be waiting to be read, and
+            // asking again now (a set-current above all) would undo what the board did since.
+            outstanding_->deadline = now + kReadGrace;
+        } else {
+            outstanding_.reset();
+            request_failed(now);
+        }
     }
     if (holding_ && hold_until_ && now >= *hold_until_) {
         end_hold(now);

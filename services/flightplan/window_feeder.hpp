@@ -119,6 +119,7 @@ class WindowFeeder {
     struct Outstanding {
         FeederRequest request;
         TimePoint deadline;
+        bool read_grace = false;  // the deadline was already put off once for a late wake
     };
     /// How far the vehicle can drive on what the autopilot holds, from the head: `entries` queue entries on
     /// board in ring order, then either their barrier (or a Stop entry) ends it, or a slot holding anything
@@ -130,6 +131,10 @@ class WindowFeeder {
     enum class Mode : std::uint8_t { Unknown, Auto, Hold, Manual };
 
     static constexpr std::uint16_t kFirstRingSlot = 2;
+    /// A request overdue by more than this when the feeder wakes was not answered because the daemon was not
+    /// running: it is given kReadGrace for the answers waiting in the port before it is asked again.
+    static constexpr Duration kLateWake = milliseconds(250);
+    static constexpr Duration kReadGrace = milliseconds(250);
     static constexpr std::uint16_t kWrapSlots = 3;
     /// W, the last ring position: slots K+1..K+3.
     std::uint16_t wrap_slot() const { return static_cast<std::uint16_t>(config_.window + 1); }

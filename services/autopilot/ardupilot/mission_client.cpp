@@ -358,6 +358,7 @@ void MissionClient::transmit(WorkItem& w, TimePoint now, bool retry) {
     w.retransmitted = retry;
     w.sent_at = now;
     w.deadline = now + current_timeout(w);
+    w.read_grace = false;
 }
 
 // Until the first RTT sample, Karn's rule: the timeout doubles with each retransmission, otherwise a link
@@ -402,6 +403,13 @@ void MissionClient::handle_timeout(TimePoint now) {
         return;
     }
     WorkItem& w = work_.front();
+    if (now - w.deadline > kLateWake && !w.read_grace) {
+        w.read_grace = true;
+        // Woken this late, the daemon itself was not running: the vehicle's answer may be waiting in the port.
+        // A resend now (a MISSION_SET_CURRENT above all) would take the vehicle back to a slot it has left.
+        w.deadline = now + kReadGrace;
+        return;
+    }
     const bool uploading = w.op == MissionOperation::Upload || w.op == MissionOperation::WritePartial;
     if (uploading && w.any_request && now - w.last_heard >= config_.vehicle_gives_up &&
         w.restarts < config_.retries) {
@@ -575,6 +583,7 @@ void MissionClient::on_request(std::uint16_t seq, bool as_int, TimePoint now) {
         ++stray_items_;
     }
     w.deadline = now + current_timeout(w);
+    w.read_grace = false;
 }
 
 void MissionClient::on_ack(std::uint8_t type, TimePoint now) {

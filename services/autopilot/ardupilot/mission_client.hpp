@@ -84,6 +84,10 @@ struct MissionClientStats {
 class MissionClient {
   public:
     static constexpr std::size_t kMaxQueued = 16;
+    /// A deadline found this late was missed because the daemon was not running: the answers waiting in the
+    /// port get kReadGrace to be read before anything is sent again (once per deadline).
+    static constexpr Duration kLateWake = milliseconds(250);
+    static constexpr Duration kReadGrace = milliseconds(250);
     /// Repeated requests for an item answered as MISSION_ITEM_INT before a board that never took one is
     /// answered with MISSION_ITEM instead (a lost frame makes one repeat; three mean it is not understood).
     static constexpr unsigned kIntRepeatsBeforeFallback = 3;
@@ -141,6 +145,7 @@ class MissionClient {
         bool any_request = false;    // upload: the vehicle asked for at least one item
         unsigned attempt = 0;        // retries of the current step
         TimePoint deadline = kNever;
+        bool read_grace = false;  // this deadline was already put off once for a late wake
         TimePoint sent_at{};
         bool retransmitted = false;  // Karn's rule: no RTT sample from a retransmission
         bool answer_int = true;      // reply form for the last request
