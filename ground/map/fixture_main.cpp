@@ -2,6 +2,7 @@
 // (tests/integration/ground_map). Prints "listening on http://127.0.0.1:PORT/" once it serves.
 //
 //   airseg-map-fixture [--control] [--seconds N] [--web-dir DIR] [--leaflet-dir DIR]
+// N (default 60): how long the vehicle drives and the event stream stays open, from the first browser connection.
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -101,6 +102,8 @@ int main(int argc, char** argv) {
     double along = 0.0;
     airseg::asio::steady_timer step(strand);
     airseg::asio::steady_timer end(strand);
+    airseg::asio::signal_set signals(io, SIGINT, SIGTERM);
+    bool end_armed = false;
     std::function<void()> drive = [&] {
         const auto [lat0, lon0] = route[leg % route.size()];
         const auto [lat1, lon1] = route[(leg + 1) % route.size()];
@@ -121,6 +124,19 @@ int main(int argc, char** argv) {
             along = 0.0;
             ++leg;
         }
+        if (!end_armed && map.connections_accepted() > 0) {
+            // The run is counted from the browser's first request: a browser slow to start (a loaded
+            // machine) finds the page served all the same.
+            end_armed = true;
+            end.expires_after(std::chrono::milliseconds(static_cast<long>(seconds * 1000)));
+            end.async_wait([&](boost::system::error_code ec) {
+                if (!ec) {
+                    step.cancel();
+                    map.stop();
+                    signals.cancel();
+                }
+            });
+        }
         step.expires_after(std::chrono::milliseconds(100));
         step.async_wait([&](boost::system::error_code ec) {
             if (!ec) {
@@ -128,14 +144,7 @@ int main(int argc, char** argv) {
             }
         });
     };
-    airseg::asio::signal_set signals(io, SIGINT, SIGTERM);
     airseg::asio::post(strand, drive);
-    end.expires_after(std::chrono::milliseconds(static_cast<long>(seconds * 1000)));
-    end.async_wait([&](boost::system::error_code) {
-        step.cancel();
-        map.stop();
-        signals.cancel();
-    });
     signals.async_wait([&](boost::system::error_code, int) {
         airseg::asio::post(strand, [&] {
             end.cancel();

@@ -197,6 +197,7 @@ struct MapServer::Impl : std::enable_shared_from_this<MapServer::Impl> {
     std::string web_dir;
     CommandSink sink;
     tcp::acceptor acceptor;
+    std::uint64_t accepted = 0;
     asio::steady_timer keepalive;
     bool running = false;
     std::set<std::shared_ptr<Session>> sessions;
@@ -449,6 +450,7 @@ void MapServer::Impl::accept() {
             return;
         }
         if (!ec) {
+            ++self->accepted;
             auto session = std::make_shared<Session>(self, std::move(socket));
             if (self->sessions.size() >= kMaxConnections) {
                 session->refuse_busy();  // kept alive by its write until the answer is out
@@ -554,6 +556,10 @@ std::uint16_t MapServer::port() const {
     boost::system::error_code ec;
     const auto endpoint = impl_->acceptor.local_endpoint(ec);
     return ec ? 0 : endpoint.port();
+}
+
+std::uint64_t MapServer::connections_accepted() const {
+    return impl_->accepted;
 }
 
 void MapServer::set_plan(const Json& geometry) {

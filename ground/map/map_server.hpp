@@ -48,6 +48,8 @@ class MapServer {
     void stop();
     /// The bound port.
     std::uint16_t port() const;
+    /// Browser connections accepted since start (read on the server's strand).
+    std::uint64_t connections_accepted() const;
 
     // Fed by the hub, on the strand:
     void set_plan(const nlohmann::json& geometry);  // the answer of plan.geometry

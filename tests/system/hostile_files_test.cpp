@@ -248,6 +248,14 @@ TEST_F(HostileFiles, AStoredPlanThatNoLongerLoadsIsSetAsideAtStart) {
     expect_restart_answers("a stored plan that no longer loads");
 }
 
+// Under a sanitizer or an emulator (AIRSEG_SLOWED_BUILD) the programs run several times slower, and beside
+// other suites on CI slower still: the time figures are printed there and checked in the shipped build.
+#ifdef AIRSEG_SLOWED_BUILD
+constexpr bool kSlowed = true;
+#else
+constexpr bool kSlowed = false;
+#endif
+
 std::string config_with(const std::string& extra) {
     return read_file(source_path("config/airseg.yaml")) + extra;
 }
@@ -261,14 +269,16 @@ void expect_config_refused(const std::string& config, const std::string& expecte
             argv.push_back("--check-config");
         }
         const auto started = std::chrono::steady_clock::now();
-        const auto r = run(argv, {}, 20s);
+        const auto r = run(argv, {}, kSlowed ? 120s : 20s);
         const double seconds = seconds_since(started);
         EXPECT_EQ(r.exit_code, 78) << config << (check ? " --check-config" : "") << "\n"
                                    << r.err.substr(0, 2000);
         EXPECT_NE(r.err.find(expected), std::string::npos) << r.err.substr(0, 2000);
         EXPECT_LT(r.err.size(), 16'384u) << config;
         EXPECT_LE(std::count(r.err.begin(), r.err.end(), '\n'), 52) << config;
-        EXPECT_LT(seconds, 10.0) << config;
+        if (!kSlowed) {
+            EXPECT_LT(seconds, 10.0) << config;  // printed below in every build, checked where it ships
+        }
         std::cout << "[ figures ] " << fs::path(config).filename().string()
                   << (check ? " --check-config" : " start") << ": exit " << r.exit_code << " in " << seconds
                   << " s, " << r.err.size() << " bytes of error\n";
@@ -308,12 +318,15 @@ TEST_F(HostileFiles, AConfigurationThatIsNotOneDocumentOfTextIsRefused) {
     expect_config_refused(dir.file("value.yaml"), "larger than the 1 MiB allowed");
     write_file(dir.file("long.yaml"), "log_level: " + std::string(1'000'000, 'x') + "\n");
     expect_config_refused(dir.file("long.yaml"), "… (1000000 bytes)");
+    // The field report's 100,000 keys; a fifth of them where every instruction is several times slower.
+    const int key_count = kSlowed ? 20'000 : 100'000;
     std::string keys;
-    for (int i = 0; i < 100'000; ++i) {
+    for (int i = 0; i < key_count; ++i) {
         keys += "k" + std::to_string(i) + ": 1\n";
     }
     write_file(dir.file("keys.yaml"), keys);
-    expect_config_refused(dir.file("keys.yaml"), "... and 99950 more errors");
+    expect_config_refused(dir.file("keys.yaml"),
+                          "... and " + std::to_string(key_count - 50) + " more errors");
 }
 
 // The field report: on SIGHUP a FIFO drop-in stopped the watchdog pings and SIGTERM; a directory was read as
