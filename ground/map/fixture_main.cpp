@@ -2,7 +2,8 @@
 // (tests/integration/ground_map). Prints "listening on http://127.0.0.1:PORT/" once it serves.
 //
 //   airseg-map-fixture [--control] [--seconds N] [--web-dir DIR] [--leaflet-dir DIR]
-// N (default 60): how long the vehicle drives and the event stream stays open, from the first browser connection.
+// N (default 60): how long the vehicle drives and the event stream stays open, from the first browser
+// connection.
 #include <cmath>
 #include <csignal>
 #include <cstdio>
