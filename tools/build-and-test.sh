@@ -33,7 +33,7 @@ cd "$(dirname "$0")/.."
 . tools/ci-lib.sh
 export AIRSEG_CI_LOGS=$PWD/build-logs
 mkdir -p "$AIRSEG_CI_LOGS"
-rm -f "$AIRSEG_CI_LOGS/stages.tsv"
+rm -f "$AIRSEG_CI_LOGS/stages.tsv" "$AIRSEG_CI_LOGS/failed.tsv"
 airseg_ccache_env "$PWD"
 stages=${AIRSEG_STAGES:-sanitize tidy fuzz tsan cross}
 jobs=$(nproc)
@@ -219,6 +219,7 @@ if has_stage tsan; then
     pids+=($!)
   done
   failed=0 t_passed=0 t_failed=0 t_skipped=0
+  : >build-tsan/logs/ctest-failed.txt
   for i in "${!pids[@]}"; do
     code=0
     wait "${pids[$i]}" || code=$?
@@ -231,6 +232,9 @@ if has_stage tsan; then
     n=$(sed -n 's/^\[  FAILED  \] \([0-9]*\) test.*/\1/p' "$log" | tail -n1); t_failed=$((t_failed + ${n:-0}))
     n=$(sed -n 's/^\[  SKIPPED \] \([0-9]*\) test.*/\1/p' "$log" | tail -n1); t_skipped=$((t_skipped + ${n:-0}))
     [ "$code" = 0 ] || [ -n "$(sed -n 's/^\[  FAILED  \] \([0-9]*\) test.*/\1/p' "$log")" ] || t_failed=$((t_failed + 1))
+    # The failed cases' names (GoogleTest's list after its "listed below"), or the executable when it died.
+    sed -n 's/^\[  FAILED  \] \([A-Za-z_][^ ,]*\.[^ ,]*\)\(,.*\)\{0,1\}$/\1/p' "$log" | sort -u >>build-tsan/logs/ctest-failed.txt
+    [ "$code" = 0 ] || grep -q "^\[  FAILED  \]" "$log" || echo "${tsan_targets[$i]} (exit $code)" >>build-tsan/logs/ctest-failed.txt
   done
   echo "passed=$t_passed failed=$t_failed skipped=$t_skipped reruns=" >build-tsan/logs/summary.txt
   elapsed "tsan: the concurrency tests, whole, at once" "$start" build-tsan/logs/summary.txt

@@ -48,7 +48,8 @@ ccache_stage_rate() {
 }
 
 # record_stage NAME WALL_SECONDS [SUMMARY_FILE] [CCACHE_STAGE]: one row of the closing table. SUMMARY_FILE is
-# a ctest-summary.txt from tools/run-ctest.sh ("passed=N failed=N skipped=N reruns=A,B").
+# a ctest-summary.txt from tools/run-ctest.sh ("passed=N failed=N skipped=N reruns=A,B"); the ctest-failed.txt
+# beside it (a failed case's name per line) goes to the list of failed cases printed under the table.
 record_stage() {
   local name=$1 wall=$2 summary=${3:-} cstage=${4:-} passed=- failed=- skipped=- reruns=- rate=-
   if [ -n "$summary" ] && [ -f "$summary" ]; then
@@ -62,11 +63,15 @@ record_stage() {
   fi
   [ -z "$cstage" ] || rate=$(ccache_stage_rate "$cstage")
   mkdir -p "$AIRSEG_CI_LOGS"
+  if [ -n "$summary" ] && [ -s "$(dirname "$summary")/ctest-failed.txt" ]; then
+    sed "s/^/$name\t/" "$(dirname "$summary")/ctest-failed.txt" >>"$AIRSEG_CI_LOGS/failed.tsv"
+  fi
   printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "$wall" "$passed" "$failed" "$skipped" "$rate" "$reruns" \
     >>"$AIRSEG_CI_LOGS/stages.tsv"
 }
 
-# print_stage_table TOTAL_SECONDS: the table of every recorded stage, then one plain line of test counts.
+# print_stage_table TOTAL_SECONDS: the table of every recorded stage, one plain line of test counts, then each
+# failed case with its stage (the end of the log is what a reader of a failed run sees first).
 print_stage_table() {
   local table="$AIRSEG_CI_LOGS/stages.tsv" p=0 f=0 s=0
   [ -f "$table" ] || return 0
@@ -84,4 +89,7 @@ print_stage_table() {
     [[ "$skipped" =~ ^[0-9]+$ ]] && s=$((s + skipped))
   done <"$table"
   echo "tests: $p passed, $f failed, $s skipped"
+  [ -s "$AIRSEG_CI_LOGS/failed.tsv" ] || return 0
+  awk -F'\t' '{ n[$1]++; if (n[$1] <= 20) print "failed: " $1 ": " $2; else if (n[$1] == 21) print "failed: " $1 ": (more in its log)" }' \
+    "$AIRSEG_CI_LOGS/failed.tsv"
 }

@@ -9,7 +9,8 @@
 #     case is ever rerun, whatever the file says.
 #   - With AIRSEG_TEST_LOCK set, it waits for that lock first and runs at nice 0 (CI's side-by-side ARM
 #     builds: one suite at a time, or AIRSEG_SUITES_AT_ONCE, never behind a compile).
-#   - BUILD_DIR/ctest-summary.txt gets "passed=N failed=N skipped=N reruns=NAME,NAME", read by the table at
+#   - BUILD_DIR/ctest-summary.txt gets "passed=N failed=N skipped=N reruns=NAME,NAME", and
+#     BUILD_DIR/ctest-failed.txt the name of each case that failed, one per line; both are read by the table at
 #     the end of CI's log.
 # CTEST_ARGS go to every ctest run (e.g. -j8 --timeout 600 --exclude-regex ...). Exit status: 0 when every case
 # passed (a rerun one included), 1 otherwise.
@@ -41,13 +42,14 @@ junit_failed() { sed -n 's/^[[:space:]]*<testcase name="\([^"]*\)".* status="fai
 regex_quote() { sed 's/[][\.*^$+?(){}|]/\\&/g'; }
 
 first="$dir/ctest-attempt-1.xml"
-rm -f "$dir"/ctest-attempt-*.xml "$dir/ctest-summary.txt"
+rm -f "$dir"/ctest-attempt-*.xml "$dir/ctest-summary.txt" "$dir/ctest-failed.txt"
 code=0
 # A suite that finds no test at all is a failure, not a pass.
 ctest --test-dir "$dir" --output-on-failure --no-tests=error --output-junit "$first" "$@" || code=$?
 if [ ! -f "$first" ]; then
   echo "ctest: no result file (ctest exit $code)" >&2
   echo "passed=0 failed=? skipped=0 reruns=" >"$dir/ctest-summary.txt"
+  echo "(no result file: ctest exit $code)" >"$dir/ctest-failed.txt"
   exit 1
 fi
 total=$(junit_field "$first" tests)
@@ -92,6 +94,7 @@ n_failed=${#final_failed[@]}
 passed=$((total - skipped - n_failed))
 [ "$passed" -ge 0 ] || passed=0
 echo "passed=$passed failed=$n_failed skipped=$skipped reruns=$(IFS=,; echo "${reruns[*]}")" >"$dir/ctest-summary.txt"
+[ "$n_failed" = 0 ] || printf '%s\n' "${final_failed[@]}" >"$dir/ctest-failed.txt"
 echo "ctest: $passed passed, $n_failed failed, $skipped skipped"
 [ ${#reruns[@]} = 0 ] || echo "ctest: ${#reruns[@]} of them passed only on a rerun: ${reruns[*]}"
 for name in "${final_failed[@]}"; do
