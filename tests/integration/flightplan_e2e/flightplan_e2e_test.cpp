@@ -313,8 +313,13 @@ TEST_P(FlightplanE2e, LongScanRunsToTheEndWithEveryWaypointReachedOnceInOrderAnd
         std::cout << "[ figures ] " << GetParam() << ": " << plan.value("frontier_stops", 0u)
                   << " waits at the frontier (slowed build), " << holds.size() << " HOLDs\n";
     } else {
+        // Not starved, the feeder never falls behind: no wait at the frontier, no time lost to one.
         EXPECT_TRUE(holds.empty()) << holds.dump() << plan.dump();
+        EXPECT_EQ(plan.value("frontier_stops", 0u), 0u) << plan.dump();
+        EXPECT_EQ(plan.value("frontier_wait_s", 0.0), 0.0) << plan.dump();
     }
+    std::cout << "[ figures ] " << GetParam() << ": long scan, " << plan.value("frontier_stops", 0u)
+              << " stops at the frontier, " << plan.value("frontier_wait_s", 0.0) << " s lost to them\n";
     EXPECT_EQ(control_->json("state")["mode"], mode_after_the_end());
 }
 
@@ -818,9 +823,15 @@ TEST_P(FlightplanSurveyE2e,
     }
     const double actual = done_at - reached[0].t - held;
     const auto restarts = control_->json("stats").value("auto_restarts", 0);
+    const auto plan = show();
     std::cout << "[ figures ] " << GetParam() << ": survey, " << legs.size() << " waypoints, " << actual
               << " s driving (simulated), ideal " << ideal << " s (" << 100.0 * (actual - ideal) / ideal
-              << " %), " << held << " s held, " << restarts << " restarted commands\n";
+              << " %), " << held << " s held, " << restarts << " restarted commands, "
+              << plan.value("frontier_stops", 0u) << " stops at the frontier ("
+              << plan.value("frontier_wait_s", 0.0) << " s)\n";
+    if (!kSlowed) {
+        EXPECT_EQ(plan.value("frontier_stops", 0u), 0u) << plan.dump();
+    }
     if (GetParam() == "rover2") {
         EXPECT_NEAR(actual, ideal, 0.05 * ideal);
         return;
@@ -836,12 +847,12 @@ TEST_P(FlightplanSurveyE2e,
 }
 
 // Current Rover boots disarmed (ARMING_REQUIRE 1): the daemon arms it when the plan starts, never forcing,
-// and a board that will not arm (no GPS fix: no position estimate) fails the plan in its own words.
-TEST_P(FlightplanE2e,
+// and a board that will not arm (no GPS fix: no position estimate) fails the plan in its own words. Run on
+// the current profile only: APM:Rover 2.x is armed from boot and has no arming to refuse.
+class FlightplanArmingE2e : public FlightplanE2e {};
+
+TEST_P(FlightplanArmingE2e,
        APlanOnABoardThatNeedsArmingIsArmedByTheDaemonAndARefusalFailsThePlanWithTheBoardsReason) {
-    if (GetParam() == "rover2") {
-        GTEST_SKIP() << "APM:Rover 2.x is armed from boot";
-    }
     start_daemon(10);
     EXPECT_EQ(status()["autopilot"].value("armed", Json()), Json(false));
     const auto a = write_plan("a.yaml", line_plan("armed", kHomeLat, kHomeLon + 0.0001, 0, 4, 10));
@@ -1030,11 +1041,97 @@ TEST_P(FlightplanStarvedE2e, AStarvedDaemonStopsTheVehicleAtTheFrontierAndNeverL
     }
 }
 
+// The example survey under the same starvation: its timed photo stop, orbit, patrol loop and the operator's
+// hold (released here) between the writes the starved feeder makes. The photo stop is cut from 20 s to 2 s
+// (it is timed by the daemon in real time and only lengthens each run); the route is the example's.
+class FlightplanStarvedSurveyE2e : public FlightplanE2e {
+  protected:
+    int speedup() const override { return kSurveySpeedup; }
+};
+
+TEST_P(FlightplanStarvedSurveyE2e, AStarvedDaemonDrivesTheExampleSurveyInOrderAndNothingElse) {
+    const char* runs_env = std::getenv("AIRSEG_STARVE_RUNS");
+    const char* seed_env = std::getenv("AIRSEG_STARVE_SEED");
+    const int runs = runs_env != nullptr ? std::max(1, std::atoi(runs_env)) : 1;
+    const unsigned first_seed = seed_env != nullptr ? static_cast<unsigned>(std::atoi(seed_env)) : 1u;
+    std::string text = read_file(source_path("config/plans/rover-survey.yaml"));
+    const std::string photo = "hold: {name: photo-stop, seconds: 20}";
+    const auto at = text.find(photo);
+    ASSERT_NE(at, std::string::npos) << "the example survey's photo stop moved";
+    text.replace(at, photo.size(), "hold: {name: photo-stop, seconds: 2}");
+    const auto file = write_plan("survey.yaml", text);
+    const auto legs = legs_of(file);
+    ASSERT_GT(legs.size(), 30u);
+    std::vector<E7> expected;
+    for (const auto& l : legs) {
+        expected.push_back(l.to);
+    }
+    start_daemon(5);
+    for (int run = 0; run < runs; ++run) {
+        const unsigned seed = first_seed + static_cast<unsigned>(run);
+        const auto first = reached_total(*control_);
+        const auto before = show();
+        auto load = ctl({"plan", "load", file});
+        ASSERT_EQ(load.exit_code, 0) << load.json.dump() << load.err;
+        Starver starver(daemon_->pid(), seed);
+        ASSERT_TRUE(
+            wait_until([&] { return show().value("element", "").find("elements[7]") != std::string::npos; },
+                       240s, kPoll))
+            << "seed " << seed << " " << show().dump() << daemon_->err();
+        ASSERT_TRUE(wait_until([&] { return control_->json("state")["mode"] == "HOLD"; }, 120s, kPoll))
+            << "seed " << seed;
+        auto released = ctl({"plan", "resume"});
+        ASSERT_EQ(released.exit_code, 0) << released.json.dump() << released.err;
+        ASSERT_TRUE(wait_until([&] { return show().value("state", "") == "done"; }, 240s, kPoll))
+            << "seed " << seed << " " << show().dump() << daemon_->err();
+        starver.stop();
+        const auto all = reached_log(*control_, first);
+        const auto reached = plan_waypoints_of(all);
+        std::size_t same = 0;
+        while (same < reached.size() && same < expected.size() &&
+               same_place(reached[same].at, expected[same])) {
+            ++same;
+        }
+        ASSERT_GE(reached.size(), expected.size())
+            << "seed " << seed << ": every waypoint, in order; the first that is not:\n"
+            << describe_reached_around(reached, expected, same) << daemon_->err();
+        for (std::size_t i = 0; i < expected.size(); ++i) {
+            ASSERT_PRED2(same_place, reached[i].at, expected[i])
+                << "seed " << seed << ": reached #" << i << " is not plan waypoint " << i << "\n"
+                << describe_reached_around(reached, expected, i);
+        }
+        // After the end only the last waypoint again (a board that takes the Stop for a plain waypoint may
+        // reach its copies before its HOLD lands), and every Stop reached at a plan waypoint.
+        for (std::size_t i = expected.size(); i < reached.size(); ++i) {
+            EXPECT_PRED2(same_place, reached[i].at, expected.back()) << "seed " << seed << ": after the end";
+        }
+        for (const auto& r : all) {
+            if (r.command == 17) {
+                EXPECT_TRUE(std::any_of(expected.begin(), expected.end(),
+                                        [&](const E7& e) { return same_place(r.at, e); }))
+                    << "seed " << seed << ": stopped at " << r.at.first << "," << r.at.second;
+            }
+        }
+        const auto plan = show();
+        const auto stops = plan.value("frontier_stops", 0) - before.value("frontier_stops", 0);
+        const double waited = plan.value("frontier_wait_s", 0.0) - before.value("frontier_wait_s", 0.0);
+        std::cout << "[ figures ] " << GetParam() << " survey seed " << seed << ": " << starver.pauses()
+                  << " pauses of the daemon, " << starver.paused_s() << " s stopped; " << stops
+                  << " stops at the frontier, " << waited << " s waited there\n";
+        EXPECT_GT(starver.pauses(), 0);
+        EXPECT_EQ(plan.value("starvation_holds", 0), 0) << plan.dump();
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(Firmware, FlightplanE2e, ::testing::Values("modern", "rover2"),
+                         [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
+INSTANTIATE_TEST_SUITE_P(Firmware, FlightplanArmingE2e, ::testing::Values("modern"),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
 INSTANTIATE_TEST_SUITE_P(Firmware, FlightplanSurveyE2e, ::testing::Values("modern", "rover2"),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
 INSTANTIATE_TEST_SUITE_P(Firmware, FlightplanStarvedE2e, ::testing::Values("modern", "rover2"),
+                         [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
+INSTANTIATE_TEST_SUITE_P(Firmware, FlightplanStarvedSurveyE2e, ::testing::Values("modern", "rover2"),
                          [](const ::testing::TestParamInfo<std::string>& p) { return p.param; });
 
 }  // namespace
