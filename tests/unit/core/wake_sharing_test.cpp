@@ -162,15 +162,18 @@ TEST(TimerWakeUps, ADeadlineMovedLaterPastAnotherNoLongerWakesAtItsOldInstant) {
     asio::steady_timer other(io);
     const TimePoint start = SteadyClock::now();
     int fired = 0;
-    timer.arm(start + milliseconds(20), [&] { ++fired; });
-    other.expires_at(start + milliseconds(70));
+    // Deadlines 100 ms apart: under qemu-arm beside a loaded suite, setting up took more than the 20 ms
+    // this case once allowed, and a wake-up already due at io.run() is no sleep to count.
+    timer.arm(start + milliseconds(100), [&] { ++fired; });
+    other.expires_at(start + milliseconds(350));
     other.async_wait([](const boost::system::error_code&) {});
-    timer.arm(start + milliseconds(120), [&] { ++fired; });
+    timer.arm(start + milliseconds(600), [&] { ++fired; });
     const auto before = voluntary_switches();
+    ASSERT_LT(SteadyClock::now(), start + milliseconds(350)) << "set up too slowly to count the sleeps";
     io.run();
     EXPECT_EQ(fired, 1);
-    EXPECT_GE(SteadyClock::now(), start + milliseconds(120));
-    // Asleep until the other timer, then until the new deadline; not also at +20 ms.
+    EXPECT_GE(SteadyClock::now(), start + milliseconds(600));
+    // Asleep until the other timer, then until the new deadline; not also at +100 ms.
     EXPECT_EQ(voluntary_switches() - before, 2);
 }
 
@@ -183,15 +186,17 @@ TEST(TimerWakeUps, ASlackTimerRunAtAnotherWakeUpLeavesNoWakeUpAtItsDeadline) {
     asio::steady_timer end(io);
     const TimePoint start = SteadyClock::now();
     int ran = 0;
-    tick.arm(start + milliseconds(10), milliseconds(60), [&] { ++ran; });
-    input.expires_at(start + milliseconds(20));
+    // As above, 100 ms apart or more.
+    tick.arm(start + milliseconds(50), milliseconds(300), [&] { ++ran; });
+    input.expires_at(start + milliseconds(100));
     input.async_wait([&](const boost::system::error_code&) { sharing.woke(SteadyClock::now()); });
-    end.expires_at(start + milliseconds(150));
+    end.expires_at(start + milliseconds(750));
     end.async_wait([](const boost::system::error_code&) {});
     const auto before = voluntary_switches();
+    ASSERT_LT(SteadyClock::now(), start + milliseconds(100)) << "set up too slowly to count the sleeps";
     io.run();
     EXPECT_EQ(ran, 1);
-    // Asleep until the input, then until the end; not also at the tick's own deadline (+70 ms).
+    // Asleep until the input, then until the end; not also at the tick's own deadline (+350 ms).
     EXPECT_EQ(voluntary_switches() - before, 2);
 }
 

@@ -11,6 +11,8 @@
 namespace airseg::groundlink {
 namespace {
 
+constexpr std::uint64_t kSeedGroups = 6;
+
 using namespace std::chrono_literals;
 
 struct Sent {
@@ -135,17 +137,23 @@ void run_seed(std::uint64_t seed) {
     EXPECT_GT(s.replays + s.mac_failures + s.crc_errors + s.framing_errors, 0U) << "seed " << seed;
 }
 
-TEST(GroundlinkTransportProperty, SafeExactlyOnceInOrderUnderRandomImpairments) {
+// The seeds in six cases of their own (seed k in case (k - 1) mod 6): under qemu-arm on armel, with no FPU
+// and the rest of the suite beside it, the 24 seeds as one case ran past its 60-s limit.
+class GroundlinkTransportProperty : public ::testing::TestWithParam<std::uint64_t> {};
+
+TEST_P(GroundlinkTransportProperty, SafeExactlyOnceInOrderUnderRandomImpairments) {
     // AIRSEG_PROPERTY_SEEDS=n runs more seeds (the default keeps the suite fast).
     const char* env = std::getenv("AIRSEG_PROPERTY_SEEDS");
     const std::uint64_t seeds = env != nullptr ? std::strtoull(env, nullptr, 10) : 24;
-    for (std::uint64_t seed = 1; seed <= seeds; ++seed) {
+    for (std::uint64_t seed = 1 + GetParam(); seed <= seeds; seed += kSeedGroups) {
         run_seed(seed);
         if (HasFatalFailure()) {
             return;
         }
     }
 }
+
+INSTANTIATE_TEST_SUITE_P(Seeds, GroundlinkTransportProperty, ::testing::Range<std::uint64_t>(0, kSeedGroups));
 
 }  // namespace
 }  // namespace airseg::groundlink
