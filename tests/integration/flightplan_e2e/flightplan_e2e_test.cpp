@@ -815,7 +815,15 @@ TEST_P(FlightplanSurveyE2e,
         const double until = i + 1 < modes.size() ? modes[i + 1]["t"].get<double>() : done_at;
         held += until - t;
     }
-    EXPECT_EQ(holds, 2) << modes.dump();
+    // Under a sanitizer or an emulator beside other suites the daemon may fall behind a board at speedup 100:
+    // the vehicle then waits at the frontier (a HOLD on 2.x), and every such wait must be one it counted.
+    const auto counted = show().value("frontier_stops", 0);
+    if (kSlowed) {
+        EXPECT_GE(holds, 2) << modes.dump();
+        EXPECT_LE(holds, 2 + counted) << modes.dump();
+    } else {
+        EXPECT_EQ(holds, 2) << modes.dump();
+    }
     // Ideal: each leg at its speed (the first leg from wherever the vehicle started is not counted).
     double ideal = 0;
     for (std::size_t i = 1; i < legs.size(); ++i) {
@@ -1074,9 +1082,12 @@ TEST_P(FlightplanStarvedSurveyE2e, AStarvedDaemonDrivesTheExampleSurveyInOrderAn
         auto load = ctl({"plan", "load", file});
         ASSERT_EQ(load.exit_code, 0) << load.json.dump() << load.err;
         Starver starver(daemon_->pid(), seed);
-        ASSERT_TRUE(
-            wait_until([&] { return show().value("element", "").find("elements[7]") != std::string::npos; },
-                       240s, kPoll))
+        // The element shown is null between plans (the previous run's end, this one's start).
+        const auto at_operator_check = [&] {
+            const auto element = show()["element"];
+            return element.is_string() && element.get<std::string>().find("elements[7]") != std::string::npos;
+        };
+        ASSERT_TRUE(wait_until(at_operator_check, 240s, kPoll))
             << "seed " << seed << " " << show().dump() << daemon_->err();
         ASSERT_TRUE(wait_until([&] { return control_->json("state")["mode"] == "HOLD"; }, 120s, kPoll))
             << "seed " << seed;
