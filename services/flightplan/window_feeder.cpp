@@ -239,7 +239,6 @@ void WindowFeeder::start_fresh(TimePoint now) {
     }
     left_frontier(now);
     queue_.clear();
-    retake_.reset();
     fresh_slot_ = first_slot;
     need_set_current_ = true;
     repoint_only_ = false;
@@ -279,7 +278,6 @@ void WindowFeeder::continue_with(PlanFeed feed, TimePoint now) {
 void WindowFeeder::clear_plan() {
     stream_.reset();
     queue_.clear();
-    retake_.reset();
     holds_.clear();
     holding_ = false;
     hold_until_.reset();
@@ -598,11 +596,10 @@ void WindowFeeder::on_current(std::uint16_t slot, TimePoint now) {
                 if (retake && !frontier_since_) {
                     // The slot held a barrier until lately, and nothing says whether the board got there
                     // before or after the write: pointing it at the slot it reports takes what the slot
-                    // holds now. Not at once: a report read late says where the vehicle was, and by then it
-                    // may have reached the slot and left it. If it still heads there after the grace, it has
-                    // not left the slot and drives nothing twice.
+                    // holds now (it drives nothing twice: it has not left the slot).
                     written_over_stop_[slot] = false;
-                    retake_ = Retake{slot, now + kRetakeGrace};
+                    need_set_current_ = true;
+                    repoint_only_ = true;
                 }
                 return;
             }
@@ -789,7 +786,6 @@ void WindowFeeder::request_succeeded(const FeederRequest& request, TimePoint now
     if (const auto* up = std::get_if<autopilot::UploadMission>(&request.op)) {
         std::fill(confirmed_.begin(), confirmed_.end(), std::nullopt);
         std::fill(written_over_stop_.begin(), written_over_stop_.end(), false);
-        retake_.reset();
         for (std::size_t i = 0; i < up->items.size() && i + 1 < confirmed_.size(); ++i) {
             confirmed_[i + 1] = up->items[i];
         }
@@ -834,20 +830,6 @@ void WindowFeeder::handle_timeout(TimePoint now) {
     if (holding_ && hold_until_ && now >= *hold_until_) {
         end_hold(now);
         check_done();
-    }
-    if (retake_ && now >= retake_->due) {
-        if (now - retake_->due > kLateWake && !retake_->read_grace) {
-            retake_->read_grace = true;  // the reports that came meanwhile are read first
-            retake_->due = now + kReadGrace;
-        } else {
-            const std::uint16_t slot = retake_->slot;
-            retake_.reset();
-            if (!queue_.empty() && queue_[0].slot == slot && ap_target_ == slot && !need_set_current_ &&
-                !frontier_since_ && !starving_) {
-                need_set_current_ = true;
-                repoint_only_ = true;
-            }
-        }
     }
 }
 
@@ -1009,9 +991,6 @@ TimePoint WindowFeeder::poll_timeout() const {
     }
     if (fault_ && retry_not_before_ != TimePoint::min()) {
         t = std::min(t, retry_not_before_);
-    }
-    if (retake_) {
-        t = std::min(t, retake_->due);
     }
     return t;
 }

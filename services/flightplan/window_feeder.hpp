@@ -200,16 +200,6 @@ class WindowFeeder {
     // Slots where an entry replaced a barrier while the entry before it was not yet seen reached: a board
     // that got there first drives (or waits at) its copy of the Stop, whatever the slot holds now.
     std::vector<bool> written_over_stop_;
-    /// The board reported heading for such a slot: pointed at it again (to take what the slot holds now) only
-    /// if, kRetakeGrace later, it still does and the slot is still the head. Pointed at once, a report read
-    /// late (a busy or stopped daemon) sent the vehicle back to a slot it had reached and left.
-    struct Retake {
-        std::uint16_t slot = 0;
-        TimePoint due;
-        bool read_grace = false;  // put off once already for a late wake
-    };
-    static constexpr Duration kRetakeGrace = milliseconds(250);
-    std::optional<Retake> retake_;
     std::optional<std::uint16_t> ap_target_;  // the slot the autopilot is believed to head for
     bool need_set_current_ = false;
     std::optional<std::uint16_t> old_target_;  // after a fresh start: the target the vehicle had, kept apart
