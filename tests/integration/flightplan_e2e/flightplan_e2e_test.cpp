@@ -988,7 +988,55 @@ class Starver {
 // holds) while the board drives a scan. The vehicle waits at the last waypoint written and goes on once the
 // writes land: every plan waypoint reached once and in order, and nothing else reached, ever.
 // AIRSEG_STARVE_RUNS repeats the case (default 1) and AIRSEG_STARVE_SEED picks the first seed.
-class FlightplanStarvedE2e : public FlightplanE2e {};
+class FlightplanStarvedE2e : public FlightplanE2e {
+  protected:
+    /// One starved run, from the simulator's reached log from event `first` on: every plan waypoint reached
+    /// once and in order, then nothing (`exact`) or only the last one again (a board that takes the Stop for
+    /// a plain waypoint may reach its copies before its HOLD lands); every Stop reached at a plan waypoint.
+    /// The run's figures are printed under `what`.
+    void judge_starved_run(const std::string& what, unsigned seed, const std::vector<E7>& expected,
+                           std::uint64_t first, const Json& before, const Starver& starver, bool exact) {
+        const auto all = reached_log(*control_, first);
+        const auto reached = plan_waypoints_of(all);
+        std::size_t same = 0;
+        while (same < reached.size() && same < expected.size() &&
+               same_place(reached[same].at, expected[same])) {
+            ++same;
+        }
+        if (exact) {
+            ASSERT_EQ(reached.size(), expected.size())
+                << "seed " << seed << ": every waypoint once, nothing else; the first that is not:\n"
+                << describe_reached_around(reached, expected, same) << daemon_->err();
+        } else {
+            ASSERT_GE(reached.size(), expected.size())
+                << "seed " << seed << ": every waypoint, in order; the first that is not:\n"
+                << describe_reached_around(reached, expected, same) << daemon_->err();
+        }
+        for (std::size_t i = 0; i < expected.size(); ++i) {
+            ASSERT_PRED2(same_place, reached[i].at, expected[i])
+                << "seed " << seed << ": reached #" << i << " is not plan waypoint " << i << "\n"
+                << describe_reached_around(reached, expected, i);
+        }
+        for (std::size_t i = expected.size(); i < reached.size(); ++i) {
+            EXPECT_PRED2(same_place, reached[i].at, expected.back()) << "seed " << seed << ": after the end";
+        }
+        for (const auto& r : all) {
+            if (r.command == 17) {
+                EXPECT_TRUE(std::any_of(expected.begin(), expected.end(),
+                                        [&](const E7& e) { return same_place(r.at, e); }))
+                    << "seed " << seed << ": stopped at " << r.at.first << "," << r.at.second;
+            }
+        }
+        const auto plan = show();
+        const auto stops = plan.value("frontier_stops", 0) - before.value("frontier_stops", 0);
+        const double waited = plan.value("frontier_wait_s", 0.0) - before.value("frontier_wait_s", 0.0);
+        std::cout << "[ figures ] " << GetParam() << what << " seed " << seed << ": " << starver.pauses()
+                  << " pauses of the daemon, " << starver.paused_s() << " s stopped; " << stops
+                  << " stops at the frontier, " << waited << " s waited there\n";
+        EXPECT_GT(starver.pauses(), 0);
+        EXPECT_EQ(plan.value("starvation_holds", 0), 0) << plan.dump();
+    }
+};
 
 TEST_P(FlightplanStarvedE2e, AStarvedDaemonStopsTheVehicleAtTheFrontierAndNeverLetsItDriveAStalePoint) {
     const char* runs_env = std::getenv("AIRSEG_STARVE_RUNS");
@@ -1015,44 +1063,17 @@ TEST_P(FlightplanStarvedE2e, AStarvedDaemonStopsTheVehicleAtTheFrontierAndNeverL
         starver.stop();
         ASSERT_TRUE(wait_until([&] { return show().value("state", "") == "done"; }, kGenerous, kPoll))
             << "seed " << seed << " " << show().dump();
-        const auto all = reached_log(*control_, first);
-        const auto reached = plan_waypoints_of(all);
-        std::size_t same = 0;
-        while (same < reached.size() && same < expected.size() &&
-               same_place(reached[same].at, expected[same])) {
-            ++same;
+        judge_starved_run("", seed, expected, first, before, starver, true);
+        if (HasFatalFailure()) {
+            return;
         }
-        ASSERT_EQ(reached.size(), expected.size())
-            << "seed " << seed << ": every waypoint once, nothing else; the first that is not:\n"
-            << describe_reached_around(reached, expected, same) << daemon_->err();
-        for (std::size_t i = 0; i < expected.size(); ++i) {
-            ASSERT_PRED2(same_place, reached[i].at, expected[i])
-                << "seed " << seed << ": reached #" << i << " is not plan waypoint " << i << "\n"
-                << describe_reached_around(reached, expected, i);
-        }
-        // Where it waited (a Stop reached), it waited at a plan waypoint.
-        for (const auto& r : all) {
-            if (r.command == 17) {
-                EXPECT_TRUE(std::any_of(expected.begin(), expected.end(),
-                                        [&](const E7& e) { return same_place(r.at, e); }))
-                    << "seed " << seed << ": stopped at " << r.at.first << "," << r.at.second;
-            }
-        }
-        const auto plan = show();
-        const auto stops = plan.value("frontier_stops", 0) - before.value("frontier_stops", 0);
-        const double waited = plan.value("frontier_wait_s", 0.0) - before.value("frontier_wait_s", 0.0);
-        std::cout << "[ figures ] " << GetParam() << " seed " << seed << ": " << starver.pauses()
-                  << " pauses of the daemon, " << starver.paused_s() << " s stopped; " << stops
-                  << " stops at the frontier, " << waited << " s waited there\n";
-        EXPECT_GT(starver.pauses(), 0);
-        EXPECT_EQ(plan.value("starvation_holds", 0), 0) << plan.dump();
     }
 }
 
 // The example survey under the same starvation: its timed photo stop, orbit, patrol loop and the operator's
 // hold (released here) between the writes the starved feeder makes. The photo stop is cut from 20 s to 2 s
 // (it is timed by the daemon in real time and only lengthens each run); the route is the example's.
-class FlightplanStarvedSurveyE2e : public FlightplanE2e {
+class FlightplanStarvedSurveyE2e : public FlightplanStarvedE2e {
   protected:
     int speedup() const override { return kSurveySpeedup; }
 };
@@ -1096,41 +1117,10 @@ TEST_P(FlightplanStarvedSurveyE2e, AStarvedDaemonDrivesTheExampleSurveyInOrderAn
         ASSERT_TRUE(wait_until([&] { return show().value("state", "") == "done"; }, 240s, kPoll))
             << "seed " << seed << " " << show().dump() << daemon_->err();
         starver.stop();
-        const auto all = reached_log(*control_, first);
-        const auto reached = plan_waypoints_of(all);
-        std::size_t same = 0;
-        while (same < reached.size() && same < expected.size() &&
-               same_place(reached[same].at, expected[same])) {
-            ++same;
+        judge_starved_run(" survey", seed, expected, first, before, starver, false);
+        if (HasFatalFailure()) {
+            return;
         }
-        ASSERT_GE(reached.size(), expected.size())
-            << "seed " << seed << ": every waypoint, in order; the first that is not:\n"
-            << describe_reached_around(reached, expected, same) << daemon_->err();
-        for (std::size_t i = 0; i < expected.size(); ++i) {
-            ASSERT_PRED2(same_place, reached[i].at, expected[i])
-                << "seed " << seed << ": reached #" << i << " is not plan waypoint " << i << "\n"
-                << describe_reached_around(reached, expected, i);
-        }
-        // After the end only the last waypoint again (a board that takes the Stop for a plain waypoint may
-        // reach its copies before its HOLD lands), and every Stop reached at a plan waypoint.
-        for (std::size_t i = expected.size(); i < reached.size(); ++i) {
-            EXPECT_PRED2(same_place, reached[i].at, expected.back()) << "seed " << seed << ": after the end";
-        }
-        for (const auto& r : all) {
-            if (r.command == 17) {
-                EXPECT_TRUE(std::any_of(expected.begin(), expected.end(),
-                                        [&](const E7& e) { return same_place(r.at, e); }))
-                    << "seed " << seed << ": stopped at " << r.at.first << "," << r.at.second;
-            }
-        }
-        const auto plan = show();
-        const auto stops = plan.value("frontier_stops", 0) - before.value("frontier_stops", 0);
-        const double waited = plan.value("frontier_wait_s", 0.0) - before.value("frontier_wait_s", 0.0);
-        std::cout << "[ figures ] " << GetParam() << " survey seed " << seed << ": " << starver.pauses()
-                  << " pauses of the daemon, " << starver.paused_s() << " s stopped; " << stops
-                  << " stops at the frontier, " << waited << " s waited there\n";
-        EXPECT_GT(starver.pauses(), 0);
-        EXPECT_EQ(plan.value("starvation_holds", 0), 0) << plan.dump();
     }
 }
 
