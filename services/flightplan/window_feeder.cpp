@@ -54,9 +54,7 @@ std::optional<std::string> FeederConfig::validate() const {
 }
 
 WindowFeeder::WindowFeeder(FeederConfig config)
-    : config_(config),
-      confirmed_(config.window + 1u + kWrapSlots),
-      written_over_stop_(config.window + 1u + kWrapSlots, false) {}
+    : config_(config), confirmed_(config.window + 1u + kWrapSlots) {}
 
 std::vector<MissionItem> WindowFeeder::slot_items(std::uint16_t slot, const MissionItem& item) const {
     if (slot != wrap_slot()) {
@@ -519,7 +517,6 @@ void WindowFeeder::on_reached(std::uint16_t slot, TimePoint now) {
             break;
         }
         if (e.slot == slot && confirmed(e)) {
-            written_over_stop_[ring_next(slot)] = false;  // it moves on to what the slot holds now
             left_frontier(now);
             need_set_current_ = false;
             repoint_only_ = false;
@@ -591,15 +588,17 @@ void WindowFeeder::on_current(std::uint16_t slot, TimePoint now) {
                 current_mismatches_ = 0;
                 need_set_current_ = false;
                 repoint_only_ = false;
-                const bool retake = written_over_stop_[slot];
+                // The board reports its target as it changes, in order with its answers to the writes: a
+                // report read before the entry's write was confirmed says the board took the slot while it
+                // still held the barrier, and waits there (a Stop at the waypoint it just reached); once the
+                // entry is written it is pointed at the slot again. A report read after the confirmation
+                // says the board took the entry: it is never pointed back, however late the report is read
+                // (pointed back then, a vehicle that had reached the slot and left it drove it again).
+                const bool at_barrier = !confirmed(queue_[p]);
                 complete_through(p - 1, now);
-                if (retake && !frontier_since_) {
-                    // The slot held a barrier until lately, and nothing says whether the board got there
-                    // before or after the write: pointing it at the slot it reports takes what the slot
-                    // holds now (it drives nothing twice: it has not left the slot).
-                    written_over_stop_[slot] = false;
-                    need_set_current_ = true;
-                    repoint_only_ = true;
+                if (at_barrier && !queue_.empty() && queue_[0].slot == slot) {
+                    ap_target_ = slot;
+                    at_frontier(now);
                 }
                 return;
             }
@@ -785,7 +784,6 @@ void WindowFeeder::request_failed(TimePoint now) {
 void WindowFeeder::request_succeeded(const FeederRequest& request, TimePoint now) {
     if (const auto* up = std::get_if<autopilot::UploadMission>(&request.op)) {
         std::fill(confirmed_.begin(), confirmed_.end(), std::nullopt);
-        std::fill(written_over_stop_.begin(), written_over_stop_.end(), false);
         for (std::size_t i = 0; i < up->items.size() && i + 1 < confirmed_.size(); ++i) {
             confirmed_[i + 1] = up->items[i];
         }
@@ -916,11 +914,7 @@ std::optional<FeederRequest> WindowFeeder::next_write(TimePoint now) {
             return write(after, e.barrier(), now);
         }
     }
-    auto w = write(e.slot, e.item(), now);
-    if (w && c.entries > 0 && holds_stop(e.slot)) {
-        written_over_stop_[e.slot] = true;
-    }
-    return w;
+    return write(e.slot, e.item(), now);
 }
 
 std::optional<FeederRequest> WindowFeeder::poll_request(TimePoint now) {

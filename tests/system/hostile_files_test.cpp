@@ -96,6 +96,14 @@ long rss_kb(pid_t pid) {
 }
 
 /// airsegd as systemd runs it, without devices (neither the autopilot's nor the radio's port exists).
+// Under a sanitizer or an emulator (AIRSEG_SLOWED_BUILD) the programs run several times slower, and beside
+// other suites on CI slower still: the time figures are printed there and checked in the shipped build.
+#ifdef AIRSEG_SLOWED_BUILD
+constexpr bool kSlowed = true;
+#else
+constexpr bool kSlowed = false;
+#endif
+
 class HostileFiles : public ::testing::Test {
   public:
     HostileFiles() : notify(dir.file("notify.sock")) {}
@@ -155,7 +163,9 @@ class HostileFiles : public ::testing::Test {
         daemon->signal(SIGKILL);
         ASSERT_TRUE(daemon->wait_exit(10s));
         const double took = start();
-        EXPECT_LT(took, 2.0) << "answering " << took << " s after a restart following " << after;
+        if (!kSlowed) {
+            EXPECT_LT(took, 2.0) << "answering " << took << " s after a restart following " << after;
+        }
         expect_answering("the restart after " + after);
         std::cout << "[ figures ] " << after << ": answering " << took << " s after kill -9 and restart\n";
     }
@@ -237,7 +247,10 @@ TEST_F(HostileFiles, AStoredPlanThatNoLongerLoadsIsSetAsideAtStart) {
     progress.plan_digest = flightplan::hex64(flightplan::fnv1a64(kBadNamePlan));
     ASSERT_FALSE(store.save_progress(progress));
     const double took = start();
-    EXPECT_LT(took, 2.0);
+    if (!kSlowed) {
+        EXPECT_LT(took, 2.0);
+    }
+    std::cout << "[ figures ] a start with a stored plan that no longer loads: answering " << took << " s\n";
     expect_answering("a start with a stored plan that no longer loads");
     EXPECT_TRUE(fs::exists(dir.file("state/plan.yaml.corrupt-1")));
     EXPECT_TRUE(fs::exists(dir.file("state/progress.state.corrupt-1")));
@@ -247,14 +260,6 @@ TEST_F(HostileFiles, AStoredPlanThatNoLongerLoadsIsSetAsideAtStart) {
     EXPECT_TRUE(plan.value("ok", false)) << plan.dump();
     expect_restart_answers("a stored plan that no longer loads");
 }
-
-// Under a sanitizer or an emulator (AIRSEG_SLOWED_BUILD) the programs run several times slower, and beside
-// other suites on CI slower still: the time figures are printed there and checked in the shipped build.
-#ifdef AIRSEG_SLOWED_BUILD
-constexpr bool kSlowed = true;
-#else
-constexpr bool kSlowed = false;
-#endif
 
 std::string config_with(const std::string& extra) {
     return read_file(source_path("config/airseg.yaml")) + extra;
