@@ -54,7 +54,9 @@ std::optional<std::string> FeederConfig::validate() const {
 }
 
 WindowFeeder::WindowFeeder(FeederConfig config)
-    : config_(config), confirmed_(config.window + 1u + kWrapSlots) {}
+    : config_(config),
+      confirmed_(config.window + 1u + kWrapSlots),
+      written_over_stop_(config.window + 1u + kWrapSlots, false) {}
 
 std::vector<MissionItem> WindowFeeder::slot_items(std::uint16_t slot, const MissionItem& item) const {
     if (slot != wrap_slot()) {
@@ -517,6 +519,7 @@ void WindowFeeder::on_reached(std::uint16_t slot, TimePoint now) {
             break;
         }
         if (e.slot == slot && confirmed(e)) {
+            written_over_stop_[ring_next(slot)] = false;  // it moves on to what the slot holds now
             left_frontier(now);
             need_set_current_ = false;
             repoint_only_ = false;
@@ -588,17 +591,18 @@ void WindowFeeder::on_current(std::uint16_t slot, TimePoint now) {
                 current_mismatches_ = 0;
                 need_set_current_ = false;
                 repoint_only_ = false;
-                // The board reports its target as it changes, in order with its answers to the writes: a
-                // report read before the entry's write was confirmed says the board took the slot while it
-                // still held the barrier, and waits there (a Stop at the waypoint it just reached); once the
-                // entry is written it is pointed at the slot again. A report read after the confirmation
-                // says the board took the entry: it is never pointed back, however late the report is read
-                // (pointed back then, a vehicle that had reached the slot and left it drove it again).
-                const bool at_barrier = !confirmed(queue_[p]);
+                // The slot held a barrier until lately. The board reports its target as it changes, in order
+                // with its answers to the writes: a report read before the entry's write was confirmed says
+                // the board took the slot while it held the barrier, and it is pointed at the slot again to
+                // take what the slot holds now. A report read after the confirmation says it took the entry:
+                // never pointed back, however late the report is read (pointed back then, a vehicle that had
+                // reached the slot and left it drove it again).
+                const bool retake = written_over_stop_[slot] && !confirmed(queue_[p]);
+                written_over_stop_[slot] = false;
                 complete_through(p - 1, now);
-                if (at_barrier && !queue_.empty() && queue_[0].slot == slot) {
-                    ap_target_ = slot;
-                    at_frontier(now);
+                if (retake && !frontier_since_) {
+                    need_set_current_ = true;
+                    repoint_only_ = true;
                 }
                 return;
             }
@@ -784,6 +788,7 @@ void WindowFeeder::request_failed(TimePoint now) {
 void WindowFeeder::request_succeeded(const FeederRequest& request, TimePoint now) {
     if (const auto* up = std::get_if<autopilot::UploadMission>(&request.op)) {
         std::fill(confirmed_.begin(), confirmed_.end(), std::nullopt);
+        std::fill(written_over_stop_.begin(), written_over_stop_.end(), false);
         for (std::size_t i = 0; i < up->items.size() && i + 1 < confirmed_.size(); ++i) {
             confirmed_[i + 1] = up->items[i];
         }
@@ -914,7 +919,11 @@ std::optional<FeederRequest> WindowFeeder::next_write(TimePoint now) {
             return write(after, e.barrier(), now);
         }
     }
-    return write(e.slot, e.item(), now);
+    auto w = write(e.slot, e.item(), now);
+    if (w && c.entries > 0 && holds_stop(e.slot)) {
+        written_over_stop_[e.slot] = true;
+    }
+    return w;
 }
 
 std::optional<FeederRequest> WindowFeeder::poll_request(TimePoint now) {

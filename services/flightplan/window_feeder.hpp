@@ -197,6 +197,9 @@ class WindowFeeder {
     // What the autopilot is known to hold.
     bool mission_ok_ = false;
     std::vector<std::optional<autopilot::MissionItem>> confirmed_;  // by slot, 0..K+3
+    // Slots where an entry replaced a barrier while the entry before it was not yet seen reached: a board
+    // that got there first drives (or waits at) its copy of the Stop, whatever the slot holds now.
+    std::vector<bool> written_over_stop_;
     std::optional<std::uint16_t> ap_target_;  // the slot the autopilot is believed to head for
     bool need_set_current_ = false;
     std::optional<std::uint16_t> old_target_;  // after a fresh start: the target the vehicle had, kept apart
