@@ -299,9 +299,9 @@ plan:  # its mapping
         {"short lines, one-space indent",
          [] {
              // The emitter writes this longer than it is: the merge runs again at the exact size (checked
-             // below). 60 lines are enough for that; each line costs every pair a load under qemu.
+             // below). 30 lines are enough for that; each line costs every pair a load under qemu.
              std::string t = "plan:\n name: short\n elements:\n";
-             for (int i = 0; i < 60; ++i) {
+             for (int i = 0; i < 30; ++i) {
                  t += " - waypoint: {lat: 41.0" + std::to_string(100 + i) + ",lon: 2.0}\n";
              }
              return t;
@@ -437,9 +437,17 @@ plan:
     return plans;
 }
 
-TEST(FlightplanAppend, StreamingMergeLoadsLikeTheWholeTreeMerge) {
+// The running plans in three cases of their own (plan k in case k mod 3): under qemu-arm on armel, with no
+// FPU and the suite beside it, all of them as one case ran past its 60-s limit.
+constexpr std::size_t kRunningGroups = 3;
+class FlightplanAppendPairs : public ::testing::TestWithParam<std::size_t> {};
+
+TEST_P(FlightplanAppendPairs, StreamingMergeLoadsLikeTheWholeTreeMerge) {
     int loaded = 0, pairs = 0, second_passes = 0;
-    for (const auto& r : running_plans()) {
+    bool long_sample = false;
+    for (std::size_t i = GetParam(); i < running_plans().size(); i += kRunningGroups) {
+        const auto& r = running_plans()[i];
+        long_sample = long_sample || std::string_view(r.name).starts_with("short lines");
         for (const auto& a : appended_plans()) {
             SCOPED_TRACE(std::string("running: ") + r.name + "; appended: " + a.name);
             ++pairs;
@@ -472,8 +480,13 @@ TEST(FlightplanAppend, StreamingMergeLoadsLikeTheWholeTreeMerge) {
         }
     }
     EXPECT_GT(loaded, pairs / 2) << "too few merged plans load: the comparison says little";
-    EXPECT_GT(second_passes, 0) << "no merge took its second pass: the samples no longer test it";
+    if (long_sample) {
+        EXPECT_GT(second_passes, 0) << "no merge took its second pass: the samples no longer test it";
+    }
 }
+
+INSTANTIATE_TEST_SUITE_P(RunningPlans, FlightplanAppendPairs,
+                         ::testing::Range<std::size_t>(0, kRunningGroups));
 
 TEST(FlightplanAppend, ErrorsAreTheWholeTreeMergeErrors) {
     const std::vector<std::pair<std::string, std::string>> cases = {
