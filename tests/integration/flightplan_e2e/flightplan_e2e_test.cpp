@@ -990,6 +990,14 @@ class Starver {
 // AIRSEG_STARVE_RUNS repeats the case (default 1) and AIRSEG_STARVE_SEED picks the first seed.
 class FlightplanStarvedE2e : public FlightplanE2e {
   protected:
+    static int starve_runs() {
+        const char* env = std::getenv("AIRSEG_STARVE_RUNS");
+        return env != nullptr ? std::max(1, std::atoi(env)) : 1;
+    }
+    static unsigned starve_first_seed() {
+        const char* env = std::getenv("AIRSEG_STARVE_SEED");
+        return env != nullptr ? static_cast<unsigned>(std::atoi(env)) : 1u;
+    }
     /// One starved run, from the simulator's reached log from event `first` on: every plan waypoint reached
     /// once and in order, then nothing (`exact`) or only the last one again (a board that takes the Stop for
     /// a plain waypoint may reach its copies before its HOLD lands); every Stop reached at a plan waypoint.
@@ -1052,10 +1060,8 @@ class FlightplanStarvedE2e : public FlightplanE2e {
 };
 
 TEST_P(FlightplanStarvedE2e, AStarvedDaemonStopsTheVehicleAtTheFrontierAndNeverLetsItDriveAStalePoint) {
-    const char* runs_env = std::getenv("AIRSEG_STARVE_RUNS");
-    const char* seed_env = std::getenv("AIRSEG_STARVE_SEED");
-    const int runs = runs_env != nullptr ? std::max(1, std::atoi(runs_env)) : 1;
-    const unsigned first_seed = seed_env != nullptr ? static_cast<unsigned>(std::atoi(seed_env)) : 1u;
+    const int runs = starve_runs();
+    const unsigned first_seed = starve_first_seed();
     // 96 m x 96 m, a waypoint every 8 m: 168 of them.
     const auto file = write_plan("scan.yaml", scan_plan("starved-scan", 96, 96, 8));
     const auto expected = expected_positions(file);
@@ -1092,10 +1098,8 @@ class FlightplanStarvedSurveyE2e : public FlightplanStarvedE2e {
 };
 
 TEST_P(FlightplanStarvedSurveyE2e, AStarvedDaemonDrivesTheExampleSurveyInOrderAndNothingElse) {
-    const char* runs_env = std::getenv("AIRSEG_STARVE_RUNS");
-    const char* seed_env = std::getenv("AIRSEG_STARVE_SEED");
-    const int runs = runs_env != nullptr ? std::max(1, std::atoi(runs_env)) : 1;
-    const unsigned first_seed = seed_env != nullptr ? static_cast<unsigned>(std::atoi(seed_env)) : 1u;
+    const int runs = starve_runs();
+    const unsigned first_seed = starve_first_seed();
     std::string text = read_file(source_path("config/plans/rover-survey.yaml"));
     const std::string photo = "hold: {name: photo-stop, seconds: 20}";
     const auto at = text.find(photo);
