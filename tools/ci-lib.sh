@@ -49,7 +49,8 @@ ccache_stage_rate() {
 
 # record_stage NAME WALL_SECONDS [SUMMARY_FILE] [CCACHE_STAGE]: one row of the closing table. SUMMARY_FILE is
 # a ctest-summary.txt from tools/run-ctest.sh ("passed=N failed=N skipped=N reruns=A,B"); the ctest-failed.txt
-# beside it (a failed case's name per line) goes to the list of failed cases printed under the table.
+# beside it (a failed case's name, a tab and why, per line) goes to the list of failed cases printed under the
+# table.
 record_stage() {
   local name=$1 wall=$2 summary=${3:-} cstage=${4:-} passed=- failed=- skipped=- reruns=- rate=-
   if [ -n "$summary" ] && [ -f "$summary" ]; then
@@ -90,6 +91,8 @@ print_stage_table() {
   done <"$table"
   echo "tests: $p passed, $f failed, $s skipped"
   [ -s "$AIRSEG_CI_LOGS/failed.tsv" ] || return 0
-  awk -F'\t' '{ n[$1]++; if (n[$1] <= 20) print "failed: " $1 ": " $2; else if (n[$1] == 21) print "failed: " $1 ": (more in its log)" }' \
+  awk -F'\t' '{ n[$1]++
+               if (n[$1] <= 20) { print "failed: " $1 ": " $2; if ($3 != "") print "    why: " $3 }
+               else if (n[$1] == 21) print "failed: " $1 ": (more in its log)" }' \
     "$AIRSEG_CI_LOGS/failed.tsv"
 }

@@ -10,8 +10,9 @@
 #   - With AIRSEG_TEST_LOCK set, it waits for that lock first and runs at nice 0 (CI's side-by-side ARM
 #     builds: one suite at a time, or AIRSEG_SUITES_AT_ONCE, never behind a compile).
 #   - BUILD_DIR/ctest-summary.txt gets "passed=N failed=N skipped=N reruns=NAME,NAME", and
-#     BUILD_DIR/ctest-failed.txt the name of each case that failed, one per line; both are read by the table at
-#     the end of CI's log.
+#     BUILD_DIR/ctest-failed.txt one line per case that failed: its name, a tab, and why (its first assertion
+#     failure and the lines after it, or the last lines it printed); both are read by the table at the end of
+#     CI's log, where only the end of a long log may be seen.
 # CTEST_ARGS go to every ctest run (e.g. -j8 --timeout 600 --exclude-regex ...). Exit status: 0 when every case
 # passed (a rerun one included), 1 otherwise.
 set -euo pipefail
@@ -40,6 +41,29 @@ junit_field() { sed -n "s/^[[:space:]]*$2=\"\([0-9]*\)\".*/\1/p" "$1" | head -n1
 # junit_failed FILE: the names of the cases that failed, one per line.
 junit_failed() { sed -n 's/^[[:space:]]*<testcase name="\([^"]*\)".* status="fail".*/\1/p' "$1"; }
 regex_quote() { sed 's/[][\.*^$+?(){}|]/\\&/g'; }
+# junit_why FILE NAME: why case NAME failed, on one line of at most 600 characters: from its output, the first
+# gtest failure and the four lines after it, or (a timeout, a crash) its run time and the last four lines it
+# printed.
+junit_why() {
+  awk -v want="<testcase name=\"$2\"" '
+    index($0, want) == 1 || index($0, "\t" want) == 1 {
+      inside = 1
+      if (match($0, /time="[0-9.]+"/)) took = substr($0, RSTART + 6, RLENGTH - 7)
+      next
+    }
+    inside && /<\/testcase>/ { exit }
+    inside {
+      gsub(/<\/?system-out>|<failure[^>]*>/, ""); gsub(/[\t ]+/, " "); sub(/^ /, "")
+      if ($0 != "" && $0 != " ") out[++n] = $0
+    }
+    END {
+      for (i = 1; i <= n; i++) if (out[i] ~ /(: Failure|^unknown file: .*)$/) break
+      from = i <= n ? i : (n > 4 ? n - 3 : 1)
+      line = i <= n ? "" : "no assertion failed (a timeout or a crash?) after " took " s; it printed last:"
+      for (i = from; i <= n && i < from + 5; i++) line = line (line == "" ? "" : " | ") out[i]
+      print line
+    }' "$1" | sed 's/&lt;/</g; s/&gt;/>/g; s/&quot;/"/g; s/&apos;/'"'"'/g; s/&amp;/\&/g' | tr -d '\r' | cut -c1-600
+}
 
 first="$dir/ctest-attempt-1.xml"
 rm -f "$dir"/ctest-attempt-*.xml "$dir/ctest-summary.txt" "$dir/ctest-failed.txt"
@@ -94,7 +118,17 @@ n_failed=${#final_failed[@]}
 passed=$((total - skipped - n_failed))
 [ "$passed" -ge 0 ] || passed=0
 echo "passed=$passed failed=$n_failed skipped=$skipped reruns=$(IFS=,; echo "${reruns[*]}")" >"$dir/ctest-summary.txt"
-[ "$n_failed" = 0 ] || printf '%s\n' "${final_failed[@]}" >"$dir/ctest-failed.txt"
+if [ "$n_failed" != 0 ]; then
+  for name in "${final_failed[@]}"; do
+    # The last attempt in which the case ran holds its latest failure.
+    why=
+    for ((k = attempt; k >= 1; k--)); do
+      xml="$dir/ctest-attempt-$k.xml"
+      [ -f "$xml" ] && grep -qF "<testcase name=\"$name\"" "$xml" && { why=$(junit_why "$xml" "$name"); break; }
+    done
+    printf '%s\t%s\n' "$name" "$why"
+  done >"$dir/ctest-failed.txt"
+fi
 echo "ctest: $passed passed, $n_failed failed, $skipped skipped"
 [ ${#reruns[@]} = 0 ] || echo "ctest: ${#reruns[@]} of them passed only on a rerun: ${reruns[*]}"
 for name in "${final_failed[@]}"; do
