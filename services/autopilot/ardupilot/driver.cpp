@@ -122,6 +122,11 @@ void Driver::handle_bytes(std::span<const std::uint8_t> bytes, TimePoint now) {
         }
         tap_incoming(f);
         on_frame(f, now);
+        // A request's result goes out in its place among the board's reports: the board reports its target
+        // in order with its answers to the writes, and the flight plan tells by that order whether a target
+        // report came before or after a write landed. A slow daemon reads many frames at once; finishing the
+        // requests only after the whole read put every report of the read before them.
+        drain_clients(now);
     });
     drain_clients(now);
     send_gcs_heartbeat_if_due(now);

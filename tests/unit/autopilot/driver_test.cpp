@@ -369,6 +369,50 @@ TEST(Driver, PartialWriteAndSetCurrent) {
     EXPECT_EQ(rig.wait_result(rig.driver.write_items(0, {jump}, rig.now())).result, RequestResult::Invalid);
 }
 
+TEST(Driver, AWritesResultComesInItsPlaceAmongTheReportsReadWithIt) {
+    // A slow daemon reads the board's answer to a write and the target report the board sent after it in one
+    // read. The flight plan tells by their order whether the board took the slot before or after the write
+    // landed: the result must come first, as the board sent it.
+    Rig rig(apm2_config(), apm2_rover());
+    rig.bring_up();
+    ASSERT_EQ(rig.wait_result(rig.driver.upload_mission(plan(6), rig.now())).result, RequestResult::Ok);
+    const auto id = rig.driver.write_items(3, {plan(2).front()}, rig.now());
+    while (rig.driver.poll_transmit()) {
+    }  // the write's start; the board's side is played here by hand
+    mav::Encoder board{1, 1, mav::Version::V1};
+    mav::MissionRequest request;
+    request.target_system = 255;
+    request.target_component = 191;
+    request.seq = 3;
+    rig.driver.handle_bytes(board.encode(request), rig.now());
+    ASSERT_TRUE(rig.driver.poll_transmit()) << "the item, asked for";
+    mav::MissionAck ack;
+    ack.target_system = 255;
+    ack.target_component = 191;
+    ack.type = mav::kMissionAccepted;
+    mav::MissionCurrent current;
+    current.seq = 3;
+    auto read = board.encode(ack);
+    const auto report = board.encode(current);
+    read.insert(read.end(), report.begin(), report.end());
+    rig.events.clear();
+    rig.driver.handle_bytes(read, rig.now());
+    rig.drain();
+
+    std::optional<std::size_t> done_at, current_at;
+    for (std::size_t i = 0; i < rig.events.size(); ++i) {
+        if (const auto* d = std::get_if<RequestDone>(&rig.events[i]); d && d->id == id) {
+            EXPECT_EQ(d->result, RequestResult::Ok) << d->detail;
+            done_at = i;
+        }
+        if (const auto* c = std::get_if<MissionCurrentChanged>(&rig.events[i]); c && c->seq == 3) {
+            current_at = i;
+        }
+    }
+    ASSERT_TRUE(done_at && current_at);
+    EXPECT_LT(*done_at, *current_at);
+}
+
 TEST(Driver, RebootMidMissionIsDetectedAndResynced) {
     Rig rig(apm2_config(), apm2_rover());
     rig.bring_up();
