@@ -1005,19 +1005,7 @@ class FlightplanStarvedE2e : public FlightplanE2e {
     void judge_starved_run(const std::string& what, unsigned seed, const std::vector<E7>& expected,
                            std::uint64_t first, const Json& before, const Starver& starver, bool exact) {
         const auto all = reached_log(*control_, first);
-        // A slot reported reached again where the vehicle stands, within a simulated second (a re-point that
-        // came as it arrived: docs/reliability.md, open), is counted and printed, not taken for a second
-        // visit.
-        std::vector<Reached> reached;
-        int in_place = 0;
-        for (const auto& r : plan_waypoints_of(all)) {
-            if (!reached.empty() && reached.back().seq == r.seq && same_place(reached.back().at, r.at) &&
-                r.t - reached.back().t < 1.0) {
-                ++in_place;
-                continue;
-            }
-            reached.push_back(r);
-        }
+        const auto reached = plan_waypoints_of(all);
         std::size_t same = 0;
         while (same < reached.size() && same < expected.size() &&
                same_place(reached[same].at, expected[same])) {
@@ -1052,8 +1040,7 @@ class FlightplanStarvedE2e : public FlightplanE2e {
         const double waited = plan.value("frontier_wait_s", 0.0) - before.value("frontier_wait_s", 0.0);
         std::cout << "[ figures ] " << GetParam() << what << " seed " << seed << ": " << starver.pauses()
                   << " pauses of the daemon, " << starver.paused_s() << " s stopped; " << stops
-                  << " stops at the frontier, " << waited << " s waited there; " << in_place
-                  << " slots reported reached again in place\n";
+                  << " stops at the frontier, " << waited << " s waited there\n";
         EXPECT_GT(starver.pauses(), 0);
         EXPECT_EQ(plan.value("starvation_holds", 0), 0) << plan.dump();
     }
