@@ -289,6 +289,14 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
             sim.fail_check(reason, now);
             return "ok fail-check " + reason;
         }
+        if (verb == "battery") {
+            need(2, "battery full");
+            if (w[1] != "full") {
+                return "error: battery: expected full, got '" + w[1] + "'";
+            }
+            sim.swap_battery(now);
+            return "ok battery full";
+        }
         if (verb == "slow") {
             need(2, "slow MS");
             sim.faults().slow = cli::parse_milliseconds(verb, w[1]);
@@ -313,7 +321,8 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
             return "ok commands: state, modes [N], reached [FROM [COUNT]], speeds [FROM [COUNT]], stats, "
                    "rcpilot MODE, mode MODE, reboot [S], unplug, replug, hbstall S, loss P [BURST], corrupt "
                    "P, "
-                   "ignore-mission on|off, freeze on|off, slow MS, param NAME [VALUE], arm [force], disarm, "
+                   "ignore-mission on|off, freeze on|off, battery full, slow MS, param NAME [VALUE], arm [force], "
+                   "disarm, "
                    "gps lose|fix, fail-check REASON...|off";
         }
         return "error: unknown command '" + verb + "' (try help)";

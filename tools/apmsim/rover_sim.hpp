@@ -214,6 +214,8 @@ class RoverSim {
     /// on a loaded machine, acts, instead of racing the accelerated clock.
     void freeze(bool on, TimePoint now);
     bool frozen() const { return frozen_; }
+    /// A fresh battery, as swapped in the field between runs: nothing consumed from `now` on.
+    void swap_battery(TimePoint now);
 
     Faults& faults() { return faults_; }
     const Faults& faults() const { return faults_; }

@@ -61,6 +61,11 @@ void RoverSim::freeze(bool on, TimePoint now) {
     last_step_ = std::max(last_step_, now_);
 }
 
+void RoverSim::swap_battery(TimePoint now) {
+    advance(now);  // what was drawn up to now came from the old battery
+    consumed_mah_ = 0;
+}
+
 bool RoverSim::physics_active() const {
     if (frozen_) {
         return false;
