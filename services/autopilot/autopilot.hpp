@@ -83,6 +83,13 @@ struct MissionItem {
 struct WaypointReached {
     std::uint16_t seq = 0;
 };
+/// A mission item of a running partial write is on the board (the board asked for the next one), told in
+/// order with the board's reports, before the write's result: a report of that slot read after it is of
+/// this item.
+struct MissionItemStored {
+    std::uint16_t slot = 0;
+    MissionItem item;
+};
 enum class ModeChangeCause : std::uint8_t {
     Requested,  // the change this system asked for
     External,   // the RC pilot, the autopilot itself (failsafe, end of mission), another ground station
@@ -153,7 +160,7 @@ struct RequestDone {
 };
 
 using Event = std::variant<WaypointReached, MissionCurrentChanged, ModeChanged, LinkUp, LinkDown,
-                           AutopilotRebooted, Ready, StatusText, RequestDone>;
+                           AutopilotRebooted, Ready, StatusText, RequestDone, MissionItemStored>;
 
 // --- bus requests to the autopilot service (answered through their Reply)
 // -----------------------------------

@@ -87,6 +87,11 @@ void FlightplanService::on_start() {
             controller_.on_current(c.seq, SteadyClock::now());
             flush();
         }));
+    subscriptions_.push_back(
+        bus.subscribe<autopilot::MissionItemStored>(strand(), [this](const autopilot::MissionItemStored& s) {
+            controller_.on_item_stored(s.slot, s.item, SteadyClock::now());
+            flush();
+        }));
     subscriptions_.push_back(bus.subscribe<autopilot::GroundStationMission>(
         strand(), [this](const autopilot::GroundStationMission& m) { on_ground_station_mission(m); }));
     subscriptions_.push_back(

@@ -289,6 +289,11 @@ void PlanController::on_current(std::uint32_t seq, TimePoint now) {
     pump(now);
 }
 
+void PlanController::on_item_stored(std::uint16_t slot, const autopilot::MissionItem& item, TimePoint now) {
+    feeder_.on_item_stored(slot, item);
+    pump(now);
+}
+
 void PlanController::on_rebooted(TimePoint now) {
     feeder_.on_autopilot_rebooted(now);
     in_flight_.clear();

@@ -108,6 +108,7 @@ class PlanController {
     void on_telemetry(const autopilot::Telemetry& t, TimePoint now);
     void on_reached(std::uint32_t seq, TimePoint now);
     void on_current(std::uint32_t seq, TimePoint now);
+    void on_item_stored(std::uint16_t slot, const autopilot::MissionItem& item, TimePoint now);
     void on_rebooted(TimePoint now);
     void on_mode_changed(const autopilot::ModeChanged& m, TimePoint now);
     /// The answer to the AutopilotCall with this id (its RequestDone::id is the autopilot's own).

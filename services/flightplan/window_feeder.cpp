@@ -102,6 +102,10 @@ bool WindowFeeder::confirmed(const Entry& e) const {
     return holds(e.slot, e.item());
 }
 
+bool WindowFeeder::drives_to(const Entry& e) const {
+    return mission_ok_ && e.slot < confirmed_.size() && confirmed_[e.slot] == e.item();
+}
+
 bool WindowFeeder::holds_stop(std::uint16_t slot) const {
     return mission_ok_ && slot < confirmed_.size() && confirmed_[slot] &&
            confirmed_[slot]->kind == MissionItem::Kind::Stop;
@@ -518,7 +522,7 @@ void WindowFeeder::on_reached(std::uint16_t slot, TimePoint now) {
         if (e.stop) {
             break;
         }
-        if (e.slot == slot && confirmed(e)) {
+        if (e.slot == slot && drives_to(e)) {
             written_over_stop_[ring_next(slot)] = false;  // it moves on to what the slot holds now
             left_frontier(now);
             need_set_current_ = false;
@@ -585,7 +589,7 @@ void WindowFeeder::on_current(std::uint16_t slot, TimePoint now) {
             if (queue_[p - 1].stop) {
                 break;
             }
-            if (queue_[p].slot == slot && (confirmed(queue_[p]) || holds(slot, queue_[p - 1].barrier()))) {
+            if (queue_[p].slot == slot && (drives_to(queue_[p]) || holds(slot, queue_[p - 1].barrier()))) {
                 // The autopilot moved past entries whose reached reports were lost (or are still on the way).
                 ap_target_ = slot;
                 current_mismatches_ = 0;
@@ -597,7 +601,7 @@ void WindowFeeder::on_current(std::uint16_t slot, TimePoint now) {
                 // take what the slot holds now. A report read after the confirmation says it took the entry:
                 // never pointed back, however late the report is read (pointed back then, a vehicle that had
                 // reached the slot and left it drove it again).
-                const bool retake = written_over_stop_[slot] && !confirmed(queue_[p]);
+                const bool retake = written_over_stop_[slot] && !drives_to(queue_[p]);
                 written_over_stop_[slot] = false;
                 complete_through(p - 1, now);
                 if (retake && !frontier_since_) {
@@ -618,6 +622,23 @@ void WindowFeeder::on_current(std::uint16_t slot, TimePoint now) {
         need_set_current_ = true;
         repoint_only_ = false;
         current_mismatches_ = 0;
+    }
+}
+
+void WindowFeeder::on_item_stored(std::uint16_t slot, const autopilot::MissionItem& item) {
+    // A write of several slots (the wrap) lands item by item: the vehicle may reach its first slot, holding
+    // the new entry, before the write's answer. Taken for the barrier the slot held, that arrival would be a
+    // wait at the frontier and the vehicle would be pointed at the slot again.
+    if (!outstanding_ || !mission_ok_) {
+        return;
+    }
+    const auto* wr = std::get_if<autopilot::WriteMissionItems>(&outstanding_->request.op);
+    if (wr == nullptr || slot < wr->first_slot || slot >= confirmed_.size()) {
+        return;
+    }
+    const std::size_t i = slot - wr->first_slot;
+    if (i < wr->items.size() && wr->items[i] == item) {
+        confirmed_[slot] = item;
     }
 }
 

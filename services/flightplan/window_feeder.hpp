@@ -20,7 +20,8 @@
 //
 // Contract (the driver, on the service's strand):
 //   inputs   replace_plan(), skip_to(), jump_to(), pause(), resume(), release_hold(),
-//            on_reached(slot), on_current(slot), on_mode(state, cause), on_request_result(id, result),
+//            on_reached(slot), on_current(slot), on_item_stored(slot, item), on_mode(state, cause),
+//            on_request_result(id, result),
 //            on_autopilot_rebooted(),
 //            handle_timeout(now) when poll_timeout() is due;
 //   outputs  poll_request(now) after every input, until it returns nothing: at most one request is
@@ -84,6 +85,9 @@ class WindowFeeder {
 
     void on_reached(std::uint16_t slot, TimePoint now);
     void on_current(std::uint16_t slot, TimePoint now);
+    /// An item of the write in flight is on the board already (the board asked for the next one), told in
+    /// order with its reports: the slot is confirmed from here on, before the write's result.
+    void on_item_stored(std::uint16_t slot, const autopilot::MissionItem& item);
     /// The vehicle's state changed (`cause` Requested: by this daemon, the feeder or an operator's state
     /// command). Leaving AUTO while the plan runs, without the feeder asking, interrupts it: the board's own
     /// HOLD (end of its mission, a quirk, a failsafe) is undone at once (the window is made whole, the head
@@ -152,6 +156,9 @@ class WindowFeeder {
     /// The autopilot is known to hold `item` at ring position `slot`.
     bool holds(std::uint16_t slot, const autopilot::MissionItem& item) const;
     /// The autopilot is known to hold a Stop at ring position `slot` (a barrier, or the plan's end).
+    /// The slot of `e` holds e's item: what the vehicle drives to there is the entry (the wrap's jump and
+    /// copy after it aside, which `confirmed` also checks).
+    bool drives_to(const Entry& e) const;
     bool holds_stop(std::uint16_t slot) const;
     Chain chain_from(std::size_t first) const;
     /// Entries the window keeps: K-1, one less while the vehicle still heads for a slot outside it (the

@@ -334,6 +334,20 @@ void Driver::sequence_failed(const std::string& why, TimePoint now) {
 }
 
 void Driver::drain_clients(TimePoint now) {
+    while (auto s = missions_.poll_stored()) {
+        auto it = mission_ops_.find(s->id);
+        if (it == mission_ops_.end() || it->second.kind != RequestKind::WriteItems || it->second.id == 0) {
+            continue;
+        }
+        PendingOp& op = it->second;
+        for (std::uint16_t slot = std::max(op.first, op.stored_through); slot < s->through; ++slot) {
+            const std::size_t i = static_cast<std::size_t>(slot - op.first);
+            if (i < op.items.size()) {
+                emit(MissionItemStored{slot, op.items[i]});
+            }
+        }
+        op.stored_through = std::max(op.stored_through, s->through);
+    }
     while (auto c = missions_.poll_completion()) {
         on_mission_done(std::move(*c), now);
     }

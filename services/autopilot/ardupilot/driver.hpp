@@ -155,6 +155,7 @@ class Driver {
         RequestKind kind = RequestKind::UploadMission;
         std::vector<MissionItem> items;  // what an upload/partial write puts in the cache on success
         std::uint16_t first = 1;
+        std::uint16_t stored_through = 0;  // partial write: the slots before this one are told on board
     };
 
     // driver.cpp: lifecycle, sequencing, requests

@@ -405,8 +405,9 @@ void MissionClient::handle_timeout(TimePoint now) {
     WorkItem& w = work_.front();
     if (now - w.deadline > kLateWake && !w.read_grace) {
         w.read_grace = true;
-        // Woken this late, the daemon itself was not running: the vehicle's answer may be waiting in the port.
-        // A resend now (a MISSION_SET_CURRENT above all) would take the vehicle back to a slot it has left.
+        // Woken this late, the daemon itself was not running: the vehicle's answer may be waiting in the
+        // port. A resend now (a MISSION_SET_CURRENT above all) would take the vehicle back to a slot it has
+        // left.
         w.deadline = now + kReadGrace;
         return;
     }
@@ -453,6 +454,15 @@ void MissionClient::handle_timeout(TimePoint now) {
 
 TimePoint MissionClient::poll_timeout() const {
     return work_.empty() ? kNever : work_.front().deadline;
+}
+
+std::optional<MissionItemsStored> MissionClient::poll_stored() {
+    if (stored_.empty()) {
+        return std::nullopt;
+    }
+    const auto s = stored_.front();
+    stored_.pop_front();
+    return s;
 }
 
 std::optional<MissionCompletion> MissionClient::poll_completion() {
@@ -549,6 +559,11 @@ void MissionClient::on_request(std::uint16_t seq, bool as_int, TimePoint now) {
         int_proven_ = true;  // it went on after our MISSION_ITEM_INT: it takes them
     }
     if (fresh) {
+        if (w.op == MissionOperation::WritePartial && seq > w.first) {
+            // The board asks for this item once it holds the one before it (ArduPilot stores each item of a
+            // partial write as it comes): those are on board already, before the transfer's MISSION_ACK.
+            stored_.push_back({w.id, w.first, seq});
+        }
         w.int_repeats = 0;
         progress(w, now);
         if (!w.best || seq > *w.best) {

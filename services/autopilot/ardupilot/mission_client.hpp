@@ -71,6 +71,14 @@ struct MissionCompletion {
     std::optional<std::uint8_t> refusal{};       // Denied / NoSpace: the MAV_MISSION_RESULT the board sent
 };
 
+/// A partial write lands item by item: the board asks for an item only once it holds the one before it.
+/// Items `first` .. `through - 1` of operation `id` are on the board.
+struct MissionItemsStored {
+    std::uint32_t id = 0;
+    std::uint16_t first = 0;
+    std::uint16_t through = 0;
+};
+
 struct MissionClientStats {
     std::uint64_t retransmissions = 0;
     std::uint64_t duplicate_requests = 0;  // the vehicle asked again for an item already sent
@@ -109,6 +117,9 @@ class MissionClient {
     void handle_timeout(TimePoint now);
     TimePoint poll_timeout() const;
     std::optional<MissionCompletion> poll_completion();
+    /// The items of a running partial write the board has taken so far, as its requests show it (in order
+    /// with the frames: poll after each one).
+    std::optional<MissionItemsStored> poll_stored();
 
     bool idle() const { return work_.empty(); }
     /// Whether items go as MISSION_ITEM_INT (false after a fallback, or when configured so).
@@ -185,6 +196,7 @@ class MissionClient {
     MissionConfig config_;
     std::deque<WorkItem> work_;
     std::deque<MissionCompletion> done_;
+    std::deque<MissionItemsStored> stored_;  // bounded: one per fresh request of the running write
     std::uint32_t next_id_ = 1;
     RttEstimator rtt_;
     unsigned backoff_ = 1;

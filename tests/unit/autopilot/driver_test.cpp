@@ -413,6 +413,46 @@ TEST(Driver, AWritesResultComesInItsPlaceAmongTheReportsReadWithIt) {
     EXPECT_LT(*done_at, *current_at);
 }
 
+TEST(Driver, EachItemOfAWriteIsToldOnBoardWhenTheBoardAsksForTheNextInOrderWithItsReports) {
+    // ArduPilot stores each item of a partial write as it comes and then asks for the next: the vehicle may
+    // reach the first before the write's MISSION_ACK. The item is told on board at the request for the next
+    // one, in its place among the reports read with it, before the write's result.
+    Rig rig(apm2_config(), apm2_rover());
+    rig.bring_up();
+    ASSERT_EQ(rig.wait_result(rig.driver.upload_mission(plan(8), rig.now())).result, RequestResult::Ok);
+    auto items = plan(3);
+    items[2].kind = MissionItem::Kind::Waypoint;
+    const auto id = rig.driver.write_items(6, items, rig.now());
+    while (rig.driver.poll_transmit()) {
+    }
+    mav::Encoder board{1, 1, mav::Version::V1};
+    const auto request = [&](std::uint16_t seq) {
+        mav::MissionRequest r;
+        r.target_system = 255;
+        r.target_component = 191;
+        r.seq = seq;
+        return board.encode(r);
+    };
+    rig.driver.handle_bytes(request(6), rig.now());
+    rig.drain();
+    EXPECT_TRUE(rig.all<MissionItemStored>().empty()) << "asked for its first item: nothing on board yet";
+    rig.events.clear();
+    mav::MissionItemReached reached;
+    reached.seq = 6;
+    auto read = request(7);
+    const auto report = board.encode(reached);
+    read.insert(read.end(), report.begin(), report.end());
+    rig.driver.handle_bytes(read, rig.now());
+    rig.drain();
+    ASSERT_EQ(rig.events.size(), 2u);
+    const auto* stored = std::get_if<MissionItemStored>(&rig.events[0]);
+    ASSERT_NE(stored, nullptr) << "the item on board comes before the report read after it";
+    EXPECT_EQ(stored->slot, 6);
+    EXPECT_EQ(stored->item, items[0]);
+    ASSERT_NE(std::get_if<WaypointReached>(&rig.events[1]), nullptr);
+    EXPECT_FALSE(rig.result_of(id)) << "the write is still running";
+}
+
 TEST(Driver, RebootMidMissionIsDetectedAndResynced) {
     Rig rig(apm2_config(), apm2_rover());
     rig.bring_up();

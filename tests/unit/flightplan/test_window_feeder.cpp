@@ -583,6 +583,98 @@ TEST(FlightplanFeeder, ASkipWhoseSetCurrentComesLateNeverDrivesAWaypointTwice) {
     }
 }
 
+// The wrap's three items go in one write, which the board takes item by item: the vehicle can reach the
+// wrap's waypoint, holding the new entry, before the write's answer. Told the item is on board (in order with
+// the reports), the feeder takes that arrival for the entry, not for the barrier the slot held: no wait at
+// the frontier, and the vehicle is never pointed at the slot again.
+TEST(FlightplanFeeder, AnArrivalAtTheWrapBeforeItsWriteIsAnsweredIsTheEntryOnceTheBoardHoldsIt) {
+    using autopilot::MissionItem;
+    WindowFeeder f(FeederConfig{});  // window 5: ring slots 2..5, the wrap 6..8
+    TimePoint now{};
+    f.replace_plan(test::synthetic(40), now);
+    std::map<std::uint16_t, MissionItem> board;
+    std::uint16_t target = 1;
+    std::vector<FeederEvent::Kind> kinds;
+    const auto drain = [&] {
+        while (auto e = f.poll_event()) {
+            kinds.push_back(e->kind);
+        }
+    };
+    // The vehicle reaches at most one place per request answered: it outruns the feeder, which falls behind.
+    const auto drive_one = [&] {
+        const auto at = board.find(target);
+        if (at == board.end() || at->second.kind != MissionItem::Kind::Waypoint) {
+            return;  // a barrier (or nothing): it waits there
+        }
+        f.on_reached(target, now);
+        target = static_cast<std::uint16_t>(target + 1);
+        if (const auto next = board.find(target);
+            next != board.end() && next->second.kind == MissionItem::Kind::JumpTo) {
+            target = next->second.jump_slot;
+        }
+        f.on_current(target, now);
+    };
+    bool met = false;
+    for (int i = 0; i < 400 && !met; ++i) {
+        now += milliseconds(100);
+        const auto r = f.poll_request(now);
+        if (!r) {
+            drive_one();
+            drain();
+            continue;
+        }
+        if (const auto* up = std::get_if<autopilot::UploadMission>(&r->op)) {
+            for (std::size_t k = 0; k < up->items.size(); ++k) {
+                board[static_cast<std::uint16_t>(k + 1)] = up->items[k];
+            }
+        } else if (const auto* sc = std::get_if<autopilot::SetMissionCurrent>(&r->op)) {
+            target = sc->slot;
+        } else if (const auto* w = std::get_if<autopilot::WriteMissionItems>(&r->op)) {
+            const bool at_the_wrap = w->first_slot == 6 && w->items.size() == 3 && target == 6 &&
+                                     board[6].kind == MissionItem::Kind::Stop;
+            board[w->first_slot] = w->items[0];
+            if (at_the_wrap) {
+                // The board took the first item and asked for the next; the vehicle reached it meanwhile and
+                // went on through the jump to slot 2, whose barrier stops it. No target report follows (a 2.x
+                // board runs that Stop as a jump past its end, reports nothing of use, and holds).
+                drain();
+                kinds.clear();
+                f.on_item_stored(6, w->items[0]);
+                f.on_reached(6, now);
+                target = 2;
+                drain();
+                met = true;
+            }
+            for (std::size_t k = 1; k < w->items.size(); ++k) {
+                board[static_cast<std::uint16_t>(w->first_slot + k)] = w->items[k];
+            }
+        }
+        f.on_request_result(r->id, autopilot::RequestResult::Ok, now);
+        drain();
+        if (!met) {
+            drive_one();
+            drain();
+        }
+    }
+    ASSERT_TRUE(met) << "the scenario needs the wrap written while the vehicle heads for its barrier";
+    // The arrival is the entry's, not a wait at the frontier.
+    const auto reached = std::find(kinds.begin(), kinds.end(), FeederEvent::Kind::WaypointReached);
+    ASSERT_NE(reached, kinds.end());
+    EXPECT_EQ(std::find(kinds.begin(), reached, FeederEvent::Kind::HeldAtFrontier), reached);
+    // What follows: the writes for slot 2 on, and the vehicle never pointed back at the wrap.
+    for (int i = 0; i < 50; ++i) {
+        now += milliseconds(100);
+        const auto r = f.poll_request(now);
+        if (!r) {
+            break;
+        }
+        if (const auto* sc = std::get_if<autopilot::SetMissionCurrent>(&r->op)) {
+            EXPECT_NE(sc->slot, 6) << "pointed back at the slot it reached";
+        }
+        f.on_request_result(r->id, autopilot::RequestResult::Ok, now);
+    }
+}
+
 TEST(FlightplanFeeder, ProgressReportsWindowAndResumePoint) {
     Harness h;
     EXPECT_EQ(h.feeder.progress().state, PlanState::None);
