@@ -469,7 +469,8 @@ void WindowFeeder::check_done() {
 }
 
 void WindowFeeder::check_starvation() {
-    if (!mission_ok_ || need_set_current_ || queue_.empty() || starving_ || confirmed(queue_[0]) ||
+    // A head whose first item is on board (the rest of the wrap's write still landing) is driven right.
+    if (!mission_ok_ || need_set_current_ || queue_.empty() || starving_ || drives_to(queue_[0]) ||
         holds_stop(queue_[0].slot)) {
         return;
     }
