@@ -236,6 +236,14 @@ class GcsEndpointE2e : public AutopilotE2e {
   protected:
     GcsEndpointE2e() : port_(free_udp_port()) {
         extra_daemon_args_ = {"--set", "autopilot.gcs_endpoint.udp=127.0.0.1:" + std::to_string(port_)};
+        // The endpoint sends every frame of the board as a datagram of its own (telemetry at 10 times its
+        // rate here, a parameter list at once), and the station reads between its other calls: with the
+        // kernel's default 208 KiB, about 200 datagrams, a slow moment of this process under a sanitizer
+        // lost a banner in its own receive buffer (19 of 20). 4 MiB (forced where allowed) holds seconds.
+        const int bytes = 4 << 20;
+        if (::setsockopt(fd_, SOL_SOCKET, SO_RCVBUFFORCE, &bytes, sizeof bytes) != 0) {
+            ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &bytes, sizeof bytes);
+        }
     }
     ~GcsEndpointE2e() override {
         if (fd_ >= 0) {
