@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "services/autopilot/mavlink/enums.hpp"
 #include "tests/unit/autopilot/fake_rover.hpp"
 #include "tests/unit/autopilot/sim_harness.hpp"
 
