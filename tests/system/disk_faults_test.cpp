@@ -99,7 +99,12 @@ TEST(SystemDisk, DiskFullWhileWritingTheTlogAndTheStateFileKeepsTheDaemonUpAndTh
     ASSERT_TRUE(kept_next) << kept;
     ASSERT_TRUE(doc["plan"]["next_waypoint"].is_number()) << doc["plan"].dump();
     EXPECT_LE(*kept_next, doc["plan"]["next_waypoint"].get<unsigned long>()) << kept;
-    EXPECT_FALSE(std::filesystem::exists(bench.state_dir() + "/progress.state.tmp"));
+    // No leftover: each failed save removes its temporary file, but the plan goes on and the next save may be
+    // under way as this looks (under qemu-armel one was, once). A leftover stays; a save in progress goes.
+    EXPECT_TRUE(
+        wait_until([&] { return !std::filesystem::exists(bench.state_dir() + "/progress.state.tmp"); },
+                   kGenerous, std::chrono::milliseconds(5)))
+        << "progress.state.tmp left behind";
     EXPECT_TRUE(std::filesystem::exists(bench.state_dir() + "/plan.yaml"));
     // The daemon goes on: it answers, and the plan keeps being driven.
     send_unique(bench, serial++, tally);
