@@ -64,6 +64,9 @@ nlohmann::json autopilot_status_json(const autopilot::AutopilotStatus& s) {
         stations["tcp_clients"] = s.gcs_tcp_clients;
         stations["udp_peers_evicted"] = s.gcs_udp_peers_evicted;
         stations["tcp_refused"] = s.gcs_tcp_refused;
+        stations["frames_in"] = s.gcs_frames_in;
+        stations["invalid_in"] = s.gcs_invalid_in;
+        stations["dropped_out"] = s.gcs_dropped_out;
     }
     if (s.tlog_enabled) {
         // A recorder that cannot write (disk full, read-only) is reported; the daemon goes on without it.

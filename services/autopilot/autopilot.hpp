@@ -273,6 +273,9 @@ struct AutopilotStatus {
     std::size_t gcs_tcp_clients = 0;
     std::uint64_t gcs_udp_peers_evicted = 0;
     std::uint64_t gcs_tcp_refused = 0;
+    std::uint64_t gcs_frames_in = 0;    // valid frames from ground stations, passed on
+    std::uint64_t gcs_invalid_in = 0;   // damaged or unknown frames from ground stations, dropped
+    std::uint64_t gcs_dropped_out = 0;  // sends to a ground station dropped (its queue full)
     // autopilot.tlog (filled by the service from its .tlog writer; absent when recording is off)
     bool tlog_enabled = false;
     std::uint64_t tlog_write_errors = 0;    // autopilot.tlog.write_errors

@@ -344,6 +344,9 @@ void AutopilotService::publish_status() {
         s.gcs_tcp_clients = e.tcp_clients;
         s.gcs_udp_peers_evicted = e.udp_peers_evicted;
         s.gcs_tcp_refused = e.tcp_refused;
+        s.gcs_frames_in = e.frames_in;
+        s.gcs_invalid_in = e.invalid_in;
+        s.gcs_dropped_out = e.dropped_out;
     }
     ctx_.bus.publish_latest(s);
     ctx_.bus.publish_latest(driver_.telemetry());

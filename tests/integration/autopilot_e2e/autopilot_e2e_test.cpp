@@ -367,6 +367,13 @@ TEST_F(GcsEndpointE2e, ParameterListsFromAnotherStationBringBannersButNoReboot) 
     EXPECT_EQ(after["link_losses"], 0);
     EXPECT_EQ(after["ready_s"], at_ready["ready_s"]);
     EXPECT_EQ(daemon_->err().find("rebooted"), std::string::npos) << daemon_->err();
+    // The endpoint's counters in status: the station's heartbeat and 20 requests passed on, nothing damaged,
+    // one UDP peer, and the drop counter present (a station that keeps up loses nothing).
+    const auto stations = after.value("ground_stations", Json());
+    EXPECT_GE(stations.value("frames_in", 0), 21) << stations.dump();
+    EXPECT_EQ(stations.value("invalid_in", -1), 0) << stations.dump();
+    EXPECT_EQ(stations.value("udp_peers", 0), 1) << stations.dump();
+    EXPECT_TRUE(stations.contains("dropped_out")) << stations.dump();
 
     ASSERT_EQ(control_->ask("reboot").value_or("").rfind("ok", 0), 0u);
     EXPECT_TRUE(wait_until([&] { return autopilot_section().value("reboots", 0) == 1; }, kGenerous, kPoll))

@@ -171,6 +171,29 @@ TEST(GcsEndpoint, TcpClientsPastTheBoundAreClosedAtOnce) {
     EXPECT_EQ(rig.endpoint.stats().tcp_clients, GcsEndpoint::kMaxTcpClients);
 }
 
+// A ground station that connects and never reads: once the kernel's buffers are full, the endpoint keeps at
+// most kMaxTcpBacklog bytes for it and drops (and counts) the rest, instead of queueing the vehicle's whole
+// stream.
+TEST(GcsEndpoint, ATcpClientThatNeverReadsCostsAtMostTheBacklogAndItsDropsAreCounted) {
+    Rig rig;
+    tcp::socket silent(rig.io);
+    silent.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), rig.endpoint.tcp_port()));
+    silent.set_option(asio::socket_base::receive_buffer_size(4096));
+    ASSERT_TRUE(rig.run_until([&] { return rig.endpoint.stats().tcp_clients == 1; }));
+    const std::vector<std::uint8_t> frames(1000, 0xfd);  // what the endpoint sends is not parsed here
+    constexpr std::size_t kSends = 20'000;               // 20 MB: far past any socket buffer
+    for (std::size_t i = 0; i < kSends; ++i) {
+        rig.endpoint.from_vehicle(frames);
+        rig.io.poll();
+    }
+    const auto s = rig.endpoint.stats();
+    EXPECT_GT(s.dropped_out, 0u);
+    EXPECT_EQ(s.bytes_out + s.dropped_out * frames.size(), kSends * frames.size());
+    // Taken into the queue: what the socket took plus at most the backlog (the kernel's buffers on loopback
+    // hold a few MB at most).
+    EXPECT_LT(s.bytes_out, 16u * 1024 * 1024) << s.dropped_out << " dropped";
+}
+
 TEST(GcsEndpoint, AFixedUdpDestinationGetsFramesWithoutSendingFirst) {
     asio::io_context listener_io;
     udp::socket listener(listener_io, udp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
