@@ -145,7 +145,11 @@ build_one() {
     case "$deb" in
       *-dbgsym_*) cp "$deb" "$AIRSEG_ROOT/dist/debug/" ;;
       *) rm -f "$AIRSEG_ROOT"/dist/"$(basename "${deb%%_*}")"_*_"$arch".deb
-         cp "$deb" "$AIRSEG_ROOT/dist/"; debs+=("$AIRSEG_ROOT/dist/$(basename "$deb")") ;;
+         # Copied whole, then renamed: the builds of other architectures beside this one copy the same
+         # architecture-independent package, and check it, at any moment.
+         cp "$deb" "$AIRSEG_ROOT/dist/.$(basename "$deb").$$"
+         mv -f "$AIRSEG_ROOT/dist/.$(basename "$deb").$$" "$AIRSEG_ROOT/dist/$(basename "$deb")"
+         debs+=("$AIRSEG_ROOT/dist/$(basename "$deb")") ;;
     esac
   done
   "$AIRSEG_ROOT/packaging/check-deb.sh" "$arch" "${debs[@]}"

@@ -13,11 +13,12 @@
 #    code), and the test-only hang injection compiled in (the stuck-service test runs on ARM too).
 # 3. Checks each .deb (packaging/check-deb.sh: lintian, Architecture, shlibs Depends, ELF format
 #    and loader).
-# 4. amd64 is built first, without its tests (the whole suite runs natively in CI's sanitize stage) and
-#    without debug information, checked the same way (with the manual pages against --help), rebuilt from
-#    the same build directory as the next version (build-debs.sh --upgrade-build), and then installed,
-#    upgraded to that rebuild and removed in a throwaway chroot (packaging/test-install.sh) in the background
-#    while the ARM packages build: that test mostly downloads. AIRSEG_CI_SKIP_INSTALL_TEST=1 skips it.
+# 4. amd64 is built without its tests (the whole suite runs natively in CI's sanitize stage) and without
+#    debug information, checked the same way (with the manual pages against --help), rebuilt from the same
+#    build directory as the next version (build-debs.sh --upgrade-build), and then installed, upgraded to
+#    that rebuild and removed in a throwaway chroot (packaging/test-install.sh); all of it at the lowest
+#    priority beside the ARM builds, whose suites leave a core mostly idle (AIRSEG_CROSS_OVERLAP=0: first,
+#    before them). AIRSEG_CI_SKIP_INSTALL_TEST=1 skips the install test.
 # With --prepare, only step 1: CI runs it in the background while it compiles the sanitizer build, so
 # the downloads overlap the compiling.
 # The .debs are left in dist/. Each step prints its start time in seconds since the stage began,
@@ -75,8 +76,9 @@ if [ "$prepare_only" = 1 ]; then
 fi
 
 summary=()
-install_pid=""
+version=$(dpkg-parsechangelog -l "$AIRSEG_ROOT/packaging/debian/changelog" -S Version)
 mkdir -p "$AIRSEG_CI_LOGS"
+rm -f "$AIRSEG_CI_LOGS/cross-amd64.summary"
 # The ARM builds that run a suite under qemu, and those that are only built and checked.
 arm_with_suite() { [ "$1" != arm64 ] || [ "${AIRSEG_CROSS_TEST_ARM64:-0}" = 1 ]; }
 # build_arm ARCH: one ARM package build (with its suite where arm_with_suite), its compiles counted apart.
@@ -98,7 +100,8 @@ build_arm() {
 }
 # record_arm ARCH WALL: the ARCH row of the closing table and of this stage's summary.
 record_arm() {
-  local arch=$1 wall=$2 obj="$AIRSEG_ROOT/build-pkg-$1/airseg-$(dpkg-parsechangelog -l "$AIRSEG_ROOT/packaging/debian/changelog" -S Version)/obj-$(arch_triplet "$1")"
+  local arch=$1 wall=$2 obj
+  obj="$AIRSEG_ROOT/build-pkg-$1/airseg-$version/obj-$(arch_triplet "$1")"
   if arm_with_suite "$arch"; then
     record_stage "cross: $arch packages, suite under $(qemu_for "$arch")" "$wall" "$obj/ctest-summary.txt" "cross-$arch"
     summary+=("$arch: $wall s wall; $(cat "$obj/ctest-summary.txt" 2>/dev/null || echo 'no ctest summary'); ccache $(ccache_stage_rate "cross-$arch")")
@@ -108,37 +111,54 @@ record_arm() {
   fi
 }
 
-arm_arches=()
-for arch in "${arches[@]}"; do
-  start=$SECONDS cpu0=$(cpu_seconds)
-  if [ "$arch" != amd64 ]; then
-    arm_arches+=("$arch")
-    continue
-  fi
+# amd64_packages: the amd64 packages built (without their tests: the whole suite runs natively in CI's sanitize
+# stage) and checked, rebuilt as the next version, then installed, upgraded and removed in a throwaway chroot.
+# Its rows go to the closing table, its summary line to cross-amd64.summary.
+amd64_packages() {
+  local start=$SECONDS cpu0 line
+  cpu0=$(cpu_seconds)
   step "building amd64 (its tests run in the sanitize stage)"
   ccache_stage_begin cross-amd64
   "$AIRSEG_ROOT/packaging/build-debs.sh" --no-check --no-debug-info amd64
   record_stage "cross: amd64 packages, built and checked" "$((SECONDS - start))" "" cross-amd64
-  summary+=("amd64: $((SECONDS - start)) s wall, $(($(cpu_seconds) - cpu0)) CPU-s; packages checked; ccache $(ccache_stage_rate cross-amd64)")
+  line="amd64: $((SECONDS - start)) s wall; packages checked; ccache $(ccache_stage_rate cross-amd64)"
   if [ "${AIRSEG_CI_SKIP_INSTALL_TEST:-0}" != 1 ]; then
+    # The install test's own copy, from the build's own directory (the ARM builds write dist/ meanwhile),
+    # before the rebuild below empties that directory.
+    rm -rf "$AIRSEG_CI_LOGS/install-debs" && mkdir -p "$AIRSEG_CI_LOGS/install-debs/next"
+    cp "$AIRSEG_ROOT"/build-pkg-amd64/*_"$version"_amd64.deb "$AIRSEG_ROOT"/build-pkg-amd64/*_"$version"_all.deb \
+      "$AIRSEG_CI_LOGS/install-debs/"
     start=$SECONDS
     step "the amd64 packages rebuilt as the next version, for the upgrade"
     "$AIRSEG_ROOT/packaging/build-debs.sh" --no-check --no-debug-info --upgrade-build amd64
     record_stage "cross: amd64 rebuilt as the next version" "$((SECONDS - start))" "" ""
-    summary+=("amd64 rebuilt as the next version: $((SECONDS - start)) s wall")
-    step "install / upgrade / remove test of the amd64 packages, in the background"
-    # Its own copy: the ARM builds write dist/ meanwhile.
-    rm -rf "$AIRSEG_CI_LOGS/install-debs" && mkdir -p "$AIRSEG_CI_LOGS/install-debs/next"
-    cp "$AIRSEG_ROOT"/dist/*_amd64.deb "$AIRSEG_ROOT"/dist/*_all.deb "$AIRSEG_CI_LOGS/install-debs/"
+    line="$line; rebuilt as the next version in $((SECONDS - start)) s"
     cp "$AIRSEG_ROOT"/dist/upgrade-test/*.deb "$AIRSEG_CI_LOGS/install-debs/next/"
-    install_start=$SECONDS
-    "$AIRSEG_ROOT/packaging/test-install.sh" "$AIRSEG_CI_LOGS/install-debs" \
-      "$AIRSEG_CI_LOGS/install-debs/next" >"$AIRSEG_CI_LOGS/test-install.log" 2>&1 &
-    install_pid=$!
+    start=$SECONDS
+    step "install / upgrade / remove test of the amd64 packages"
+    if ! "$AIRSEG_ROOT/packaging/test-install.sh" "$AIRSEG_CI_LOGS/install-debs" \
+      "$AIRSEG_CI_LOGS/install-debs/next" >"$AIRSEG_CI_LOGS/test-install.log" 2>&1; then
+      cat "$AIRSEG_CI_LOGS/test-install.log"
+      die "the install / upgrade / remove test failed"
+    fi
+    cat "$AIRSEG_CI_LOGS/test-install.log"
+    record_stage "cross: amd64 install, upgrade, remove (chroot)" "$((SECONDS - start))" "" ""
   fi
-done
+  echo "$line; $(($(cpu_seconds) - cpu0)) CPU-s in all" >"$AIRSEG_CI_LOGS/cross-amd64.summary"
+}
 
-if [ ${#arm_arches[@]} -gt 0 ] && [ "${AIRSEG_CROSS_OVERLAP:-1}" = 1 ]; then
+arm_arches=()
+with_amd64=0
+for arch in "${arches[@]}"; do
+  if [ "$arch" = amd64 ]; then with_amd64=1; else arm_arches+=("$arch"); fi
+done
+overlap=${AIRSEG_CROSS_OVERLAP:-1}
+[ ${#arm_arches[@]} -gt 0 ] || overlap=0
+if [ "$with_amd64" = 1 ] && [ "$overlap" = 0 ]; then
+  amd64_packages
+fi
+
+if [ "$overlap" = 1 ]; then
   # The ARM builds side by side: compiles are CPU-bound, the suites under qemu mostly wait on real time. Each
   # build runs at a lower priority than the one before it (nice 0, 10, 19), so the first one's compile has
   # the CPU and the next compile takes what is left; the suites run one at a time, each at nice 0 again
@@ -159,6 +179,18 @@ if [ ${#arm_arches[@]} -gt 0 ] && [ "${AIRSEG_CROSS_OVERLAP:-1}" = 1 ]; then
     arm_pids+=($!)
     level=$((level + 10 > 19 ? 19 : level + 10))  # relative to this script's own priority
   done
+  # The amd64 packages at the lowest priority beside them (the ARM suites come first; its compile takes the
+  # CPU they leave), then its install test, which mostly downloads.
+  amd64_pid=""
+  if [ "$with_amd64" = 1 ]; then
+    (
+      code=0
+      renice -n 19 -p "$BASHPID" >/dev/null
+      amd64_packages >"$AIRSEG_CI_LOGS/cross-amd64.log" 2>&1 || code=$?
+      exit "$code"
+    ) &
+    amd64_pid=$!
+  fi
   failed=()
   for i in "${!arm_arches[@]}"; do
     arch=${arm_arches[$i]}
@@ -167,6 +199,11 @@ if [ ${#arm_arches[@]} -gt 0 ] && [ "${AIRSEG_CROSS_OVERLAP:-1}" = 1 ]; then
     sed "s/^/$arch| /" "$AIRSEG_CI_LOGS/cross-$arch.log"
     record_arm "$arch" "$(cut -d' ' -f1 "$AIRSEG_CI_LOGS/cross-$arch.result")"
   done
+  if [ -n "$amd64_pid" ]; then
+    wait "$amd64_pid" || failed+=(amd64)
+    step "amd64 finished; log:"
+    sed "s/^/amd64| /" "$AIRSEG_CI_LOGS/cross-amd64.log"
+  fi
   [ ${#failed[@]} = 0 ] || die "the package build for ${failed[*]} failed (logs: $AIRSEG_CI_LOGS/cross-ARCH.log)"
 else
   for arch in "${arm_arches[@]}"; do
@@ -176,19 +213,11 @@ else
     record_arm "$arch" "$((SECONDS - start))"
   done
 fi
-if [ -n "$install_pid" ]; then
-  step "waiting for the install test"
-  code=0
-  wait "$install_pid" || code=$?
-  cat "$AIRSEG_CI_LOGS/test-install.log"
-  record_stage "cross: amd64 install, upgrade, remove (chroot, beside the ARM builds)" \
-    "$((SECONDS - install_start))" "" ""
-  [ "$code" = 0 ] || die "the install / upgrade / remove test failed"
-fi
 
 for deb in "$AIRSEG_ROOT"/dist/*.deb; do
   echo "== $(basename "$deb")"
   dpkg-deb --info "$deb" | sed -n '/^ Package:/,$p'
 done
 step "done"
+[ ! -f "$AIRSEG_CI_LOGS/cross-amd64.summary" ] || summary=("$(cat "$AIRSEG_CI_LOGS/cross-amd64.summary")" "${summary[@]}")
 printf 'ci-cross: %s\n' "${summary[@]}"

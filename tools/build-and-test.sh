@@ -5,7 +5,8 @@
 #   sanitize  clang build of the whole tree with AddressSanitizer, UndefinedBehaviorSanitizer and libFuzzer
 #             coverage (build-san/); the whole ctest suite, unit to system tests, any report fails the test
 #   tidy      clang-tidy's braces and naming checks (.clang-tidy) on the sources changed since the whole tree
-#             last passed them (tools/clang-tidy-check.sh; build-tidy/ is configured, not built)
+#             last passed them (tools/clang-tidy-check.sh; build-tidy/ is configured, not built); at nice 19
+#             beside the sanitize stage's suite when both run
 #   fuzz      each libFuzzer target for AIRSEG_FUZZ_SECONDS (default 30) on its seed corpus (tests/fuzz/run.sh,
 #             same build directory), one at a time at nice 19 beside the sanitize stage's suite (one per core
 #             without it); a crash or a broken property fails the stage
@@ -70,7 +71,7 @@ kill_tree() {
 finish() {
   local code=$? pid
   if [ "$code" != 0 ]; then
-    for pid in ${fuzz_pid:-} ${tsan_build_pid:-} ${prepare_pid:-}; do
+    for pid in ${fuzz_pid:-} ${tsan_build_pid:-} ${tidy_pid:-} ${prepare_pid:-}; do
       kill_tree "$pid"
     done
     record_stage "FAILED (exit $code) after the stages above" "-" "" ""
@@ -167,6 +168,15 @@ if has_stage tsan && has_stage sanitize && [ "${AIRSEG_TSAN_BESIDE_SUITE:-1}" = 
   tsan_build_pid=$!
 fi
 
+# clang-tidy, too, at nice 19 beside the suite: it parses each changed source on its own, CPU-bound work for
+# the core the suite leaves idle.
+tidy_pid=""
+if has_stage tidy && has_stage sanitize; then
+  tidy_start=$SECONDS
+  nice -n 19 tools/clang-tidy-check.sh build-tidy >build-logs/tidy.log 2>&1 &
+  tidy_pid=$!
+fi
+
 if has_stage sanitize; then
   start=$SECONDS
   # Any sanitizer report ends the process with an error, in the tests and in the programs they start.
@@ -176,7 +186,13 @@ if has_stage sanitize; then
   [ "${suite:-0}" = 0 ] || exit 1
 fi
 
-if has_stage tidy; then
+if [ -n "$tidy_pid" ]; then
+  code=0
+  wait "$tidy_pid" || code=$?
+  cat build-logs/tidy.log
+  [ "$code" = 0 ] || { echo "build-and-test: clang-tidy found a problem" >&2; exit 1; }
+  elapsed "tidy: clang-tidy on the changed sources, beside the ASan+UBSan suite" "$tidy_start"
+elif has_stage tidy; then
   start=$SECONDS
   tools/clang-tidy-check.sh build-tidy
   elapsed "tidy: clang-tidy on the changed sources" "$start"
