@@ -55,6 +55,9 @@ class UdpSocket::Impl : public std::enable_shared_from_this<Impl> {
         if (!ec) {
             socket_.bind(local, ec);
         }
+        if (!ec) {
+            socket_.non_blocking(true, ec);  // send_to() tries the kernel first and must never wait
+        }
         if (ec) {
             boost::system::error_code ignored;
             socket_.close(ignored);
@@ -110,6 +113,18 @@ class UdpSocket::Impl : public std::enable_shared_from_this<Impl> {
         }
         if (datagram.size() > kMaxDatagram) {
             return WriteResult::TooLarge;
+        }
+        if (in_flight_ == 0) {
+            // Straight to the kernel while no send waits before it. Completions run on this strand only after
+            // the caller's handler returns, so a burst sent from one handler (a whole read of the autopilot's
+            // frames, one datagram each) would otherwise meet the in-flight bound after 64 datagrams and lose
+            // the rest although the kernel had room for them.
+            boost::system::error_code ec;
+            socket_.send_to(boost::asio::buffer(datagram), to, 0, ec);
+            if (ec != boost::asio::error::would_block && ec != boost::asio::error::try_again) {
+                note_send_result(ec);
+                return WriteResult::Queued;
+            }
         }
         if (in_flight_ >= kMaxSendsInFlight) {
             return WriteResult::QueueFull;
@@ -187,6 +202,10 @@ class UdpSocket::Impl : public std::enable_shared_from_this<Impl> {
             return;
         }
         --in_flight_;
+        note_send_result(ec);
+    }
+
+    void note_send_result(boost::system::error_code ec) {
         if (ec && ec != boost::asio::error::operation_aborted) {
             if (send_errors_++ == 0) {
                 spdlog::warn("{}send failed: {} (further failures are only counted)", prefix_, ec.message());

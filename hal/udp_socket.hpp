@@ -35,7 +35,8 @@ class UdpSocket {
     using ErrorHandler = std::function<void(std::error_code error, const std::string& what)>;
 
     static constexpr std::size_t kMaxDatagram = 2048;
-    /// Sends handed to the kernel and not yet completed; beyond this send() returns QueueFull.
+    /// A send goes straight to the kernel when none waits before it; when the kernel's buffer is full it
+    /// waits, in order, and beyond this many waiting send() returns QueueFull.
     static constexpr std::size_t kMaxSendsInFlight = 64;
 
     explicit UdpSocket(Executor executor);

@@ -361,7 +361,8 @@ TEST_F(GcsEndpointE2e, ParameterListsFromAnotherStationBringBannersButNoReboot) 
     listen(1s);
     const double board_minutes = (board_t() - start) / 60.0;
     const auto after = autopilot_section();
-    EXPECT_EQ(banners, 20) << "each request brought the banner to the station";
+    EXPECT_EQ(banners, 20) << "each request brought the banner to the station: "
+                           << after.value("ground_stations", Json()).dump();
     EXPECT_EQ(after["reboots"], 0) << after.dump() << daemon_->err();
     EXPECT_EQ(after["syncs"], 1) << "the parameters and the mission were read once";
     EXPECT_EQ(after["link_losses"], 0);
@@ -385,7 +386,7 @@ TEST_F(GcsEndpointE2e, ParameterListsFromAnotherStationBringBannersButNoReboot) 
     std::cout << "[ figures ] " << banners << " parameter lists with their banner over " << board_minutes
               << " board minutes: " << after["reboots"] << " reboots, " << after["syncs"]
               << " syncs; ready_s " << at_ready["ready_s"] << "; a real reboot: " << rebooted["reboots"]
-              << " reboot, " << rebooted["syncs"] << " syncs\n";
+              << " reboot, " << rebooted["syncs"] << " syncs; the endpoint: " << stations.dump() << "\n";
 }
 
 TEST_F(GcsEndpointE2e, AGroundStationsMissionBecomesThePlanAndAnotherIsRefusedWhileItRuns) {

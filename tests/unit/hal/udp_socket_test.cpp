@@ -80,6 +80,28 @@ TEST_F(HalUdpSocketTest, DatagramsFlowAndTheReplyGoesToTheLastSender) {
     EXPECT_EQ(air_inbox_.datagrams[0], (std::vector<std::uint8_t>{9, 8, 7}));
 }
 
+// A burst sent from one handler, as the autopilot service forwards a whole read of frames to a ground
+// station: far more datagrams than kMaxSendsInFlight, every one delivered, in order, while the kernel has
+// room.
+TEST_F(HalUdpSocketTest, ABurstFromOneHandlerIsSentWholeInOrder) {
+    // Three times the bound, and within what the receiver's default buffer holds of such small datagrams (256).
+    constexpr std::size_t kBurst = 3 * UdpSocket::kMaxSendsInFlight;
+    std::size_t queued = 0;
+    for (std::size_t i = 0; i < kBurst; ++i) {
+        const std::vector<std::uint8_t> d{static_cast<std::uint8_t>(i), static_cast<std::uint8_t>(i >> 8), 1,
+                                          2};
+        queued += air_.send(d) == WriteResult::Queued ? 1 : 0;
+    }
+    EXPECT_EQ(queued, kBurst);
+    ASSERT_TRUE(run_until(io_, [&] { return ground_inbox_.datagrams.size() == kBurst; }))
+        << ground_inbox_.datagrams.size() << " of " << kBurst << " arrived";
+    for (std::size_t i = 0; i < kBurst; ++i) {
+        ASSERT_EQ(ground_inbox_.datagrams[i][0] | (ground_inbox_.datagrams[i][1] << 8),
+                  static_cast<int>(i & 0xffff));
+    }
+    EXPECT_EQ(air_.send_errors(), 0u);
+}
+
 TEST_F(HalUdpSocketTest, OversizeDatagramsAreDroppedWholeAndCounted) {
     EXPECT_EQ(air_.send(std::vector<std::uint8_t>(UdpSocket::kMaxDatagram + 1, 0)), WriteResult::TooLarge);
 
