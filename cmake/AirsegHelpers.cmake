@@ -55,12 +55,10 @@ function(airseg_add_library name)
   target_link_libraries(${name} PUBLIC airseg_options ${A_LIBS})
 endfunction()
 
-# airseg_add_test(NAME SOURCES... [LIBS ...] [LABELS ...] [TIMEOUT seconds]
-#                 [RESOURCE_LOCK name | LOCK_BY_FILTER gtest-filter name [gtest-filter name...]])
-# One GoogleTest executable whose cases ctest discovers one by one. LOCK_BY_FILTER gives the cases each
-# GoogleTest filter selects their own lock (every case must be selected by one filter).
+# airseg_add_test(NAME SOURCES... [LIBS ...] [LABELS ...] [TIMEOUT seconds] [RESOURCE_LOCK name])
+# One GoogleTest executable whose cases ctest discovers one by one.
 function(airseg_add_test name)
-  cmake_parse_arguments(A "" "TIMEOUT;RESOURCE_LOCK" "SOURCES;LIBS;LABELS;LOCK_BY_FILTER" ${ARGN})
+  cmake_parse_arguments(A "" "TIMEOUT;RESOURCE_LOCK" "SOURCES;LIBS;LABELS" ${ARGN})
   if(NOT AIRSEG_BUILD_TESTS)
     return()
   endif()
@@ -74,15 +72,6 @@ function(airseg_add_test name)
   if(A_RESOURCE_LOCK)
     # Cases that must not run beside each other (they share a scarce resource, e.g. real-time radio links).
     set(_lock RESOURCE_LOCK ${A_RESOURCE_LOCK})
-  endif()
-  if(A_LOCK_BY_FILTER)
-    set(_pairs ${A_LOCK_BY_FILTER})
-    while(_pairs)
-      list(POP_FRONT _pairs _filter _lock_name)
-      gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60 TEST_FILTER "${_filter}"
-                           PROPERTIES TIMEOUT ${A_TIMEOUT} LABELS "${A_LABELS}" RESOURCE_LOCK ${_lock_name})
-    endwhile()
-    return()
   endif()
   gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60
                        PROPERTIES TIMEOUT ${A_TIMEOUT} LABELS "${A_LABELS}" ${_lock})
