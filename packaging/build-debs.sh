@@ -65,8 +65,18 @@ stage_source() {
   mkdir -p "$dir"
   find "$dir" -mindepth 1 -maxdepth 1 ! -name 'obj-*' -exec rm -rf {} +
   if [ "$clean" = 1 ]; then rm -rf "$dir"/obj-*; fi
-  tar -C "$source_tree" --exclude=./.git --exclude='./build*' --exclude=./dist --exclude=./sysroots \
-      --exclude=./.cache -cf - . | tar -C "$dir" -xf -
+  # The top-level entries by name, never the top directory itself: the builds of the other architectures
+  # beside this one create their build-pkg-ARCH/ and dist/ in it, and tar fails ("file changed as we read it")
+  # on a directory that changes while it is archived.
+  local -a entries=()
+  local entry name
+  for entry in "$source_tree"/* "$source_tree"/.[!.]*; do
+    [ -e "$entry" ] || continue
+    name=${entry##*/}
+    case "$name" in .git | build* | dist | sysroots | .cache) continue ;; esac
+    entries+=("$name")
+  done
+  tar -C "$source_tree" -cf - -- "${entries[@]}" | tar -C "$dir" -xf -
   cp -a "$source_tree/packaging/debian" "$dir/debian"
 }
 
