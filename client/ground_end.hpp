@@ -59,6 +59,9 @@ class GroundEnd {
     /// Link statistics as the status document's groundlink section shows them, seen from the ground.
     nlohmann::json link_stats() const;
     bool link_up() const;
+    /// Why the vehicle's handshakes cannot be taken, for people ("not authorised: ..."); empty while none
+    /// has shown a key mismatch.
+    std::string authorisation_problem() const;
     /// Bytes this end's transport wrote to the link so far (all paths, framing included).
     std::uint64_t bytes_sent() const;
     /// Whether the key the vehicle accepted is loaded (an authenticated link).

@@ -44,13 +44,19 @@ class RadioClient::Impl {
             }
         });
         const auto deadline = std::chrono::steady_clock::now() + timeout;
-        while (!answer && !not_sent && std::chrono::steady_clock::now() < deadline) {
+        std::string refused;
+        while (!answer && !not_sent && refused.empty() && std::chrono::steady_clock::now() < deadline) {
             io_.run_for(std::chrono::milliseconds(20));
             if (io_.stopped()) {
                 io_.restart();
             }
+            refused = end_.authorisation_problem();
         }
         answer_ = nullptr;
+        if (!answer && !refused.empty()) {
+            out.error = refused;
+            return out;
+        }
         if (not_sent) {
             // Refused here, before the air: answered as the vehicle answers a request it cannot take.
             out.answer = nlohmann::json{{"ok", false}, {"status", "bad_request"}, {"error", *not_sent}};

@@ -137,6 +137,7 @@ class App::Impl {
         g.reconnect_min = gl.reconnect_min;
         g.reconnect_max = gl.reconnect_max;
         g.key_file = gl.key_file;
+        g.insecure = gl.insecure;
         g.udp.bind_address = gl.udp_bind;
         g.udp.bind_port = static_cast<std::uint16_t>(gl.udp_port);
         g.udp.remote_address = gl.udp_remote;

@@ -463,6 +463,9 @@ std::vector<KeySpec> build_schema() {
     s.push_back(string(
         "groundlink.key_file", [](Config& c) -> std::string& { return c.groundlink.key_file; },
         "pre-shared key file (mode 0600) authenticating every frame; empty = none", true));
+    s.push_back(boolean(
+        "groundlink.insecure", [](Config& c) -> bool& { return c.groundlink.insecure; },
+        "without key_file, accept commands from an unauthenticated ground (false: refuse them)"));
     s.push_back(duration(
         "groundlink.reconnect_min", [](Config& c) -> milliseconds& { return c.groundlink.reconnect_min; },
         milliseconds(10), seconds(60),

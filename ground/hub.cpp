@@ -478,6 +478,9 @@ void Hub::tick() {
     }
     broadcast(hub::encode_json({{"link", link_stats()}}));
     const auto now = std::chrono::steady_clock::now();
+    if (const auto why = end_.authorisation_problem(); !why.empty()) {
+        log_.log("ground hub: not authorised", now, spdlog::level::warn, "ground hub: {}", why);
+    }
     log_.flush(now);
     std::vector<std::shared_ptr<ClientConnection>> silent;
     for (auto& [id, client] : clients_) {

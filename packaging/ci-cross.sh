@@ -18,7 +18,8 @@
 #    build directory as the next version (build-debs.sh --upgrade-build), and then installed, upgraded to
 #    that rebuild and removed in a throwaway chroot (packaging/test-install.sh); all of it at the lowest
 #    priority beside the ARM builds, whose suites leave a core mostly idle (AIRSEG_CROSS_OVERLAP=0: first,
-#    before them). AIRSEG_CI_SKIP_INSTALL_TEST=1 skips the install test.
+#    before them); then booted under a real systemd in a virtual machine (packaging/test-vm.sh).
+#    AIRSEG_CI_SKIP_INSTALL_TEST=1 skips both.
 # With --prepare, only step 1: CI runs it in the background while it compiles the sanitizer build, so
 # the downloads overlap the compiling.
 # The .debs are left in dist/. Each step prints its start time in seconds since the stage began,
@@ -33,7 +34,7 @@ for a in "$@"; do
   case "$a" in
     --prepare) prepare_only=1 ;;
     amd64|armhf|armel|arm64) arches+=("$a") ;;
-    -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,25p' "$0"; exit 0 ;;
     *) die "unknown argument '$a' (expected --prepare, amd64, armhf, armel, arm64)" ;;
   esac
 done
@@ -143,6 +144,16 @@ amd64_packages() {
     fi
     cat "$AIRSEG_CI_LOGS/test-install.log"
     record_stage "cross: amd64 install, upgrade, remove (chroot)" "$((SECONDS - start))" "" ""
+    start=$SECONDS
+    step "the amd64 packages booted under systemd in a virtual machine"
+    if ! "$AIRSEG_ROOT/packaging/test-vm.sh" "$AIRSEG_CI_LOGS/install-debs" \
+      "$AIRSEG_CI_LOGS/install-debs/next" >"$AIRSEG_CI_LOGS/test-vm.log" 2>&1; then
+      cat "$AIRSEG_CI_LOGS/test-vm.log"
+      die "the packages' checks under systemd in a virtual machine failed"
+    fi
+    cat "$AIRSEG_CI_LOGS/test-vm.log"
+    record_stage "cross: amd64 booted under systemd (qemu VM)" "$((SECONDS - start))" "" ""
+    line="$line; VM checks in $((SECONDS - start)) s"
   fi
   echo "$line; $(($(cpu_seconds) - cpu0)) CPU-s in all" >"$AIRSEG_CI_LOGS/cross-amd64.summary"
 }

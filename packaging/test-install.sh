@@ -16,9 +16,10 @@
 #   daemon, no airsegd unit, no user airseg;
 # - all packages: user airseg (in dialout and gpio), the conffile, /etc/airseg/conf.d, the unit enabled and
 #   not started, `systemd-analyze verify` clean, `airsegd --check-config` accepts the shipped file with a
-#   drop-in, manual pages, the licence and the docs under /usr/share/doc;
+#   drop-in, manual pages, the licence and the docs under /usr/share/doc; the ground-link key made at install
+#   (64 hexadecimal characters, mode 600, owner airseg) and named by the shipped file;
 # - upgrade with a local setting in conf.d: no conffile prompt (dpkg runs without stdin), the new shipped
-#   file installed, the drop-in kept, try-restart of airsegd.service and airseg-ground.service asked and
+#   file installed, the drop-in and the key kept, try-restart of airsegd.service and airseg-ground.service asked and
 #   no unit stopped before the new files are in place;
 # - removal: stop asked, the daemon gone, the conffile kept; purge: the conffile, /var/lib/airseg and
 #   /var/log/airseg gone; removing airseg-client asks to stop the hub.
@@ -119,6 +120,13 @@ out=$(systemd-analyze verify /lib/systemd/system/airsegd.service 2>&1)
 echo "  $(systemd-analyze security --offline=true --no-pager /lib/systemd/system/airsegd.service | tail -n1)"
 grep -q '^LogsDirectory=airseg$' /lib/systemd/system/airsegd.service && ok "unit has LogsDirectory=airseg" \
   || bad "no LogsDirectory=airseg"
+check "a ground-link key was made" test -s /etc/airseg/ground.key
+[ "$(stat -c '%a %U' /etc/airseg/ground.key)" = "600 airseg" ] && ok "the key is mode 600, owner airseg" \
+  || bad "the key is $(stat -c '%a %U' /etc/airseg/ground.key), not 600 airseg"
+grep -qxE '[0-9a-f]{64}' /etc/airseg/ground.key && ok "the key is 64 hexadecimal characters" \
+  || bad "the key is not 64 hexadecimal characters"
+key_sum=$(sha256sum /etc/airseg/ground.key)
+check "the shipped configuration uses it" grep -qE '^  key_file: /etc/airseg/ground.key$' /etc/airseg/airseg.yaml
 printf 'log_level: debug\n' >/etc/airseg/conf.d/50-local.yaml
 check "shipped configuration with a drop-in is valid" /usr/sbin/airsegd --check-config
 /usr/sbin/airsegd --check-config 2>&1 | grep -q "conf.d/50-local.yaml" && ok "--check-config names the drop-in" \
@@ -140,6 +148,8 @@ dpkg -i airsegd.deb airseg-client.deb airseg-sim.deb airseg.deb </dev/null >/tmp
 [ "$(dpkg-query -W -f '${Version}' airsegd)" = "$next" ] && ok "airsegd is $next" || bad "airsegd not upgraded"
 check "the new shipped configuration is installed" grep -qx "# shipped by $next" /etc/airseg/airseg.yaml
 check "the drop-in is kept" grep -qx 'log_level: debug' /etc/airseg/conf.d/50-local.yaml
+[ "$(sha256sum /etc/airseg/ground.key)" = "$key_sum" ] && ok "the upgrade kept the ground-link key" \
+  || bad "the upgrade changed the ground-link key"
 invoked "try-restart airsegd.service" && ok "upgrade asks systemd to try-restart airsegd.service" \
   || bad "no try-restart on upgrade: $(cat /tmp/invoked)"
 invoked "try-restart airseg-ground.service" && ok "upgrade asks systemd to try-restart airseg-ground.service" \
@@ -159,6 +169,7 @@ mkdir -p /var/lib/airseg /var/log/airseg   # as the unit's StateDirectory and Lo
 dpkg -P airsegd </dev/null >/dev/null || bad "dpkg -P failed"
 check "dpkg -P removes the conffile" test ! -e /etc/airseg/airseg.yaml
 check "dpkg -P removes /var/lib/airseg" test ! -e /var/lib/airseg
+check "dpkg -P removes the ground-link key" test ! -e /etc/airseg/ground.key
 check "dpkg -P removes /var/log/airseg" test ! -e /var/log/airseg
 check "dpkg -P removes the enablement link" test ! -e /etc/systemd/system/multi-user.target.wants/airsegd.service
 : >/tmp/invoked

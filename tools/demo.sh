@@ -52,15 +52,21 @@ if [ -x "$build/tools/apmsim/airseg-apmsim" ]; then
   wait_for "$autopilot_port"
 fi
 
+# The ground link's key, made for this run as the package makes one at install: the vehicle and the hub
+# hold the same one.
+key="$run_dir/ground.key"
+(umask 077 && od -An -N32 -tx1 /dev/urandom | tr -d ' \n' >"$key" && echo >>"$key")
+
 "$build/daemon/airsegd" --config config/airseg.yaml \
   --set "status.socket=$run_dir/status.sock" --set "state_dir=$run_dir/state" \
   --set "autopilot.port=$autopilot_port" --set "groundlink.ports=[$run_dir/radio-air]" \
+  --set "groundlink.key_file=$key" \
   --set groundlink.mavlink_forward.enabled=true \
   > "$run_dir/airsegd.log" 2>&1 &
 pids+=($!)
 
 # The map on a free port (named in the hub's log): a fixed one may be taken on a developer's machine.
-"$build/ground/airseg-ground" --link "$run_dir/radio-ground" --baud 57600 --socket "$run_dir/ground.sock" \
+"$build/ground/airseg-ground" --link "$run_dir/radio-ground" --baud 57600 --key "$key" --socket "$run_dir/ground.sock" \
   --map "127.0.0.1:${AIRSEG_DEMO_MAP_PORT:-0}" --map-control --mavlink-tcp "127.0.0.1:${AIRSEG_DEMO_MAVLINK_TCP:-0}" \
   --mavlink-udp "${AIRSEG_DEMO_MAVLINK_UDP:-127.0.0.1:14550}" \
   > "$run_dir/airseg-ground.log" 2>&1 &

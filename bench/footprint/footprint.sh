@@ -86,7 +86,8 @@ pids+=($!)
 wait_for "$run_dir/apm"
 "${launch[@]}" "$daemon" --config config/airseg.yaml \
   --set "status.socket=$run_dir/status.sock" --set "state_dir=$run_dir/state" \
-  --set "autopilot.port=$run_dir/apm" --set "groundlink.ports=[$run_dir/radio-air]" "${extra[@]}" \
+  --set "autopilot.port=$run_dir/apm" --set "groundlink.ports=[$run_dir/radio-air]" \
+  --set groundlink.key_file= --set groundlink.insecure=true "${extra[@]}" \
   > "$run_dir/airsegd.log" 2>&1 &
 daemon_pid=$!
 pids+=($daemon_pid)

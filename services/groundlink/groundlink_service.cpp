@@ -18,6 +18,10 @@ namespace airseg::groundlink {
 
 namespace {
 
+constexpr const char* kNoKeyRefusal =
+    "this vehicle has no ground-link key (groundlink.key_file) and groundlink.insecure is not set, so every "
+    "command from the ground is refused";
+
 std::uint64_t random_nonce() {
     std::random_device rd;
     std::uint64_t v = 0;
@@ -81,8 +85,12 @@ void GroundlinkService::on_start() {
         }
         control_key_ = key.key;
         transport_.key = key.key;
+    } else if (config_.insecure) {
+        spdlog::warn(
+            "groundlink: groundlink.insecure is set and there is no key_file: frames are not authenticated, "
+            "and anyone on the radio channel (or network) may command this vehicle");
     } else {
-        spdlog::warn("groundlink: no key_file configured: frames are not authenticated");
+        spdlog::warn("groundlink: {}", kNoKeyRefusal);
     }
     if (!config_.monitor_key_file.empty()) {
         if (!control_key_) {
@@ -248,7 +256,12 @@ void GroundlinkService::on_command(const protocol::Command& command) {
                       "groundlink: request {} from the ground ({}): {}", id, to_string(role), shown);
     ctx_.commands.dispatch(request, role, [this, id, lowered](CommandResult result) {
         asio::dispatch(strand(), [this, id, lowered, result = std::move(result)]() mutable {
-            if (result.status == CommandStatus::Forbidden) {
+            if (result.status == CommandStatus::Forbidden && refusing_unauthenticated()) {
+                ++commands_refused_;
+                result.error = std::string("not authorised: ") + kNoKeyRefusal;
+                log_.log("groundlink: refused a command: no key", SteadyClock::now(), spdlog::level::warn,
+                         "groundlink: refused a command from the ground: {}", kNoKeyRefusal);
+            } else if (result.status == CommandStatus::Forbidden) {
                 ++commands_refused_;
                 result.error += lowered
                                     ? " (a monitor client of the ground hub; commands need its control role)"
@@ -274,7 +287,8 @@ void GroundlinkService::on_command(const protocol::Command& command) {
 void GroundlinkService::on_joystick(const protocol::Joystick& joystick) {
     if (ground_role() != Role::Control) {
         if (joystick_refused_++ == 0) {
-            spdlog::warn("groundlink: joystick input from a monitor key refused");
+            spdlog::warn("groundlink: joystick input refused ({})",
+                         refusing_unauthenticated() ? "no ground-link key on the vehicle" : "monitor key");
         }
         return;
     }
@@ -287,7 +301,9 @@ void GroundlinkService::on_ground_station_frames(protocol::MavlinkFrames frames)
         if (from_ground_refused_++ == 0) {
             spdlog::warn(
                 "groundlink: MAVLink frames from the ground dropped ({})",
-                config_.mavlink_forward.enabled ? "monitor key" : "groundlink.mavlink_forward is off");
+                !config_.mavlink_forward.enabled ? "groundlink.mavlink_forward is off"
+                : refusing_unauthenticated()     ? "no ground-link key on the vehicle"
+                                                 : "monitor key");
         }
         return;
     }
@@ -327,7 +343,11 @@ void GroundlinkService::on_event(const TransportEvent& event) {
     switch (event.kind) {
         case TransportEvent::Kind::LinkUp:
             log_.log("groundlink: link up", SteadyClock::now(), spdlog::level::info,
-                     "groundlink: link up ({} key)", ground_role() == Role::Control ? "control" : "monitor");
+                     "groundlink: link up ({})",
+                     refusing_unauthenticated()          ? "no key: commands refused"
+                     : !control_key_                     ? "unauthenticated: groundlink.insecure"
+                     : ground_role() == Role::Control ? "control key"
+                                                         : "monitor key");
             break;
         case TransportEvent::Kind::LinkDown:
             log_.log("groundlink: link down", SteadyClock::now(), spdlog::level::warn,
@@ -477,6 +497,8 @@ void GroundlinkService::update_health() {
         set_health(Health::Degraded, missing.empty() ? "no ground station heard" : missing);
     } else if (!missing.empty()) {
         set_health(Health::Degraded, missing);
+    } else if (refusing_unauthenticated()) {
+        set_health(Health::Degraded, "no ground-link key: commands refused");
     } else {
         set_health(Health::Up);
     }
@@ -508,7 +530,10 @@ void GroundlinkService::publish_status() {
         [mode = config_.mode, up, s = stats, goodput = goodput_bps_, ports = std::move(ports),
          counters = std::array{commands_, commands_refused_, joystick_inputs_, joystick_refused_,
                                events_sent_, events_dropped_, bad_messages_},
-         role = std::string(!stats.authenticated ? "control (unauthenticated)" : to_string(ground_role())),
+         role = std::string(refusing_unauthenticated() ? "monitor (no key on the vehicle: commands refused)"
+                            : !stats.authenticated ? "control (unauthenticated, groundlink.insecure)"
+                                                   : to_string(ground_role())),
+         refusal = std::string(refusing_unauthenticated() ? kNoKeyRefusal : ""),
          rates = rates_snapshot(), fwd = forwarder_.stats(), fwd_enabled = config_.mavlink_forward.enabled,
          fwd_budget = forwarder_.budget_bytes_per_s(),
          fwd_counters = std::array{forward_refused_, from_ground_frames_, from_ground_refused_}] {
@@ -542,6 +567,9 @@ void GroundlinkService::publish_status() {
             g["commands"] = counters[0];
             g["commands_refused"] = counters[1];
             g["role"] = role;
+            if (!refusal.empty()) {
+                g["commands_refused_because"] = refusal;
+            }
             g["joystick_inputs"] = counters[2];
             g["joystick_refused"] = counters[3];
             g["events_sent"] = counters[4];

@@ -30,6 +30,9 @@ struct GroundlinkServiceConfig {
     std::string key_file;  // empty: frames are not authenticated (status says so)
     /// A second key whose holders may watch but not command (empty: none). Needs key_file.
     std::string monitor_key_file;
+    /// Without key_file, whether the ground may command the vehicle unauthenticated (groundlink.insecure).
+    /// Without either, every command, joystick input and MAVLink frame from the ground is refused.
+    bool insecure = false;
     TelemetrySchedulerConfig telemetry;
     hal::UdpConfig udp;
     TransportConfig transport;  // paths, path_mode, link rate, key and boot nonce are set by the service
@@ -53,8 +56,13 @@ class GroundlinkService : public Service {
     /// The ground end's role, from the key its session was authenticated with: the monitor key (the
     /// transport's second key) may watch, the control key may command. Unkeyed links are control.
     [[nodiscard]] Role ground_role() const {
+        if (refusing_unauthenticated()) {
+            return Role::Monitor;
+        }
         return driver_ && driver_->core().session_key() == 1 ? Role::Monitor : Role::Control;
     }
+    /// No key and no explicit groundlink.insecure: anyone on the channel could be the ground station.
+    [[nodiscard]] bool refusing_unauthenticated() const { return !control_key_ && !config_.insecure; }
     void make_driver();
     void attach_writers();
     void register_commands();

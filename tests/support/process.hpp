@@ -49,6 +49,13 @@ void write_file(const std::string& path, const std::string& text);
 std::string binary(const std::string& relative);
 std::string source_path(const std::string& relative);
 
+/// airsegd's `--set`s for a ground link without a key: the shipped configuration names the installed key
+/// (/etc/airseg/ground.key), which a test machine does not have, and a daemon without a key refuses every
+/// command from the ground unless groundlink.insecure says otherwise.
+inline std::vector<std::string> unkeyed_ground_link() {
+    return {"--set", "groundlink.key_file=", "--set", "groundlink.insecure=true"};
+}
+
 class Subprocess {
   public:
     /// Starts argv[0] with argv; `env` entries are added to (or replace) the test's environment. stdout and

@@ -118,6 +118,9 @@ void SystemBench::start_daemon() {
     sets.push_back(std::string("groundlink.mode=") + (options_.radios == 2 ? "split" : "single"));
     if (options_.key) {
         sets.push_back("groundlink.key_file=" + key_file_);
+    } else {
+        sets.push_back("groundlink.key_file=");
+        sets.push_back("groundlink.insecure=true");
     }
     if (boxed) {
         sets.push_back("autopilot.tlog.enabled=true");

@@ -121,6 +121,10 @@ class HostileFiles : public ::testing::Test {
                 "--set",
                 "groundlink.ports=[" + dir.file("ttyUSB0") + "]",
                 "--set",
+                "groundlink.key_file=",
+                "--set",
+                "groundlink.insecure=true",
+                "--set",
                 "flightplan.fsync=false"};
     }
     std::string socket() const { return dir.file("status.sock"); }

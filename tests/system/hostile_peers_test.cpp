@@ -180,7 +180,8 @@ class HostilePeers : public ::testing::Test {
                                      "--set", "status.socket=" + socket(), "--set",
                                      "state_dir=" + dir.file("state"), "--set",
                                      "autopilot.port=" + dir.file("ttyACM0"), "--set",
-                                     "groundlink.ports=[" + dir.file("ttyUSB0") + "]"},
+                                     "groundlink.ports=[" + dir.file("ttyUSB0") + "]", "--set",
+                                     "groundlink.key_file=", "--set", "groundlink.insecure=true"},
             std::map<std::string, std::string>{
                 {"NOTIFY_SOCKET", notify.path()},
                 {"WATCHDOG_USEC", std::to_string(kWatchdogPeriod.count() * 1000)}},

@@ -227,6 +227,13 @@ struct LinkStats {
     std::uint64_t oversized = 0;  ///< messages dropped for growing beyond max_message_size (Safe or Fast)
     std::uint64_t hellos_sent = 0;
     std::uint64_t hellos_received = 0;
+    /// Frames whose authentication does not match this end's (each also counted above as a CRC or MAC
+    /// failure): the peer has a key and this end none (its handshakes, or its frames before a session), this
+    /// end a key and the peer's handshakes none, or handshakes under another key. What a ground end tells its
+    /// operator instead of "no link".
+    std::uint64_t frames_needing_key = 0;
+    std::uint64_t hellos_without_key = 0;
+    std::uint64_t hellos_with_other_key = 0;
     std::uint64_t peer_restarts = 0;
     std::uint64_t acks_sent = 0;  ///< ACK chunks
     std::uint64_t acks_received = 0;

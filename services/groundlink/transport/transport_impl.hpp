@@ -59,6 +59,7 @@ class Transport::Impl {
 
     // transport_rx.cpp
     void handle_bytes(std::size_t path, std::span<const std::uint8_t> bytes, TimePoint now);
+    void count_key_mismatch(std::span<const std::uint8_t> plain, bool keyed, frame::Kind kind);
     /// `wire_bytes`: the frame's size on the wire for the error meter (0: rebuilt from shards, not counted).
     void on_plain_frame(std::size_t path, std::span<const std::uint8_t> plain, std::size_t wire_bytes,
                         TimePoint now);

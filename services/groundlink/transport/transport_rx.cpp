@@ -109,6 +109,21 @@ void Transport::Impl::on_shard(std::size_t path, std::span<const std::uint8_t> p
     }
 }
 
+// A frame that fails its CRC one way and passes it the other (keyed CRCs carry no nonce prefix, unkeyed
+// handshakes a zero one) came from a peer whose authentication differs from ours; a damaged frame passes
+// neither.
+void Transport::Impl::count_key_mismatch(std::span<const std::uint8_t> plain, bool keyed, frame::Kind kind) {
+    const auto other = frame::check_crc(plain, !keyed, MacContext{});
+    if (!other) {
+        return;
+    }
+    if (!keyed && (kind == frame::Kind::Data || other->size() == 1 + frame::kHelloBodyBytes + kMacTagBytes)) {
+        ++stats.frames_needing_key;
+    } else if (keyed && kind == frame::Kind::Hello && other->size() == 1 + frame::kHelloBodyBytes) {
+        ++stats.hellos_without_key;
+    }
+}
+
 void Transport::Impl::on_plain_frame(std::size_t path, std::span<const std::uint8_t> plain,
                                      std::size_t wire_bytes, TimePoint now) {
     const bool keyed = mac != nullptr;
@@ -126,6 +141,9 @@ void Transport::Impl::on_plain_frame(std::size_t path, std::span<const std::uint
     }
     const auto body = frame::check_crc(plain, keyed, ctx);
     if (!body || body->size() < tag_bytes + 1) {
+        if (*kind == frame::Kind::Hello || (!keyed && !established)) {
+            count_key_mismatch(plain, keyed, *kind);
+        }
         ++stats.crc_errors;
         if (keyed || established || *kind == frame::Kind::Hello) {
             ++damaged_since_numbered;
@@ -144,6 +162,7 @@ void Transport::Impl::on_plain_frame(std::size_t path, std::span<const std::uint
             }
             if (key == keys.size()) {
                 ++stats.mac_failures;
+                ++stats.hellos_with_other_key;
                 return;
             }
         }

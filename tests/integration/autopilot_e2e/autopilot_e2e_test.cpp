@@ -69,7 +69,8 @@ class AutopilotE2e : public ::testing::Test {
                                           "state_dir=" + dir_.file("state"), "--set",
                                           "autopilot.port=" + dir_.file("ttyACM0"), "--set",
                                           "autopilot.reconnect_max=500ms", "--set",
-                                          "groundlink.ports=[" + dir_.file("ttyUSB0") + "]"},
+                                          "groundlink.ports=[" + dir_.file("ttyUSB0") + "]", "--set",
+                                          "groundlink.key_file=", "--set", "groundlink.insecure=true"},
                  extra_daemon_args_),
             std::map<std::string, std::string>{}, dir_.path());
     }
@@ -434,7 +435,8 @@ TEST(AutopilotHostileClock, TimeBootFlippingBetweenItsLimitsIsNoRebootAndNoLogFl
     Subprocess daemon({binary("daemon/airsegd"), "--config", source_path("config/airseg.yaml"), "--set",
                        "status.socket=" + dir.file("status.sock"), "--set", "state_dir=" + dir.file("state"),
                        "--set", std::string("autopilot.port=") + name.data(), "--set",
-                       "autopilot.board=pixhawk", "--set", "groundlink.ports=[" + dir.file("ttyUSB0") + "]"},
+                       "autopilot.board=pixhawk", "--set", "groundlink.ports=[" + dir.file("ttyUSB0") + "]",
+                       "--set", "groundlink.key_file=", "--set", "groundlink.insecure=true"},
                       {}, dir.path());
     const auto autopilot = [&] {
         const auto r = run({binary("client/airsegctl"), "--local", "--socket", dir.file("status.sock"),

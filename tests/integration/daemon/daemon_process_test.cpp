@@ -28,7 +28,11 @@ class DaemonProcess : public ::testing::Test {
                 "--set",
                 "autopilot.port=" + dir.file("ttyACM0"),
                 "--set",
-                "groundlink.ports=[" + dir.file("ttyUSB0") + "]"};
+                "groundlink.ports=[" + dir.file("ttyUSB0") + "]",
+                "--set",
+                "groundlink.key_file=",
+                "--set",
+                "groundlink.insecure=true"};
     }
     std::map<std::string, std::string> env(const std::string& watchdog_usec = "400000") {
         return {{"NOTIFY_SOCKET", notify.path()}, {"WATCHDOG_USEC", watchdog_usec}};

@@ -174,7 +174,11 @@ class FlightplanE2e : public ::testing::TestWithParam<std::string> {
                                      "--set",
                                      "flightplan.window=" + std::to_string(window),
                                      "--set",
-                                     "flightplan.fsync=false"},
+                                     "flightplan.fsync=false",
+                                     "--set",
+                                     "groundlink.key_file=",
+                                     "--set",
+                                     "groundlink.insecure=true"},
             std::map<std::string, std::string>{}, dir_.path());
         ASSERT_TRUE(wait_until([&] { return ready(); }, kGenerous, kPoll)) << daemon_->err();
     }

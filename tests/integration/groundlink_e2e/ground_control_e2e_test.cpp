@@ -102,6 +102,8 @@ class GroundControlE2e : public ::testing::Test {
                                       "autopilot.reconnect_max=500ms",
                                       "--set",
                                       "groundlink.ports=[" + dir.file("air") + "]"};
+        const auto unkeyed = unkeyed_ground_link();
+        args.insert(args.end(), unkeyed.begin(), unkeyed.end());
         args.insert(args.end(), extra.begin(), extra.end());
         daemon = std::make_unique<Subprocess>(args, std::map<std::string, std::string>{}, dir.path());
     }
@@ -288,6 +290,62 @@ TEST_F(GroundControlE2e, AMonitorKeyWatchesButItsCommandsAreRefused) {
     EXPECT_EQ(stranger.exit_code, 3);
 }
 
+TEST_F(GroundControlE2e, AClientWithoutTheVehiclesKeyIsToldItIsNotAuthorised) {
+    const auto control = key_file("control.key", 'a');
+    const auto other = key_file("other.key", 'c');
+    start_link();
+    start_daemon({"--set", "groundlink.key_file=" + control});
+
+    // Told at once, not after the whole timeout: the vehicle's handshakes carry a tag this end cannot check.
+    const auto started = std::chrono::steady_clock::now();
+    auto stranger = ctl({"status"}, {}, 60'000);
+    EXPECT_EQ(stranger.exit_code, 3) << stranger.err;
+    EXPECT_NE(stranger.err.find("not authorised"), std::string::npos) << stranger.err;
+    EXPECT_NE(stranger.err.find("--key"), std::string::npos) << stranger.err;
+    EXPECT_EQ(Json::parse(stranger.out, nullptr, false).value("status", ""), "not_authorised") << stranger.out;
+    EXPECT_LT(std::chrono::steady_clock::now() - started, 30s);
+
+    auto wrong = ctl({"status"}, other, 60'000);
+    EXPECT_EQ(wrong.exit_code, 3) << wrong.err;
+    EXPECT_NE(wrong.err.find("not authorised"), std::string::npos) << wrong.err;
+
+    auto right = ctl({"rates", "vehicle=4"}, control);
+    EXPECT_EQ(right.exit_code, 0) << right.err << "\ndaemon:\n" << daemon->err();
+}
+
+TEST_F(GroundControlE2e, AVehicleWithoutAKeyRefusesEveryCommandAndSaysWhy) {
+    start_link();
+    start_daemon({"--set", "groundlink.insecure=false"});
+
+    auto refused = ctl({"rates", "vehicle=4"});
+    EXPECT_EQ(refused.exit_code, 1) << refused.err << "\ndaemon:\n" << daemon->err();
+    const auto why = Json::parse(refused.out, nullptr, false);
+    EXPECT_EQ(why.value("status", ""), "forbidden") << refused.out;
+    EXPECT_NE(why.value("error", "").find("not authorised"), std::string::npos) << refused.out;
+    EXPECT_NE(why.value("error", "").find("groundlink.insecure"), std::string::npos) << refused.out;
+    auto stick = ctl({"joystick", "--duration", "500"});
+    EXPECT_EQ(stick.exit_code, 1) << stick.err;
+
+    const auto doc = status_doc();
+    ASSERT_TRUE(doc.contains("groundlink")) << daemon->err();
+    EXPECT_EQ(doc["groundlink"]["commands_refused"], 2);  // the rates and the joystick's mode change
+    EXPECT_NE(doc["groundlink"]["role"].get<std::string>().find("commands refused"), std::string::npos);
+    EXPECT_NE(doc["groundlink"].value("commands_refused_because", "").find("groundlink.key_file"),
+              std::string::npos)
+        << doc.dump();
+    EXPECT_EQ(doc["groundlink"]["telemetry"]["requested_hz"]["vehicle"], 2.0) << "the refused rate was not set";
+    EXPECT_NE(daemon->err().find("groundlink.insecure is not set"), std::string::npos) << daemon->err();
+}
+
+TEST_F(GroundControlE2e, AnInsecureVehicleWarnsAtStartAndTakesCommandsWithoutAKey) {
+    start_link();
+    start_daemon();  // groundlink.insecure: true, no key (unkeyed_ground_link)
+    auto accepted = ctl({"rates", "vehicle=4"});
+    EXPECT_EQ(accepted.exit_code, 0) << accepted.err << "\ndaemon:\n" << daemon->err();
+    EXPECT_NE(daemon->err().find("groundlink.insecure is set"), std::string::npos) << daemon->err();
+    EXPECT_EQ(status_doc()["groundlink"]["role"], "control (unauthenticated, groundlink.insecure)");
+}
+
 TEST_F(GroundControlE2e, JoystickDrivesTheRoverAndTheOverrideIsReleasedWhenInputStops) {
     start_link();
     start_sim();
@@ -392,7 +450,8 @@ TEST_F(GroundControlE2e, SighupAppliesTheTelemetryRatesOverThoseSetFromTheGround
         std::vector<std::string>{
             binary("daemon/airsegd"), "--config", config, "--set", "status.socket=" + dir.file("status.sock"),
             "--set", "state_dir=" + dir.file("state"), "--set", "autopilot.port=" + dir.file("ttyACM0"),
-            "--set", "groundlink.ports=[" + dir.file("air") + "]"},
+            "--set", "groundlink.ports=[" + dir.file("air") + "]", "--set", "groundlink.key_file=", "--set",
+            "groundlink.insecure=true"},
         std::map<std::string, std::string>{}, dir.path());
     auto local = [&](std::vector<std::string> args) {
         std::vector<std::string> argv{binary("client/airsegctl"), "--local", "--socket",

@@ -52,6 +52,8 @@ class GroundlinkEndToEnd : public ::testing::Test {
                                       "state_dir=" + dir.file("state"),
                                       "--set",
                                       "autopilot.port=" + dir.file("ttyACM0")};
+        const auto unkeyed = unkeyed_ground_link();
+        args.insert(args.end(), unkeyed.begin(), unkeyed.end());
         args.insert(args.end(), link.begin(), link.end());
         daemon = std::make_unique<Subprocess>(
             args, std::map<std::string, std::string>{{"NOTIFY_SOCKET", notify.path()}}, dir.path());

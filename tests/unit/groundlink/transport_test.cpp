@@ -127,6 +127,54 @@ TEST(GroundlinkTransport, WithoutKeyStatsSayUnauthenticated) {
     EXPECT_FALSE(link.b().core->stats().authenticated);
 }
 
+// A ground end tells "not authorised" from "no link" by these counters: each mismatch shows on the end that
+// must say so, and a matching pair (or a damaged frame) counts none.
+TEST(GroundlinkTransport, AKeyMismatchIsCountedOnTheEndThatHearsIt) {
+    auto key_of = [](std::uint8_t seed) {
+        std::array<std::uint8_t, kKeyBytes> k{};
+        k.fill(seed);
+        return k;
+    };
+    struct Case {
+        const char* what;
+        std::optional<std::array<std::uint8_t, kKeyBytes>> vehicle, ground;
+        std::uint64_t LinkStats::*counter;
+    };
+    const Case cases[] = {
+        {"the vehicle has a key, the ground none", key_of(1), std::nullopt, &LinkStats::frames_needing_key},
+        {"the ground has a key, the vehicle none", std::nullopt, key_of(1), &LinkStats::hellos_without_key},
+        {"different keys", key_of(1), key_of(2), &LinkStats::hellos_with_other_key},
+    };
+    for (const auto& c : cases) {
+        TransportConfig vehicle = base_config(0x30, false);
+        vehicle.key = c.vehicle;
+        TransportConfig ground = base_config(0x40, false);
+        ground.key = c.ground;
+        SimLink link(vehicle, ground, one_path(), 3);
+        link.b().core->send_safe(0, pattern(50, 7), link.now());
+        link.run_for(3s);
+        EXPECT_FALSE(link.b().core->session_established()) << c.what;
+        EXPECT_GT(link.b().core->stats().*c.counter, 0U) << c.what;
+    }
+    // A matching pair under byte corruption: damaged frames are not mistaken for a mismatch.
+    for (const bool keyed : {false, true}) {
+        test::Impairments imp;
+        imp.byte_corrupt = 2e-3;
+        SimLink link(base_config(0x50, keyed), base_config(0x60, keyed), one_path(imp), 4);
+        for (std::uint32_t i = 0; i < 20; ++i) {
+            link.a().core->send_safe(1, pattern(200, i), link.now());
+            link.b().core->send_safe(1, pattern(200, i + 100), link.now());
+        }
+        link.run_for(20s);
+        for (const auto* end : {&link.a(), &link.b()}) {
+            const auto& s = end->core->stats();
+            EXPECT_GT(s.crc_errors, 0U) << "the corruption reached the frames";
+            EXPECT_EQ(s.frames_needing_key + s.hellos_without_key + s.hellos_with_other_key, 0U)
+                << (keyed ? "keyed" : "unkeyed");
+        }
+    }
+}
+
 TEST(GroundlinkTransport, PacingNeverExceedsRateTimesElapsedPlusOneFrame) {
     SimLink link(base_config(1), base_config(2), one_path(), 3);
     for (std::uint32_t i = 0; i < 60; ++i) {
