@@ -58,7 +58,7 @@ dpkg-deb --field "$(ls "$work"/debs/next/airsegd_*.deb)" Version >"$work/debs/ne
 # The packages' Depends without versions and without each other, in the image so that plain dpkg -i runs.
 deps=$(for f in "$work"/debs/v1/*.deb; do dpkg-deb --field "$f" Depends; done | tr ',' '\n' | sed -e 's/(.*)//' \
   -e 's/|.*//' -e 's/ //g' | grep -vxE 'airsegd|airseg-client|airseg-sim|' | sort -u | paste -sd,)
-include="systemd-sysv,udev,linux-image-amd64,initramfs-tools,procps,kmod,$deps"
+include="systemd-sysv,udev,dbus,linux-image-amd64,initramfs-tools,procps,kmod,$deps"
 # The image's recipe is this script's image section and the package list: a change to either makes a new one.
 recipe=$(sed -n '/^# image:begin/,/^# image:end/p' "$0")
 hash=$(printf '%s\n%s\n%s\n' "$include" "$mirror" "$recipe" | sha256sum | cut -c1-16)

@@ -16,7 +16,8 @@
 #             report fails it
 #   cross     packaging/ci-cross.sh for the architectures in AIRSEG_CROSS (default "amd64 armhf armel arm64"): the
 #             amd64 packages are built and checked (lintian, contents, manual pages against --help) and
-#             installed, upgraded and removed in a throwaway chroot; the armhf and armel packages are
+#             installed, upgraded and removed in a throwaway chroot, then booted under systemd in a qemu
+#             virtual machine (packaging/test-vm.sh); the armhf and armel packages are
 #             cross-built with the whole test suite, which runs under qemu-arm; the arm64 packages are
 #             cross-built and checked (their suite under qemu-aarch64 with AIRSEG_CROSS_TEST_ARM64=1; needs root)
 #   native    GCC build as shipped (build/, the one tools/demo.sh runs) and the whole ctest suite
