@@ -163,13 +163,13 @@ std::size_t GroundEnd::max_message_size() const {
 nlohmann::json GroundEnd::link_stats() const {
     const auto& s = driver_->stats();
     nlohmann::json out{{"link", driver_->link_up() ? "up" : "down"},
-            {"rtt_ms", std::round(s.srtt_ms)},
-            {"loss", std::round(s.frame_loss * 1000) / 1000},
-            {"frames_sent", s.frames_sent},
-            {"frames_received", s.frames_received},
-            {"crc_errors", s.crc_errors},
-            {"mac_failures", s.mac_failures},
-            {"authenticated", s.authenticated}};
+                       {"rtt_ms", std::round(s.srtt_ms)},
+                       {"loss", std::round(s.frame_loss * 1000) / 1000},
+                       {"frames_sent", s.frames_sent},
+                       {"frames_received", s.frames_received},
+                       {"crc_errors", s.crc_errors},
+                       {"mac_failures", s.mac_failures},
+                       {"authenticated", s.authenticated}};
     if (auto why = authorisation_problem(); !why.empty()) {
         out["key_problem"] = std::move(why);
     }
@@ -182,17 +182,20 @@ std::string GroundEnd::authorisation_problem() const {
     }
     const auto& s = driver_->stats();
     if (s.frames_needing_key > 0) {
-        return "not authorised: the vehicle authenticates its ground link and this end has no key (--key FILE, "
+        return "not authorised: the vehicle authenticates its ground link and this end has no key (--key "
+               "FILE, "
                "a copy of the vehicle's groundlink.key_file, /etc/airseg/ground.key on an installed vehicle)";
     }
     // A vehicle with a monitor key too sends its handshakes under each key in turn: one that does not verify
     // says little until several have come and none did.
     if (s.hellos_with_other_key >= 3 && s.hellos_received == 0) {
-        return "not authorised: the vehicle's handshake does not verify with this key: it is not the vehicle's "
+        return "not authorised: the vehicle's handshake does not verify with this key: it is not the "
+               "vehicle's "
                "groundlink.key_file (nor its monitor_key_file)";
     }
     if (s.hellos_without_key > 0) {
-        return "the vehicle's ground link has no key and this end has one (--key): no link; give the vehicle the "
+        return "the vehicle's ground link has no key and this end has one (--key): no link; give the vehicle "
+               "the "
                "same key (groundlink.key_file)";
     }
     return {};

@@ -69,7 +69,8 @@ const char* const kUsageTail =
     "docs/flight-plan.md);\n"
     "                     a loaded plan drives at once, or waits for plan resume with --paused\n"
     "\n"
-    "Exit codes: 0 done, 1 refused by the vehicle (\"not authorised\" from a vehicle without a key), 2 usage,\n"
+    "Exit codes: 0 done, 1 refused by the vehicle (\"not authorised\" from a vehicle without a key), 2 "
+    "usage,\n"
     "3 no link (no answer in time; \"not authorised\" when the link's keys do not match).\n";
 
 struct Options {
@@ -189,11 +190,10 @@ int show_answer(const Options& o, const airseg::client::LocalAnswer& a,
                 const std::function<std::string(const nlohmann::json&)>& render) {
     if (!a.answer) {
         if (o.json) {
-            std::cout << airseg::client::dump_text(
-                             nlohmann::json{{"ok", false},
-                                            {"status", a.error.starts_with("not authorised") ? "not_authorised"
-                                                                                             : "no_link"},
-                                            {"error", a.error}})
+            std::cout << airseg::client::dump_text(nlohmann::json{
+                             {"ok", false},
+                             {"status", a.error.starts_with("not authorised") ? "not_authorised" : "no_link"},
+                             {"error", a.error}})
                       << "\n";
         }
         std::cerr << "airsegctl: " << a.error << "\n";

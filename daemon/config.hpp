@@ -48,18 +48,18 @@ struct AutopilotConfig {
 };
 
 struct GroundlinkConfig {
-    std::string mode = "single";                     // groundlink.mode: single | split | redundant | udp
-    std::vector<std::string> ports{"/dev/ttyUSB0"};  // groundlink.ports: one or two serial devices
-    int baud = 57600;                                // groundlink.baud
+    std::string mode = "single";                      // groundlink.mode: single | split | redundant | udp
+    std::vector<std::string> ports{"/dev/ttyUSB0"};   // groundlink.ports: one or two serial devices
+    int baud = 57600;                                 // groundlink.baud
     std::string key_file = "/etc/airseg/ground.key";  // groundlink.key_file: empty = no authentication
-    bool insecure = false;                           // groundlink.insecure: commands without a key
-    milliseconds reconnect_min{500};                 // groundlink.reconnect_min
-    milliseconds reconnect_max{10'000};              // groundlink.reconnect_max
-    std::string udp_bind = "127.0.0.1";              // groundlink.udp.bind
-    int udp_port = 14650;                            // groundlink.udp.port
-    std::string udp_remote;                          // groundlink.udp.remote: empty = answer the last sender
-    int udp_remote_port = 0;                         // groundlink.udp.remote_port
-    std::string monitor_key_file;                    // groundlink.monitor_key_file: empty = no monitor role
+    bool insecure = false;                            // groundlink.insecure: commands without a key
+    milliseconds reconnect_min{500};                  // groundlink.reconnect_min
+    milliseconds reconnect_max{10'000};               // groundlink.reconnect_max
+    std::string udp_bind = "127.0.0.1";               // groundlink.udp.bind
+    int udp_port = 14650;                             // groundlink.udp.port
+    std::string udp_remote;                           // groundlink.udp.remote: empty = answer the last sender
+    int udp_remote_port = 0;                          // groundlink.udp.remote_port
+    std::string monitor_key_file;                     // groundlink.monitor_key_file: empty = no monitor role
     std::map<std::string, double> telemetry_rates{{"vehicle", 2.0}, {"link_stats", 1.0}};  // .telemetry.rates
     double telemetry_budget_share = 0.25;  // groundlink.telemetry.budget_share
     double telemetry_min_hz = 0.2;         // groundlink.telemetry.min_hz

@@ -299,11 +299,10 @@ void GroundlinkService::on_joystick(const protocol::Joystick& joystick) {
 void GroundlinkService::on_ground_station_frames(protocol::MavlinkFrames frames) {
     if (!config_.mavlink_forward.enabled || ground_role() != Role::Control) {
         if (from_ground_refused_++ == 0) {
-            spdlog::warn(
-                "groundlink: MAVLink frames from the ground dropped ({})",
-                !config_.mavlink_forward.enabled ? "groundlink.mavlink_forward is off"
-                : refusing_unauthenticated()     ? "no ground-link key on the vehicle"
-                                                 : "monitor key");
+            spdlog::warn("groundlink: MAVLink frames from the ground dropped ({})",
+                         !config_.mavlink_forward.enabled ? "groundlink.mavlink_forward is off"
+                         : refusing_unauthenticated()     ? "no ground-link key on the vehicle"
+                                                          : "monitor key");
         }
         return;
     }
@@ -344,10 +343,10 @@ void GroundlinkService::on_event(const TransportEvent& event) {
         case TransportEvent::Kind::LinkUp:
             log_.log("groundlink: link up", SteadyClock::now(), spdlog::level::info,
                      "groundlink: link up ({})",
-                     refusing_unauthenticated()          ? "no key: commands refused"
-                     : !control_key_                     ? "unauthenticated: groundlink.insecure"
+                     refusing_unauthenticated()       ? "no key: commands refused"
+                     : !control_key_                  ? "unauthenticated: groundlink.insecure"
                      : ground_role() == Role::Control ? "control key"
-                                                         : "monitor key");
+                                                      : "monitor key");
             break;
         case TransportEvent::Kind::LinkDown:
             log_.log("groundlink: link down", SteadyClock::now(), spdlog::level::warn,
@@ -531,10 +530,10 @@ void GroundlinkService::publish_status() {
          counters = std::array{commands_, commands_refused_, joystick_inputs_, joystick_refused_,
                                events_sent_, events_dropped_, bad_messages_},
          role = std::string(refusing_unauthenticated() ? "monitor (no key on the vehicle: commands refused)"
-                            : !stats.authenticated ? "control (unauthenticated, groundlink.insecure)"
-                                                   : to_string(ground_role())),
-         refusal = std::string(refusing_unauthenticated() ? kNoKeyRefusal : ""),
-         rates = rates_snapshot(), fwd = forwarder_.stats(), fwd_enabled = config_.mavlink_forward.enabled,
+                            : !stats.authenticated     ? "control (unauthenticated, groundlink.insecure)"
+                                                       : to_string(ground_role())),
+         refusal = std::string(refusing_unauthenticated() ? kNoKeyRefusal : ""), rates = rates_snapshot(),
+         fwd = forwarder_.stats(), fwd_enabled = config_.mavlink_forward.enabled,
          fwd_budget = forwarder_.budget_bytes_per_s(),
          fwd_counters = std::array{forward_refused_, from_ground_frames_, from_ground_refused_}] {
             nlohmann::json g;

@@ -302,7 +302,8 @@ TEST_F(GroundControlE2e, AClientWithoutTheVehiclesKeyIsToldItIsNotAuthorised) {
     EXPECT_EQ(stranger.exit_code, 3) << stranger.err;
     EXPECT_NE(stranger.err.find("not authorised"), std::string::npos) << stranger.err;
     EXPECT_NE(stranger.err.find("--key"), std::string::npos) << stranger.err;
-    EXPECT_EQ(Json::parse(stranger.out, nullptr, false).value("status", ""), "not_authorised") << stranger.out;
+    EXPECT_EQ(Json::parse(stranger.out, nullptr, false).value("status", ""), "not_authorised")
+        << stranger.out;
     EXPECT_LT(std::chrono::steady_clock::now() - started, 30s);
 
     auto wrong = ctl({"status"}, other, 60'000);
@@ -333,7 +334,8 @@ TEST_F(GroundControlE2e, AVehicleWithoutAKeyRefusesEveryCommandAndSaysWhy) {
     EXPECT_NE(doc["groundlink"].value("commands_refused_because", "").find("groundlink.key_file"),
               std::string::npos)
         << doc.dump();
-    EXPECT_EQ(doc["groundlink"]["telemetry"]["requested_hz"]["vehicle"], 2.0) << "the refused rate was not set";
+    EXPECT_EQ(doc["groundlink"]["telemetry"]["requested_hz"]["vehicle"], 2.0)
+        << "the refused rate was not set";
     EXPECT_NE(daemon->err().find("groundlink.insecure is not set"), std::string::npos) << daemon->err();
 }
 
