@@ -182,21 +182,19 @@ std::string GroundEnd::authorisation_problem() const {
     }
     const auto& s = driver_->stats();
     if (s.frames_needing_key > 0) {
-        return "not authorised: the vehicle authenticates its ground link and this end has no key (--key "
-               "FILE, "
-               "a copy of the vehicle's groundlink.key_file, /etc/airseg/ground.key on an installed vehicle)";
+        return "not authorised: the vehicle authenticates its ground link and this end has no key "
+               "(--key FILE, a copy of the vehicle's groundlink.key_file, /etc/airseg/ground.key on an "
+               "installed vehicle)";
     }
     // A vehicle with a monitor key too sends its handshakes under each key in turn: one that does not verify
     // says little until several have come and none did.
     if (s.hellos_with_other_key >= 3 && s.hellos_received == 0) {
         return "not authorised: the vehicle's handshake does not verify with this key: it is not the "
-               "vehicle's "
-               "groundlink.key_file (nor its monitor_key_file)";
+               "vehicle's groundlink.key_file (nor its monitor_key_file)";
     }
     if (s.hellos_without_key > 0) {
-        return "the vehicle's ground link has no key and this end has one (--key): no link; give the vehicle "
-               "the "
-               "same key (groundlink.key_file)";
+        return "the vehicle's ground link has no key and this end has one (--key): no link; give the "
+               "vehicle the same key (groundlink.key_file)";
     }
     return {};
 }
