@@ -120,9 +120,25 @@ TEST_F(SystemPlan, AutopilotRebootMidPlan) {
     ASSERT_TRUE(bench->wait_ready()) << bench->logs();
     const double ready_s = seconds_since(rebooted);
     radio_commands(1);
-    end_checks(expected);
+    end_checks(expected, false);
+    // A reboot loses what the board had not yet sent: when the vehicle reached a waypoint just before it,
+    // the report is lost, the daemon points the board at that waypoint again, and the board reports it
+    // again where the vehicle stands, with no leg driven. Driving back to it would be a leg.
+    auto log = plan_waypoints_of(reached_log(bench->sim(), first_reached));
+    std::size_t reported_again = 0;
+    for (std::size_t i = 1; i < log.size();) {
+        if (same_place(log[i].at, log[i - 1].at) && log[i].leg_s < 1.0) {
+            log.erase(log.begin() + static_cast<std::ptrdiff_t>(i));
+            ++reported_again;
+        } else {
+            ++i;
+        }
+    }
+    EXPECT_LE(reported_again, 1u);
+    expect_reached_in_order(log, expected);
     std::cout << "[ figures ] reboot mid-plan: ready again " << ready_s << " s after; " << expected.size()
-              << " waypoints reached in order, once each; " << tally.answered << "/" << tally.sent
+              << " waypoints reached in order, once each (" << reported_again
+              << " reported again where the vehicle stood); " << tally.answered << "/" << tally.sent
               << " radio commands answered\n";
 }
 
