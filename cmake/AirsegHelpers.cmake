@@ -57,10 +57,12 @@ function(airseg_add_library name)
   target_link_libraries(${name} PUBLIC airseg_options ${A_LIBS})
 endfunction()
 
-# airseg_add_test(NAME SOURCES... [LIBS ...] [LABELS ...] [TIMEOUT seconds] [RESOURCE_LOCK name])
-# One GoogleTest executable whose cases ctest discovers one by one.
+# airseg_add_test(NAME SOURCES... [LIBS ...] [LABELS ...] [TIMEOUT seconds] [RESOURCE_LOCK name]
+#                  [ALONE gtest-filter])
+# One GoogleTest executable whose cases ctest discovers one by one. The cases ALONE matches run with nothing
+# else of the suite beside them (RUN_SERIAL): measurements of real-time pace, which a starved process spoils.
 function(airseg_add_test name)
-  cmake_parse_arguments(A "" "TIMEOUT;RESOURCE_LOCK" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(A "" "TIMEOUT;RESOURCE_LOCK;ALONE" "SOURCES;LIBS;LABELS" ${ARGN})
   if(NOT AIRSEG_BUILD_TESTS)
     return()
   endif()
@@ -75,6 +77,13 @@ function(airseg_add_test name)
     # Cases that must not run beside each other (they share a scarce resource, e.g. real-time radio links).
     set(_lock RESOURCE_LOCK ${A_RESOURCE_LOCK})
   endif()
-  gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60
-                       PROPERTIES TIMEOUT ${A_TIMEOUT} LABELS "${A_LABELS}" ${_lock})
+  set(_properties TIMEOUT ${A_TIMEOUT} LABELS "${A_LABELS}" ${_lock})
+  if(A_ALONE)
+    gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60 TEST_FILTER "-${A_ALONE}"
+                         PROPERTIES ${_properties})
+    gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60 TEST_FILTER "${A_ALONE}"
+                         PROPERTIES ${_properties} RUN_SERIAL TRUE)
+  else()
+    gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60 PROPERTIES ${_properties})
+  endif()
 endfunction()
