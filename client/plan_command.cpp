@@ -53,6 +53,9 @@ std::optional<nlohmann::json> file_request(const std::string& cmd, const std::st
 
 std::string render_plan(const nlohmann::json& r) {
     std::ostringstream o;
+    if (r.value("kept", false)) {
+        o << "kept; starts when the autopilot is ready\n";
+    }
     for (const char* key : {"state", "name", "source", "element", "waypoints_reached", "next_waypoint",
                             "window", "reaction", "interruption", "error"}) {
         if (r.contains(key)) {

@@ -250,7 +250,7 @@ void PlanController::on_autopilot_status(const autopilot::AutopilotStatus& s, Ti
     if (!autopilot_ready_) {
         // Lost: the window is kept. A board that only went silent drives on, and the waypoints it reports
         // reached meanwhile still count; a reboot (its own event) or a reopened port makes it unknown.
-        fail_waiters("the autopilot is not ready");
+        answer_waiters_without_autopilot("the autopilot is not ready");
         pump(now);
         return;
     }
@@ -434,7 +434,7 @@ void PlanController::answer_waiters(TimePoint now) {
         return;
     }
     if (!autopilot_ready_) {
-        fail_waiters("the autopilot is not ready (the plan is kept and starts when it is)");
+        answer_waiters_without_autopilot("the autopilot is not ready");
         return;
     }
     if (fault_) {
@@ -469,6 +469,26 @@ void PlanController::fail_waiters(const std::string& why) {
     waiters_.clear();
     for (auto& w : failed) {
         reply(w.id, Status::Failed, w.what + ": " + why);
+    }
+}
+
+void PlanController::answer_waiters_without_autopilot(const std::string& why) {
+    // A plan loaded or appended is the plan from now on, kept in the state directory, and the board gets it
+    // when it is back: the command is done ("kept"). A skip, pause or resume is kept as well, but it is done
+    // only when the board does it, and a board that merely went silent may still be driving: the operator is
+    // told it is not done yet.
+    auto waiting = std::move(waiters_);
+    waiters_.clear();
+    for (auto& w : waiting) {
+        if (w.what == "plan.load" || w.what == "plan.append") {
+            Json kept = progress_json();
+            kept["kept"] = true;
+            reply(w.id, Status::Ok, {}, std::move(kept));
+        } else {
+            reply(
+                w.id, Status::Failed,
+                w.what + ": " + why + "; the board has not done it (it is kept, and done when it is ready)");
+        }
     }
 }
 

@@ -188,6 +188,7 @@ class PlanController {
     void wait_for_autopilot(CommandId id, std::string what, TimePoint now);
     void answer_waiters(TimePoint now);
     void fail_waiters(const std::string& why);
+    void answer_waiters_without_autopilot(const std::string& why);
     void reply(CommandId id, CommandReply::Status status, std::string error, Json result = Json::object());
     void log(LogLine::Level level, std::string text);
 

@@ -280,5 +280,28 @@ TEST_F(DaemonProcess, UnknownCommandsAreRefusedByTheDaemon) {
     EXPECT_NE(r.err.find("unknown command 'warp'"), std::string::npos) << r.err;
 }
 
+// A plan loaded while no autopilot is there is kept (in the state directory) and starts when the autopilot is
+// ready: the load is done, exit 0, and says so. A pause is done only by the board: without one it is not done
+// yet (exit 1), though kept.
+TEST_F(DaemonProcess, APlanLoadedWithoutAnAutopilotIsKeptAndExitsZeroAPauseIsRefused) {
+    Subprocess daemon(daemon_args(), env(), dir.path());
+    ASSERT_TRUE(notify.wait_for("READY=1", 10s)) << daemon.err();
+    ASSERT_TRUE(wait_until([&] { return std::filesystem::exists(socket()); }));
+    const auto plan = source_path("config/plans/rover-survey.yaml");
+    auto load = ctl({"plan", "load", plan, "--socket", socket()});
+    EXPECT_EQ(load.exit_code, 0) << load.err;
+    EXPECT_EQ(load.out.rfind("kept; starts when the autopilot is ready\n", 0), 0u) << load.out;
+    EXPECT_NE(load.out.find("plan.state"), std::string::npos) << load.out;
+    EXPECT_TRUE(std::filesystem::exists(dir.file("state/plan.yaml")));
+    auto json = ctl({"plan", "load", plan, "--socket", socket(), "--json"});
+    ASSERT_EQ(json.exit_code, 0) << json.err;
+    EXPECT_EQ(nlohmann::json::parse(json.out).value("kept", false), true) << json.out;
+    auto pause = ctl({"plan", "pause", "--socket", socket()});
+    EXPECT_EQ(pause.exit_code, 1) << pause.out;
+    EXPECT_NE(pause.err.find("plan.pause: the autopilot is not ready; the board has not done it"),
+              std::string::npos)
+        << pause.err;
+}
+
 }  // namespace
 }  // namespace airseg::test

@@ -230,18 +230,47 @@ TEST(FlightplanController, ThePlanSectionGoesOutOnlyWhenWhatItShowsChanged) {
     EXPECT_EQ(check(true), r.state());
 }
 
-TEST(FlightplanController, LoadWaitsForTheAutopilotAndFailsWhenItIsNotReady) {
+TEST(FlightplanController, ALoadWhileTheAutopilotIsNotReadyIsKeptAndDoneAPauseIsNot) {
     Rig rig;
     const auto id = rig.load(plan_text());
     EXPECT_TRUE(rig.requests.empty()) << "nothing is sent to an autopilot that is not ready";
     const auto replies = rig.replies_to(id);
     ASSERT_EQ(replies.size(), 1u);
-    EXPECT_EQ(replies.front().status, Status::Failed);
-    EXPECT_NE(replies.front().error.find("not ready"), std::string::npos) << replies.front().error;
-    // The plan is kept and starts once the autopilot is there.
+    EXPECT_EQ(replies.front().status, Status::Ok) << replies.front().error;
+    EXPECT_EQ(replies.front().result.value("kept", false), true) << replies.front().result.dump();
+    EXPECT_EQ(replies.front().result.value("state", ""), "running") << replies.front().result.dump();
+    // A pause is done only when the board does it: the vehicle may still be driving.
+    rig.c.pause(rig.next_id, rig.now);
+    rig.drain();
+    const auto paused = rig.replies_to(rig.next_id++);
+    ASSERT_EQ(paused.size(), 1u);
+    EXPECT_EQ(paused.front().status, Status::Failed);
+    EXPECT_EQ(
+        paused.front().error,
+        "plan.pause: the autopilot is not ready; the board has not done it (it is kept, and done when it "
+        "is ready)");
+    // The plan is kept, paused, and goes to the autopilot once it is there.
     rig.ready();
-    ASSERT_FALSE(rig.requests.empty());
-    EXPECT_TRUE(is_upload(rig.requests.front()));
+    rig.confirm_all();
+    EXPECT_EQ(rig.count(is_upload), 1u);
+    EXPECT_GE(rig.count(is_hold), 1u);
+    EXPECT_EQ(rig.state(), "paused");
+}
+
+TEST(FlightplanController, AnAutopilotLostWhileALoadWaitsForItKeepsThePlanAndSaysSo) {
+    Rig rig;
+    rig.ready();
+    const auto id = rig.load(plan_text());
+    ASSERT_TRUE(rig.replies_to(id).empty()) << "waiting for the board";
+    rig.not_ready();
+    const auto replies = rig.replies_to(id);
+    ASSERT_EQ(replies.size(), 1u);
+    EXPECT_EQ(replies.front().status, Status::Ok) << replies.front().error;
+    EXPECT_EQ(replies.front().result.value("kept", false), true);
+    // Once the board is there again, the kept plan goes to it.
+    const auto uploads = rig.count(is_upload);
+    rig.ready(1, 0);
+    EXPECT_GT(rig.count(is_upload), uploads);
 }
 
 TEST(FlightplanController, ACommandTheAutopilotDoesNotConfirmTimesOutOnce) {
