@@ -5,6 +5,7 @@
 
 #include <csignal>
 #include <iostream>
+#include <thread>
 
 #include "client/json_text.hpp"
 #include "client/stick_input.hpp"
@@ -73,7 +74,10 @@ int run_radio_watch(VehicleLink& radio, const LiveOptions& o) {
             << "\x1b[?25l\x1b[2J";  // hide the cursor, clear once; each refresh then overwrites in place
     }
     while (g_stop == 0 && !expired(o, started)) {
+        const auto next = Clock::now() + o.refresh;
         radio.run_for(o.refresh, take);
+        // The view is redrawn at its interval only, even over a link that returns early (nothing to wait on).
+        std::this_thread::sleep_until(next);
         state.set_ground_link(radio.link_stats());
         const auto now = Clock::now();
         if (o.json) {

@@ -38,6 +38,10 @@ class MqttClient final : public VehicleLink {
     void on_message(const std::string& topic, const std::string& payload);
 
     asio::io_context io_;
+    // libmosquitto's network thread posts each message to io_, which otherwise has nothing to wait on between
+    // two: run_for() would return at once and a live view redraw as fast as it can print.
+    asio::any_io_executor keep_waiting_ =
+        asio::prefer(io_.get_executor(), asio::execution::outstanding_work.tracked);
     std::string vehicle_;
     std::unique_ptr<MqttSession> session_;
     bool connected_ = false;
