@@ -37,12 +37,20 @@ proto::Event::Severity severity_named(const std::string& name) {
 }  // namespace
 
 std::optional<proto::Telemetry> telemetry_from_json(const Json& v) {
-    if (!v.is_object() || !v.contains("lat") || !v["lat"].is_number()) {
+    if (!v.is_object() || !v.contains("lat")) {
+        return std::nullopt;
+    }
+    // A sample without a fix has no place: lat and lon null, position_valid false.
+    const auto valid = v.find("position_valid");
+    const bool placeless = valid != v.end() && *valid == false;
+    if (!v["lat"].is_number() && !(placeless && v["lat"].is_null())) {
         return std::nullopt;
     }
     proto::Telemetry t;
-    t.lat_deg = v.value("lat", 0.0);
-    t.lon_deg = v.value("lon", 0.0);
+    if (!placeless) {
+        t.lat_deg = v.value("lat", 0.0);
+        t.lon_deg = v["lon"].is_number() ? v["lon"].get<double>() : 0.0;
+    }
     t.alt_m = v.value("alt_m", 0.0);
     t.ground_speed_mps = v.value("ground_speed_mps", 0.0);
     t.heading_deg = v.value("heading_deg", 0.0);
@@ -54,9 +62,7 @@ std::optional<proto::Telemetry> telemetry_from_json(const Json& v) {
     }
     t.gps_fix = v.value("gps_fix", std::uint8_t{0});
     t.satellites = v.value("satellites", std::uint8_t{0});
-    if (const auto valid = v.find("position_valid"); valid != v.end() && valid->is_boolean()) {
-        t.no_position = !valid->get<bool>();
-    }
+    t.no_position = placeless;
     t.vehicle_state = code_named(v.value("state", ""), 15, proto::vehicle_state_name).value_or(0);
     t.mode =
         code_named(v.value("mode", ""), proto::kModeUnknown - 1, autopilot::ardupilot::rover_mode_known_name)

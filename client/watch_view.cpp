@@ -56,6 +56,11 @@ nlohmann::json telemetry_json(const proto::Telemetry& t) {
                      {"gps_fix", t.gps_fix},
                      {"satellites", t.satellites},
                      {"position_valid", !t.no_position}};
+    if (t.no_position) {
+        // No fix: no place, never 0,0 (a consumer drawing it would draw a line to the Gulf of Guinea).
+        j["lat"] = nullptr;
+        j["lon"] = nullptr;
+    }
     j["battery_pct"] = t.battery_pct ? nlohmann::json(*t.battery_pct) : nlohmann::json();
     if (t.plan_state != 0) {
         j["plan"] = {{"state", plan_state_name(t.plan_state)},

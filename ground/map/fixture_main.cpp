@@ -1,9 +1,11 @@
 // Test-only: the map serving a fixed plan while a vehicle drives along it, for the browser test
 // (tests/integration/ground_map). Prints "listening on http://127.0.0.1:PORT/" once it serves.
 //
-//   airseg-map-fixture [--control] [--seconds N] [--web-dir DIR] [--leaflet-dir DIR]
+//   airseg-map-fixture [--control] [--seconds N] [--fixless-first K] [--lose-fix-after K] [--web-dir DIR]
+//                      [--leaflet-dir DIR]
 // N (default 60): how long the vehicle drives and the event stream stays open, from the first browser
-// connection.
+// connection. --fixless-first K: the first K samples have no position (sent as 0,0, as the daemon does before
+// a GPS fix); --lose-fix-after K: every sample after the first K has none.
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -60,6 +62,8 @@ int main(int argc, char** argv) {
     MapConfig config;
     config.listen = "127.0.0.1:0";
     double seconds = 60;
+    long fixless_first = 0;
+    long lose_fix_after = -1;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         const bool has_value = i + 1 < argc;
@@ -67,6 +71,10 @@ int main(int argc, char** argv) {
             config.control = true;
         } else if (arg == "--seconds" && has_value) {
             seconds = std::stod(argv[++i]);
+        } else if (arg == "--fixless-first" && has_value) {
+            fixless_first = std::stol(argv[++i]);
+        } else if (arg == "--lose-fix-after" && has_value) {
+            lose_fix_after = std::stol(argv[++i]);
         } else if (arg == "--web-dir" && has_value) {
             config.web_dir = argv[++i];
         } else if (arg == "--leaflet-dir" && has_value) {
@@ -105,6 +113,7 @@ int main(int argc, char** argv) {
     airseg::asio::steady_timer end(strand);
     airseg::asio::signal_set signals(io, SIGINT, SIGTERM);
     bool end_armed = false;
+    long samples = 0;
     std::function<void()> drive = [&] {
         const auto [lat0, lon0] = route[leg % route.size()];
         const auto [lat1, lon1] = route[(leg + 1) % route.size()];
@@ -119,6 +128,14 @@ int main(int argc, char** argv) {
         t.battery_v = 12.4;
         t.battery_pct = 80;
         t.plan_state = 1;
+        t.gps_fix = 3;
+        const long n = samples++;
+        if (n < fixless_first || (lose_fix_after >= 0 && n >= lose_fix_after)) {
+            t.no_position = true;
+            t.lat_deg = 0;
+            t.lon_deg = 0;
+            t.gps_fix = 1;
+        }
         map.add_position(t, std::chrono::system_clock::now());
         along += 0.25;
         if (along >= 1.0) {

@@ -205,6 +205,7 @@ struct MapServer::Impl : std::enable_shared_from_this<MapServer::Impl> {
     Json plan = empty_plan();
     std::deque<TrackPoint> track;
     Json last_position;  // with the fields the track leaves out (battery, plan state)
+    Json fix;            // {"valid": whether the last sample had a position, ...}; null before any sample
     Json link;
     std::deque<Json> events;
 };
@@ -497,9 +498,14 @@ Json MapServer::Impl::state() const {
     for (const auto& p : track) {
         points.push_back(Json::array({p.lat, p.lon}));
     }
-    return {
-        {"plan", plan},           {"track", std::move(points)}, {"position", last_position},  {"link", link},
-        {"events", Json(events)}, {"control", config.control},  {"tile_url", config.tile_url}};
+    return {{"plan", plan},
+            {"track", std::move(points)},
+            {"position", last_position},
+            {"fix", fix},
+            {"link", link},
+            {"events", Json(events)},
+            {"control", config.control},
+            {"tile_url", config.tile_url}};
 }
 
 MapServer::MapServer(asio::any_io_executor strand, MapConfig config, CommandSink sink)
@@ -569,10 +575,17 @@ void MapServer::set_plan(const Json& geometry) {
 
 void MapServer::add_position(const groundlink::protocol::Telemetry& t,
                              std::chrono::system_clock::time_point at) {
-    if (t.no_position) {
-        return;  // no place to show: the vehicle and its track stay where they were last known
-    }
     auto& s = *impl_;
+    if (t.no_position) {
+        // No place to show: the vehicle and its track stay where they were last known, and the page says
+        // "no fix" from the first such sample until the next position.
+        if (!s.fix.is_object() || s.fix.value("valid", true)) {
+            s.fix = {{"valid", false}, {"gps_fix", t.gps_fix}, {"t", utc_time(at)}};
+            s.broadcast("fix", s.fix);
+        }
+        return;
+    }
+    s.fix = {{"valid", true}};
     const TrackPoint p{t.lat_deg, t.lon_deg, t.alt_m, t.heading_deg, t.ground_speed_mps, at};
     s.track.push_back(p);
     if (s.track.size() > kTrackPoints) {

@@ -29,6 +29,7 @@
 
   const counts = { elements: 0, lines: 0, polygons: 0, holds: 0, no_fly: 0 };
   let lastPosition = null;
+  let noFix = false;
   let planName = null;
   let linkState = null;
   let eventCount = 0;
@@ -54,7 +55,8 @@
       vehicle: lastPosition ? { lat: lastPosition.lat, lon: lastPosition.lon, heading: lastPosition.heading } : null,
       link: linkState,
       events: eventCount,
-      control: control
+      control: control,
+      no_fix: noFix
     };
   }
   // Mirrored into the page so that a headless browser's DOM dump shows what is drawn.
@@ -142,6 +144,7 @@
 
   function setPosition(p, addToTrack) {
     lastPosition = p;
+    noFix = false;
     const ll = [p.lat, p.lon];
     if (!vehicle) {
       vehicle = L.marker(ll, { icon: vehicleIcon(p.heading), keyboard: false }).addTo(map);
@@ -151,6 +154,7 @@
       vehicle.setIcon(vehicleIcon(p.heading));
       vehicle.getElement().classList.add('airseg-vehicle');
     }
+    vehicle.getElement().classList.remove('airseg-no-fix');
     vehicle.getElement().dataset.heading = String(p.heading);
     if (addToTrack) {
       trackLine.addLatLng(ll);
@@ -165,6 +169,19 @@
       parts.push('battery ' + p.battery_pct + ' %');
     }
     document.getElementById('vehicle-text').textContent = parts.join(' · ');
+    publish();
+  }
+
+  // A sample without a fix: the vehicle stays where it was last known, greyed, and says so.
+  function setNoFix(fix) {
+    noFix = true;
+    if (vehicle) {
+      vehicle.getElement().classList.add('airseg-no-fix');
+    }
+    const last = lastPosition ? ' · last known ' + lastPosition.lat.toFixed(6) + ', ' +
+                                lastPosition.lon.toFixed(6) + ' at ' + lastPosition.t : '';
+    document.getElementById('vehicle-text').textContent =
+      'no fix (GPS fix type ' + fix.gps_fix + ')' + last;
     publish();
   }
 
@@ -258,6 +275,9 @@
     if (s.position) {
       setPosition(s.position, false);
     }
+    if (s.fix && s.fix.valid === false) {
+      setNoFix(s.fix);
+    }
     setLink(s.link);
     document.getElementById('events').textContent = '';
     eventCount = 0;
@@ -265,6 +285,7 @@
   });
   events.addEventListener('plan', ev => drawPlan(JSON.parse(ev.data)));
   events.addEventListener('position', ev => setPosition(JSON.parse(ev.data), true));
+  events.addEventListener('fix', ev => setNoFix(JSON.parse(ev.data)));
   events.addEventListener('link', ev => setLink(JSON.parse(ev.data)));
   events.addEventListener('event', ev => addEvent(JSON.parse(ev.data)));
   events.onerror = () => {

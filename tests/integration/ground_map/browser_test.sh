@@ -28,7 +28,7 @@ trap cleanup EXIT
 # Starts the fixture for $1 seconds; sets $url.
 start_fixture() {
   local out=$work/fixture.$RANDOM
-  "$fixture" --seconds "$1" >"$out" 2>&1 &
+  "$fixture" --seconds "$@" >"$out" 2>&1 &
   pids+=($!)
   for _ in $(seq 100); do
     url=$(sed -n 's/^listening on \(http:[^ ]*\)$/\1/p' "$out")
@@ -48,7 +48,8 @@ run_browser() {
     2>>"$work/browser.log"
 }
 
-start_fixture 4
+# The vehicle's first samples come before a GPS fix (0,0, flagged as no position), as on every bench.
+start_fixture 4 --fixless-first 5
 run_browser --dump-dom "$url" >"$work/dom.html" || {
   echo "FAIL: chromium failed:" >&2
   tail -20 "$work/browser.log" >&2
@@ -73,6 +74,9 @@ checks = [
     ("1 hold", s["holds"] == 1),
     ("1 no-fly zone", s["no_fly"] == 1),
     ("the vehicle has a position", s["vehicle"] is not None),
+    ("the vehicle is not at 0,0", s["vehicle"] is not None and abs(s["vehicle"]["lat"]) > 1),
+    ("the track has no point without a fix (under 100 km; one at 0,0 adds 4,600)", 0 < s["track_m"] < 100000),
+    ("the vehicle has a fix", s["no_fix"] is False),
     ("the track moved (more than one point)", s["track_points"] > 1),
     ("an event listed", s["events"] >= 1),
     ("the buttons are read-only", s["control"] is False),
@@ -88,6 +92,30 @@ check "no-fly polygon in the SVG" "$([ "$(count 'class="airseg-no-fly')" -eq 1 ]
 check "track polyline in the SVG" "$([ "$(count 'class="airseg-track')" -eq 1 ] && echo yes || echo no)"
 check "vehicle marker" "$([ "$(count 'airseg-vehicle ')$(count 'airseg-vehicle"')" != 00 ] && echo yes || echo no)"
 check "buttons disabled" "$(grep -q '<button id="btn-pause" type="button" disabled' "$work/dom.html" && echo yes || echo no)"
+
+# The fix lost after 10 samples: the vehicle stays where it was last known, greyed, and says "no fix".
+start_fixture 4 --lose-fix-after 10
+run_browser --dump-dom "$url" >"$work/dom-nofix.html" || {
+  echo "FAIL: chromium failed:" >&2
+  tail -20 "$work/browser.log" >&2
+  exit 1
+}
+nofix_state=$(sed -n 's/.*<pre id="airseg-state"[^>]*>\([^<]*\)<\/pre>.*/\1/p' "$work/dom-nofix.html" | sed 's/&quot;/"/g; s/&lt;/</g; s/&gt;/>/g; s/&amp;/\&/g')
+echo "page state after the fix is lost: $nofix_state"
+python3 - "$nofix_state" <<'PY' || fail=1
+import json, sys
+s = json.loads(sys.argv[1])
+checks = [
+    ("no fix said in the page state", s["no_fix"] is True),
+    ("the vehicle kept its last known place", s["vehicle"] is not None and abs(s["vehicle"]["lat"]) > 1),
+    ("the track kept only the positions with a fix (10)", s["track_points"] == 10),
+]
+for name, ok in checks:
+    print(("ok: " if ok else "FAIL: ") + name)
+sys.exit(0 if all(ok for _, ok in checks) else 1)
+PY
+check "the vehicle says no fix" "$(grep -q '<div id="vehicle-text">no fix (GPS fix type 1)' "$work/dom-nofix.html" && echo yes || echo no)"
+check "the vehicle marker greyed" "$(grep -q 'airseg-no-fix' "$work/dom-nofix.html" && echo yes || echo no)"
 
 start_fixture 4
 run_browser --screenshot="$work/map.png" "$url" >/dev/null || true

@@ -39,6 +39,22 @@ TEST(MqttClient, TelemetryJsonRoundTrips) {
     EXPECT_EQ(telemetry_from_json(telemetry_json(t)), t);
 }
 
+TEST(MqttClient, ASampleWithoutAFixIsPublishedWithoutAPlace) {
+    groundlink::protocol::Telemetry t;
+    t.no_position = true;  // the daemon sends 0,0 with it
+    t.gps_fix = 1;
+    t.battery_v = 12.1;
+    const auto j = telemetry_json(t);
+    EXPECT_TRUE(j["lat"].is_null()) << j.dump();
+    EXPECT_TRUE(j["lon"].is_null()) << j.dump();
+    EXPECT_EQ(j["position_valid"], false);
+    EXPECT_EQ(telemetry_from_json(j), t);
+    // A null place is a sample only when it says it has none.
+    auto unsaid = j;
+    unsaid.erase("position_valid");
+    EXPECT_FALSE(telemetry_from_json(unsaid));
+}
+
 TEST(MqttClient, WhatIsNotASampleIsNone) {
     EXPECT_FALSE(telemetry_from_json(nlohmann::json::object()));
     EXPECT_FALSE(telemetry_from_json(nlohmann::json{{"lat", "north"}}));

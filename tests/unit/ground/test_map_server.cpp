@@ -243,20 +243,26 @@ TEST(MapServer, TheEventStreamStartsWithTheWholeStateThenFollowsUpdates) {
     EXPECT_EQ(state["events"][0]["text"], "hello");
     EXPECT_EQ(state["control"], false);
 
-    // A sample without a valid position is no place: neither the vehicle nor its track moves.
+    // A sample without a valid position is no place: neither the vehicle nor its track moves, and the page
+    // is told once that there is no fix (not again for the next such sample).
     groundlink::protocol::Telemetry nowhere;
     nowhere.no_position = true;
+    nowhere.gps_fix = 1;
     t.lat_deg = 41.6;
     rig.on_strand([&] {
+        rig.map->add_position(nowhere, std::chrono::system_clock::now());
         rig.map->add_position(nowhere, std::chrono::system_clock::now());
         rig.map->add_position(t, std::chrono::system_clock::now());
         rig.map->add_event("bad \xff utf-8 <b>");
     });
-    const auto next = read_events(s, buffer, 2);
-    EXPECT_EQ(next[0].first, "position");
-    EXPECT_EQ(next[0].second["lat"], 41.6);
-    EXPECT_EQ(next[1].first, "event");
-    EXPECT_NE(next[1].second["text"].get<std::string>().find("<b>"), std::string::npos);
+    const auto next = read_events(s, buffer, 3);
+    EXPECT_EQ(next[0].first, "fix");
+    EXPECT_EQ(next[0].second["valid"], false);
+    EXPECT_EQ(next[0].second["gps_fix"], 1);
+    EXPECT_EQ(next[1].first, "position");
+    EXPECT_EQ(next[1].second["lat"], 41.6);
+    EXPECT_EQ(next[2].first, "event");
+    EXPECT_NE(next[2].second["text"].get<std::string>().find("<b>"), std::string::npos);
 }
 
 TEST(MapServer, ManyBrowsersAtOnceAreServed) {
