@@ -90,6 +90,10 @@ int main(int argc, char** argv) {
         .flag("map-control",
               "let the map's buttons load, pause, resume and skip the plan (default: view only)",
               [&o] { o.map.control = true; })
+        .value("map-host", "NAME",
+               "a host name the map answers to, besides its addresses and localhost (repeatable; others are "
+               "refused)",
+               [&o](std::string_view, std::string_view v) { o.map.host_names.emplace_back(v); })
         .value("map-tiles", "URL",
                "tile server for the map, e.g. https://tile.openstreetmap.org/{z}/{x}/{y}.png (default: an "
                "offline grid)",

@@ -92,6 +92,8 @@ int main(int argc, char** argv) {
     MapServer* map_ptr = nullptr;
     MapServer map(strand, config, [&map_ptr](Json request, std::function<void(Json)> done) {
         map_ptr->add_event("command " + request.value("cmd", std::string()));
+        std::printf("vehicle got the command %s\n", request.dump().c_str());
+        std::fflush(stdout);
         done({{"ok", true}, {"result", {{"state", "running"}}}});
     });
     map_ptr = &map;

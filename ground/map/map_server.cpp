@@ -1,6 +1,8 @@
 #include "ground/map/map_server.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cctype>
 #include <charconv>
 #include <deque>
 #include <filesystem>
@@ -11,6 +13,8 @@
 #include "base/file_text.hpp"
 #include "ground/map/http.hpp"
 #include "ground/map/plan_export.hpp"
+#include "ground/map/request_guard.hpp"
+#include "services/common/limited_log.hpp"
 
 namespace airseg::ground {
 
@@ -206,6 +210,8 @@ struct MapServer::Impl : std::enable_shared_from_this<MapServer::Impl> {
     std::deque<TrackPoint> track;
     Json last_position;  // with the fields the track leaves out (battery, plan state)
     Json fix;            // {"valid": whether the last sample had a position, ...}; null before any sample
+    RequestGuard guard;
+    LimitedLog log;  // refusals: any page the operator opens can make them
     Json link;
     std::deque<Json> events;
 };
@@ -356,6 +362,12 @@ void Session::handle(const http::Request& req) {
     const std::string& path = req.path;
     const bool head = req.method == "HEAD";
     auto& s = *server_;
+    if (const auto why = s.guard.host_refusal(req)) {
+        s.log.log("map: refused a request for another host", SteadyClock::now(), spdlog::level::warn,
+                  "map: refused {} {}: {}", req.method, req.path.substr(0, 100), *why);
+        send(error_response(403, *why), true);
+        return;
+    }
     if (path == "/api/command") {
         if (req.method != "POST") {
             send(error_response(405, "use POST", {"Allow: POST"}), true);
@@ -426,6 +438,12 @@ void Session::command(const http::Request& req) {
              true);
         return;
     }
+    if (const auto why = s.guard.command_refusal(req)) {
+        s.log.log("map: refused a command", SteadyClock::now(), spdlog::level::warn,
+                  "map: refused a command: {}", *why);
+        send(json_response(403, {{"ok", false}, {"error", *why}}), true);
+        return;
+    }
     auto checked = map_command(req.body);
     if (auto* why = std::get_if<std::string>(&checked)) {
         send(json_response(400, {{"ok", false}, {"error", *why}}), true);
@@ -435,6 +453,10 @@ void Session::command(const http::Request& req) {
         send(json_response(503, {{"ok", false}, {"error", "no vehicle link to send the command on"}}), true);
         return;
     }
+    const auto& request = std::get<Json>(checked);
+    s.log.log("map: command", SteadyClock::now(), spdlog::level::info, "map: command {} from the page of {}",
+              request.value("cmd", std::string()),
+              req.header("origin").value_or(req.header("host").value_or("")));
     answered_ = true;
     auto once = std::make_shared<bool>(false);
     s.sink(std::move(std::get<Json>(checked)), [self = shared_from_this(), once](Json answer) {
@@ -498,14 +520,20 @@ Json MapServer::Impl::state() const {
     for (const auto& p : track) {
         points.push_back(Json::array({p.lat, p.lon}));
     }
-    return {{"plan", plan},
-            {"track", std::move(points)},
-            {"position", last_position},
-            {"fix", fix},
-            {"link", link},
-            {"events", Json(events)},
-            {"control", config.control},
-            {"tile_url", config.tile_url}};
+    Json out = {{"plan", plan},
+                {"track", std::move(points)},
+                {"position", last_position},
+                {"fix", fix},
+                {"link", link},
+                {"events", Json(events)},
+                {"control", config.control},
+                {"tile_url", config.tile_url}};
+    if (config.control) {
+        // Only the map's own page reads this stream: no CORS header lets another origin's page read it, and
+        // a request naming another host (DNS rebinding) is refused.
+        out["token"] = guard.token;
+    }
+    return out;
 }
 
 MapServer::MapServer(asio::any_io_executor strand, MapConfig config, CommandSink sink)
@@ -537,6 +565,14 @@ std::string MapServer::start() {
         boost::system::error_code ignored;
         s.acceptor.close(ignored);
         return "cannot listen on " + s.config.listen + ": " + ec.message();
+    }
+    s.guard.token = random_token();
+    s.guard.names.clear();
+    for (const auto& name : s.config.host_names) {
+        std::string lowered = name;
+        std::transform(lowered.begin(), lowered.end(), lowered.begin(),
+                       [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+        s.guard.names.push_back(std::move(lowered));
     }
     s.running = true;
     s.accept();

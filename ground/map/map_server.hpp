@@ -10,6 +10,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "services/common/asio.hpp"
 #include "services/groundlink/protocol/ground_protocol.hpp"
@@ -22,6 +23,7 @@ struct MapConfig {
     std::string web_dir;   // the page's own files; default: installed share dir, or the source dir (tests)
     std::string tile_url;  // empty: offline grid
     bool control = false;  // buttons command the vehicle; otherwise they are shown disabled
+    std::vector<std::string> host_names;  // names the map answers to besides addresses and localhost
 };
 
 /// The page's files: `configured` when given, else the installed ones, else the source tree's.

@@ -30,6 +30,7 @@
   const counts = { elements: 0, lines: 0, polygons: 0, holds: 0, no_fly: 0 };
   let lastPosition = null;
   let noFix = false;
+  let token = '';  // the map's own page is given it; commands carry it
   let planName = null;
   let linkState = null;
   let eventCount = 0;
@@ -233,8 +234,11 @@
     const out = document.getElementById('command-result');
     out.textContent = request.cmd + '…';
     try {
-      const r = await fetch('/api/command', { method: 'POST', headers: { 'Content-Type': 'application/json' },
-                                              body: JSON.stringify(request) });
+      const r = await fetch('/api/command', {
+        method: 'POST',
+        headers: { 'Content-Type': 'application/json', 'X-Airseg-Token': token },
+        body: JSON.stringify(request)
+      });
       const answer = await r.json();
       out.textContent = request.cmd + ': ' + (answer.ok ? 'done' : answer.error);
     } catch (err) {
@@ -268,6 +272,7 @@
   const events = new EventSource('/events' + (follow ? '?for=' + encodeURIComponent(follow) : ''));
   events.addEventListener('state', ev => {
     const s = JSON.parse(ev.data);
+    token = s.token || '';
     setControl(!!s.control);
     setBackground(s.tile_url);
     drawPlan(s.plan);

@@ -25,9 +25,9 @@ cleanup() {
 }
 trap cleanup EXIT
 
-# Starts the fixture for $1 seconds; sets $url.
+# Starts the fixture for $1 seconds (the rest: its options); sets $url and $out (its output).
 start_fixture() {
-  local out=$work/fixture.$RANDOM
+  out=$work/fixture.$RANDOM
   "$fixture" --seconds "$@" >"$out" 2>&1 &
   pids+=($!)
   for _ in $(seq 100); do
@@ -116,6 +116,39 @@ sys.exit(0 if all(ok for _, ok in checks) else 1)
 PY
 check "the vehicle says no fix" "$(grep -q '<div id="vehicle-text">no fix (GPS fix type 1)' "$work/dom-nofix.html" && echo yes || echo no)"
 check "the vehicle marker greyed" "$(grep -q 'airseg-no-fix' "$work/dom-nofix.html" && echo yes || echo no)"
+
+# The attack: a page on another origin, opened in the operator's browser, POSTs a command to a map started
+# with control ("no-cors": it cannot read the answer, and needs none). The map must refuse it and say so.
+start_fixture 4 --control
+fixture_out=$out
+attacker=$work/attacker
+mkdir -p "$attacker"
+cat >"$attacker/index.html" <<HTML
+<!DOCTYPE html><html><body><pre id="result">pending</pre><script>
+fetch('${url}api/command', { method: 'POST', mode: 'no-cors', headers: { 'Content-Type': 'text/plain' },
+                             body: '{"cmd":"plan.pause"}' })
+  .then(() => { document.getElementById('result').textContent = 'sent'; })
+  .catch(e => { document.getElementById('result').textContent = 'failed: ' + e; });
+</script></body></html>
+HTML
+python3 -m http.server 0 --bind 127.0.0.1 --directory "$attacker" >"$work/attacker.log" 2>&1 &
+pids+=($!)
+attacker_url=""
+for _ in $(seq 100); do
+  attacker_url=$(sed -n 's/^Serving HTTP on [^ ]* port \([0-9]*\).*/http:\/\/127.0.0.1:\1\//p' "$work/attacker.log")
+  [ -n "$attacker_url" ] && break
+  sleep 0.1
+done
+[ -n "$attacker_url" ] || { echo "FAIL: the attacker's page server did not start" >&2; cat "$work/attacker.log" >&2; exit 1; }
+run_browser --dump-dom "$attacker_url" >"$work/attack.html" || true
+echo "attacker page: $(grep -o '<pre id="result">[^<]*' "$work/attack.html" | sed 's/.*>//')"
+for _ in $(seq 100); do
+  grep -q "map: refused a command" "$fixture_out" && break
+  sleep 0.1
+done
+check "the cross-origin command was refused and logged" \
+  "$(grep -q "map: refused a command: a page from ${attacker_url%/} may not command the vehicle" "$fixture_out" && echo yes || echo no)"
+check "the vehicle got no command" "$(grep -q 'vehicle got the command' "$fixture_out" && echo no || echo yes)"
 
 start_fixture 4
 run_browser --screenshot="$work/map.png" "$url" >/dev/null || true

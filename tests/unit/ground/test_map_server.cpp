@@ -68,11 +68,33 @@ struct Rig {
         return exchange("GET " + path + " HTTP/1.1\r\nHost: localhost\r\n\r\n");
     }
 
-    std::string post_command(const std::string& body) const {
+    /// The page's token, read as the page reads it: from the first (state) event of /events.
+    std::string page_token() const {
+        asio::io_context client;
+        tcp::socket s(client);
+        s.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), map->port()));
+        asio::write(s, asio::buffer(std::string("GET /events HTTP/1.1\r\nHost: localhost\r\n\r\n")));
+        std::string buffer;
+        for (;;) {
+            const auto data = buffer.find("data: ");
+            const auto end = data == std::string::npos ? data : buffer.find("\n\n", data);
+            if (end != std::string::npos) {
+                return Json::parse(buffer.substr(data + 6, end - data - 6)).value("token", "");
+            }
+            std::array<char, 4096> chunk{};
+            buffer.append(chunk.data(), s.read_some(asio::buffer(chunk)));
+        }
+    }
+
+    /// A command as the map's own page sends it (its origin and token), unless `headers` says otherwise.
+    std::string post_command(const std::string& body,
+                             std::optional<std::string> headers = std::nullopt) const {
+        if (!headers) {
+            headers = "Origin: http://localhost\r\nX-Airseg-Token: " + page_token() + "\r\n";
+        }
         return exchange(
-            "POST /api/command HTTP/1.1\r\nHost: localhost\r\nContent-Type: application/json\r\n"
-            "Content-Length: " +
-            std::to_string(body.size()) + "\r\n\r\n" + body);
+            "POST /api/command HTTP/1.1\r\nHost: localhost\r\nContent-Type: application/json\r\n" + *headers +
+            "Content-Length: " + std::to_string(body.size()) + "\r\n\r\n" + body);
     }
 
     static inline int counter = 0;
@@ -119,7 +141,7 @@ TEST(MapServer, ServesThePageLeafletAndTheExports) {
               std::string::npos);
     EXPECT_EQ(Json::parse(body_of(rig.get("/track.geojson")))["type"], "FeatureCollection");
     EXPECT_NE(body_of(rig.get("/track.kml")).find("<kml"), std::string::npos);
-    const auto head = rig.exchange("HEAD / HTTP/1.1\r\nHost: x\r\n\r\n");
+    const auto head = rig.exchange("HEAD / HTTP/1.1\r\nHost: localhost\r\n\r\n");
     EXPECT_EQ(status_line(head), "HTTP/1.1 200 OK");
     EXPECT_EQ(body_of(head), "");
 }
@@ -135,9 +157,9 @@ TEST(MapServer, UnknownPathsEscapesAndBadRequestsAreRefused) {
     EXPECT_NE(body_of(bad).find("request line"), std::string::npos) << "the reason is given";
     EXPECT_EQ(status_line(rig.exchange("GET / HTTP/1.1\r\n\r\n")), "HTTP/1.1 400 Bad Request");
     const auto huge =
-        rig.exchange("POST /api/command HTTP/1.1\r\nHost: x\r\nContent-Length: 999999999\r\n\r\n");
+        rig.exchange("POST /api/command HTTP/1.1\r\nHost: localhost\r\nContent-Length: 999999999\r\n\r\n");
     EXPECT_EQ(status_line(huge), "HTTP/1.1 413 Content Too Large");
-    const auto wrong = rig.exchange("DELETE / HTTP/1.1\r\nHost: x\r\n\r\n");
+    const auto wrong = rig.exchange("DELETE / HTTP/1.1\r\nHost: localhost\r\n\r\n");
     EXPECT_EQ(status_line(wrong), "HTTP/1.1 405 Method Not Allowed");
     EXPECT_EQ(status_line(rig.get("/api/command")), "HTTP/1.1 405 Method Not Allowed");
 }
@@ -173,6 +195,47 @@ TEST(MapServer, WithControlOnlyPlanCommandsReachTheVehicle) {
         EXPECT_EQ(rig.commands[1], Json::parse(R"({"cmd":"plan.skip","element":"gate"})"));
         EXPECT_EQ(rig.commands[2], Json::parse(R"({"cmd":"plan.load","text":"plan: {}","source":"f.yaml"})"));
     });
+}
+
+// Any page the operator's browser opens can send requests to the map: one on another origin POSTs without
+// reading the answer, one on a name rebound to 127.0.0.1 reads the map as its own. Neither commands anything.
+TEST(MapServer, CommandsNeedThePagesTokenAndOriginAndRequestsMustNameTheMap) {
+    MapConfig config;
+    config.control = true;
+    config.host_names = {"Rover-Base.local"};
+    Rig rig(config);
+    const auto token = rig.page_token();
+    EXPECT_EQ(token.size(), 32u);
+    const std::string body = R"({"cmd":"plan.pause"})";
+    const auto no_token = rig.post_command(body, "");
+    EXPECT_EQ(status_line(no_token), "HTTP/1.1 403 Forbidden");
+    EXPECT_NE(body_of(no_token).find("not from this map's page"), std::string::npos) << no_token;
+    EXPECT_EQ(status_line(rig.post_command(body, "X-Airseg-Token: " + std::string(32, '0') + "\r\n")),
+              "HTTP/1.1 403 Forbidden");
+    const auto foreign =
+        rig.post_command(body, "Origin: http://evil.example\r\nX-Airseg-Token: " + token + "\r\n");
+    EXPECT_EQ(status_line(foreign), "HTTP/1.1 403 Forbidden");
+    EXPECT_NE(body_of(foreign).find("a page from http://evil.example may not command"), std::string::npos)
+        << foreign;
+    // A tool without an Origin (curl) with the token is the page's equal.
+    EXPECT_EQ(status_line(rig.post_command(body, "X-Airseg-Token: " + token + "\r\n")), "HTTP/1.1 200 OK");
+    rig.on_strand([&] { EXPECT_EQ(rig.commands.size(), 1u); });
+
+    const auto as_host = [&](const std::string& host) {
+        return status_line(rig.exchange("GET / HTTP/1.1\r\nHost: " + host + "\r\n\r\n"));
+    };
+    EXPECT_EQ(as_host("evil.example:8080"), "HTTP/1.1 403 Forbidden") << "DNS rebinding";
+    EXPECT_EQ(as_host("localhost.evil.example"), "HTTP/1.1 403 Forbidden");
+    EXPECT_EQ(as_host("127.0.0.1:9000"), "HTTP/1.1 200 OK") << "an address, on any port (an SSH tunnel)";
+    EXPECT_EQ(as_host("[::1]:8080"), "HTTP/1.1 200 OK");
+    EXPECT_EQ(as_host("LOCALHOST"), "HTTP/1.1 200 OK");
+    EXPECT_EQ(as_host("rover-base.LOCAL:8080"), "HTTP/1.1 200 OK") << "a configured name";
+    EXPECT_EQ(as_host("[::1"), "HTTP/1.1 403 Forbidden");
+}
+
+TEST(MapServer, AViewOnlyMapGivesNoToken) {
+    Rig rig;
+    EXPECT_EQ(rig.page_token(), "");
 }
 
 /// Reads server-sent events until `count` have arrived (after the response head).
@@ -225,8 +288,8 @@ TEST(MapServer, TheEventStreamStartsWithTheWholeStateThenFollowsUpdates) {
     asio::io_context client;
     tcp::socket s(client);
     s.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), rig.map->port()));
-    asio::write(
-        s, asio::buffer(std::string("GET /events HTTP/1.1\r\nHost: x\r\nAccept: text/event-stream\r\n\r\n")));
+    asio::write(s, asio::buffer(std::string(
+                       "GET /events HTTP/1.1\r\nHost: localhost\r\nAccept: text/event-stream\r\n\r\n")));
     std::string buffer;
     asio::read_until(s, asio::dynamic_buffer(buffer), "\r\n\r\n");
     ASSERT_TRUE(buffer.starts_with("HTTP/1.1 200 OK\r\n"));
