@@ -664,12 +664,21 @@ void WindowFeeder::fail_plan(std::string why) {
     emit(FeederEvent::Kind::PlanFailed, nullptr, generation_, {}, std::move(why));
 }
 
-void WindowFeeder::on_mode(VehicleState state, autopilot::ModeChangeCause cause, TimePoint) {
+void WindowFeeder::on_mode(VehicleState state, autopilot::ModeChangeCause cause, TimePoint now) {
     const Mode before = mode_;
     const bool requested = cause == autopilot::ModeChangeCause::Requested;
     switch (state) {
         case VehicleState::Unknown:
+            mode_ = Mode::Unknown;
+            return;
         case VehicleState::ConfigureCheck:
+            if (before != Mode::Unknown) {
+                // A board seen booting (Rover's INITIALISING) keeps its mission in storage and starts it at
+                // slot 1 in AUTO: a waypoint of an old turn of the window. The reboot is declared only once
+                // its clock has run on (docs/autopilot.md, Reboots), and AUTO asked for meanwhile drove back
+                // there. Its window is written again, as after a declared reboot, before AUTO.
+                on_autopilot_rebooted(now);
+            }
             mode_ = Mode::Unknown;
             return;
         case VehicleState::WaypointNavigation:

@@ -133,6 +133,16 @@ class SimAutopilot {
         target_ = home();
     }
 
+    /// ArduPilot's own reboot, as the driver first sees it: the mission stays in the board's storage and AUTO
+    /// starts it at slot 1; the boot shows as INITIALISING (configure_check), then the boot mode (MANUAL).
+    /// (reboot() is the board as the feeder knows it once the reboot is declared: nothing it held counts.)
+    void boot_keeping_mission() {
+        current_ = slots_.size() > 1 ? 1 : 0;
+        take_target();
+        set_mode(VehicleState::ConfigureCheck, ModeChangeCause::External);
+        set_mode(VehicleState::Manual, ModeChangeCause::External);
+    }
+
     /// The RC pilot takes the vehicle out of AUTO (the transmitter's MANUAL switch).
     void operator_takes_over() { set_mode(VehicleState::Directed, ModeChangeCause::External); }
     /// The autopilot falls into HOLD by itself (a failsafe, a quirk of its mission logic).

@@ -168,6 +168,29 @@ TEST(FlightplanFeeder, RebootMidPlanRebuildsTheWindowAndCarriesOn) {
     EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
 }
 
+// The daemon declares a reboot 1.5 s after the board's clock went back (docs/autopilot.md, Reboots); under
+// qemu-armel that was after the board's boot heartbeats (INITIALISING, then MANUAL) had been read, and the
+// feeder, seeing MANUAL mid-plan, asked for AUTO: the board started its stored mission at slot 1 and drove
+// back to a waypoint of an old turn of the window (reached 0 1 2 3 4 2 5 …). A board seen booting holds no
+// window the feeder can count on.
+TEST(FlightplanFeeder, ABoardSeenBootingIsNotPutInAutoBeforeItsWindowIsWrittenAgain) {
+    Harness h;
+    h.feeder.replace_plan(test::synthetic(800), h.now);
+    for (int i = 0; i < 300; ++i) {
+        h.step();
+    }
+    const auto visited = h.ap.visited().size();
+    const auto next = *h.feeder.progress().next_waypoint;
+    ASSERT_NE(h.ap.slots()[1].lat, SyntheticStream::position_of(41.0, next).lat) << "slot 1 holds an old one";
+    h.ap.boot_keeping_mission();
+    ASSERT_LT(h.run_until_done(3000), 3000);
+    ASSERT_GT(h.ap.visited().size(), visited);
+    EXPECT_EQ(h.ap.visited()[visited], SyntheticStream::position_of(41.0, next))
+        << "the first place driven after the boot is the first waypoint not reached";
+    EXPECT_EQ(h.reached, iota(0, 800));
+    expect_visited(h, 41.0, next, 800, visited);
+}
+
 TEST(FlightplanFeeder, ReplacePlanKeepsCurrentTargetThenFollowsNewPlanWithoutStopping) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(1000, 41.0), h.now);
