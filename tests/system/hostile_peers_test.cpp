@@ -39,6 +39,12 @@ constexpr bool kMeasuredChecks = false;  // RSS and answer times are printed, no
 constexpr bool kMeasuredChecks = true;
 #endif
 constexpr auto kWatchdogPeriod = 1000ms;
+// The longest gap between pings the case accepts. On the board it is the period systemd enforces. Under an
+// emulator on CI's loaded machine the daemon's threads have been seen unscheduled for 2.7 s (armel, a flood
+// that takes 3.2 s and never gaps over 0.26 s on a quiet machine or beside two nice-19 compiles; the daemon
+// does no disk I/O in it), so there the gap is printed and held only to a bound a hung service would still
+// break: a stuck service stops the pings for good, which the "pings have stopped" check sees as well.
+constexpr auto kLongestPingGap = kMeasuredChecks ? kWatchdogPeriod : 5 * kWatchdogPeriod;
 constexpr auto kAnswerWithin = 1000ms;
 constexpr long kRssSlackKb = 2048;
 
@@ -273,9 +279,10 @@ class HostilePeers : public ::testing::Test {
         }
         EXPECT_NE(last, std::chrono::steady_clock::time_point{}) << "no watchdog ping at all";
         EXPECT_LT(std::chrono::steady_clock::now() - last, kWatchdogPeriod) << "the pings have stopped";
-        EXPECT_LT(longest, kWatchdogPeriod) << "the longest gap between watchdog pings";
+        EXPECT_LT(longest, kLongestPingGap) << "the longest gap between watchdog pings; the daemon's log:\n"
+                                            << daemon->err();
         std::cout << "[ figures ] watchdog: longest gap between pings " << longest.count() << " ms (period "
-                  << kWatchdogPeriod.count() << " ms)\n";
+                  << kWatchdogPeriod.count() << " ms, accepted below " << kLongestPingGap.count() << " ms)\n";
         EXPECT_TRUE(daemon->running()) << daemon->err();
     }
     /// RSS after the test's warm-up: what the daemon keeps once it has answered and run for a moment.
