@@ -2,7 +2,9 @@
 
 #include <atomic>
 
+#include "base/fnv1a.hpp"
 #include "base/utf8.hpp"
+#include "services/common/command_record.hpp"
 
 namespace airseg {
 
@@ -59,10 +61,20 @@ const char* to_string(CommandStatus s) {
 }
 
 Json CommandResult::to_json() const {
-    if (status == CommandStatus::Ok) {
-        return Json{{"ok", true}, {"result", result}};
+    Json out = status == CommandStatus::Ok
+                   ? Json{{"ok", true}, {"result", result}}
+                   : Json{{"ok", false}, {"status", to_string(status)}, {"error", error}};
+    if (replayed) {
+        out["replayed"] = true;
     }
-    return Json{{"ok", false}, {"status", to_string(status)}, {"error", error}};
+    return out;
+}
+
+CommandDispatcher::CommandDispatcher() : record_(std::make_shared<CommandRecord>()) {}
+CommandDispatcher::~CommandDispatcher() = default;
+
+CommandRecordStats CommandDispatcher::record_stats() const {
+    return record_->stats();
 }
 
 void CommandDispatcher::add(const std::string& name, Strand strand, Role required, Handler handler) {
@@ -100,6 +112,40 @@ void CommandDispatcher::dispatch(const Json& request, Role caller, Reply reply) 
         reply(CommandResult::fail(CommandStatus::Forbidden,
                                   "'" + name + "' needs the control role; this connection is a monitor"));
         return;
+    }
+    // At most once: a command that changes something, sent again under its request id, is answered from
+    // the record instead of running twice. Read-only commands (a monitor may call them) run every time.
+    if (entry->required == Role::Control) {
+        const auto id = CommandRecord::id_of(request);
+        if (!id.error.empty()) {
+            reply(CommandResult::fail(CommandStatus::BadRequest, id.error));
+            return;
+        }
+        if (id.id) {
+            auto content = request;
+            content.erase("request_id");
+            const auto fingerprint =
+                fnv1a64(content.dump(-1, ' ', false, Json::error_handler_t::replace));
+            switch (record_->admit(*id.id, fingerprint, SteadyClock::now(), reply)) {
+                case CommandRecord::Admit::Replayed:
+                case CommandRecord::Admit::Joined:
+                    return;
+                case CommandRecord::Admit::Conflict:
+                    reply(CommandResult::fail(
+                        CommandStatus::BadRequest,
+                        "request_id '" + *id.id +
+                            "' was used for a different command in the last 10 minutes; a new command "
+                            "needs a new id"));
+                    return;
+                case CommandRecord::Admit::Run:
+                    reply = [record = record_, key = *id.id, fingerprint,
+                             reply = std::move(reply)](CommandResult r) {
+                        record->finish(key, fingerprint, r, SteadyClock::now());
+                        reply(std::move(r));
+                    };
+                    break;
+            }
+        }
     }
     // Guard the exactly-once promise: a handler bug must not answer twice on a connection.
     auto answered = std::make_shared<std::atomic<bool>>(false);

@@ -12,6 +12,11 @@
 #include "services/common/asio.hpp"
 
 namespace airseg {
+class CommandRecord;
+struct CommandRecordStats;
+}  // namespace airseg
+
+namespace airseg {
 
 using Json = nlohmann::json;
 
@@ -28,6 +33,7 @@ struct CommandResult {
     CommandStatus status = CommandStatus::Ok;
     Json result = Json::object();  // command-specific payload when ok
     std::string error;             // what went wrong, for people, when not ok
+    bool replayed = false;         // the answer of an earlier run of the same request (command_record.hpp)
 
     static CommandResult ok(Json result = Json::object()) {
         return {CommandStatus::Ok, std::move(result), {}};
@@ -36,7 +42,8 @@ struct CommandResult {
         return {s, Json::object(), std::move(error)};
     }
 
-    /// The wire form: {"ok":true,"result":{...}} or {"ok":false,"status":"refused","error":"..."}.
+    /// The wire form: {"ok":true,"result":{...}} or {"ok":false,"status":"refused","error":"..."}, with
+    /// "replayed": true when the answer comes from the record of an earlier run.
     Json to_json() const;
 };
 
@@ -55,6 +62,12 @@ class CommandDispatcher {
 
     std::vector<std::string> names() const;
 
+    /// The record behind "request_id" (command_record.hpp): how often it spared a second run.
+    CommandRecordStats record_stats() const;
+
+    CommandDispatcher();
+    ~CommandDispatcher();
+
   private:
     struct Entry {
         Strand strand;
@@ -63,6 +76,7 @@ class CommandDispatcher {
     };
     mutable std::mutex mutex_;
     std::map<std::string, std::shared_ptr<const Entry>> entries_;
+    std::shared_ptr<CommandRecord> record_;  // shared with the replies that finish its entries
 };
 
 }  // namespace airseg

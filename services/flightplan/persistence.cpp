@@ -120,15 +120,6 @@ std::optional<SavedProgress> parse_progress(std::string_view data, std::string& 
 
 }  // namespace
 
-std::uint64_t fnv1a64(std::string_view data) {
-    std::uint64_t h = 0xcbf29ce484222325ull;
-    for (const char c : data) {
-        h ^= static_cast<unsigned char>(c);
-        h *= 0x100000001b3ull;
-    }
-    return h;
-}
-
 std::string hex64(std::uint64_t v) {
     char buf[17];
     auto [ptr, ec] = std::to_chars(buf, buf + sizeof buf, v, 16);

@@ -15,13 +15,13 @@
 #include <string_view>
 #include <vector>
 
+#include "base/fnv1a.hpp"
 #include "services/flightplan/feeder_types.hpp"
 #include "services/flightplan/waypoint.hpp"
 
 namespace airseg::flightplan {
 
-/// FNV-1a, 64 bit: a checksum against truncation and stray bytes (not against an adversary).
-std::uint64_t fnv1a64(std::string_view data);
+using airseg::fnv1a64;
 std::string hex64(std::uint64_t v);
 
 struct SavedProgress {

@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "services/common/command_record.hpp"
 #include "services/status/status_document.hpp"
 
 namespace airseg::status {
@@ -24,6 +25,18 @@ nlohmann::json StatusService::document() const {
     return build_document(ctx_.health.snapshot(), sections_, uptime);
 }
 
+namespace {
+
+/// The at-most-once record (command_record.hpp): commands run under a request id, and those it spared.
+nlohmann::json request_ids_json(const CommandRecordStats& r) {
+    return {{"recorded", r.recorded},   {"replayed", r.replayed},
+            {"joined", r.joined},       {"conflicts", r.conflicts},
+            {"entries", r.entries},     {"forgotten_early", r.forgotten_early},
+            {"unrecorded", r.unrecorded}};
+}
+
+}  // namespace
+
 nlohmann::json StatusService::own_section() const {
     const auto s = server_.stats();
     return {{"local_socket",
@@ -33,6 +46,7 @@ nlohmann::json StatusService::own_section() const {
               {"evicted", s.evicted},
               {"closed_slow", s.closed_slow},
               {"closed_idle", s.closed_idle}}},
+            {"request_ids", request_ids_json(ctx_.commands.record_stats())},
             {"log_lines_held", LimitedLog::held_everywhere()}};
 }
 
