@@ -13,6 +13,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <random>
 #include <string>
 #include <thread>
 #include <vector>
@@ -52,8 +53,9 @@ const char* const kUsageTail =
     "  status             health of every service and the vehicle's state\n"
     "  watch [--interval MS] [--duration MS] [--note TEXT]...\n"
     "                     a live view refreshed in place until Ctrl-C: over the radio from the telemetry\n"
-    "                     the vehicle pushes (state, position, speed, battery, plan, link, events), locally\n"
-    "                     from the status document every --interval (default 1000 ms); each --note is a\n"
+    "                     the vehicle pushes (state, position, speed, battery, plan, link, events), redrawn\n"
+    "                     every --interval (default 500 ms), locally from the status document every\n"
+    "                     --interval (default 1000 ms); each --note is a\n"
     "                     line kept under the view\n"
     "  state STATE        PARKING | DIRECTED | MANUAL_NAVIGATION | WAYPOINT_NAVIGATION\n"
     "  param get NAME | param set NAME VALUE | param list\n"
@@ -85,6 +87,7 @@ struct Options {
     bool local_chosen = false;  // --local or --socket: never look for a ground hub instead
     bool json = false;
     long timeout_ms = 5000;
+    std::string request_id;  // --request-id; otherwise a new one per run (one-shot commands)
     std::vector<std::string> positional;
 };
 
@@ -145,6 +148,21 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
                                         std::string(v) + "'");
                    }
                })
+        .value("request-id", "ID",
+               "name the command for the vehicle's record of recent commands: sent again under the same ID "
+               "within 10 minutes (its answer lost, the link down), it is answered from the record and never "
+               "done twice; 1 to 64 printable characters (default: a new random ID, printed when no answer "
+               "comes)",
+               [&o](std::string_view option, std::string_view v) {
+                   const bool printable =
+                       std::all_of(v.begin(), v.end(), [](char c) { return c > ' ' && c < 0x7f; });
+                   if (v.empty() || v.size() > 64 || !printable) {
+                       throw UsageError(std::string(option) +
+                                        ": expected 1 to 64 printable characters without spaces, got '" +
+                                        std::string(v) + "'");
+                   }
+                   o.request_id = v;
+               })
         .flag("json", "machine-readable JSON instead of text", [&o] { o.json = true; })
         .help_and_version();
     const Program program{"airsegctl", [&table] { return kUsageHead + describe(table) + kUsageTail; }};
@@ -185,28 +203,64 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
     return std::nullopt;
 }
 
+/// A new request id for this run: random, so two operators' commands never share one.
+std::string new_request_id() {
+    std::random_device random;
+    const auto value = (static_cast<std::uint64_t>(random()) << 32) | random();
+    return fmt::format("{:016x}", value);
+}
+
+/// A one-shot command goes with a request id (--request-id, or a new one): sent again under it, the vehicle
+/// answers from its record instead of doing it twice (docs/ground-protocol.md, "At most once").
+nlohmann::json with_request_id(nlohmann::json request, Options& o) {
+    if (o.request_id.empty()) {
+        o.request_id = new_request_id();
+    }
+    if (request.is_object() && !request.contains("request_id")) {
+        request["request_id"] = o.request_id;
+    }
+    return request;
+}
+
 /// Prints an answer; the exit code says whether the vehicle did it.
 int show_answer(const Options& o, const airseg::client::LocalAnswer& a,
                 const std::function<std::string(const nlohmann::json&)>& render) {
     if (!a.answer) {
         if (o.json) {
-            std::cout << airseg::client::dump_text(nlohmann::json{
-                             {"ok", false},
-                             {"status", a.error.starts_with("not authorised") ? "not_authorised" : "no_link"},
-                             {"error", a.error}})
-                      << "\n";
+            nlohmann::json out{
+                {"ok", false},
+                {"status", a.error.starts_with("not authorised") ? "not_authorised" : "no_link"},
+                {"error", a.error}};
+            if (!o.request_id.empty()) {
+                out["request_id"] = o.request_id;
+            }
+            std::cout << airseg::client::dump_text(out) << "\n";
         }
         std::cerr << "airsegctl: " << a.error << "\n";
+        if (!o.request_id.empty()) {
+            // The command may have reached the vehicle and only its answer been lost.
+            std::cerr << "airsegctl: the vehicle may have done it; send it again with --request-id "
+                      << o.request_id << " (within 10 minutes) and it is done at most once\n";
+        }
         return kNoLink;
     }
     const auto& answer = *a.answer;
     const bool ok = answer.value("ok", false);
+    const bool replayed = answer.value("replayed", false);
     if (o.json) {
-        std::cout << airseg::client::dump_text(ok ? answer["result"] : answer) << "\n";
+        auto shown = ok ? answer["result"] : answer;
+        if (replayed && shown.is_object()) {
+            shown["replayed"] = true;
+        }
+        std::cout << airseg::client::dump_text(shown) << "\n";
     } else if (ok) {
         std::cout << render(answer["result"]);
     } else {
         std::cerr << "airsegctl: refused: " << answer.value("error", "no reason given") << "\n";
+    }
+    if (replayed && !o.json) {
+        std::cerr << "airsegctl: answered from the vehicle's record of request " << o.request_id
+                  << ": done once, at an earlier try, not again\n";
     }
     return ok ? kDone : kRefused;
 }
@@ -269,13 +323,19 @@ int live_command(const Options& o, Requester& client, airseg::client::VehicleLin
     live.timeout = std::chrono::milliseconds(o.timeout_ms);
     airseg::client::JoystickOptions stick;
     double interval_ms = 1000;
+    bool interval_given = false;
     double duration_ms = 0;
     using namespace airseg::cli;
     // Each command's own options, after its name; the same parser and messages as the global ones.
     OptionTable table;
     table.value("duration", "MS", "", number(duration_ms, 1, 1e9));
     if (cmd == "watch") {
-        table.value("interval", "MS", "", number(interval_ms, 100, 1e9))
+        table
+            .value("interval", "MS", "",
+                   [&](std::string_view option, std::string_view v) {
+                       number(interval_ms, 100, 1e9)(option, v);
+                       interval_given = true;
+                   })
             .value("note", "TEXT", "",
                    [&live](std::string_view, std::string_view v) { live.notes.emplace_back(v); });
     } else if (cmd == "joystick") {
@@ -288,6 +348,9 @@ int live_command(const Options& o, Requester& client, airseg::client::VehicleLin
         return usage_error(cmd + ": " + e.what());
     }
     live.duration = std::chrono::milliseconds(static_cast<long>(duration_ms));
+    if (interval_given) {
+        live.refresh = std::chrono::milliseconds(static_cast<long>(interval_ms));  // the radio's view too
+    }
     airseg::client::install_stop_handlers();
     if (cmd == "watch") {
         if (radio != nullptr) {
@@ -371,7 +434,7 @@ int main(int argc, char** argv) {
         if (!built.usage_error.empty()) {
             return usage_error(built.usage_error);
         }
-        return show_answer(o, client.request(built.request), built.render);
+        return show_answer(o, client.request(with_request_id(built.request, o)), built.render);
     }
     if (cmd == "request") {
         if (o.positional.size() != 2) {
@@ -381,7 +444,7 @@ int main(int argc, char** argv) {
         if (req.is_discarded() || !req.is_object()) {
             return usage_error("request: not a JSON object: " + o.positional[1]);
         }
-        return show_answer(o, client.request(req),
+        return show_answer(o, client.request(with_request_id(req, o)),
                            [](const nlohmann::json& r) { return airseg::client::dump_text(r, 2) + "\n"; });
     }
     if (cmd == "plan") {
@@ -394,7 +457,7 @@ int main(int argc, char** argv) {
         if (!plan.request) {
             return usage_error(plan.error);
         }
-        return show_answer(o, client.request(*plan.request), plan.render);
+        return show_answer(o, client.request(with_request_id(*plan.request, o)), plan.render);
     }
     return usage_error("unknown command '" + cmd + "'" + airseg::did_you_mean(cmd, kCommandNames));
 }

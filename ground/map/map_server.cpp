@@ -191,6 +191,8 @@ struct MapServer::Impl : std::enable_shared_from_this<MapServer::Impl> {
           keepalive(strand) {}
 
     void accept();
+    /// Closes the oldest connection still waiting for its request, if any.
+    void make_room();
     void tick();
     void broadcast(const std::string& event, const Json& data);
     Json state() const;
@@ -202,6 +204,7 @@ struct MapServer::Impl : std::enable_shared_from_this<MapServer::Impl> {
     CommandSink sink;
     tcp::acceptor acceptor;
     std::uint64_t accepted = 0;
+    MapServer::Counts counts;
     asio::steady_timer keepalive;
     bool running = false;
     std::set<std::shared_ptr<Session>> sessions;
@@ -236,6 +239,10 @@ class Session : public std::enable_shared_from_this<Session> {
 
     void refuse_busy() { send(error_response(503, "too many connections to the map"), true); }
 
+    /// Connected, and its request not complete yet: what a newcomer may take the place of.
+    bool waiting_for_request() const { return !answered_ && !closed_; }
+    TimePoint connected_at() const { return connected_at_; }
+
     /// One server-sent event, if this is an event stream.
     void event(const std::string& text) {
         if (streaming_) {
@@ -250,6 +257,9 @@ class Session : public std::enable_shared_from_this<Session> {
             return;
         }
         closed_ = true;
+        if (streaming_) {
+            --server_->counts.streams;
+        }
         deadline_.cancel();
         boost::system::error_code ignored;
         socket_.shutdown(tcp::socket::shutdown_both, ignored);
@@ -355,6 +365,7 @@ class Session : public std::enable_shared_from_this<Session> {
     bool close_after_ = false;
     bool streaming_ = false;
     bool closed_ = false;
+    TimePoint connected_at_ = SteadyClock::now();
 };
 
 void Session::handle(const http::Request& req) {
@@ -387,8 +398,18 @@ void Session::handle(const http::Request& req) {
     } else if (path.starts_with("/leaflet/")) {
         serve_file(req, s.config.leaflet_dir, std::string_view(path).substr(9));
     } else if (path == "/events") {
+        if (s.counts.streams >= MapServer::kMaxStreams) {
+            ++s.counts.refused_streams;
+            s.log.log("map: refused an event stream", SteadyClock::now(), spdlog::level::warn,
+                      "map: refused an event stream: {} are open (close a map tab)", MapServer::kMaxStreams);
+            send(error_response(503, "too many live maps open (" + std::to_string(MapServer::kMaxStreams) +
+                                         "); close a map tab"),
+                 true);
+            return;
+        }
         answered_ = true;
         streaming_ = true;
+        ++s.counts.streams;
         send(
             "HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-cache\r\n"
             "X-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n",
@@ -474,8 +495,13 @@ void MapServer::Impl::accept() {
         }
         if (!ec) {
             ++self->accepted;
+            ++self->counts.accepted;
             auto session = std::make_shared<Session>(self, std::move(socket));
-            if (self->sessions.size() >= kMaxConnections) {
+            if (self->sessions.size() - self->counts.streams >= kMaxConnections) {
+                self->make_room();
+            }
+            if (self->sessions.size() - self->counts.streams >= kMaxConnections) {
+                ++self->counts.refused_busy;
                 session->refuse_busy();  // kept alive by its write until the answer is out
             } else {
                 self->sessions.insert(session);
@@ -484,6 +510,19 @@ void MapServer::Impl::accept() {
         }
         self->accept();
     });
+}
+
+void MapServer::Impl::make_room() {
+    std::shared_ptr<Session> oldest;
+    for (const auto& session : sessions) {
+        if (session->waiting_for_request() && (!oldest || session->connected_at() < oldest->connected_at())) {
+            oldest = session;
+        }
+    }
+    if (oldest) {
+        ++counts.evicted_idle;
+        oldest->close();
+    }
 }
 
 void MapServer::Impl::tick() {
@@ -602,6 +641,10 @@ std::uint16_t MapServer::port() const {
 
 std::uint64_t MapServer::connections_accepted() const {
     return impl_->accepted;
+}
+
+MapServer::Counts MapServer::counts() const {
+    return impl_->counts;
 }
 
 void MapServer::set_plan(const Json& geometry) {

@@ -37,8 +37,21 @@ class MapServer {
 
     /// Points of the track kept (the oldest go first).
     static constexpr std::size_t kTrackPoints = 10000;
-    /// Browser connections served at once; more are answered 503.
+    /// Requests served at once (pages, files, exports, commands). When all are taken, the oldest one that
+    /// has not yet sent its request is closed for a newcomer (idle or slow clients cannot lock out the page);
+    /// only when every one is being answered is a newcomer answered 503.
     static constexpr std::size_t kMaxConnections = 64;
+    /// Event streams (/events, one per open map tab), apart from the requests above: the 33rd is answered
+    /// 503, and however many there are, pages and exports are still served.
+    static constexpr std::size_t kMaxStreams = 32;
+
+    struct Counts {
+        std::uint64_t accepted = 0;         // connections accepted since start
+        std::uint64_t evicted_idle = 0;     // closed before their request for a newcomer
+        std::uint64_t refused_busy = 0;     // answered 503: every request slot was being answered
+        std::uint64_t refused_streams = 0;  // /events answered 503: kMaxStreams open
+        std::size_t streams = 0;            // event streams open now
+    };
 
     MapServer(asio::any_io_executor strand, MapConfig config, CommandSink sink);
     ~MapServer();
@@ -52,6 +65,8 @@ class MapServer {
     std::uint16_t port() const;
     /// Browser connections accepted since start (read on the server's strand).
     std::uint64_t connections_accepted() const;
+    /// What the bounds did (read on the server's strand).
+    Counts counts() const;
 
     // Fed by the hub, on the strand:
     void set_plan(const nlohmann::json& geometry);  // the answer of plan.geometry

@@ -124,8 +124,7 @@ void CommandDispatcher::dispatch(const Json& request, Role caller, Reply reply) 
         if (id.id) {
             auto content = request;
             content.erase("request_id");
-            const auto fingerprint =
-                fnv1a64(content.dump(-1, ' ', false, Json::error_handler_t::replace));
+            const auto fingerprint = fnv1a64(content.dump(-1, ' ', false, Json::error_handler_t::replace));
             switch (record_->admit(*id.id, fingerprint, SteadyClock::now(), reply)) {
                 case CommandRecord::Admit::Replayed:
                 case CommandRecord::Admit::Joined:

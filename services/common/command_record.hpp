@@ -21,12 +21,12 @@
 namespace airseg {
 
 struct CommandRecordStats {
-    std::uint64_t recorded = 0;  // commands run under a request id
-    std::uint64_t replayed = 0;  // answered from the record, not run again
-    std::uint64_t joined = 0;    // sent again while the first was running; given the first's answer
-    std::uint64_t conflicts = 0; // an id recorded for a different command: refused
+    std::uint64_t recorded = 0;         // commands run under a request id
+    std::uint64_t replayed = 0;         // answered from the record, not run again
+    std::uint64_t joined = 0;           // sent again while the first was running; given the first's answer
+    std::uint64_t conflicts = 0;        // an id recorded for a different command: refused
     std::uint64_t forgotten_early = 0;  // entries dropped by the bound before their age
-    std::uint64_t unrecorded = 0;  // run without a record: every entry was a command still running
+    std::uint64_t unrecorded = 0;       // run without a record: every entry was a command still running
     std::size_t entries = 0;
 };
 

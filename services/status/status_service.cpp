@@ -29,9 +29,8 @@ namespace {
 
 /// The at-most-once record (command_record.hpp): commands run under a request id, and those it spared.
 nlohmann::json request_ids_json(const CommandRecordStats& r) {
-    return {{"recorded", r.recorded},   {"replayed", r.replayed},
-            {"joined", r.joined},       {"conflicts", r.conflicts},
-            {"entries", r.entries},     {"forgotten_early", r.forgotten_early},
+    return {{"recorded", r.recorded},    {"replayed", r.replayed}, {"joined", r.joined},
+            {"conflicts", r.conflicts},  {"entries", r.entries},   {"forgotten_early", r.forgotten_early},
             {"unrecorded", r.unrecorded}};
 }
 

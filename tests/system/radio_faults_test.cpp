@@ -413,5 +413,69 @@ TEST(SystemRadio, AFloodOfCommandsIsAnsweredOrCleanlyRefusedNeverDuplicated) {
     }
 }
 
+// At most once over the radio. An airsegctl that gets no answer says which request id to send its command
+// again under; sent again under it, a command the vehicle never received is done then, and one whose answer
+// was lost (the client gone as it travelled) is answered from the vehicle's record, not done twice.
+TEST(SystemRadio, ACommandSentAgainUnderItsRequestIdIsDoneOnce) {
+    BenchOptions o;
+    o.speedup = 10;
+    SystemBench bench(o);
+    ASSERT_TRUE(bench.wait_ready()) << bench.logs();
+    const auto route = bench.dir().file("route.yaml");
+    const auto leg = bench.dir().file("leg2.yaml");
+    write_file(route, line_plan("route", 6, 20));
+    write_file(leg, line_plan("leg2", 3, 20, 30));
+    const auto loaded = bench.ctl_local({"plan", "load", "--paused", route});
+    ASSERT_EQ(loaded.exit_code, 0) << loaded.out << loaded.err << bench.logs();
+    const auto elements = [&] {
+        const auto r = bench.ctl_local({"plan", "show"});
+        const auto j = Json::parse(r.out, nullptr, false);
+        return j.is_object() && j.contains("elements") ? j["elements"].size() : std::size_t{0};
+    };
+    const std::size_t before = elements();
+    ASSERT_GT(before, 0u);
+
+    // 1. No answer (the radio silent both ways): airsegctl names the id to retry under.
+    ASSERT_EQ(bench.link().ask("outage 6").value_or("").rfind("ok", 0), 0u);
+    const auto cut = std::chrono::steady_clock::now();
+    const auto unanswered = bench.ctl({"plan", "append", leg}, 2'000);
+    EXPECT_EQ(unanswered.exit_code, 3) << unanswered.out << unanswered.err;
+    const auto said = Json::parse(unanswered.out, nullptr, false);
+    ASSERT_TRUE(said.is_object() && said.contains("request_id")) << unanswered.out << unanswered.err;
+    const auto id = said["request_id"].get<std::string>();
+    EXPECT_NE(unanswered.err.find("--request-id " + id), std::string::npos) << unanswered.err;
+    ASSERT_TRUE(wait_until([&] { return seconds_since(cut) > 7.0; }, kGenerous, kPoll));
+    const auto retried = bench.ctl({"--request-id", id, "plan", "append", leg}, 60'000);
+    ASSERT_EQ(retried.exit_code, 0) << retried.out << retried.err << bench.logs();
+    EXPECT_FALSE(Json::parse(retried.out, nullptr, false).value("replayed", false))
+        << "the vehicle never had it: " << retried.out;
+    const std::size_t appended = elements();
+    EXPECT_GT(appended, before);
+
+    // 2. The answer lost: the client is gone once the vehicle has the command (and the answer's way cut).
+    const auto commands = counter(bench.status(), "/groundlink/commands");
+    Subprocess lost({binary("client/airsegctl"), "--link", bench.ground_link(), "--timeout", "60000",
+                     "--json", "--request-id", "lost-1", "plan", "append", leg},
+                    {}, bench.dir().path());
+    ASSERT_TRUE(wait_until([&] { return counter(bench.status(), "/groundlink/commands") > commands; },
+                           kGenerous, std::chrono::milliseconds(20)))
+        << lost.err() << bench.logs();
+    (void)bench.link().ask("outage 3 ba");
+    lost.signal(SIGKILL);
+    (void)lost.wait_exit(std::chrono::seconds(5));
+    ASSERT_TRUE(wait_until([&] { return elements() > appended; }, kGenerous, kPoll)) << bench.logs();
+    const std::size_t appended_twice = elements();
+    const auto again = bench.ctl({"--request-id", "lost-1", "plan", "append", leg}, 60'000);
+    ASSERT_EQ(again.exit_code, 0) << again.out << again.err << bench.logs();
+    EXPECT_EQ(Json::parse(again.out, nullptr, false).value("replayed", false), true) << again.out;
+    EXPECT_EQ(elements(), appended_twice) << "the append was done twice";
+    const auto ids = section(bench.status(), "status")["request_ids"];
+    EXPECT_EQ(ids.value("replayed", 0), 1) << ids.dump();
+    std::cout << "[ figures ] plan elements " << before << " -> " << appended
+              << " (retried after no answer) -> " << appended_twice << " (its answer lost) -> " << elements()
+              << " after its retry; record " << ids.dump() << "\n";
+    expect_daemon_alive(bench);
+}
+
 }  // namespace
 }  // namespace airseg::test::sys

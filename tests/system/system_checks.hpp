@@ -63,7 +63,8 @@ inline std::string rate_text(double v) {
 /// executes, before answering it).
 inline int times_requested(SystemBench& bench, double v) {
     const std::string log = bench.daemon_err();
-    const std::string needle = "{\"cmd\":\"rates.set\",\"rates\":{\"vehicle\":" + Json(v).dump() + "}}";
+    // Its request id (airsegctl adds one) follows the rates in the logged request.
+    const std::string needle = "{\"cmd\":\"rates.set\",\"rates\":{\"vehicle\":" + Json(v).dump() + "}";
     int n = 0;
     for (auto at = log.find(needle); at != std::string::npos; at = log.find(needle, at + needle.size())) {
         ++n;

@@ -248,6 +248,24 @@ TEST_F(DaemonProcess, ClientExitCodes) {
     EXPECT_NE(help.out.find("Exit codes"), std::string::npos);
 }
 
+// The local watch redraws at its interval, never faster: over 2 s at 250 ms, 8 or 9 views, not a stream.
+TEST_F(DaemonProcess, TheLocalWatchRedrawsAtItsIntervalOnly) {
+    Subprocess daemon(daemon_args(), env(), dir.path());
+    ASSERT_TRUE(notify.wait_for("READY=1", 10s)) << daemon.err();
+    ASSERT_TRUE(wait_until([&] { return std::filesystem::exists(socket()); }));
+    auto watch = ctl({"watch", "--socket", socket(), "--json", "--interval", "250", "--duration", "2000"});
+    ASSERT_EQ(watch.exit_code, 0) << watch.err;
+    std::size_t views = 0;
+    for (std::size_t at = 0; (at = watch.out.find('\n', at)) != std::string::npos; ++at) {
+        ++views;
+    }
+    EXPECT_GE(views, 3u) << watch.out.substr(0, 2000);
+    EXPECT_LE(views, 9u) << "more views than intervals: " << watch.out.substr(0, 2000);
+    EXPECT_LT(watch.out.size(), 9u * 64 * 1024) << "bounded output";
+    std::cout << "[ figures ] local watch: " << views << " views in 2 s at 250 ms, " << watch.out.size()
+              << " bytes\n";
+}
+
 // A usage error is one line with the near miss and where the help is, not the whole help.
 TEST_F(DaemonProcess, ClientUsageErrorsAreOneLineWithTheNearMiss) {
     const std::vector<std::pair<std::vector<std::string>, std::string>> cases{

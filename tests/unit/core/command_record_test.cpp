@@ -16,14 +16,15 @@ namespace {
 class AtMostOnce : public ::testing::Test {
   protected:
     AtMostOnce() {
-        dispatcher.add("plan.append", strand, Role::Control, [&](const Json& req, CommandDispatcher::Reply r) {
-            ++appended;
-            if (hold) {
-                held.push_back(std::move(r));
-                return;
-            }
-            r(CommandResult::ok({{"elements", appended}, {"file", req.value("path", "")}}));
-        });
+        dispatcher.add("plan.append", strand, Role::Control,
+                       [&](const Json& req, CommandDispatcher::Reply r) {
+                           ++appended;
+                           if (hold) {
+                               held.push_back(std::move(r));
+                               return;
+                           }
+                           r(CommandResult::ok({{"elements", appended}, {"file", req.value("path", "")}}));
+                       });
         dispatcher.add("status", strand, Role::Monitor, [&](const Json&, CommandDispatcher::Reply r) {
             ++statuses;
             r(CommandResult::ok({{"n", statuses}}));
@@ -108,8 +109,8 @@ TEST_F(AtMostOnce, ReadOnlyCommandsRunEveryTimeAndBadIdsAreRefused) {
     EXPECT_EQ(statuses, 2);
     EXPECT_FALSE(second->replayed);
 
-    for (const Json& bad : {Json(""), Json("has space"), Json(std::string(65, 'x')), Json(-1), Json(1.5),
-                            Json::array()}) {
+    for (const Json& bad :
+         {Json(""), Json("has space"), Json(std::string(65, 'x')), Json(-1), Json(1.5), Json::array()}) {
         const auto r = call({{"cmd", "plan.append"}, {"path", "a.yaml"}, {"request_id", bad}});
         ASSERT_TRUE(r);
         EXPECT_EQ(r->status, CommandStatus::BadRequest) << bad.dump();

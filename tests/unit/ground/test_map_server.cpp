@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <future>
+#include <iostream>
 #include <optional>
 #include <thread>
 
@@ -337,6 +338,52 @@ TEST(MapServer, ManyBrowsersAtOnceAreServed) {
     for (auto& a : answers) {
         EXPECT_EQ(status_line(a.get()), "HTTP/1.1 200 OK");
     }
+}
+
+// 100 live maps and 500 connections that never send a request: the streams are bounded by their own limit
+// (the 33rd is answered 503), idle connections give way to newcomers, and the page is still served.
+TEST(MapServer, IdleConnectionsAndManyLiveMapsCannotLockOutThePage) {
+    Rig rig;
+    asio::io_context client;
+    const tcp::endpoint at(asio::ip::make_address("127.0.0.1"), rig.map->port());
+    std::vector<std::unique_ptr<tcp::socket>> streams;
+    int live = 0, refused = 0;
+    for (int i = 0; i < 100; ++i) {
+        auto s = std::make_unique<tcp::socket>(client);
+        s->connect(at);
+        asio::write(*s, asio::buffer(std::string("GET /events HTTP/1.1\r\nHost: localhost\r\n\r\n")));
+        std::string head;
+        asio::read_until(*s, asio::dynamic_buffer(head), "\r\n");
+        const auto line = head.substr(0, head.find("\r\n"));
+        live += line == "HTTP/1.1 200 OK" ? 1 : 0;
+        refused += line.starts_with("HTTP/1.1 503") ? 1 : 0;
+        streams.push_back(std::move(s));
+    }
+    EXPECT_EQ(live, static_cast<int>(MapServer::kMaxStreams));
+    EXPECT_EQ(refused, 100 - static_cast<int>(MapServer::kMaxStreams));
+
+    std::vector<std::unique_ptr<tcp::socket>> idle;
+    for (int i = 0; i < 500; ++i) {
+        idle.push_back(std::make_unique<tcp::socket>(client));
+        idle.back()->connect(at);
+    }
+    const auto asked = std::chrono::steady_clock::now();
+    const auto page = rig.get("/");
+    const auto took = std::chrono::steady_clock::now() - asked;
+    EXPECT_EQ(status_line(page), "HTTP/1.1 200 OK");
+    EXPECT_NE(body_of(page).find("<html"), std::string::npos);
+    EXPECT_EQ(status_line(rig.get("/track.geojson")), "HTTP/1.1 200 OK");
+    MapServer::Counts counts;
+    rig.on_strand([&] { counts = rig.map->counts(); });
+    EXPECT_EQ(counts.streams, MapServer::kMaxStreams) << "the live maps stay open";
+    EXPECT_EQ(counts.refused_streams, 100u - MapServer::kMaxStreams);
+    EXPECT_GE(counts.evicted_idle, 500u - MapServer::kMaxConnections);
+    EXPECT_EQ(counts.refused_busy, 0u);
+    // A lockout shows as a 503 above, or as the 15 s request deadline of an idle connection here.
+    EXPECT_LT(took, std::chrono::seconds(5));
+    std::cout << "[ figures ] GET / with 32 live maps, 68 refused and 500 idle connections: "
+              << std::chrono::duration_cast<std::chrono::milliseconds>(took).count() << " ms; "
+              << counts.evicted_idle << " idle connections closed for newcomers\n";
 }
 
 TEST(MapServer, ABusyPortIsReportedForPeople) {
