@@ -3,11 +3,13 @@
 // at the severity an operator should give it. Header-only: a few pure functions over bus messages.
 #include <fmt/format.h>
 
+#include <optional>
 #include <string>
 #include <string_view>
 
 #include "services/autopilot/autopilot.hpp"
 #include "services/common/text.hpp"
+#include "services/flightplan/plan_progress.hpp"
 #include "services/groundlink/protocol/ground_protocol.hpp"
 
 namespace airseg::groundlink {
@@ -30,6 +32,47 @@ inline std::string mode_change_text(const autopilot::ModeChanged& m) {
         return modes + external;
     }
     return fmt::format("vehicle {} -> {} ({}{})", state_words(m.from), state_words(m.to), modes, external);
+}
+
+/// Nothing, for a change the operator cannot see: the same state and the same mode name (a reconnect's
+/// configure check passing through), whatever moved it.
+inline std::optional<std::string> mode_change_event(const autopilot::ModeChanged& m) {
+    if (m.from == m.to && m.from_mode == m.to_mode) {
+        return std::nullopt;
+    }
+    return mode_change_text(m);
+}
+
+/// Whether a text or a slot event has nothing to say while a flight plan drives the mission (running, or
+/// paused with its window on the board): the autopilot's mission is then the plan's rolling window, so its
+/// slots cycle and every rewrite of the window is "Flight plan received". The plan's own events say it once.
+inline bool plan_drives_mission(flightplan::PlanState s) {
+    return s == flightplan::PlanState::Running || s == flightplan::PlanState::Paused;
+}
+
+/// ArduPilot's texts about its mission that the rolling window causes on every waypoint: "Reached waypoint
+/// #N dist Mm" (N a slot of the window), "Flight plan received" (each rewrite), "Mission: N ..." (each item
+/// started). While a plan drives, the plan's own event replaces them (they are counted in status,
+/// groundlink.events_folded).
+inline bool is_window_text(std::string_view text) {
+    const std::string lower = to_lower(std::string(text));  // older boards say "flight plan received"
+    return lower.starts_with("reached waypoint #") || lower.starts_with("flight plan received") ||
+           lower.starts_with("mission: ");
+}
+
+/// "plan waypoint 7 reached" when the plan's reached count grows by one (its number is the plan's, as
+/// `next waypoint` shows it before); "plan waypoints reached: 3 more, next 12" when several are counted at
+/// once; nothing otherwise (a new plan starts its count again).
+inline std::optional<std::string> plan_reached_text(const flightplan::PlanProgress& before,
+                                                    const flightplan::PlanProgress& after) {
+    if (after.waypoints_reached <= before.waypoints_reached) {
+        return std::nullopt;
+    }
+    const auto more = after.waypoints_reached - before.waypoints_reached;
+    if (more == 1) {
+        return fmt::format("plan waypoint {} reached", before.next_waypoint);
+    }
+    return fmt::format("plan waypoints reached: {} more, next {}", more, after.next_waypoint);
 }
 
 /// The severity of an autopilot status text. MAV_SEVERITY 0..3 (emergency..error) is an error, except the

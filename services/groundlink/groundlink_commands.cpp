@@ -110,6 +110,10 @@ void GroundlinkService::register_commands() {
         });
 }
 
+bool GroundlinkService::plan_driving() const {
+    return plan_progress_ && plan_drives_mission(plan_progress_->state);
+}
+
 void GroundlinkService::subscribe_bus() {
     auto& bus = ctx_.bus;
     using Sev = protocol::Event::Severity;
@@ -121,6 +125,12 @@ void GroundlinkService::subscribe_bus() {
     }
     subscriptions_.push_back(
         bus.subscribe<flightplan::PlanProgress>(strand(), [this](const flightplan::PlanProgress& p) {
+            if (plan_progress_) {
+                if (auto text = plan_reached_text(*plan_progress_, p)) {
+                    send_event(Sev::Info, *text);
+                }
+            }
+            plan_progress_ = p;
             plan_ = PlanProgressSample{
                 static_cast<std::uint8_t>(p.state),
                 static_cast<std::uint16_t>(std::min<std::uint32_t>(p.element, 16383)),
@@ -133,10 +143,18 @@ void GroundlinkService::subscribe_bus() {
             arm_telemetry();
             publish_status();
         }));
-    subscriptions_.push_back(bus.subscribe<autopilot::ModeChanged>(
-        strand(), [this](const autopilot::ModeChanged& m) { send_event(Sev::Info, mode_change_text(m)); }));
+    subscriptions_.push_back(
+        bus.subscribe<autopilot::ModeChanged>(strand(), [this](const autopilot::ModeChanged& m) {
+            if (auto text = mode_change_event(m)) {
+                send_event(Sev::Info, *text);
+            }
+        }));
     subscriptions_.push_back(
         bus.subscribe<autopilot::StatusText>(strand(), [this](const autopilot::StatusText& t) {
+            if (plan_driving() && is_window_text(t.text)) {
+                ++events_folded_;
+                return;
+            }
             send_event(status_text_severity(t.severity, t.text), "autopilot: " + t.text);
         }));
     subscriptions_.push_back(bus.subscribe<autopilot::LinkUp>(
@@ -151,6 +169,10 @@ void GroundlinkService::subscribe_bus() {
         }));
     subscriptions_.push_back(
         bus.subscribe<autopilot::WaypointReached>(strand(), [this](const autopilot::WaypointReached& w) {
+            if (plan_driving()) {
+                ++events_folded_;  // a slot of the plan's window: the plan's own event says which waypoint
+                return;
+            }
             send_event(Sev::Info, fmt::format("mission slot {} reached", w.seq));
         }));
 }

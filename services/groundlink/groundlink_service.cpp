@@ -528,7 +528,7 @@ void GroundlinkService::publish_status() {
     section.render =
         [mode = config_.mode, up, s = stats, goodput = goodput_bps_, ports = std::move(ports),
          counters = std::array{commands_, commands_refused_, joystick_inputs_, joystick_refused_,
-                               events_sent_, events_dropped_, bad_messages_},
+                               events_sent_, events_dropped_, bad_messages_, events_folded_},
          role = std::string(refusing_unauthenticated() ? "monitor (no key on the vehicle: commands refused)"
                             : !stats.authenticated     ? "control (unauthenticated, groundlink.insecure)"
                                                        : to_string(ground_role())),
@@ -573,6 +573,7 @@ void GroundlinkService::publish_status() {
             g["joystick_refused"] = counters[3];
             g["events_sent"] = counters[4];
             g["events_dropped"] = counters[5];
+            g["events_folded"] = counters[7];
             g["bad_messages"] = counters[6];
             g["telemetry"] = rates_json(rates);
             g["mavlink_forward"] = {{"enabled", fwd_enabled},

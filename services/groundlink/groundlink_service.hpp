@@ -2,6 +2,7 @@
 // The ground-link service: the transport core on one or two serial radio pairs (or UDP), the ground protocol
 // on top, commands from the ground through the shared dispatcher, and link statistics in the status document.
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "services/common/port_keeper.hpp"
 #include "services/common/service.hpp"
 #include "services/common/slack_timer.hpp"
+#include "services/flightplan/plan_progress.hpp"
 #include "services/groundlink/delivery_meter.hpp"
 #include "services/groundlink/frame_forwarder.hpp"
 #include "services/groundlink/link/link_driver.hpp"
@@ -67,6 +69,8 @@ class GroundlinkService : public Service {
     void attach_writers();
     void register_commands();
     void subscribe_bus();
+    /// A flight plan drives the autopilot's mission (its rolling window): slot events are the plan's to say.
+    bool plan_driving() const;
     void on_message(Delivered message);
     void on_command(const protocol::Command& command);
     void on_joystick(const protocol::Joystick& joystick);
@@ -106,6 +110,8 @@ class GroundlinkService : public Service {
     std::uint64_t from_ground_refused_ = 0;  // ... dropped: forwarding off, or from a monitor key
     std::optional<autopilot::Telemetry> vehicle_;
     PlanProgressSample plan_;
+    std::optional<flightplan::PlanProgress> plan_progress_;  // the last, for the plan's own events
+    std::uint64_t events_folded_ = 0;  // slot events and window texts not sent while a plan drives
     std::vector<Subscription> subscriptions_;
     bool commands_registered_ = false;
     std::vector<std::unique_ptr<PortKeeper>> keepers_;

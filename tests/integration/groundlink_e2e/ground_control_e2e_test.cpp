@@ -258,6 +258,30 @@ TEST_F(GroundControlE2e, APlanLoadedOverTheRadioIsDrivenPausedResumedAndSkipped)
         }
     }
     EXPECT_GT(running, 0) << "no sample of the running plan in the watch:\n" << watch.out;
+    // Events in plan terms, once per waypoint: not the window's slots, nor the board's texts about them.
+    // `log` follows the events until two waypoints are reached: by then the board's slot events and texts
+    // of those reaches would have come too.
+    Subprocess log({binary("client/airsegctl"), "--link", ground(), "--json", "log", "--duration", "120000"},
+                   {}, dir.path());
+    const auto plan_events_in = [&](const std::string& out) {
+        int n = 0;
+        for (const auto& e : json_lines(out)) {
+            n += e.value("text", "").starts_with("plan waypoint") ? 1 : 0;
+        }
+        return n;
+    };
+    EXPECT_TRUE(wait_until([&] { return plan_events_in(log.out()) >= 2; }, kGenerous, 500ms)) << log.out();
+    log.signal(SIGTERM);
+    ASSERT_TRUE(log.wait_exit(kGenerous));
+    for (const auto& e : json_lines(log.out())) {
+        const auto text = e.value("text", "");
+        EXPECT_EQ(text.find("mission slot"), std::string::npos) << text;
+        EXPECT_EQ(text.find("Reached waypoint #"), std::string::npos) << text;
+        EXPECT_EQ(text.find("flight plan received"), std::string::npos) << text;
+    }
+    EXPECT_GE(plan_events_in(log.out()), 2) << log.out() << log.err();
+    const auto folded = status_doc()["groundlink"].value("events_folded", 0);
+    EXPECT_GT(folded, 0) << "the board's slot events and texts are counted";
 }
 
 TEST_F(GroundControlE2e, AMonitorKeyWatchesButItsCommandsAreRefused) {

@@ -42,5 +42,40 @@ TEST(EventText, BootCalibrationNoticesAreInfoAndRealFailuresStayErrors) {
     EXPECT_EQ(status_text_severity(6, "Ready to drive."), Sev::Info);
 }
 
+TEST(EventText, AModeChangeNobodyCanSeeIsNoEvent) {
+    const ModeChanged same{VehicleState::Manual, VehicleState::Manual, "MANUAL", "MANUAL",
+                           ModeChangeCause::External};
+    EXPECT_FALSE(mode_change_event(same));
+    const ModeChanged state_only{VehicleState::ConfigureCheck, VehicleState::Directed, "MANUAL", "MANUAL",
+                                 ModeChangeCause::Requested};
+    ASSERT_TRUE(mode_change_event(state_only));
+    EXPECT_EQ(*mode_change_event(state_only),
+              "vehicle STARTING -> DIRECTED (autopilot mode MANUAL -> MANUAL)");
+}
+
+// While a plan drives, the board's mission is the plan's rolling window: its slots and its texts about them
+// say nothing to an operator; the plan's own event says which waypoint, once.
+TEST(EventText, WhileAPlanDrivesWaypointsAreNamedInPlanTermsOnce) {
+    using flightplan::PlanProgress;
+    using flightplan::PlanState;
+    EXPECT_TRUE(plan_drives_mission(PlanState::Running));
+    EXPECT_TRUE(plan_drives_mission(PlanState::Paused));
+    EXPECT_FALSE(plan_drives_mission(PlanState::None));
+    EXPECT_FALSE(plan_drives_mission(PlanState::Done));
+    EXPECT_TRUE(is_window_text("Reached waypoint #3 dist 1m"));
+    EXPECT_TRUE(is_window_text("flight plan received"));
+    EXPECT_TRUE(is_window_text("Flight plan received"));
+    EXPECT_TRUE(is_window_text("Mission: 4 WP"));
+    EXPECT_FALSE(is_window_text("PreArm: Compass not calibrated"));
+    EXPECT_FALSE(is_window_text("Mission complete, changing mode to HOLD"));
+
+    const PlanProgress before{PlanState::Running, 0, 7, 6};
+    EXPECT_EQ(plan_reached_text(before, {PlanState::Running, 0, 8, 7}), "plan waypoint 7 reached");
+    EXPECT_EQ(plan_reached_text(before, {PlanState::Running, 1, 12, 9}),
+              "plan waypoints reached: 3 more, next 12");
+    EXPECT_FALSE(plan_reached_text(before, before)) << "no change, no event";
+    EXPECT_FALSE(plan_reached_text(before, {PlanState::Running, 0, 0, 0})) << "a new plan starts again";
+}
+
 }  // namespace
 }  // namespace airseg::groundlink
