@@ -147,9 +147,11 @@ std::string WatchState::render(Clock::time_point now) const {
                            l.rtt_ms, l.loss_permille / 10.0, l.goodput_bps, l.retransmissions);
         out += "            ";
     }
-    out += fmt::format("ground: {} rtt {} ms, loss {}, {} frames received, {} crc errors\n",
+    // Loss as a percentage, as the vehicle's side above and the map show it (the ground end gives a
+    // fraction).
+    out += fmt::format("ground: {} rtt {} ms, loss {:.1f} %, {} frames received, {} crc errors\n",
                        ground_link_.value("link", std::string("?")), ground_link_.value("rtt_ms", 0.0),
-                       ground_link_.value("loss", 0.0), ground_link_.value("frames_received", 0),
+                       ground_link_.value("loss", 0.0) * 100, ground_link_.value("frames_received", 0),
                        ground_link_.value("crc_errors", 0));
     out += "\nrecent events\n";
     if (events_.empty()) {

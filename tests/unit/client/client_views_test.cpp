@@ -70,6 +70,7 @@ TEST(WatchState, ShowsTheLatestSampleTheLinkAndRecentEvents) {
         w.take(proto::Event{proto::Event::Severity::Warning, "event " + std::to_string(i)}, t0);
     }
     w.take(proto::LinkStatsReport{120, 200, 300, 4, 0}, t0);
+    w.set_ground_link({{"link", "up"}, {"rtt_ms", 90.0}, {"loss", 0.316}});
     const auto now = t0 + std::chrono::milliseconds(4600);
     EXPECT_NEAR(w.sample_rate(now), 2.0, 0.01);
     const auto screen = w.render(now);
@@ -78,6 +79,7 @@ TEST(WatchState, ShowsTheLatestSampleTheLinkAndRecentEvents) {
     EXPECT_NE(screen.find("77 %"), std::string::npos) << screen;
     EXPECT_NE(screen.find("plan        running  element 3"), std::string::npos) << screen;
     EXPECT_NE(screen.find("loss 20.0 %"), std::string::npos) << screen;
+    EXPECT_NE(screen.find("ground: up rtt 90 ms, loss 31.6 %"), std::string::npos) << "as the map says it";
     EXPECT_EQ(screen.find("event 3\n"), std::string::npos) << "only the last 8 events";
     EXPECT_NE(screen.find("warning: event 11"), std::string::npos);
     const auto j = w.to_json(now);
