@@ -295,11 +295,8 @@ void PlanController::on_item_stored(std::uint16_t slot, const autopilot::Mission
 }
 
 void PlanController::on_rebooted(TimePoint now) {
-    // A boot the feeder already rebuilt its window for keeps its requests: the driver answers them (failed,
-    // cancelled by its reconnect), and the feeder asks again.
-    if (feeder_.on_reboot_declared(now)) {
-        in_flight_.clear();
-    }
+    feeder_.on_autopilot_rebooted(now);
+    in_flight_.clear();
     pump(now);
 }
 

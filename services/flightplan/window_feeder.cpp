@@ -672,13 +672,12 @@ void WindowFeeder::on_mode(VehicleState state, autopilot::ModeChangeCause cause,
             mode_ = Mode::Unknown;
             return;
         case VehicleState::ConfigureCheck:
-            if (before != Mode::Unknown && !same_boot(now)) {
+            if (before != Mode::Unknown) {
                 // A board seen booting (Rover's INITIALISING) keeps its mission in storage and starts it at
                 // slot 1 in AUTO: a waypoint of an old turn of the window. The reboot is declared only once
                 // its clock has run on (docs/autopilot.md, Reboots), and AUTO asked for meanwhile drove back
                 // there. Its window is written again, as after a declared reboot, before AUTO.
                 on_autopilot_rebooted(now);
-                boot_handled_at_ = now;
             }
             mode_ = Mode::Unknown;
             return;
@@ -750,18 +749,6 @@ void WindowFeeder::on_mode(VehicleState state, autopilot::ModeChangeCause cause,
         "the autopilot left AUTO for HOLD by itself (end of its mission, a failsafe or a mode switch); "
         "continuing at the next waypoint",
         false);
-}
-
-bool WindowFeeder::same_boot(TimePoint now) const {
-    return boot_handled_at_ && now - *boot_handled_at_ < kSameBoot;
-}
-
-bool WindowFeeder::on_reboot_declared(TimePoint now) {
-    if (same_boot(now)) {
-        return false;
-    }
-    on_autopilot_rebooted(now);
-    return true;
 }
 
 void WindowFeeder::on_autopilot_rebooted(TimePoint now) {

@@ -99,11 +99,6 @@ class WindowFeeder {
     void on_request_result(std::uint32_t id, autopilot::RequestResult result, TimePoint now,
                            std::string_view detail = {});
     void on_autopilot_rebooted(TimePoint now);
-    /// The daemon declared a reboot (its evidence: the board's clock went back and ran on). False, and
-    /// nothing done, when it is the boot the feeder saw begin (the board's INITIALISING, on_mode) and has
-    /// already rebuilt its window for: a second rebuild while the vehicle drives the first would restart its
-    /// leg toward a waypoint it may have passed meanwhile.
-    bool on_reboot_declared(TimePoint now);
     void handle_timeout(TimePoint now);
 
     std::optional<FeederRequest> poll_request(TimePoint now);
@@ -113,10 +108,6 @@ class WindowFeeder {
     const FeederConfig& config() const { return config_; }
 
   private:
-    /// How long after the feeder saw the board boot a declared reboot, or the driver's configure check, is
-    /// still that boot: the declaration needs the board's clock to run on 1.5 s, plus the daemon's latency.
-    static constexpr Duration kSameBoot = std::chrono::seconds(10);
-    bool same_boot(TimePoint now) const;
     struct Entry {
         Waypoint wp;
         bool stop = false;
@@ -230,9 +221,6 @@ class WindowFeeder {
     std::string last_interruption_;
     std::optional<std::string> failed_;  // why the autopilot refused the plan
     bool starving_ = false;
-    // When the feeder last rebuilt its window for a board seen booting: the reboot the daemon declares for
-    // that boot a moment later, and its own configure check then, are the same boot (kSameBoot).
-    std::optional<TimePoint> boot_handled_at_;
     std::optional<TimePoint> frontier_since_;  // the vehicle waits at a barrier for the next write
     bool fault_ = false;
     TimePoint retry_not_before_ = TimePoint::min();

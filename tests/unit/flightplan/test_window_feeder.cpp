@@ -191,49 +191,6 @@ TEST(FlightplanFeeder, ABoardSeenBootingIsNotPutInAutoBeforeItsWindowIsWrittenAg
     expect_visited(h, 41.0, next, 800, visited);
 }
 
-// The reboot the daemon declares a moment after the board was seen booting (its clock ran on 1.5 s), and the
-// driver's own configure check with it, are the boot the feeder has already rebuilt its window for. A second
-// rebuild while the vehicle drives the first restarted the leg toward a waypoint it could have passed
-// (reached "… 5 5 6 …" on armhf and "… 10 7 8 …" on armel in the reboot case under qemu).
-TEST(FlightplanFeeder, TheRebootDeclaredForABootAlreadySeenIsNotASecondRebuild) {
-    Harness h;
-    h.feeder.replace_plan(test::synthetic(800), h.now);
-    for (int i = 0; i < 300; ++i) {
-        h.step();
-    }
-    const auto visited = h.ap.visited().size();
-    const auto next = *h.feeder.progress().next_waypoint;
-    h.ap.boot_keeping_mission();
-    for (int i = 0; i < 4; ++i) {
-        h.step();  // the window written again, AUTO, driving
-    }
-    ASSERT_TRUE(h.ap.in_auto());
-    const int restarts = h.ap.restarts();
-    // 4 s after the boot was seen: the driver's configure check, then the declaration. (This simulator does
-    // not reproduce the race a second rebuild lost on qemu; SystemPlan.AutopilotRebootMidPlan does.)
-    h.feeder.on_mode(autopilot::VehicleState::ConfigureCheck, autopilot::ModeChangeCause::External, h.now);
-    EXPECT_FALSE(h.feeder.on_reboot_declared(h.now)) << "the same boot, rebuilt for a second time";
-    for (int i = 0; i < 5; ++i) {
-        h.step();
-    }
-    EXPECT_EQ(h.ap.restarts(), restarts) << "the leg being driven was restarted";
-    ASSERT_LT(h.run_until_done(3000), 3000);
-    EXPECT_EQ(h.reached, iota(0, 800));
-    expect_visited(h, 41.0, next, 800, visited);
-
-    // A reboot declared later than that is a new one: rebuilt.
-    Harness later;
-    later.feeder.replace_plan(test::synthetic(100), later.now);
-    for (int i = 0; i < 20; ++i) {
-        later.step();
-    }
-    later.ap.boot_keeping_mission();
-    for (int i = 0; i < 12; ++i) {
-        later.step();
-    }
-    EXPECT_TRUE(later.feeder.on_reboot_declared(later.now));
-}
-
 TEST(FlightplanFeeder, ReplacePlanKeepsCurrentTargetThenFollowsNewPlanWithoutStopping) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(1000, 41.0), h.now);
