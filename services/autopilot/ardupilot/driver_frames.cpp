@@ -174,7 +174,10 @@ void Driver::on_heartbeat(const mav::Heartbeat& hb, TimePoint now) {
     const bool booting = uninit_booting || hb.system_status == mavlink::kMavStateBoot ||
                          hb.system_status == mavlink::kMavStateCalibrating ||
                          hb.custom_mode == static_cast<std::uint32_t>(RoverMode::Initialising);
-    const auto seen = link_.on_heartbeat(now, booting, watching_for_reboots());
+    constexpr auto kBootMode = static_cast<std::uint32_t>(RoverMode::Initialising);
+    const std::string left_for_boot =
+        mode_ && *mode_ != kBootMode && hb.custom_mode == kBootMode ? rover_mode_name(*mode_) : std::string{};
+    const auto seen = link_.on_heartbeat(now, booting, watching_for_reboots(), left_for_boot);
     if (seen.came_up) {
         emit(LinkUp{});
         if (phase_ == Phase::Ready) {

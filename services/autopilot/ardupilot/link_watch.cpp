@@ -60,12 +60,20 @@ void LinkWatch::on_frame() {
     baud_deadline_ = kNever;
 }
 
-LinkWatch::HeartbeatSeen LinkWatch::on_heartbeat(TimePoint now, bool booting, bool watching) {
+LinkWatch::HeartbeatSeen LinkWatch::on_heartbeat(TimePoint now, bool booting, bool watching,
+                                                 std::string_view boot_mode_after) {
     HeartbeatSeen seen;
     const Duration gap = now - last_heartbeat_;
     if (watching && booting && last_heartbeat_ != TimePoint{} && gap >= kBootGap) {
         seen.reboot =
             declare("a heartbeat gap of " + seconds_text(gap) + " s ended by a booting heartbeat", now);
+    } else if (watching && !boot_mode_after.empty()) {
+        // A boot too short for kBootGap (or its gap hidden by heartbeats read late) still shows in the mode:
+        // the clock's evidence would come kClockConfirm later, while the booted board is already being
+        // driven on what it kept in storage.
+        seen.reboot = declare("the heartbeat's mode went from " + std::string(boot_mode_after) +
+                                  " to INITIALISING, which the firmware holds only while it boots",
+                              now);
     }
     last_heartbeat_ = now;
     quiet_since_ = now;

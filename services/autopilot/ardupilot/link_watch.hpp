@@ -12,8 +12,9 @@
 //
 // Reboot evidence, and only this: the autopilot's time_boot_ms went back by more than kClockBackSlack and
 // ran on from the new value for kClockConfirm (the old clock not seen again meanwhile), or a heartbeat gap of
-// kBootGap or more ended by a heartbeat of a booting autopilot. A text is never evidence (ArduPilot sends its
-// banner on every parameter list request). At most one reboot is declared per kRebootSpacing; evidence
+// kBootGap or more ended by a heartbeat of a booting autopilot, or a heartbeat in the boot mode after one in
+// a running mode (Rover is in INITIALISING only while it boots). A text is never evidence (ArduPilot sends
+// its banner on every parameter list request). At most one reboot is declared per kRebootSpacing; evidence
 // within that is held and declared when it ends (one declaration for all of it).
 //
 // What to do about it (events, port actions, the connection sequence) is the Driver's: it feeds the port
@@ -22,6 +23,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -77,8 +79,10 @@ class LinkWatch {
     /// A valid frame from the autopilot's system id: ends baud probing.
     void on_frame();
     /// `booting`: the heartbeat says the autopilot is starting up; `watching`: reboots are looked for (not
-    /// while a boot is being waited for).
-    HeartbeatSeen on_heartbeat(TimePoint now, bool booting, bool watching);
+    /// while a boot is being waited for); `boot_mode_after`, when not empty: the heartbeat's mode is the one
+    /// the firmware holds only while it boots (Rover's INITIALISING), and the last heartbeat's was this one.
+    HeartbeatSeen on_heartbeat(TimePoint now, bool booting, bool watching,
+                               std::string_view boot_mode_after = {});
     /// Feeds the autopilot's time_boot_ms; with `watching`, returns a reboot declared now.
     std::optional<std::string> on_time_boot(std::uint32_t time_boot_ms, TimePoint now, bool watching);
     /// The clock of the boot being waited for starts again; evidence held back is dropped.

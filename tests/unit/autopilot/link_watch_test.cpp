@@ -361,6 +361,33 @@ TEST(LinkWatch, AHeartbeatGapEndedByABootingHeartbeatIsAReboot) {
     EXPECT_FALSE(w.on_heartbeat(kOpen + seconds(30), true, false).reboot);
 }
 
+// A boot shorter than kBootGap (at a simulator's speedup, or heartbeats read late after it) shows in the mode
+// at once, where the clock's evidence would take kClockConfirm more: meanwhile the daemon would drive the
+// booted board on the mission it kept in storage.
+TEST(LinkWatch, AHeartbeatInTheBootModeAfterARunningOneIsAReboot) {
+    LinkWatch w(quiet_open());
+    w.on_port_open(kOpen);
+    w.on_heartbeat(kOpen, false, true);
+    const auto seen = w.on_heartbeat(kOpen + milliseconds(900), true, true, "AUTO");
+    ASSERT_TRUE(seen.reboot);
+    EXPECT_EQ(
+        *seen.reboot,
+        "the heartbeat's mode went from AUTO to INITIALISING, which the firmware holds only while it boots");
+    // Not while a boot is waited for (the port just opened on a board that resets, a reset pulse).
+    LinkWatch opening(quiet_open());
+    opening.on_port_open(kOpen);
+    opening.on_heartbeat(kOpen, false, true);
+    EXPECT_FALSE(opening.on_heartbeat(kOpen + seconds(1), true, false, "AUTO").reboot);
+    // A gap and the mode together are one reboot, told by the gap.
+    LinkWatch both(quiet_open());
+    both.on_port_open(kOpen);
+    both.on_heartbeat(kOpen, false, true);
+    const auto gap = both.on_heartbeat(kOpen + seconds(3), true, true, "HOLD");
+    ASSERT_TRUE(gap.reboot);
+    EXPECT_EQ(*gap.reboot, "a heartbeat gap of 3.0 s ended by a booting heartbeat");
+    EXPECT_EQ(both.reboots_held(), 0u);
+}
+
 TEST(LinkWatch, RebootEvidenceWithinTheSpacingIsHeldAndDeclaredAtItsEnd) {
     LinkWatch w(quiet_open());
     w.on_port_open(kOpen);
