@@ -6,6 +6,7 @@
 #include <chrono>
 
 #include "client/watch_view.hpp"
+#include "ground/fleet_command.hpp"
 
 namespace airseg::ground {
 
@@ -159,7 +160,7 @@ void FleetBridge::on_command(const std::string& payload) {
     }
     spdlog::info("fleet: command {} {}", key,
                  request->value("cmd", Json()).dump(-1, ' ', false, Json::error_handler_t::replace));
-    hub_.command(*request, [this, key, id](Json reply) {
+    hub_.command(with_request_id(*request, id), [this, key, id](Json reply) {
         if (stopped_) {
             return;
         }
