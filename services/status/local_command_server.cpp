@@ -49,6 +49,8 @@ class LocalCommandServer::Session : public std::enable_shared_from_this<Session>
     }
     /// Waiting for a request of its own to be answered: not idle, whatever the clock says.
     bool busy() const { return in_flight_; }
+    /// Has sent no request since it connected: it holds a place without using it.
+    bool silent() const { return !asked_; }
     TimePoint last_active() const { return last_active_; }
 
   private:
@@ -76,6 +78,7 @@ class LocalCommandServer::Session : public std::enable_shared_from_this<Session>
             return;
         }
         last_active_ = SteadyClock::now();
+        asked_ = true;
         std::string line(asio::buffers_begin(input_.data()), asio::buffers_begin(input_.data()) + n);
         input_.consume(n);
         while (!line.empty() && (line.back() == '\n' || line.back() == '\r')) {
@@ -191,6 +194,7 @@ class LocalCommandServer::Session : public std::enable_shared_from_this<Session>
     asio::steady_timer idle_timer_;
     TimePoint last_active_;
     bool in_flight_ = false;
+    bool asked_ = false;
     bool close_after_ = false;
     bool closed_ = false;
 };
@@ -275,14 +279,22 @@ void LocalCommandServer::do_accept() {
         }));
 }
 
-// A full table must not lock the board out: the client idle longest makes room. Only clients that all wait
-// for an answer of their own keep a newcomer out.
+// A full table must not lock the board out: a client that has never asked anything makes room first (the
+// one connected longest), then the client idle longest. A watcher between two polls is idle longer than a
+// burst of silent newcomers, and must not be the one closed for them. Only clients that all wait for an
+// answer of their own keep a newcomer out.
 void LocalCommandServer::admit(Protocol::socket socket) {
     const TimePoint now = SteadyClock::now();
     if (sessions_.size() >= kMaxConnections) {
         std::shared_ptr<Session> oldest;
+        const auto closes_before = [](const Session& a, const Session& b) {
+            if (a.silent() != b.silent()) {
+                return a.silent();
+            }
+            return a.last_active() < b.last_active();
+        };
         for (const auto& s : sessions_) {
-            if (!s->busy() && (!oldest || s->last_active() < oldest->last_active())) {
+            if (!s->busy() && (!oldest || closes_before(*s, *oldest))) {
                 oldest = s;
             }
         }
@@ -303,8 +315,8 @@ void LocalCommandServer::admit(Protocol::socket socket) {
         }
         ++stats_.evicted;
         log_.log("status: closing the local client idle longest", now, spdlog::level::info,
-                 "status: {} local connections open: closing the one idle for {} ms to make room",
-                 kMaxConnections,
+                 "status: {} local connections open: closing {} idle for {} ms to make room", kMaxConnections,
+                 oldest->silent() ? "one that has asked nothing," : "the one",
                  std::chrono::duration_cast<std::chrono::milliseconds>(now - oldest->last_active()).count());
         oldest->finish();
     }

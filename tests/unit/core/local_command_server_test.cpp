@@ -1,6 +1,7 @@
 // The local command socket's bounds with real Unix sockets: a client that does not read its answers is closed
-// at the queue limit, an idle one at the timeout, a full table makes room by closing the client idle longest,
-// and only clients that all run a request keep a newcomer out (with an error line).
+// at the queue limit, an idle one at the timeout, a full table makes room by closing a client that has asked
+// nothing (then the client idle longest), and only clients that all run a request keep a newcomer out (with
+// an error line).
 #include "services/status/local_command_server.hpp"
 
 #include <gtest/gtest.h>
@@ -230,6 +231,27 @@ TEST_F(LocalCommandServerTest, SixteenIdleClientsDoNotLockANewOneOut) {
     EXPECT_EQ(stats().evicted, 1u);
     EXPECT_EQ(stats().refused, 0u);
     EXPECT_TRUE(idle.front()->closed_by_server()) << "the oldest idle client made room";
+}
+
+TEST_F(LocalCommandServerTest, AWatcherBetweenTwoPollsIsNotClosedForSilentNewcomers) {
+    start();
+    Client watcher(path);
+    ASSERT_TRUE(watcher.send("{\"cmd\":\"status\"}\n"));
+    ASSERT_NE(watcher.line().find("\"ok\":true"), std::string::npos);
+    // Every newcomer connects after the watcher's last answer: by the clock alone the watcher is idle
+    // longest.
+    std::vector<std::unique_ptr<Client>> silent;
+    for (std::size_t i = 0; i < LocalCommandServer::kMaxConnections + 3; ++i) {
+        silent.push_back(std::make_unique<Client>(path));
+        ASSERT_TRUE(silent.back()->connected());
+    }
+    ASSERT_TRUE(wait_until([&] { return stats().evicted == 4u; })) << stats().evicted;
+    ASSERT_TRUE(watcher.send("{\"cmd\":\"status\"}\n"));
+    EXPECT_NE(watcher.line().find("\"ok\":true"), std::string::npos) << "the watcher kept its connection";
+    for (std::size_t i = 0; i < 4; ++i) {
+        EXPECT_TRUE(silent[i]->closed_by_server()) << "silent client " << i << " made room, oldest first";
+    }
+    EXPECT_EQ(stats().clients, LocalCommandServer::kMaxConnections);
 }
 
 TEST_F(LocalCommandServerTest, WhenEveryClientRunsARequestANewcomerIsRefusedWithALine) {
