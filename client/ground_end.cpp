@@ -58,6 +58,7 @@ std::string GroundEnd::open() {
         t.link_rate_bytes_per_s = 1e6;
     } else {
         t.link_rate_bytes_per_s = options_.baud / 10.0;
+        options_.profile.apply(t, t.link_rate_bytes_per_s);
         t.paths = options_.ports.size();
         t.path_mode = options_.mode == "split"       ? gl::PathMode::Split
                       : options_.mode == "redundant" ? gl::PathMode::Redundant

@@ -14,6 +14,7 @@
 #include "services/common/asio.hpp"
 #include "services/groundlink/link/link_driver.hpp"
 #include "services/groundlink/protocol/ground_protocol.hpp"
+#include "services/groundlink/transport/radio_profile.hpp"
 
 namespace airseg::hal {
 class SerialPort;
@@ -28,6 +29,8 @@ struct RadioOptions {
     std::string mode = "single";  // single | split | redundant (two ports need split or redundant)
     std::string udp;              // HOST:PORT instead of serial ports
     std::string key_file;         // must match the vehicle's groundlink.key_file
+    // --radio: the same as the vehicle's groundlink.radio; serial links only
+    groundlink::RadioProfile profile;
 };
 
 /// Checks option combinations; returns a message for people, empty when fine.

@@ -36,7 +36,16 @@ void add_radio_options(cli::OptionTable& table, RadioOptions& radio, std::functi
         .value("mode", "MODE", "single (one device), split or redundant (two devices)", text(radio.mode))
         .value("key", "FILE",
                "pre-shared key file (mode 0600), the same as the vehicle's groundlink.key_file",
-               text(radio.key_file));
+               text(radio.key_file))
+        .value("radio", "KEY=VALUE[,...]",
+               "the radios' air, the same as the vehicle's groundlink.radio (serial links only): air_speed "
+               "(kbit/s, 0 = the serial rate), ecc (on|off), packet, packet_overhead, buffer (bytes), "
+               "turnaround (e.g. 10ms), duplex (half|full); repeatable, a key given again wins",
+               [&radio](std::string_view, std::string_view v) {
+                   if (auto error = groundlink::parse_radio_profile(v, radio.profile); !error.empty()) {
+                       throw UsageError(error);
+                   }
+               });
 }
 
 }  // namespace airseg::client

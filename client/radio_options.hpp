@@ -1,6 +1,6 @@
 #pragma once
-// The radio options airsegctl and airseg-ground share (--link, --udp, --baud, --mode, --key): one table so
-// both programs spell, check and explain them the same way.
+// The radio options airsegctl and airseg-ground share (--link, --udp, --baud, --mode, --key, --radio): one
+// table so both programs spell, check and explain them the same way.
 #include <functional>
 
 #include "cli/command_line.hpp"

@@ -134,6 +134,7 @@ class App::Impl {
         g.mode = gl.mode;
         g.ports = gl.ports;
         g.baud = static_cast<unsigned>(gl.baud);
+        g.radio = gl.radio;
         g.reconnect_min = gl.reconnect_min;
         g.reconnect_max = gl.reconnect_max;
         g.key_file = gl.key_file;

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "services/groundlink/transport/radio_profile.hpp"
+
 namespace airseg::daemon {
 
 using std::chrono::milliseconds;
@@ -67,6 +69,8 @@ struct GroundlinkConfig {
     double mavlink_forward_budget = 0;  // groundlink.mavlink_forward.budget_bytes_per_s: 0 = 30 % of the link
     std::map<std::string, double>
         mavlink_forward_rates;  // groundlink.mavlink_forward.rates: name or id -> Hz
+    // groundlink.radio.*: air_speed, ecc, packet, packet_overhead, turnaround, duplex, buffer
+    groundlink::RadioProfile radio;
 };
 
 struct StatusLedConfig {

@@ -237,6 +237,12 @@ void check_consistency(const Config& c, const std::string& source,
                    named ? key : "groundlink.mavlink_forward.rates",
                    named ? problem.substr(key.size() + 2) : problem);
     }
+    // "groundlink.radio.packet_overhead needs packet ...": the key, then what is wrong with it.
+    if (const auto problem = g.radio.validate("groundlink.radio"); !problem.empty()) {
+        const auto space = problem.find(' ');
+        const std::string key = problem.substr(0, space);
+        errors.add(at(key), key, space == std::string::npos ? problem : problem.substr(space + 1));
+    }
     if (!g.monitor_key_file.empty() && g.key_file.empty()) {
         errors.add(at("groundlink.monitor_key_file"), "groundlink.monitor_key_file",
                    "needs groundlink.key_file (the control key)");

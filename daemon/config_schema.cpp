@@ -141,7 +141,33 @@ KeySpec duration(std::string path, Ref ref, milliseconds min, milliseconds max, 
         ref(c) = *d;
         return std::nullopt;
     };
-    spec.show = [ref](const Config& c) { return format_duration(ref(const_cast<Config&>(c))); };
+    spec.show = [ref](const Config& c) {
+        return format_duration(std::chrono::duration_cast<milliseconds>(ref(const_cast<Config&>(c))));
+    };
+    return spec;
+}
+
+/// A boolean spelled as one of two words, e.g. duplex: half | full.
+template <class Ref>
+KeySpec two_words(std::string path, Ref ref, std::string when_true, std::string when_false, std::string doc) {
+    KeySpec spec;
+    spec.path = std::move(path);
+    spec.type_name = fmt::format("one of {} | {}", when_true, when_false);
+    spec.doc = std::move(doc);
+    spec.apply = [ref, when_true, when_false](const YAML::Node& node,
+                                              Config& c) -> std::optional<std::string> {
+        if (node.IsScalar() && node.Scalar() == when_true) {
+            ref(c) = true;
+        } else if (node.IsScalar() && node.Scalar() == when_false) {
+            ref(c) = false;
+        } else {
+            return fmt::format("expected {} or {}, got '{}'", when_true, when_false, scalar_text(node));
+        }
+        return std::nullopt;
+    };
+    spec.show = [ref, when_true, when_false](const Config& c) {
+        return ref(const_cast<Config&>(c)) ? when_true : when_false;
+    };
     return spec;
 }
 
@@ -515,6 +541,32 @@ std::vector<KeySpec> build_schema() {
         false,
         "Hz 0..50 per telemetry message forwarded (MAVLink name or id; 'default' for the others, 1 Hz); 0 = "
         "not forwarded"));
+    // The radios' air. The bounds are RadioProfile::validate()'s, so that each bad key is reported at once;
+    // validate() (run by the loader) adds the gaps (packet 1..7, buffer 1..63) and packet_overhead without
+    // packet.
+    s.push_back(integer(
+        "groundlink.radio.air_speed",
+        [](Config& c) -> std::uint32_t& { return c.groundlink.radio.air_speed_kbps; }, 0, 100'000,
+        "kbit/s the radios send on air (SiK AIR_SPEED); 0 = the serial rate (baud / 10 bytes/s)"));
+    s.push_back(boolean(
+        "groundlink.radio.ecc", [](Config& c) -> bool& { return c.groundlink.radio.ecc; },
+        "the radios send every byte with error correction (SiK ECC), which halves the air rate"));
+    s.push_back(integer(
+        "groundlink.radio.packet", [](Config& c) -> std::size_t& { return c.groundlink.radio.packet_bytes; },
+        0, 4096, "payload bytes per air packet (SiK: 252); 0 = the air is a byte stream"));
+    s.push_back(integer(
+        "groundlink.radio.packet_overhead",
+        [](Config& c) -> std::size_t& { return c.groundlink.radio.packet_overhead; }, 0, 256,
+        "air bytes each packet adds (preamble, sync word, header, CRC); needs packet"));
+    s.push_back(duration(
+        "groundlink.radio.turnaround", [](Config& c) -> Duration& { return c.groundlink.radio.turnaround; },
+        milliseconds(0), milliseconds(100), "air lost each time a half-duplex radio pair changes sender"));
+    s.push_back(two_words(
+        "groundlink.radio.duplex", [](Config& c) -> bool& { return c.groundlink.radio.half_duplex; }, "half",
+        "full", "half: the two radios of a pair share their air time; full: each direction has its own"));
+    s.push_back(integer(
+        "groundlink.radio.buffer", [](Config& c) -> std::size_t& { return c.groundlink.radio.buffer_bytes; },
+        0, 1 << 24, "bytes the radio holds before they go on air; 0 = unknown"));
     // Flight plans
     s.push_back(integer(
         "flightplan.window", [](Config& c) -> int& { return c.flightplan.window; }, 3, 250,

@@ -28,6 +28,14 @@ struct EndpointSetup {
     bool is_a = true;  ///< end A transmits on path 0 in dual mode, end B on path 1
     TimePoint now{};
     double pacing_factor = 1.0;  ///< a pacing protocol's link rate as a fraction of baud/10
+    /// What the radio does on air, for a protocol that can be told (nullopt: it assumes its defaults).
+    struct Radio {
+        Duration turnaround{0};
+        std::size_t air_packet = 0;
+        std::size_t air_packet_overhead = 0;
+        std::size_t buffer = 0;
+    };
+    std::optional<Radio> radio;
 };
 
 class BenchEndpoint {

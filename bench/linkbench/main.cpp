@@ -5,6 +5,7 @@
 #include <limits>
 #include <string>
 #include <string_view>
+#include <tuple>
 #include <vector>
 
 #include "bench/linkbench/report.hpp"
@@ -35,6 +36,13 @@ Scenarios, for 57600 and 115200 baud, single pair and dual pair (split: each end
   frameloss=N%     the same with N % of air packets lost, both directions
   outage=30s       the same with a 30 s outage of both directions starting at 20 s (90 s run)
   bidir            bulk Safe both ways (dual/single ratio of this row is a target)
+  bidir+fast       bulk Safe both ways, and in run 2 Fast both ways: each direction's share of the air
+  telemetry        the clean row while B sends airsegd's telemetry (48 B at 2 Hz, 37 B at 1 Hz, Fast)
+Single pair only, radios whose air differs from their serial port ("cfg": the transport is told the radio, as
+groundlink.radio tells it; without, it assumes 1 ms turnaround and no per-packet overhead):
+  pkt32+8 [cfg]    32-byte air packets with 8 bytes of overhead each
+  turn10ms [cfg]   10 ms turnaround (--turnaround-ms does not change these rows)
+  turn20ms cfg     20 ms turnaround
 
 )";
 
@@ -93,6 +101,36 @@ std::vector<Scenario> scenarios(const Knobs& k) {
             bidir.impairment = "bidir";
             bidir.bidirectional = true;
             list.push_back(bidir);
+            Scenario bidir_fast = bidir;
+            bidir_fast.impairment = "bidir+fast";
+            bidir_fast.fast_both_ways = true;
+            list.push_back(bidir_fast);
+            Scenario trickle = base;
+            trickle.impairment = "telemetry";
+            trickle.telemetry_from_b = true;
+            list.push_back(trickle);
+            if (mode != LinkMode::Single) {
+                continue;
+            }
+            // Radios whose air is not their serial port: small air packets with their own overhead, and a
+            // slow change of sender; each as the transport assumes it by default, then told (configured).
+            for (bool told : {false, true}) {
+                Scenario packets = base;
+                packets.impairment = told ? "pkt32+8 cfg" : "pkt32+8";
+                packets.air_packet = 32;
+                packets.air_packet_overhead = 8;
+                packets.radio_configured = told;
+                list.push_back(packets);
+            }
+            for (auto [label, ms, told] : {std::tuple{"turn10ms", 10, false},
+                                           {"turn10ms cfg", 10, true},
+                                           {"turn20ms cfg", 20, true}}) {
+                Scenario slow = base;
+                slow.impairment = label;
+                slow.turnaround = std::chrono::milliseconds(ms);
+                slow.radio_configured = told;
+                list.push_back(slow);
+            }
         }
     }
     return list;

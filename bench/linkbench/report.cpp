@@ -71,10 +71,11 @@ void print_table(std::ostream& os, const std::vector<Row>& rows) {
 
 void print_diagnostics(std::ostream& os, const std::vector<Row>& rows) {
     os << "\ndiagnostics (ours / seed): wire = bytes written by A / by B on all pairs, % of one line's "
-          "rate\n";
+          "rate; run 2 = goodput each way in the run with Fast traffic\n";
     os << std::left << std::setw(7) << "baud" << std::setw(8) << "mode" << std::setw(15) << "impairment"
        << std::right << std::setw(17) << "wire A %" << std::setw(17) << "wire B %" << std::setw(17)
-       << "air busy %" << std::setw(21) << "FIFO overflow B" << '\n';
+       << "air busy %" << std::setw(21) << "FIFO overflow B" << std::setw(19) << "run 2 A->B %"
+       << std::setw(19) << "run 2 B->A %" << '\n';
     for (const Row& r : rows) {
         os << std::left << std::setw(7) << r.scenario.baud << std::setw(8) << to_string(r.scenario.mode)
            << std::setw(15) << r.scenario.impairment << std::right << std::setw(17)
@@ -83,7 +84,8 @@ void print_diagnostics(std::ostream& os, const std::vector<Row>& rows) {
            << pair(r, &ScenarioResult::air_utilisation_pct, 1) << std::setw(21)
            << (fig(r.ours, static_cast<double>(r.ours.radio_overflow), 0) + " / " +
                fig(r.seed, static_cast<double>(r.seed.radio_overflow), 0))
-           << '\n';
+           << std::setw(19) << pair(r, &ScenarioResult::fast_run_goodput_ab_pct, 1) << std::setw(19)
+           << pair(r, &ScenarioResult::fast_run_goodput_ba_pct, 1) << '\n';
     }
 }
 
@@ -109,6 +111,10 @@ std::vector<TargetCheck> check_targets(const std::vector<Row>& rows) {
                 "clean goodput >= 95 %", find(rows, baud, mode, "clean"),
                 [](const ScenarioResult& r) { return r.goodput_pct >= 95.0; }, &ScenarioResult::goodput_pct);
             add(
+                "bulk beside the vehicle's telemetry trickle: goodput >= 88 %",
+                find(rows, baud, mode, "telemetry"),
+                [](const ScenarioResult& r) { return r.goodput_pct >= 88.0; }, &ScenarioResult::goodput_pct);
+            add(
                 "corruption 1e-4 goodput >= 85 %", find(rows, baud, mode, "corrupt=1e-4"),
                 [](const ScenarioResult& r) { return r.goodput_pct >= 85.0; }, &ScenarioResult::goodput_pct);
             add(
@@ -130,6 +136,19 @@ std::vector<TargetCheck> check_targets(const std::vector<Row>& rows) {
             add(
                 "5 % byte loss command round trip p50 <= 5 s", find(rows, baud, mode, "loss=5%"),
                 [](const ScenarioResult& r) { return r.cmd_p50_s <= 5.0; }, &ScenarioResult::cmd_p50_s);
+            add(
+                "32-byte air packets with 8 bytes of overhead, configured: goodput >= 60 %",
+                find(rows, baud, mode, "pkt32+8 cfg"),
+                [](const ScenarioResult& r) { return r.goodput_pct >= 60.0; }, &ScenarioResult::goodput_pct);
+            add(
+                "10 ms turnaround, configured: goodput >= 75 %", find(rows, baud, mode, "turn10ms cfg"),
+                [](const ScenarioResult& r) { return r.goodput_pct >= 75.0; }, &ScenarioResult::goodput_pct);
+            for (const char* configured : {"pkt32+8 cfg", "turn10ms cfg", "turn20ms cfg"}) {
+                add(
+                    "configured radio: no radio buffer overflow", find(rows, baud, mode, configured),
+                    [](const ScenarioResult& r) { return r.radio_overflow == 0; },
+                    &ScenarioResult::goodput_pct);
+            }
             if (baud == 57600) {
                 add(
                     "Fast p99 <= 150 ms under saturating bulk", find(rows, baud, mode, "clean"),
@@ -138,6 +157,37 @@ std::vector<TargetCheck> check_targets(const std::vector<Row>& rows) {
                     },
                     &ScenarioResult::fast_p99_ms);
             }
+        }
+        for (LinkMode mode : {LinkMode::Single, LinkMode::Dual}) {
+            const Row* alone = find(rows, baud, mode, "clean");
+            const Row* both = find(rows, baud, mode, "bidir+fast");
+            if (alone == nullptr || both == nullptr) {
+                continue;
+            }
+            // Each direction keeps a third of what one direction alone carries, and no Safe message waits
+            // more than 5 s, with bulk and Fast traffic both ways.
+            TargetCheck c;
+            c.name =
+                "bulk and Fast both ways: each direction >= 33 % of one direction alone, stall <= 5 s [" +
+                where(*both) + "]";
+            const auto fair = [&](const ScenarioResult& b, const ScenarioResult& a) {
+                const double floor = a.goodput_pct / 3.0;
+                return b.fast_run_goodput_ab_pct >= floor && b.fast_run_goodput_ba_pct >= floor &&
+                       b.fast_run_stall_ab_s <= 5.0 && b.fast_run_stall_ba_s <= 5.0;
+            };
+            c.evaluated = both->ours.ran && alone->ours.ran;
+            c.pass = c.evaluated && fair(both->ours, alone->ours);
+            c.seed_pass = both->seed.ran && alone->seed.ran && fair(both->seed, alone->seed);
+            std::ostringstream d;
+            d << std::fixed << std::setprecision(1);
+            for (const auto* side : {&both->ours, &both->seed}) {
+                d << (side == &both->ours ? "ours" : ", seed") << " A->B " << side->fast_run_goodput_ab_pct
+                  << " % (stall " << side->fast_run_stall_ab_s << " s), B->A "
+                  << side->fast_run_goodput_ba_pct << " % (stall " << side->fast_run_stall_ba_s << " s)";
+            }
+            d << " of " << alone->ours.goodput_pct << " / " << alone->seed.goodput_pct << " % alone";
+            c.detail = d.str();
+            checks.push_back(std::move(c));
         }
         const Row* single = find(rows, baud, LinkMode::Single, "bidir");
         const Row* dual = find(rows, baud, LinkMode::Dual, "bidir");

@@ -19,7 +19,8 @@ constexpr std::size_t kSafeSize = 1024;
 constexpr std::size_t kFastSize = 32;
 constexpr Duration kFastPeriod = std::chrono::milliseconds(100);
 constexpr std::uint16_t kFastStreams = 8;
-constexpr std::size_t kBulkBacklog = 24;  // Safe messages the application keeps offered
+constexpr std::uint32_t kFastBackBit = 1U << 30;  // Fast ids sent B→A
+constexpr std::size_t kBulkBacklog = 24;          // Safe messages the application keeps offered
 constexpr Duration kStep = std::chrono::milliseconds(1);
 
 // Message content: a 4-byte id (little-endian) then bytes derived from it, so damage is detectable.
@@ -47,6 +48,10 @@ constexpr std::uint8_t kSaltSafeBA = 2;
 constexpr std::uint8_t kSaltFast = 3;
 constexpr std::uint8_t kSaltCommand = 4;
 constexpr std::uint8_t kSaltAnswer = 5;
+constexpr std::uint8_t kSaltTelemetry = 6;
+// airsegd's own telemetry to the ground: the vehicle's state at 2 Hz, the link statistics at 1 Hz.
+constexpr std::size_t kVehicleBytes = 48;
+constexpr std::size_t kLinkStatsBytes = 37;
 constexpr Duration kCommandPause = std::chrono::milliseconds(500);  // operator's pause between commands
 
 double percentile(std::vector<double> v, double q) {
@@ -76,7 +81,8 @@ linksim::RadioConfig bench_radio(const Scenario& s, std::uint64_t seed) {
     c.baud = s.baud;
     c.duplex = linksim::Duplex::Half;
     c.turnaround = s.turnaround;
-    c.max_air_packet = 252;
+    c.max_air_packet = s.air_packet;
+    c.air_packet_overhead = s.air_packet_overhead;
     c.radio_buffer = 2048;
     c.host_buffer = 4096;
     c.seed = seed;
@@ -94,13 +100,21 @@ linksim::RadioConfig bench_radio(const Scenario& s, std::uint64_t seed) {
 
 namespace {
 
+EndpointSetup setup(const Scenario& s, bool is_a, TimePoint t0) {
+    EndpointSetup e{s.baud, s.mode, is_a, t0, s.pacing_factor, std::nullopt};
+    if (s.radio_configured) {
+        const auto radio = bench_radio(s, 0);
+        e.radio = EndpointSetup::Radio{radio.turnaround, radio.max_air_packet, radio.air_packet_overhead,
+                                       radio.radio_buffer};
+    }
+    return e;
+}
+
 // Two ends joined by the scenario's radio pairs, with a blocking-write model of each host UART; both runs
 // drive it the same way: deliver what the radios output, then write what the ends have to send.
 struct Wiring {
     Wiring(const Scenario& s, const EndpointFactory& make, std::uint64_t seed, TimePoint t0)
-        : paths(s.mode == LinkMode::Dual ? 2 : 1),
-          ends{make({s.baud, s.mode, true, t0, s.pacing_factor}),
-               make({s.baud, s.mode, false, t0, s.pacing_factor})} {
+        : paths(s.mode == LinkMode::Dual ? 2 : 1), ends{make(setup(s, true, t0)), make(setup(s, false, t0))} {
         for (std::size_t p = 0; p < paths; ++p) {
             pairs.emplace_back(bench_radio(s, seed + p), t0);
         }
@@ -176,6 +190,8 @@ ScenarioResult run_pass(const Scenario& s, const EndpointFactory& make, bool wit
     std::array<std::uint64_t, 2> safe_bytes{0, 0};
     TimePoint last_ab_delivery = t0;
     Duration max_stall{0};
+    std::array<TimePoint, 2> last_delivery{t0, t0};  // by receiving side
+    std::array<Duration, 2> longest_gap{};
 
     std::uint32_t next_fast_id = 0;
     TimePoint next_fast = t0;
@@ -186,6 +202,12 @@ ScenarioResult run_pass(const Scenario& s, const EndpointFactory& make, bool wit
     const TimePoint fast_count_until = end - std::chrono::seconds(2);
 
     auto on_message = [&](Side to, const BenchMessage& m, TimePoint now) {
+        if (!m.safe && m.bytes.size() != kFastSize) {
+            if (!check_payload(m.bytes, m.bytes.size(), kSaltTelemetry)) {
+                ++result.damaged_deliveries;
+            }
+            return;
+        }
         if (!m.safe) {
             auto id = check_payload(m.bytes, kFastSize, kSaltFast);
             if (!id) {
@@ -218,14 +240,28 @@ ScenarioResult run_pass(const Scenario& s, const EndpointFactory& make, bool wit
         seen[*id] = true;
         safe_bytes[linksim::index(to)] += m.bytes.size();
         ++result.safe_messages;
+        auto& last = last_delivery[linksim::index(to)];
+        longest_gap[linksim::index(to)] = std::max(longest_gap[linksim::index(to)], now - last);
+        last = now;
         if (to == Side::B) {
             max_stall = std::max(max_stall, now - last_ab_delivery);
             last_ab_delivery = now;
         }
     };
 
+    TimePoint next_vehicle = t0;
+    TimePoint next_link_stats = t0;
+    std::uint32_t telemetry_id = 0;
     for (TimePoint now = t0; now <= end;) {
         wiring.deliver(now, on_message);
+        while (s.telemetry_from_b && next_vehicle <= now) {
+            ends[1]->send_fast(0, make_payload(telemetry_id++, kVehicleBytes, kSaltTelemetry), now);
+            next_vehicle += std::chrono::milliseconds(500);
+        }
+        while (s.telemetry_from_b && next_link_stats <= now) {
+            ends[1]->send_fast(1, make_payload(telemetry_id++, kLinkStatsBytes, kSaltTelemetry), now);
+            next_link_stats += std::chrono::seconds(1);
+        }
         // Workload: Fast telemetry A→B at 10 Hz, bulk Safe kept offered.
         while (with_fast && next_fast <= now) {
             const auto payload = make_payload(next_fast_id, kFastSize, kSaltFast);
@@ -233,6 +269,15 @@ ScenarioResult run_pass(const Scenario& s, const EndpointFactory& make, bool wit
             fast_sent[next_fast_id] = now;
             if (now <= fast_count_until) {
                 ++fast_counted;
+            }
+            if (s.fast_both_ways) {
+                const std::uint32_t back = next_fast_id | kFastBackBit;
+                ends[1]->send_fast(static_cast<std::uint16_t>(next_fast_id % kFastStreams),
+                                   make_payload(back, kFastSize, kSaltFast), now);
+                fast_sent[back] = now;
+                if (now <= fast_count_until) {
+                    ++fast_counted;
+                }
             }
             ++next_fast_id;
             next_fast += kFastPeriod;
@@ -250,10 +295,15 @@ ScenarioResult run_pass(const Scenario& s, const EndpointFactory& make, bool wit
         }
         wiring.transmit(now);
         const TimePoint fast_due = with_fast ? next_fast : kNever;
-        TimePoint next = std::min({now + kStep, fast_due, ends[0]->poll_timeout(), ends[1]->poll_timeout()});
+        const TimePoint telemetry_due = s.telemetry_from_b ? std::min(next_vehicle, next_link_stats) : kNever;
+        TimePoint next = std::min(
+            {now + kStep, fast_due, telemetry_due, ends[0]->poll_timeout(), ends[1]->poll_timeout()});
         now = std::max(next, now + std::chrono::microseconds(10));
     }
     max_stall = std::max(max_stall, end - last_ab_delivery);
+    for (std::size_t to = 0; to < 2; ++to) {
+        longest_gap[to] = std::max(longest_gap[to], end - last_delivery[to]);
+    }
 
     const double line = s.baud / 10.0;
     const double seconds = std::chrono::duration<double>(s.duration).count();
@@ -265,6 +315,11 @@ ScenarioResult run_pass(const Scenario& s, const EndpointFactory& make, bool wit
                                                  : 100.0 * static_cast<double>(fast_delivered_counted) /
                                                        static_cast<double>(fast_counted);
     result.max_stall_s = std::chrono::duration<double>(max_stall).count();
+    // Received by B: sent A→B.
+    result.fast_run_goodput_ab_pct = 100.0 * static_cast<double>(safe_bytes[1]) / (line * seconds);
+    result.fast_run_goodput_ba_pct = 100.0 * static_cast<double>(safe_bytes[0]) / (line * seconds);
+    result.fast_run_stall_ab_s = std::chrono::duration<double>(longest_gap[1]).count();
+    result.fast_run_stall_ba_s = std::chrono::duration<double>(longest_gap[0]).count();
     result.air_utilisation_pct = 100.0 * pairs[0].air_utilisation(Side::A, end);
     for (const auto& pair : pairs) {
         result.wire_ab_pct += 100.0 * static_cast<double>(pair.stats(Side::A).bytes_in) / (line * seconds);
@@ -365,6 +420,10 @@ ScenarioResult run_scenario(const Scenario& s, const EndpointFactory& make) {
     bulk.fast_p50_ms = mixed.fast_p50_ms;
     bulk.fast_p99_ms = mixed.fast_p99_ms;
     bulk.fast_delivery_pct = mixed.fast_delivery_pct;
+    bulk.fast_run_goodput_ab_pct = mixed.fast_run_goodput_ab_pct;
+    bulk.fast_run_goodput_ba_pct = mixed.fast_run_goodput_ba_pct;
+    bulk.fast_run_stall_ab_s = mixed.fast_run_stall_ab_s;
+    bulk.fast_run_stall_ba_s = mixed.fast_run_stall_ba_s;
     bulk.damaged_deliveries += mixed.damaged_deliveries;
     run_commands(s, make, bulk);
     return bulk;

@@ -21,8 +21,15 @@ struct Scenario {
     double frame_loss = 0.0;                ///< air packet loss, both directions, every pair
     std::optional<linksim::Outage> outage;  ///< both directions, every pair
     bool bidirectional = false;             ///< bulk Safe traffic both ways (otherwise A→B only)
+    bool fast_both_ways = false;            ///< the Fast run sends Fast B→A too (with bidirectional)
+    bool telemetry_from_b = false;  ///< B sends airsegd's telemetry (48 B at 2 Hz, 37 B at 1 Hz) as Fast
     Duration duration = std::chrono::seconds(60);
     Duration turnaround = std::chrono::milliseconds(1);  ///< radio dead air when the sending side changes
+    std::size_t air_packet = 252;                        ///< payload bytes per air packet
+    std::size_t air_packet_overhead = 0;                 ///< air bytes each packet adds
+    /// The transport is told the radio as it is (air packets, overhead, turnaround, buffer), as
+    /// groundlink.radio tells it; otherwise it assumes the defaults (1 ms turnaround, no packet overhead).
+    bool radio_configured = false;
     double pacing_factor =
         1.0;                    ///< the transport's link_rate as a fraction of baud/10 (the seed never paces)
     std::uint64_t seed = 1000;  ///< of the radios' impairments: the same seed gives the same figures
@@ -36,6 +43,12 @@ struct ScenarioResult {
     double fast_p99_ms = 0.0;
     double fast_delivery_pct = 0.0;  ///< Fast messages sent (until 2 s before the end) that arrived
     double max_stall_s = 0.0;        ///< longest time without a Safe delivery A→B
+    /// Per direction, from the run with Fast traffic (bulk and Fast both ways when fast_both_ways): goodput
+    /// as % of one line's rate, and the longest time without a Safe delivery.
+    double fast_run_goodput_ab_pct = 0.0;
+    double fast_run_goodput_ba_pct = 0.0;
+    double fast_run_stall_ab_s = 0.0;
+    double fast_run_stall_ba_s = 0.0;
     /// Command round trips (third run): a status-sized exchange on the urgent channel while telemetry flows,
     /// one command at a time; unanswered commands count as infinitely slow.
     double cmd_p50_s = 0.0;
@@ -54,7 +67,8 @@ struct ScenarioResult {
 using EndpointFactory = std::function<std::unique_ptr<BenchEndpoint>(const EndpointSetup&)>;
 
 /// The radio pair every scenario uses: SiK-like half-duplex radios whose air byte rate equals the serial byte
-/// rate, Scenario::turnaround, 252-byte air packets, 2 KiB FIFO, 4 KiB host UART buffer.
+/// rate, Scenario::turnaround, Scenario::air_packet (252 unless said) with its overhead, 2 KiB FIFO, 4 KiB
+/// host UART buffer.
 linksim::RadioConfig bench_radio(const Scenario& s, std::uint64_t seed);
 
 /// A command: kCommandBytes A→B; its answer: kAnswerBytes B→A (the size of airsegd's status answer).

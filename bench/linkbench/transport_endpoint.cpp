@@ -14,6 +14,12 @@ groundlink::TransportConfig bench_config(const EndpointSetup& setup) {
     groundlink::TransportConfig c;
     c.link_rate_bytes_per_s = setup.pacing_factor * setup.baud / 10.0;
     c.half_duplex = true;
+    if (setup.radio) {
+        c.air_turnaround = setup.radio->turnaround;
+        c.air_packet_payload = setup.radio->air_packet;
+        c.air_packet_overhead = setup.radio->air_packet_overhead;
+        c.radio_buffer_bytes = setup.radio->buffer;
+    }
     if (setup.mode == LinkMode::Dual) {
         c.paths = 2;
         c.path_mode = groundlink::PathMode::Split;

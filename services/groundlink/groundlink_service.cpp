@@ -36,6 +36,20 @@ nlohmann::json class_json(const ClassStats& s) {
             {"drops", s.drops},       {"replaced", s.replaced}, {"queue_depth", s.queue_depth}};
 }
 
+/// What the link is paced for (groundlink.baud and groundlink.radio), in the status document.
+nlohmann::json pacing_json(const TransportConfig& t) {
+    const auto bytes_per_s = [](double r) { return std::round(r * 10) / 10; };
+    return {{"serial_bytes_per_s", bytes_per_s(t.link_rate_bytes_per_s)},
+            {"air_bytes_per_s",
+             bytes_per_s(t.air_rate_bytes_per_s > 0 ? t.air_rate_bytes_per_s : t.link_rate_bytes_per_s)},
+            {"air_packet", t.air_packet_payload},
+            {"air_packet_overhead", t.air_packet_overhead},
+            {"turnaround_ms", std::chrono::duration<double, std::milli>(t.air_turnaround).count()},
+            {"duplex", t.half_duplex ? "half" : "full"},
+            {"radio_buffer", t.radio_buffer_bytes},
+            {"carried_bytes_per_s", bytes_per_s(t.carried_rate_bytes_per_s())}};
+}
+
 }  // namespace
 
 TransportConfig transport_config_for(const GroundlinkServiceConfig& config) {
@@ -46,6 +60,7 @@ TransportConfig transport_config_for(const GroundlinkServiceConfig& config) {
         t.half_duplex = false;
     } else {
         t.link_rate_bytes_per_s = config.baud / 10.0;
+        config.radio.apply(t, t.link_rate_bytes_per_s);
         t.paths = config.ports.size();
         t.path_mode = config.mode == "split"       ? PathMode::Split
                       : config.mode == "redundant" ? PathMode::Redundant
@@ -57,9 +72,10 @@ TransportConfig transport_config_for(const GroundlinkServiceConfig& config) {
 GroundlinkService::GroundlinkService(ServiceContext& ctx, GroundlinkServiceConfig config)
     : Service("groundlink", ctx),
       config_(std::move(config)),
-      scheduler_(config_.telemetry, transport_config_for(config_).link_rate_bytes_per_s, SteadyClock::now()),
+      scheduler_(config_.telemetry, transport_config_for(config_).carried_rate_bytes_per_s(),
+                 SteadyClock::now()),
       telemetry_timer_(strand(), ctx.wakes),
-      forwarder_(config_.mavlink_forward, transport_config_for(config_).link_rate_bytes_per_s,
+      forwarder_(config_.mavlink_forward, transport_config_for(config_).carried_rate_bytes_per_s(),
                  SteadyClock::now()),
       forward_timer_(strand(), ctx.wakes),
       stats_timer_(strand(), ctx.wakes) {}
@@ -234,6 +250,10 @@ void GroundlinkService::on_message(Delivered message) {
 
 void GroundlinkService::on_command(const protocol::Command& command) {
     ++commands_;
+    // The status document counts a command before its answer leaves, not at the next statistics tick: a
+    // client that has its answer and then reads the status sees its command there (a snapshot of plain
+    // values; commands come at most as fast as the radio carries them).
+    publish_status();
     const std::uint32_t id = command.request_id;
     // A ground hub relays its monitor clients' commands with "role": "monitor": the vehicle runs them with
     // the lesser of the two rights, never more than the link's key grants.
@@ -423,7 +443,7 @@ void GroundlinkService::feed_scheduler(TimePoint now) {
     // until the ground has reported enough (a ground end that does not report, or a slow rate).
     q.loss = delivery_.loss().value_or(s.frame_loss);
     q.replaced_share = fast > 0 ? static_cast<double>(replaced) / static_cast<double>(fast) : 0.0;
-    q.link_rate_bytes_per_s = transport_.link_rate_bytes_per_s;
+    q.link_rate_bytes_per_s = transport_.carried_rate_bytes_per_s();
     last_fast_messages_ = s.tx_fast.messages;
     last_fast_replaced_ = s.tx_fast.replaced + s.tx_fast.drops;
     scheduler_.update_link(q, now);
@@ -535,7 +555,8 @@ void GroundlinkService::publish_status() {
          refusal = std::string(refusing_unauthenticated() ? kNoKeyRefusal : ""), rates = rates_snapshot(),
          fwd = forwarder_.stats(), fwd_enabled = config_.mavlink_forward.enabled,
          fwd_budget = forwarder_.budget_bytes_per_s(),
-         fwd_counters = std::array{forward_refused_, from_ground_frames_, from_ground_refused_}] {
+         fwd_counters = std::array{forward_refused_, from_ground_frames_, from_ground_refused_},
+         pacing = pacing_json(transport_)] {
             nlohmann::json g;
             g["mode"] = mode;
             g["link"] = up ? "up" : "down";
@@ -544,6 +565,7 @@ void GroundlinkService::publish_status() {
             g["loss"] = std::round(s.frame_loss * 1000) / 1000;
             g["goodput_bps"] = std::round(goodput);
             g["frame_payload"] = s.frame_payload;
+            g["pacing"] = pacing;
             auto rate = [](double r) {
                 return r < 0 ? nlohmann::json(nullptr) : nlohmann::json(std::round(r * 1e6) / 1e6);
             };

@@ -20,6 +20,7 @@
 #include "services/groundlink/protocol/ground_protocol.hpp"
 #include "services/groundlink/telemetry_sample.hpp"
 #include "services/groundlink/telemetry_scheduler.hpp"
+#include "services/groundlink/transport/radio_profile.hpp"
 
 namespace airseg::groundlink {
 
@@ -38,6 +39,8 @@ struct GroundlinkServiceConfig {
     TelemetrySchedulerConfig telemetry;
     hal::UdpConfig udp;
     TransportConfig transport;  // paths, path_mode, link rate, key and boot nonce are set by the service
+    /// groundlink.radio: the radios' air, which the transport paces for on serial links (not in mode udp).
+    RadioProfile radio;
     Duration stats_interval = std::chrono::seconds(1);
     /// groundlink.mavlink_forward: the autopilot's frames for standard ground stations (ForwardedFrame from
     /// the bus, as MavlinkFrames messages) and theirs back (GroundStationFrames, control key only).
@@ -137,7 +140,7 @@ class GroundlinkService : public Service {
 };
 
 /// The transport configuration for a service configuration: paths and mode from `mode` and `ports`, the link
-/// rate from the baud rate (8N1: baud/10 bytes per second).
+/// rate from the baud rate (8N1: baud/10 bytes per second) and, on serial links, the air from `radio`.
 TransportConfig transport_config_for(const GroundlinkServiceConfig& config);
 
 }  // namespace airseg::groundlink

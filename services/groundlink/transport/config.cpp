@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -29,6 +30,14 @@ std::vector<std::string> TransportConfig::validate() const {
     need(latency_hold >= Duration::zero(), "latency_hold must not be negative");
     need(air_turnaround >= Duration::zero() && air_turnaround <= std::chrono::milliseconds(100),
          "air_turnaround must be 0..100 ms");
+    need(air_rate_bytes_per_s == 0.0 || (air_rate_bytes_per_s >= 10.0 && air_rate_bytes_per_s <= 1e8),
+         "air_rate must be 0 (the link rate) or 10..1e8 bytes/s");
+    need(air_packet_payload == 0 || (air_packet_payload >= 8 && air_packet_payload <= 4096),
+         "air_packet must be 0 (no packets) or 8..4096 bytes");
+    need(air_packet_overhead <= 256, "air_packet_overhead must be 0..256 bytes");
+    need(air_packet_payload != 0 || air_packet_overhead == 0, "air_packet_overhead needs air_packet");
+    need(radio_buffer_bytes == 0 || (radio_buffer_bytes >= 64 && radio_buffer_bytes <= (1U << 24)),
+         "radio_buffer must be 0 (unknown) or 64..16777216 bytes");
     need(urgent_pacing >= 0.5 && urgent_pacing <= 1.0, "urgent_pacing must be 0.5..1");
     need(priorities >= 1 && priorities <= kMaxPriorities, "priorities must be 1..8");
     double shares = 0.0;
@@ -61,6 +70,15 @@ std::vector<std::string> TransportConfig::validate() const {
     need(delivery_queue_cap >= 1, "delivery_queue_cap must be at least 1");
     need(boot_nonce != 0, "boot_nonce must not be 0 (the adapter supplies a random value)");
     return e;
+}
+
+double TransportConfig::carried_rate_bytes_per_s() const {
+    const double air = air_rate_bytes_per_s > 0.0 ? air_rate_bytes_per_s : link_rate_bytes_per_s;
+    const double payload_share = air_packet_payload == 0
+                                     ? 1.0
+                                     : static_cast<double>(air_packet_payload) /
+                                           static_cast<double>(air_packet_payload + air_packet_overhead);
+    return std::min(link_rate_bytes_per_s, air * payload_share);
 }
 
 std::ostream& operator<<(std::ostream& os, SendResult r) {

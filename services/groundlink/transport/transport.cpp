@@ -26,9 +26,7 @@ Transport::Impl::Impl(TransportConfig config, TimePoint now)
     : cfg(checked(std::move(config))),
       current_time(now),
       reassembly(cfg.fast_reassembly_timeout, cfg.max_message_size),
-      rtt(cfg.rto_initial, cfg.rto_min, cfg.rto_max, cfg.ack_delay,
-          std::chrono::duration_cast<Duration>(std::chrono::duration<double>(
-              static_cast<double>(cfg.max_frame_payload + 32) / cfg.link_rate_bytes_per_s))) {
+      rtt(cfg.rto_initial, cfg.rto_min, cfg.rto_max, cfg.ack_delay, frame_time(cfg.max_frame_payload + 32)) {
     if (cfg.key) {
         keys[0] = std::make_unique<FrameMac>(*cfg.key);
         mac = keys[0].get();

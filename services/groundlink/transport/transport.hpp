@@ -54,6 +54,18 @@ struct TransportConfig {
     /// air_turnaround: air time a half-duplex radio pair loses when the sending side changes; every frame
     /// heard costs the air budget two of them.
     Duration air_turnaround = std::chrono::milliseconds(1);
+    /// air_rate: bytes/s the radios carry on air, when it differs from what the serial port takes (a SiK
+    /// radio at 64 kbit/s air speed behind a 57600 baud port); 0 = link_rate. Frames are paced by the slower
+    /// of the two.
+    double air_rate_bytes_per_s = 0.0;
+    /// air_packet: payload bytes per air packet (0 = the air is not cut into packets); each packet costs
+    /// air_packet_overhead bytes more of air time (preamble, sync word, header, CRC).
+    std::size_t air_packet_payload = 0;
+    std::size_t air_packet_overhead = 0;
+    /// radio_buffer: bytes the local radio holds before they go on air (0 = unknown): the core keeps its
+    /// estimate of what waits in the radio under half of it, so the radio never drops bytes for a full
+    /// buffer.
+    std::size_t radio_buffer_bytes = 0;
 
     /// max_frame_payload: chunk bytes per frame on a clean link.
     std::size_t max_frame_payload = 1024;
@@ -134,6 +146,9 @@ struct TransportConfig {
 
     /// Every problem, each naming the field; empty when the configuration is usable.
     [[nodiscard]] std::vector<std::string> validate() const;
+    /// Payload bytes per second the link carries: the slower of the serial port (link_rate) and the air net
+    /// of each air packet's overhead. Budgets of the link's users are shares of this.
+    [[nodiscard]] double carried_rate_bytes_per_s() const;
 };
 
 enum class SendResult : std::uint8_t {

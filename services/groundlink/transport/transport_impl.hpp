@@ -101,9 +101,25 @@ class Transport::Impl {
         return false;
     }
     /// Half-duplex air gate of a path: open; only urgent (non-bulk) traffic, for an end using less than half
-    /// the air; closed until the shared budget is paid.
+    /// the air while the peer has urgent traffic; closed until the shared budget is paid (or, with a known
+    /// radio buffer, until the radio's queue has room).
     enum class AirGate : std::uint8_t { Open, UrgentOnly, Closed };
     [[nodiscard]] AirGate air_gate(std::size_t path) const;
+    /// When a closed air gate may open again.
+    [[nodiscard]] TimePoint air_reopens(std::size_t path) const;
+    /// The radio's own queue is estimated past half its buffer.
+    [[nodiscard]] bool radio_full(std::size_t path) const;
+    /// Bytes per second the air carries (air_rate, else link_rate).
+    [[nodiscard]] double air_rate() const {
+        return cfg.air_rate_bytes_per_s > 0.0 ? cfg.air_rate_bytes_per_s : cfg.link_rate_bytes_per_s;
+    }
+    /// Payload bytes per second the link carries (TransportConfig::carried_rate_bytes_per_s()).
+    [[nodiscard]] double carried_rate() const { return carried; }
+    /// Time `bytes` written as one frame occupy the link: the serial port's time or the air's with each air
+    /// packet's overhead, whichever is longer; `scale` below 1 paces slower.
+    [[nodiscard]] Duration frame_time(std::size_t bytes, double scale = 1.0) const;
+    /// Air time of `bytes` heard from the peer (a read is not a frame: overhead in proportion).
+    [[nodiscard]] Duration heard_air_time(std::size_t bytes) const;
     [[nodiscard]] TimePoint ack_due() const;
     [[nodiscard]] TimePoint content_due(std::size_t path) const;
     [[nodiscard]] std::size_t payload_cap() const;
@@ -130,6 +146,7 @@ class Transport::Impl {
     void mark_urgent(TimePoint now) { urgent_until = now + cfg.latency_hold; }
 
     TransportConfig cfg;
+    double carried = cfg.carried_rate_bytes_per_s();  // asked at every air gate: computed once
     // keys[0] from TransportConfig::key, keys[1] from second_key. `mac` is the session's key (keys[0] until a
     // handshake authenticated with keys[1] is accepted); null on an unkeyed link.
     std::array<std::unique_ptr<FrameMac>, 2> keys;

@@ -19,7 +19,8 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
     Path& ps = paths[path];
     stats.bytes_received += bytes.size();
     stats.path[path].bytes_received += bytes.size();
-    if (cfg.path_mode == PathMode::Split && cfg.split_borrow) {  // only borrowing reads it (an exp() a read)
+    // Only borrowing and the frame ceiling beside an urgent peer read it (an exp() a read).
+    if ((cfg.path_mode == PathMode::Split && cfg.split_borrow) || cfg.half_duplex) {
         ps.rx_rate =
             decayed_rate(ps.rx_rate, ps.rx_rate_time, current_time) + static_cast<double>(bytes.size());
         ps.rx_rate_time = current_time;
@@ -29,8 +30,7 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
         // with a margin (half as much again while the peer has urgent traffic) so that together the ends stay
         // below the air rate and a queue that built up in the radios drains. Only the heavier user waits for
         // that budget (air_ok), so a saturating end cannot starve the other.
-        const auto air = std::chrono::duration_cast<Duration>(
-            std::chrono::duration<double>(static_cast<double>(bytes.size()) / cfg.link_rate_bytes_per_s));
+        const Duration air = heard_air_time(bytes.size());
         ps.air_debt =
             std::max(ps.air_debt, current_time - air) + (peer_urgent ? air + air / 2 : air + air / 4);
     }

@@ -12,6 +12,13 @@ namespace {
 constexpr std::size_t kMinUsefulSafe = 16;  // do not top up a frame with a Safe sliver smaller than this
 constexpr std::size_t kMaxDataChunks = 64;
 constexpr double kFairShare = 0.45;  // of link_rate, below which an end is not held back on shared air
+// Frame ceiling (in air time) while the peer is urgent and this end is not; longer while the peer sends
+// only a trickle (under kPeerTrickle of the link: the vehicle's telemetry), whose few messages meet a frame
+// on air rarely enough that bulk should not pay for them.
+constexpr auto kPeerWaitAir = std::chrono::milliseconds(50);
+constexpr auto kPeerTrickleWaitAir = std::chrono::milliseconds(100);
+constexpr double kPeerTrickle = 0.1;
+constexpr double kBulkFloor = 0.2;  // of link_rate, below which an end's bulk does not yield to the peer's
 // Share of recent Safe segments declared lost above which frames stay at most kLossyFramePayload.
 constexpr double kLossyFraction = 0.15;
 constexpr std::size_t kLossyFramePayload = 192;
@@ -50,16 +57,14 @@ bool Transport::Impl::may_borrow(std::size_t path) const {
     const Path& ps = paths[path];
     // Not under heavy loss: the peer's acknowledgements on that pair matter more then.
     return cfg.split_borrow && ps.alive && !(peer_mask_fresh() && peer_urgent) && !lossy() &&
-           decayed_rate(ps.rx_rate, ps.rx_rate_time, current_time) < 0.25 * cfg.link_rate_bytes_per_s;
+           decayed_rate(ps.rx_rate, ps.rx_rate_time, current_time) < 0.25 * carried_rate();
 }
 
 Duration Transport::Impl::reorder_slack() const {
     if (paths.size() < 2) {
         return Duration::zero();  // one serial path never reorders
     }
-    const auto frame_time = std::chrono::duration_cast<Duration>(std::chrono::duration<double>(
-        static_cast<double>(cfg.max_frame_payload + 32) / cfg.link_rate_bytes_per_s));
-    return std::max<Duration>(rtt.srtt() / 4, frame_time);
+    return std::max<Duration>(rtt.srtt() / 4, frame_time(cfg.max_frame_payload + 32));
 }
 
 bool Transport::Impl::carries_data(std::size_t path) const {
@@ -117,11 +122,22 @@ std::size_t Transport::Impl::payload_cap() const {
     if (lossy() && !plan.fec) {
         cap = kLossyFramePayload;
     }
-    // Under urgent traffic they bound how long a frame already on its way holds the urgent message back; the
-    // peer's urgent traffic waits for this end's frames on shared air, so it counts as well.
+    // Under urgent traffic they bound how long a frame already on its way holds the urgent message back. The
+    // peer's urgent traffic waits for this end's frames on shared air too, but only for the frame on air, and
+    // a peer's telemetry trickle keeps it urgent all the time: there frames stay within kPeerWaitAir of air,
+    // which costs bulk far less than the tightest ceiling.
     const bool peer_waiting = cfg.half_duplex && peer_urgent && peer_mask_fresh();
-    if (current_time < urgent_until || peer_waiting) {
+    if (current_time < urgent_until) {
         cap = std::min(cap, cfg.latency_frame_payload);
+    } else if (peer_waiting) {
+        double heard = 0.0;
+        for (const Path& ps : paths) {
+            heard += decayed_rate(ps.rx_rate, ps.rx_rate_time, current_time);
+        }
+        const auto wait = heard < kPeerTrickle * carried_rate() ? kPeerTrickleWaitAir : kPeerWaitAir;
+        const auto peer_wait_bytes =
+            static_cast<std::size_t>(carried_rate() * std::chrono::duration<double>(wait).count());
+        cap = std::min(cap, std::max(cfg.latency_frame_payload, peer_wait_bytes));
     }
     return std::max(cap, cfg.min_frame_payload);
 }
@@ -131,16 +147,69 @@ Transport::Impl::AirGate Transport::Impl::air_gate(std::size_t path) const {
     if (!cfg.half_duplex || current_time >= ps.air_debt) {
         return AirGate::Open;
     }
+    if (radio_full(path)) {
+        return AirGate::Closed;  // more would only wait in the radio, or overflow it
+    }
     // An end using less than its fair share of the air (a little under half) is not held back, so a
-    // saturating peer cannot starve it and two saturating ends share the air; while the peer has urgent
-    // traffic only its urgent traffic goes. A heavier end waits for the air budget both ends share.
+    // saturating peer cannot starve it and two saturating ends share the air. A heavier end waits for the
+    // air budget both ends share.
     // The average decays between frames; half a frame restores its mean over the sawtooth.
     const double rate =
         decayed_rate(ps.tx_rate, ps.tx_rate_time, current_time) + 0.5 * static_cast<double>(ps.last_frame);
-    if (rate >= kFairShare * cfg.link_rate_bytes_per_s) {
+    if (rate >= kFairShare * carried_rate()) {
         return AirGate::Closed;
     }
-    return peer_urgent && peer_mask_fresh() ? AirGate::UrgentOnly : AirGate::Open;
+    // While the peer has urgent traffic and this end has none, only this end's urgent traffic goes, so the
+    // peer's is not held back by bulk. Not when this end is urgent too (two ends with Fast traffic would
+    // each wait for the other, and one direction would fall silent), nor below a floor of the air, so a
+    // peer that is urgent all the time cannot silence this direction's bulk.
+    const bool yield = peer_urgent && peer_mask_fresh() && current_time >= urgent_until &&
+                       rate >= kBulkFloor * carried_rate();
+    return yield ? AirGate::UrgentOnly : AirGate::Open;
+}
+
+bool Transport::Impl::radio_full(std::size_t path) const {
+    if (cfg.radio_buffer_bytes == 0) {
+        return false;
+    }
+    // What the air owes (both ends, from the shared budget) is at most what waits in this end's radio.
+    const double owed =
+        std::chrono::duration<double>(paths[path].air_debt - current_time).count() * air_rate();
+    return owed > 0.5 * static_cast<double>(cfg.radio_buffer_bytes);
+}
+
+TimePoint Transport::Impl::air_reopens(std::size_t path) const {
+    const Path& ps = paths[path];
+    if (cfg.radio_buffer_bytes == 0 || !radio_full(path)) {
+        return ps.air_debt;
+    }
+    // The buffer alone holds it back: open once half the buffer is what remains owed.
+    const auto room = std::chrono::duration_cast<Duration>(
+        std::chrono::duration<double>(0.5 * static_cast<double>(cfg.radio_buffer_bytes) / air_rate()));
+    const double rate =
+        decayed_rate(ps.tx_rate, ps.tx_rate_time, current_time) + 0.5 * static_cast<double>(ps.last_frame);
+    return rate >= kFairShare * carried_rate() ? ps.air_debt : std::max(current_time, ps.air_debt - room);
+}
+
+Duration Transport::Impl::frame_time(std::size_t bytes, double scale) const {
+    const double serial = static_cast<double>(bytes) / cfg.link_rate_bytes_per_s;
+    double on_air = static_cast<double>(bytes);
+    if (cfg.air_packet_payload != 0) {
+        const std::size_t packets = (bytes + cfg.air_packet_payload - 1) / cfg.air_packet_payload;
+        on_air += static_cast<double>(packets * cfg.air_packet_overhead);
+    }
+    const double air = on_air / air_rate();
+    return std::chrono::duration_cast<Duration>(std::chrono::duration<double>(std::max(serial, air) / scale));
+}
+
+Duration Transport::Impl::heard_air_time(std::size_t bytes) const {
+    double on_air = static_cast<double>(bytes);
+    if (cfg.air_packet_payload != 0) {
+        on_air *= static_cast<double>(cfg.air_packet_payload + cfg.air_packet_overhead) /
+                  static_cast<double>(cfg.air_packet_payload);
+    }
+    return std::chrono::duration_cast<Duration>(std::chrono::duration<double>(
+        std::max(on_air / air_rate(), static_cast<double>(bytes) / cfg.link_rate_bytes_per_s)));
 }
 
 TimePoint Transport::Impl::ack_due() const {
@@ -167,7 +236,7 @@ TimePoint Transport::Impl::content_due(std::size_t path) const {
         if (borrowed(path)) {
             // A borrowed path carries bulk only: urgent traffic keeps to this end's own pair.
             if (level_ready(senders.size() - 1, true)) {
-                t = std::min(t, air_gate(path) == AirGate::Open ? current_time : ps.air_debt);
+                t = std::min(t, air_gate(path) == AirGate::Open ? current_time : air_reopens(path));
             }
         } else if (!ps.mirror.empty()) {
             return std::min(t, current_time);
@@ -176,7 +245,7 @@ TimePoint Transport::Impl::content_due(std::size_t path) const {
             if (gate == AirGate::Open || (gate == AirGate::UrgentOnly && data_ready(false))) {
                 return std::min(t, current_time);
             }
-            t = std::min(t, ps.air_debt);
+            t = std::min(t, air_reopens(path));
         }
         t = std::min(t, ack_due());
     }
@@ -229,10 +298,8 @@ std::optional<std::vector<std::uint8_t>> Transport::Impl::poll_transmit(std::siz
 
 void Transport::Impl::account_sent(std::size_t path, std::size_t bytes, TimePoint now) {
     Path& ps = paths[path];
-    const bool urgent = now < urgent_until || (peer_urgent && peer_mask_fresh());
-    const double rate = cfg.link_rate_bytes_per_s * (urgent ? cfg.urgent_pacing : 1.0);
-    const auto air = std::chrono::duration_cast<Duration>(
-        std::chrono::duration<double>(static_cast<double>(bytes) / rate));
+    const bool urgent = now < urgent_until;
+    const Duration air = frame_time(bytes, urgent ? cfg.urgent_pacing : 1.0);
     ps.next_free = std::max(ps.next_free, now) + air;
     ps.air_debt = std::max(ps.air_debt, now) + air;  // the shared-air budget counts both ends
     ps.tx_rate = decayed_rate(ps.tx_rate, ps.tx_rate_time, now) + static_cast<double>(bytes);
@@ -512,9 +579,8 @@ void Transport::Impl::update_plan() {
     // On half-duplex radios every frame also costs two changes of sender (acknowledgements come back in
     // between); a group of shards pays them once.
     const double turnaround_bytes =
-        cfg.half_duplex
-            ? 2.0 * std::chrono::duration<double>(cfg.air_turnaround).count() * cfg.link_rate_bytes_per_s
-            : 0.0;
+        cfg.half_duplex ? 2.0 * std::chrono::duration<double>(cfg.air_turnaround).count() * carried_rate()
+                        : 0.0;
     const auto overhead = frame::frame_overhead(mac != nullptr) + frame::safe_chunk_overhead() +
                           static_cast<std::size_t>(std::lround(turnaround_bytes));
     // Parity sized for independent errors does not repair bursts (a lost air packet takes many shards).

@@ -8,6 +8,7 @@
 #include "daemon/config_loader.hpp"
 #include "daemon/config_schema.hpp"
 #include "daemon/duration.hpp"
+#include "services/groundlink/groundlink_service.hpp"
 #include "tests/support/tree_paths.hpp"
 
 namespace airseg::daemon {
@@ -169,6 +170,152 @@ TEST(Config, DiffNamesRuntimeChanges) {
     EXPECT_TRUE(changes[0].runtime);
     EXPECT_EQ(changes[1].key, "autopilot.port");
     EXPECT_FALSE(changes[1].runtime);
+}
+
+const char* const kRadioYaml =
+    "groundlink:\n"
+    "  radio:\n"
+    "    air_speed: 64\n"
+    "    ecc: true\n"
+    "    packet: 252\n"
+    "    packet_overhead: 8\n"
+    "    turnaround: 10ms\n"
+    "    duplex: full\n"
+    "    buffer: 2048\n";
+
+TEST(RadioConfig, SectionLoadsIntoTheProfile) {
+    auto r = load_config_text(kRadioYaml, "r.yaml");
+    ASSERT_TRUE(r.ok()) << r.errors[0].to_string();
+    const auto& p = r.config.groundlink.radio;
+    EXPECT_EQ(p.air_speed_kbps, 64u);
+    EXPECT_TRUE(p.ecc);
+    EXPECT_EQ(p.packet_bytes, 252u);
+    EXPECT_EQ(p.packet_overhead, 8u);
+    EXPECT_EQ(p.turnaround, milliseconds(10));
+    EXPECT_FALSE(p.half_duplex);
+    EXPECT_EQ(p.buffer_bytes, 2048u);
+
+    // Not a runtime key: SIGHUP reports it as needing a restart.
+    const auto changes = diff_config(Config{}, r.config);
+    ASSERT_EQ(changes.size(), 6u);  // packet is the default
+    for (const auto& change : changes) {
+        EXPECT_TRUE(change.key.starts_with("groundlink.radio.")) << change.key;
+        EXPECT_FALSE(change.runtime) << change.key;
+    }
+    EXPECT_EQ(changes[4].key, "groundlink.radio.duplex");
+    EXPECT_EQ(changes[4].from, "half");
+    EXPECT_EQ(changes[4].to, "full");
+}
+
+TEST(RadioConfig, SetOverridesReachTheProfile) {
+    auto r = load_config_text(kRadioYaml, "r.yaml",
+                              {"groundlink.radio.packet=32", "groundlink.radio.duplex=half",
+                               "groundlink.radio.ecc=off", "groundlink.radio.turnaround=5ms"});
+    ASSERT_TRUE(r.ok()) << r.errors[0].to_string();
+    EXPECT_EQ(r.config.groundlink.radio.packet_bytes, 32u);
+    EXPECT_TRUE(r.config.groundlink.radio.half_duplex);
+    EXPECT_FALSE(r.config.groundlink.radio.ecc);
+    EXPECT_EQ(r.config.groundlink.radio.turnaround, milliseconds(5));
+    EXPECT_EQ(r.config.groundlink.radio.air_speed_kbps, 64u);  // from the file
+
+    auto bad = load_config_text("", "x", {"groundlink.radio.buffer=10"});
+    ASSERT_EQ(bad.errors.size(), 1u);
+    EXPECT_EQ(bad.errors[0].where, "--set groundlink.radio.buffer");
+    EXPECT_EQ(bad.errors[0].key, "groundlink.radio.buffer");
+}
+
+TEST(RadioConfig, EachBadKeyIsNamedAtItsLine) {
+    auto r = load_config_text(
+        "groundlink:\n"
+        "  radio:\n"
+        "    air_speed: 200000\n"
+        "    ecc: maybe\n"
+        "    packet: 5000\n"
+        "    packet_overhead: 300\n"
+        "    turnaround: 200ms\n"
+        "    duplex: simplex\n"
+        "    buffer: 20000000\n"
+        "    power: 20\n",
+        "r.yaml");
+    std::vector<std::string> keys;
+    for (const auto& e : r.errors) {
+        keys.push_back(e.key);
+    }
+    EXPECT_EQ(keys, (std::vector<std::string>{"groundlink.radio.air_speed", "groundlink.radio.ecc",
+                                              "groundlink.radio.packet", "groundlink.radio.packet_overhead",
+                                              "groundlink.radio.turnaround", "groundlink.radio.duplex",
+                                              "groundlink.radio.buffer", "groundlink.radio.power"}));
+    ASSERT_EQ(r.errors.size(), 8u);
+    EXPECT_EQ(r.errors[0].where, "r.yaml:3:16");
+    EXPECT_NE(r.errors[0].message.find("out of range 0..100000"), std::string::npos) << r.errors[0].message;
+    EXPECT_NE(r.errors[5].message.find("expected half or full, got 'simplex'"), std::string::npos)
+        << r.errors[5].message;
+    EXPECT_NE(r.errors[7].message.find("unknown key"), std::string::npos) << r.errors[7].message;
+
+    // The schema's bounds are the profile's: each at its limit loads.
+    auto limits = load_config_text(
+        "groundlink:\n  radio: {air_speed: 100000, packet: 4096, packet_overhead: 256, turnaround: 100ms, "
+        "buffer: 16777216}\n",
+        "l.yaml");
+    EXPECT_TRUE(limits.ok()) << limits.errors[0].to_string();
+}
+
+TEST(RadioConfig, RulesOfTheProfileNameTheKey) {
+    auto overhead =
+        load_config_text("groundlink:\n  radio:\n    packet: 0\n    packet_overhead: 8\n", "o.yaml");
+    ASSERT_EQ(overhead.errors.size(), 1u);
+    EXPECT_EQ(overhead.errors[0].key, "groundlink.radio.packet_overhead");
+    EXPECT_EQ(overhead.errors[0].where, "o.yaml:4:5");
+    EXPECT_EQ(overhead.errors[0].to_string(),
+              "o.yaml:4:5: groundlink.radio.packet_overhead: needs packet (the bytes each packet carries)");
+
+    // Within the schema's range, but in the profile's gaps.
+    auto packet = load_config_text("groundlink:\n  radio:\n    packet: 4\n", "p.yaml");
+    ASSERT_EQ(packet.errors.size(), 1u);
+    EXPECT_EQ(packet.errors[0].key, "groundlink.radio.packet");
+    EXPECT_EQ(packet.errors[0].where, "p.yaml:3:5");
+    EXPECT_NE(packet.errors[0].message.find("must be 0 (no packets) or 8..4096"), std::string::npos)
+        << packet.errors[0].message;
+    auto buffer = load_config_text("groundlink:\n  radio:\n    buffer: 10\n", "b.yaml");
+    ASSERT_EQ(buffer.errors.size(), 1u);
+    EXPECT_EQ(buffer.errors[0].key, "groundlink.radio.buffer");
+}
+
+TEST(RadioConfig, TransportConfigForAppliesItOnSerialLinksOnly) {
+    auto r = load_config_text(kRadioYaml, "r.yaml");
+    ASSERT_TRUE(r.ok()) << r.errors[0].to_string();
+    groundlink::GroundlinkServiceConfig g;
+    g.baud = 57600;
+    g.radio = r.config.groundlink.radio;
+
+    const auto serial = groundlink::transport_config_for(g);
+    EXPECT_DOUBLE_EQ(serial.link_rate_bytes_per_s, 5760.0);
+    EXPECT_DOUBLE_EQ(serial.air_rate_bytes_per_s, 4000.0);  // 64 kbit/s, halved by ECC
+    EXPECT_EQ(serial.air_packet_payload, 252u);
+    EXPECT_EQ(serial.air_packet_overhead, 8u);
+    EXPECT_EQ(serial.air_turnaround, milliseconds(10));
+    EXPECT_FALSE(serial.half_duplex);
+    EXPECT_EQ(serial.radio_buffer_bytes, 2048u);
+    EXPECT_TRUE(serial.validate().empty());
+    // The air, net of each 252-byte packet's 8 bytes, is slower than the port: the budgets follow it.
+    EXPECT_NEAR(serial.carried_rate_bytes_per_s(), 4000.0 * 252 / 260, 0.01);
+
+    g.mode = "udp";
+    const auto udp = groundlink::transport_config_for(g);
+    const groundlink::TransportConfig defaults;
+    EXPECT_EQ(udp.air_rate_bytes_per_s, 0.0);
+    EXPECT_EQ(udp.air_packet_payload, defaults.air_packet_payload);
+    EXPECT_EQ(udp.air_packet_overhead, 0u);
+    EXPECT_EQ(udp.air_turnaround, defaults.air_turnaround);
+    EXPECT_FALSE(udp.half_duplex);
+    EXPECT_EQ(udp.radio_buffer_bytes, 0u);
+
+    // The defaults: the air is the serial port, nothing more to pace for.
+    g = {};
+    const auto plain = groundlink::transport_config_for(g);
+    EXPECT_EQ(plain.air_rate_bytes_per_s, 0.0);
+    EXPECT_EQ(plain.air_packet_overhead, 0u);
+    EXPECT_TRUE(plain.half_duplex);
 }
 
 TEST(AutopilotConfig, KeysReachTheServiceConfiguration) {
