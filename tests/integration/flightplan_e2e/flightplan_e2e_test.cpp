@@ -374,7 +374,15 @@ TEST_P(FlightplanE2e, ReplacingThePlanMidRouteHeadsForTheNewFirstWaypointWithout
     const auto reached_at_answer = reached_total(*control_);
     freeze(false);
     EXPECT_EQ(replaced.json["name"], "route-b");
-    ASSERT_TRUE(wait_until([&] { return show().value("state", "") == "done"; }, 60s, kPoll)) << show().dump();
+    ASSERT_TRUE(wait_until([&] { return show().value("state", "") == "done"; }, 60s, kPoll))
+        << show().dump() << "\nthe board: " << control_->json("state").dump()
+        << "\nholds: " << holds_after(t0).dump() << "\n"
+        <<
+        [&] {
+            const auto log = board_log(first);  // B's waypoints are matched near the end of the log
+            return describe_reached_around(log, b, log.empty() ? 0 : log.size() - 1);
+        }()
+        << daemon_->err();
 
     const auto reached = board_log(first);
     // A from its first waypoint without a gap, then B from its first waypoint to its end.
@@ -1059,7 +1067,7 @@ class FlightplanStarvedE2e : public FlightplanE2e {
         for (std::size_t i = 0; i < expected.size(); ++i) {
             ASSERT_PRED2(same_place, reached[i].at, expected[i])
                 << "seed " << seed << ": reached #" << i << " is not plan waypoint " << i << "\n"
-                << describe_reached_around(reached, expected, i);
+                << describe_reached_around(reached, expected, i) << daemon_->err();
         }
         for (std::size_t i = expected.size(); i < reached.size(); ++i) {
             EXPECT_PRED2(same_place, reached[i].at, expected.back())
