@@ -51,6 +51,11 @@ class LocalCommandServer::Session : public std::enable_shared_from_this<Session>
     bool busy() const { return in_flight_; }
     /// Has sent no request since it connected: it holds a place without using it.
     bool silent() const { return !asked_; }
+    /// Bytes of a request sent and not yet read: a daemon slower than its client has not seen it ask.
+    bool has_unread_request() const {
+        boost::system::error_code ec;
+        return input_.size() > 0 || socket_.available(ec) > 0;
+    }
     TimePoint last_active() const { return last_active_; }
 
   private:
@@ -281,7 +286,8 @@ void LocalCommandServer::do_accept() {
 
 // A full table must not lock the board out: a client that has never asked anything makes room first (the
 // one connected longest), then the client idle longest. A watcher between two polls is idle longer than a
-// burst of silent newcomers, and must not be the one closed for them. Only clients that all wait for an
+// burst of silent newcomers, and must not be the one closed for them; nor may a client whose request is
+// waiting to be read (a daemon behind its clients has not seen it yet). Only clients that all wait for an
 // answer of their own keep a newcomer out.
 void LocalCommandServer::admit(Protocol::socket socket) {
     const TimePoint now = SteadyClock::now();
@@ -294,7 +300,7 @@ void LocalCommandServer::admit(Protocol::socket socket) {
             return a.last_active() < b.last_active();
         };
         for (const auto& s : sessions_) {
-            if (!s->busy() && (!oldest || closes_before(*s, *oldest))) {
+            if (!s->busy() && !s->has_unread_request() && (!oldest || closes_before(*s, *oldest))) {
                 oldest = s;
             }
         }

@@ -232,6 +232,13 @@ class HostilePeers : public ::testing::Test {
                 std::this_thread::sleep_for(100ms);
             }
         });
+        // A watcher is one that has polled: the case's peers come after its first answer.
+        ASSERT_TRUE(wait_until(
+            [&] {
+                std::lock_guard lock(watch_mutex_);
+                return probes_ > 0;
+            },
+            20s));
     }
     void stop_watching() {
         watching_ = false;

@@ -254,6 +254,24 @@ TEST_F(LocalCommandServerTest, AWatcherBetweenTwoPollsIsNotClosedForSilentNewcom
     EXPECT_EQ(stats().clients, LocalCommandServer::kMaxConnections);
 }
 
+TEST_F(LocalCommandServerTest, AClientWhoseRequestIsOnItsWayIsNotClosedForSilentNewcomers) {
+    start();
+    // The first client's request has not all arrived (a slow client, or a daemon behind its clients): to
+    // the server it has not asked yet, and it is the oldest connection.
+    Client first(path);
+    ASSERT_TRUE(first.connected());
+    ASSERT_TRUE(first.send("{\"cmd\":"));
+    std::vector<std::unique_ptr<Client>> silent;
+    for (std::size_t i = 0; i < LocalCommandServer::kMaxConnections + 3; ++i) {
+        silent.push_back(std::make_unique<Client>(path));
+        ASSERT_TRUE(silent.back()->connected());
+    }
+    ASSERT_TRUE(wait_until([&] { return stats().evicted == 4u; })) << stats().evicted;
+    ASSERT_TRUE(first.send("\"status\"}\n"));
+    EXPECT_NE(first.line().find("\"ok\":true"), std::string::npos) << "the first client kept its connection";
+    EXPECT_EQ(stats().refused, 0u);
+}
+
 TEST_F(LocalCommandServerTest, WhenEveryClientRunsARequestANewcomerIsRefusedWithALine) {
     start();
     std::vector<std::unique_ptr<Client>> busy;
