@@ -107,6 +107,8 @@ class Transport::Impl {
     [[nodiscard]] AirGate air_gate(std::size_t path) const;
     /// When a closed air gate may open again.
     [[nodiscard]] TimePoint air_reopens(std::size_t path) const;
+    /// Bytes/s this end writes on a path, recently (what the air gate compares with its shares).
+    [[nodiscard]] double air_use(std::size_t path) const;
     /// The radio's own queue is estimated past half its buffer.
     [[nodiscard]] bool radio_full(std::size_t path) const;
     /// Bytes per second the air carries (air_rate, else link_rate).

@@ -11,14 +11,15 @@ namespace {
 
 constexpr std::size_t kMinUsefulSafe = 16;  // do not top up a frame with a Safe sliver smaller than this
 constexpr std::size_t kMaxDataChunks = 64;
-constexpr double kFairShare = 0.45;  // of link_rate, below which an end is not held back on shared air
+constexpr double kFairShare = 0.45;  // of the carried rate, below which an end is not held back on shared air
 // Frame ceiling (in air time) while the peer is urgent and this end is not; longer while the peer sends
 // only a trickle (under kPeerTrickle of the link: the vehicle's telemetry), whose few messages meet a frame
 // on air rarely enough that bulk should not pay for them.
 constexpr auto kPeerWaitAir = std::chrono::milliseconds(50);
 constexpr auto kPeerTrickleWaitAir = std::chrono::milliseconds(100);
 constexpr double kPeerTrickle = 0.1;
-constexpr double kBulkFloor = 0.2;  // of link_rate, below which an end's bulk does not yield to the peer's
+constexpr double kBulkFloor =
+    0.2;  // of the carried rate, below which an end's bulk does not yield to the peer's
 // Share of recent Safe segments declared lost above which frames stay at most kLossyFramePayload.
 constexpr double kLossyFraction = 0.15;
 constexpr std::size_t kLossyFramePayload = 192;
@@ -153,9 +154,7 @@ Transport::Impl::AirGate Transport::Impl::air_gate(std::size_t path) const {
     // An end using less than its fair share of the air (a little under half) is not held back, so a
     // saturating peer cannot starve it and two saturating ends share the air. A heavier end waits for the
     // air budget both ends share.
-    // The average decays between frames; half a frame restores its mean over the sawtooth.
-    const double rate =
-        decayed_rate(ps.tx_rate, ps.tx_rate_time, current_time) + 0.5 * static_cast<double>(ps.last_frame);
+    const double rate = air_use(path);
     if (rate >= kFairShare * carried_rate()) {
         return AirGate::Closed;
     }
@@ -166,6 +165,12 @@ Transport::Impl::AirGate Transport::Impl::air_gate(std::size_t path) const {
     const bool yield = peer_urgent && peer_mask_fresh() && current_time >= urgent_until &&
                        rate >= kBulkFloor * carried_rate();
     return yield ? AirGate::UrgentOnly : AirGate::Open;
+}
+
+double Transport::Impl::air_use(std::size_t path) const {
+    const Path& ps = paths[path];
+    // The average decays between frames; half a frame restores its mean over the sawtooth.
+    return decayed_rate(ps.tx_rate, ps.tx_rate_time, current_time) + 0.5 * static_cast<double>(ps.last_frame);
 }
 
 bool Transport::Impl::radio_full(std::size_t path) const {
@@ -186,8 +191,7 @@ TimePoint Transport::Impl::air_reopens(std::size_t path) const {
     // The buffer alone holds it back: open once half the buffer is what remains owed.
     const auto room = std::chrono::duration_cast<Duration>(
         std::chrono::duration<double>(0.5 * static_cast<double>(cfg.radio_buffer_bytes) / air_rate()));
-    const double rate =
-        decayed_rate(ps.tx_rate, ps.tx_rate_time, current_time) + 0.5 * static_cast<double>(ps.last_frame);
+    const double rate = air_use(path);
     return rate >= kFairShare * carried_rate() ? ps.air_debt : std::max(current_time, ps.air_debt - room);
 }
 
