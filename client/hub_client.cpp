@@ -16,6 +16,7 @@
 
 namespace airseg::client {
 
+namespace hub = groundside::hub;
 namespace proto = groundlink::protocol;
 using Clock = std::chrono::steady_clock;
 

@@ -1,23 +1,23 @@
 #pragma once
 // airsegctl through the ground hub (airseg-ground), which owns the radio and keeps the one session to the
-// vehicle: a Unix or TCP socket carrying hub frames (client/hub_wire.hpp). The hub grants a role per client:
-// control (one client at a time, with the control key when the hub has one) or monitor.
+// vehicle: a Unix or TCP socket carrying hub frames (groundside/hub_wire.hpp). The hub grants a role per
+// client: control (one client at a time, with the control key when the hub has one) or monitor.
 #include <chrono>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "client/hub_wire.hpp"
 #include "client/vehicle_link.hpp"
+#include "groundside/hub_wire.hpp"
 
 namespace airseg::client {
 
 struct HubOptions {
-    std::string socket{hub::kDefaultSocket};  // Unix socket path, unless tcp is set
-    std::string tcp;                          // HOST:PORT of the hub's TCP listener
-    std::string key_file;                     // proves the control key; without it the client is a monitor
-    bool want_control = false;                // commands that change the vehicle ask for control
-    std::string name = "airsegctl";           // shown by the hub to other clients and in its log
+    std::string socket{groundside::hub::kDefaultSocket};  // Unix socket path, unless tcp is set
+    std::string tcp;                                      // HOST:PORT of the hub's TCP listener
+    std::string key_file;            // proves the control key; without it the client is a monitor
+    bool want_control = false;       // commands that change the vehicle ask for control
+    std::string name = "airsegctl";  // shown by the hub to other clients and in its log
 };
 
 class HubClient final : public VehicleLink {
@@ -45,12 +45,12 @@ class HubClient final : public VehicleLink {
     bool send_frame(const std::vector<std::uint8_t>& frame);
     /// Waits for frames until `deadline` or until `done` says so; false when the connection is gone.
     bool pump(std::chrono::steady_clock::time_point deadline,
-              const std::function<bool(hub::Frame&)>& on_frame);
+              const std::function<bool(groundside::hub::Frame&)>& on_frame);
     void take_json(const nlohmann::json& j);
 
     HubOptions options_;
     int fd_ = -1;
-    hub::FrameReader reader_;
+    groundside::hub::FrameReader reader_;
     std::string role_;
     std::string role_reason_;
     std::string closed_reason_;

@@ -9,7 +9,7 @@
 
 #include "client/json_text.hpp"
 #include "client/stick_input.hpp"
-#include "client/watch_view.hpp"
+#include "groundside/watch_view.hpp"
 
 namespace airseg::client {
 
@@ -62,7 +62,7 @@ bool stop_requested() {
 }
 
 int run_radio_watch(VehicleLink& radio, const LiveOptions& o) {
-    WatchState state;
+    groundside::WatchState state;
     auto take = [&state](const proto::Message& m) { state.take(m, Clock::now()); };
     if (!wait_for_link(radio, o, take)) {
         return kNoLink;
@@ -115,7 +115,7 @@ int run_log(VehicleLink& radio, const LiveOptions& o) {
             std::cout << dump_text(nlohmann::json{{"severity", sev}, {"text", e->text}}) << "\n"
                       << std::flush;
         } else {
-            std::cout << event_line(*e) << "\n" << std::flush;
+            std::cout << groundside::event_line(*e) << "\n" << std::flush;
         }
     };
     if (!wait_for_link(radio, o, print)) {
@@ -157,7 +157,7 @@ int run_joystick(VehicleLink& radio, const LiveOptions& o, const JoystickOptions
                                          : "driving from " + j.device)
                   << "\r\n";
     }
-    WatchState view;
+    groundside::WatchState view;
     auto take = [&view](const proto::Message& m) { view.take(m, Clock::now()); };
     const auto period =
         std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::duration<double>(1.0 / j.rate_hz));

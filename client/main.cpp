@@ -24,12 +24,12 @@
 #include "client/live_commands.hpp"
 #include "client/local_client.hpp"
 #include "client/mqtt_client.hpp"
-#include "client/mqtt_options.hpp"
 #include "client/plan_command.hpp"
 #include "client/radio_client.hpp"
-#include "client/radio_options.hpp"
 #include "client/status_view.hpp"
 #include "client/vehicle_commands.hpp"
+#include "groundside/mqtt_options.hpp"
+#include "groundside/radio_options.hpp"
 #include "services/common/nearest_word.hpp"
 
 namespace {
@@ -77,9 +77,9 @@ const char* const kUsageTail =
 
 struct Options {
     std::string socket = "/run/airseg/status.sock";
-    airseg::client::RadioOptions radio;
+    airseg::groundside::RadioOptions radio;
     airseg::client::HubOptions hub;
-    airseg::client::MqttOptions mqtt;
+    airseg::groundside::MqttOptions mqtt;
     std::string vehicle;
     bool use_radio = false;
     bool use_hub = false;
@@ -135,8 +135,8 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
                    o.hub.tcp = v;
                    o.use_hub = true;
                });
-    airseg::client::add_radio_options(table, o.radio, [&o] { o.use_radio = true; });
-    airseg::client::add_mqtt_options(table, o.mqtt, o.vehicle, [&o] { o.use_mqtt = true; });
+    airseg::groundside::add_radio_options(table, o.radio, [&o] { o.use_radio = true; });
+    airseg::groundside::add_mqtt_options(table, o.mqtt, o.vehicle, [&o] { o.use_mqtt = true; });
     table
         .value("timeout", "MS", "how long to wait for an answer, in milliseconds (default 5000)",
                [&o](std::string_view option, std::string_view v) {
@@ -183,7 +183,7 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
     if (o.use_mqtt && o.vehicle.empty()) {
         return usage_error("--mqtt needs --vehicle ID: a broker serves many vehicles");
     }
-    if (auto problem = airseg::client::check_mqtt_options(o.mqtt); o.use_mqtt && !problem.empty()) {
+    if (auto problem = airseg::groundside::check_mqtt_options(o.mqtt); o.use_mqtt && !problem.empty()) {
         return usage_error(problem);
     }
     if (o.use_radio && o.use_hub) {
@@ -192,12 +192,12 @@ std::optional<int> parse(int argc, char** argv, Options& o) {
             "radio");
     }
     if (o.use_radio) {
-        if (auto problem = airseg::client::validate(o.radio); !problem.empty()) {
+        if (auto problem = airseg::groundside::validate(o.radio); !problem.empty()) {
             return usage_error(problem);
         }
     }
     if (!o.use_radio && !o.use_hub && !o.use_mqtt && !o.local_chosen && !exists(o.socket) &&
-        exists(std::string(airseg::client::hub::kDefaultSocket))) {
+        exists(std::string(airseg::groundside::hub::kDefaultSocket))) {
         o.use_hub = true;  // a ground laptop: no airsegd here, but a hub
     }
     return std::nullopt;

@@ -6,8 +6,8 @@
 #include <random>
 
 #include "client/json_text.hpp"
-#include "client/mqtt_options.hpp"
-#include "client/watch_view.hpp"
+#include "groundside/mqtt_options.hpp"
+#include "groundside/watch_view.hpp"
 #include "services/autopilot/ardupilot/rover_modes.hpp"
 
 namespace airseg::client {
@@ -68,20 +68,20 @@ std::optional<proto::Telemetry> telemetry_from_json(const Json& v) {
         code_named(v.value("mode", ""), proto::kModeUnknown - 1, autopilot::ardupilot::rover_mode_known_name)
             .value_or(proto::kModeUnknown);
     if (const auto plan = v.find("plan"); plan != v.end() && plan->is_object()) {
-        t.plan_state = code_named(plan->value("state", ""), 5, plan_state_name).value_or(0);
+        t.plan_state = code_named(plan->value("state", ""), 5, groundside::plan_state_name).value_or(0);
         t.plan_element = plan->value("element", std::uint16_t{0});
         t.next_waypoint = plan->value("next_waypoint", std::uint32_t{0});
     }
     return t;
 }
 
-MqttClient::MqttClient(MqttOptions options, std::string vehicle) : vehicle_(std::move(vehicle)) {
+MqttClient::MqttClient(groundside::MqttOptions options, std::string vehicle) : vehicle_(std::move(vehicle)) {
     std::random_device rd;
     options.client_id = fmt::format("airsegctl-{}-{:08x}", ::getpid(), rd());
     options.clean_session = true;
-    session_ = std::make_unique<MqttSession>(
+    session_ = std::make_unique<groundside::MqttSession>(
         io_.get_executor(), std::move(options),
-        MqttSession::Handlers{
+        groundside::MqttSession::Handlers{
             [this](bool up, const std::string& why) {
                 connected_ = up;
                 if (!up && !why.empty()) {
@@ -97,7 +97,7 @@ MqttClient::~MqttClient() {
 
 std::string MqttClient::open(std::chrono::milliseconds timeout) {
     for (const auto* kind : {"cmd/result", "telemetry", "events", "link", "status"}) {
-        session_->subscribe(vehicle_topic(vehicle_, kind), 1);
+        session_->subscribe(groundside::vehicle_topic(vehicle_, kind), 1);
     }
     if (auto error = session_->start(); !error.empty()) {
         return error;
@@ -118,7 +118,7 @@ std::string MqttClient::open(std::chrono::milliseconds timeout) {
 }
 
 void MqttClient::on_message(const std::string& topic, const std::string& payload) {
-    const auto prefix = vehicle_topic(vehicle_, "");
+    const auto prefix = groundside::vehicle_topic(vehicle_, "");
     if (topic.rfind(prefix, 0) != 0) {
         return;
     }
@@ -170,7 +170,7 @@ LocalAnswer MqttClient::request(const Json& request, std::chrono::milliseconds t
     awaiting_ = fmt::format("{:08x}{:08x}", rd(), rd());
     answer_.reset();
     const Json message{{"id", awaiting_}, {"request", request}};
-    if (!session_->publish(vehicle_topic(vehicle_, "cmd"), dump_text(message), 1, false)) {
+    if (!session_->publish(groundside::vehicle_topic(vehicle_, "cmd"), dump_text(message), 1, false)) {
         out.error = "the command could not be queued for the MQTT broker";
         return out;
     }

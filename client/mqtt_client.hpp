@@ -7,8 +7,8 @@
 #include <optional>
 #include <string>
 
-#include "client/mqtt_session.hpp"
 #include "client/vehicle_link.hpp"
+#include "groundside/mqtt_session.hpp"
 
 namespace airseg::client {
 
@@ -18,7 +18,7 @@ std::optional<groundlink::protocol::Telemetry> telemetry_from_json(const nlohman
 
 class MqttClient final : public VehicleLink {
   public:
-    MqttClient(MqttOptions options, std::string vehicle);
+    MqttClient(groundside::MqttOptions options, std::string vehicle);
     ~MqttClient() override;
     MqttClient(const MqttClient&) = delete;
     MqttClient& operator=(const MqttClient&) = delete;
@@ -43,7 +43,7 @@ class MqttClient final : public VehicleLink {
     asio::any_io_executor keep_waiting_ =
         asio::prefer(io_.get_executor(), asio::execution::outstanding_work.tracked);
     std::string vehicle_;
-    std::unique_ptr<MqttSession> session_;
+    std::unique_ptr<groundside::MqttSession> session_;
     bool connected_ = false;
     std::string refused_;
     nlohmann::json link_ = {{"link", "down"}};

@@ -13,10 +13,10 @@ namespace proto = airseg::groundlink::protocol;
 
 class RadioClient::Impl {
   public:
-    explicit Impl(RadioOptions options)
+    explicit Impl(groundside::RadioOptions options)
         : strand_(asio::make_strand(io_)),
           end_(strand_, std::move(options),
-               GroundEnd::Handlers{[this](proto::Message m) { on_message(std::move(m)); }, {}}) {
+               groundside::GroundEnd::Handlers{[this](proto::Message m) { on_message(std::move(m)); }, {}}) {
         std::random_device rd;
         next_id_ = rd();  // answers left over from another client's session are not mistaken for ours
     }
@@ -81,8 +81,8 @@ class RadioClient::Impl {
         on_message_ = nullptr;
     }
 
-    GroundEnd& end() { return end_; }
-    const GroundEnd& end() const { return end_; }
+    groundside::GroundEnd& end() { return end_; }
+    const groundside::GroundEnd& end() const { return end_; }
 
     void send_joystick(double steering, double throttle) {
         asio::dispatch(strand_, [this, steering, throttle] {
@@ -106,14 +106,15 @@ class RadioClient::Impl {
 
     asio::io_context io_;
     Strand strand_;
-    GroundEnd end_;
+    groundside::GroundEnd end_;
     std::uint32_t next_id_ = 1;
     std::uint32_t awaiting_ = 0;
     std::optional<nlohmann::json>* answer_ = nullptr;
     std::function<void(const proto::Message&)> on_message_;
 };
 
-RadioClient::RadioClient(RadioOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
+RadioClient::RadioClient(groundside::RadioOptions options)
+    : impl_(std::make_unique<Impl>(std::move(options))) {}
 RadioClient::~RadioClient() = default;
 std::string RadioClient::open() {
     return impl_->open();

@@ -7,14 +7,14 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "client/ground_end.hpp"
 #include "client/vehicle_link.hpp"
+#include "groundside/ground_end.hpp"
 
 namespace airseg::client {
 
 class RadioClient final : public VehicleLink {
   public:
-    explicit RadioClient(RadioOptions options);
+    explicit RadioClient(groundside::RadioOptions options);
     ~RadioClient() override;
     RadioClient(const RadioClient&) = delete;
     RadioClient& operator=(const RadioClient&) = delete;

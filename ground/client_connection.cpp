@@ -78,7 +78,7 @@ void ClientConnection::close(const std::string& why) {
     if (closed_ || closing_) {
         return;
     }
-    queue_.push_back(client::hub::encode_json({{"error", why}}));
+    queue_.push_back(groundside::hub::encode_json({{"error", why}}));
     queued_bytes_ += queue_.back().size();
     closing_ = true;
     close_reason_ = why;

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "client/hub_wire.hpp"
+#include "groundside/hub_wire.hpp"
 #include "services/common/asio.hpp"
 
 namespace airseg::ground {
@@ -18,7 +18,7 @@ class ClientConnection : public std::enable_shared_from_this<ClientConnection> {
   public:
     using Socket = asio::generic::stream_protocol::socket;
     struct Handlers {
-        std::function<void(ClientConnection&, client::hub::Frame)> on_frame;
+        std::function<void(ClientConnection&, groundside::hub::Frame)> on_frame;
         std::function<void(ClientConnection&, const std::string& why)> on_closed;
     };
     /// Bytes queued for a client beyond which it counts as stuck.
@@ -44,7 +44,7 @@ class ClientConnection : public std::enable_shared_from_this<ClientConnection> {
     std::uint32_t id_;
     std::string peer_;
     Handlers handlers_;
-    client::hub::FrameReader reader_;
+    groundside::hub::FrameReader reader_;
     std::array<std::uint8_t, 16384> buffer_{};
     std::deque<std::vector<std::uint8_t>> queue_;
     std::size_t queued_bytes_ = 0;

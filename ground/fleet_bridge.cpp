@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <chrono>
 
-#include "client/watch_view.hpp"
 #include "ground/fleet_command.hpp"
+#include "groundside/watch_view.hpp"
 
 namespace airseg::ground {
 
@@ -22,7 +22,7 @@ double unix_now() {
     return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
-client::MqttOptions session_options(const FleetConfig& config) {
+groundside::MqttOptions session_options(const FleetConfig& config) {
     auto options = config.mqtt;
     // A persistent session: the broker keeps the cmd subscription and queues QoS 1 commands while the hub is
     // away, and hands them over when it is back.
@@ -173,7 +173,7 @@ void FleetBridge::on_command(const std::string& payload) {
 
 void FleetBridge::on_vehicle(const proto::Message& message) {
     if (const auto* t = std::get_if<proto::Telemetry>(&message)) {
-        auto vehicle = client::telemetry_json(*t);
+        auto vehicle = groundside::telemetry_json(*t);
         publish("telemetry", {{"at", unix_now()}, {"vehicle", vehicle}}, kQos0);
         Json plan = vehicle.value(
             "plan",
@@ -183,10 +183,11 @@ void FleetBridge::on_vehicle(const proto::Message& message) {
             publish_plan();
         }
     } else if (const auto* e = std::get_if<proto::Event>(&message)) {
-        publish(
-            "events",
-            {{"at", unix_now()}, {"severity", client::event_severity_name(e->severity)}, {"text", e->text}},
-            kQos1);
+        publish("events",
+                {{"at", unix_now()},
+                 {"severity", groundside::event_severity_name(e->severity)},
+                 {"text", e->text}},
+                kQos1);
     } else if (const auto* s = std::get_if<proto::LinkStatsReport>(&message)) {
         vehicle_link_ = *s;
     }

@@ -11,15 +11,15 @@
 #include <string>
 #include <string_view>
 
-#include "client/mqtt_session.hpp"
 #include "ground/hub.hpp"
+#include "groundside/mqtt_session.hpp"
 
 namespace airseg::ground {
 
 struct FleetConfig {
-    client::MqttOptions mqtt;  // client_id and clean_session are set by the bridge
-    std::string vehicle;       // the <vehicle> in every topic
-    std::string hub_version;   // "airseg-ground 1.2.3", for the status topic
+    groundside::MqttOptions mqtt;  // client_id and clean_session are set by the bridge
+    std::string vehicle;           // the <vehicle> in every topic
+    std::string hub_version;       // "airseg-ground 1.2.3", for the status topic
 };
 
 class FleetBridge {
@@ -51,7 +51,7 @@ class FleetBridge {
 
     Hub& hub_;
     FleetConfig config_;
-    client::MqttSession session_;
+    groundside::MqttSession session_;
     asio::steady_timer timer_;
     bool connected_ = false;
     std::string last_why_;

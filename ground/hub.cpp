@@ -17,7 +17,7 @@
 namespace airseg::ground {
 
 namespace proto = groundlink::protocol;
-namespace hub = client::hub;
+namespace hub = groundside::hub;
 using Json = nlohmann::json;
 
 namespace {
@@ -40,18 +40,18 @@ Hub::Hub(Strand strand, HubConfig config)
     : strand_(std::move(strand)),
       config_(std::move(config)),
       end_(strand_, config_.radio,
-           client::GroundEnd::Handlers{[this](proto::Message m) { on_vehicle(std::move(m)); },
-                                       [this](const groundlink::TransportEvent& e) {
-                                           using Kind = groundlink::TransportEvent::Kind;
-                                           const auto now = std::chrono::steady_clock::now();
-                                           if (e.kind == Kind::LinkUp) {
-                                               log_.log("ground hub: link up", now, spdlog::level::info,
-                                                        "ground hub: link to the vehicle up");
-                                           } else if (e.kind == Kind::LinkDown) {
-                                               log_.log("ground hub: link down", now, spdlog::level::warn,
-                                                        "ground hub: link to the vehicle down");
-                                           }
-                                       }}),
+           groundside::GroundEnd::Handlers{[this](proto::Message m) { on_vehicle(std::move(m)); },
+                                           [this](const groundlink::TransportEvent& e) {
+                                               using Kind = groundlink::TransportEvent::Kind;
+                                               const auto now = std::chrono::steady_clock::now();
+                                               if (e.kind == Kind::LinkUp) {
+                                                   log_.log("ground hub: link up", now, spdlog::level::info,
+                                                            "ground hub: link to the vehicle up");
+                                               } else if (e.kind == Kind::LinkDown) {
+                                                   log_.log("ground hub: link down", now, spdlog::level::warn,
+                                                            "ground hub: link to the vehicle down");
+                                               }
+                                           }}),
       tick_timer_(strand_),
       accept_retry_(strand_) {}
 

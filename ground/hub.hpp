@@ -11,18 +11,18 @@
 #include <optional>
 #include <string>
 
-#include "client/ground_end.hpp"
-#include "client/hub_wire.hpp"
 #include "ground/client_connection.hpp"
+#include "groundside/ground_end.hpp"
+#include "groundside/hub_wire.hpp"
 #include "services/common/asio.hpp"
 #include "services/common/limited_log.hpp"
 
 namespace airseg::ground {
 
 struct HubConfig {
-    client::RadioOptions radio;
-    std::string socket{client::hub::kDefaultSocket};  // empty = no Unix socket
-    std::string tcp;                                  // HOST:PORT; empty = no TCP listener
+    groundside::RadioOptions radio;
+    std::string socket{groundside::hub::kDefaultSocket};  // empty = no Unix socket
+    std::string tcp;                                      // HOST:PORT; empty = no TCP listener
     std::string socket_group;  // group given access to the Unix socket; empty = the hub's own
 };
 
@@ -66,7 +66,7 @@ class Hub {
         std::shared_ptr<ClientConnection> connection;
         std::chrono::steady_clock::time_point connected;
         bool timed_out = false;  // closed for saying no hello in time
-        std::array<std::uint8_t, client::hub::kChallengeBytes> challenge{};
+        std::array<std::uint8_t, groundside::hub::kChallengeBytes> challenge{};
         bool local = false;  // came over the Unix socket
         bool welcomed = false;
         bool control = false;
@@ -87,7 +87,7 @@ class Hub {
     void accept_tcp();
     void add_client(ClientConnection::Socket socket, std::string peer, bool local);
     void retry_accept(std::function<void()> accept);
-    void on_frame(ClientConnection& connection, client::hub::Frame frame);
+    void on_frame(ClientConnection& connection, groundside::hub::Frame frame);
     void on_hello(ClientState& client, const nlohmann::json& hello);
     void on_client_message(ClientState& client, const groundlink::protocol::Message& message);
     void on_closed(ClientConnection& connection, const std::string& why);
@@ -98,7 +98,7 @@ class Hub {
 
     Strand strand_;
     HubConfig config_;
-    client::GroundEnd end_;
+    groundside::GroundEnd end_;
     std::optional<std::array<std::uint8_t, 32>> key_;
     std::unique_ptr<asio::local::stream_protocol::acceptor> unix_acceptor_;
     std::unique_ptr<asio::ip::tcp::acceptor> tcp_acceptor_;

@@ -12,13 +12,13 @@
 #include <vector>
 
 #include "cli/command_line.hpp"
-#include "client/mqtt_options.hpp"
-#include "client/mqtt_session.hpp"
-#include "client/radio_options.hpp"
 #include "ground/fleet_bridge.hpp"
 #include "ground/gcs_feed.hpp"
 #include "ground/hub.hpp"
 #include "ground/map_feed.hpp"
+#include "groundside/mqtt_options.hpp"
+#include "groundside/mqtt_session.hpp"
+#include "groundside/radio_options.hpp"
 
 namespace {
 
@@ -60,7 +60,7 @@ std::string check_fleet(Options& o) {
     if (o.fleet.vehicle.empty()) {
         return "--mqtt needs --vehicle ID";
     }
-    if (auto problem = airseg::client::check_mqtt_options(m); !problem.empty()) {
+    if (auto problem = airseg::groundside::check_mqtt_options(m); !problem.empty()) {
         return problem;
     }
     o.fleet.hub_version = std::string("airseg-ground ") + AIRSEG_VERSION;
@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
     using namespace airseg::cli;
     Options o;
     OptionTable table("Options");
-    airseg::client::add_radio_options(table, o.hub.radio, [&o] { o.radio_given = true; });
+    airseg::groundside::add_radio_options(table, o.hub.radio, [&o] { o.radio_given = true; });
     table
         .value(
             "socket", "PATH",
@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
                "serve ground stations over TCP here (default 127.0.0.1:5760; 'off'; 0.0.0.0 opens it to the "
                "network)",
                [&o](std::string_view, std::string_view v) { o.gcs.tcp = v == "off" ? "" : std::string(v); });
-    airseg::client::add_mqtt_options(table, o.fleet.mqtt, o.fleet.vehicle, [&o] { o.mqtt_given = true; });
+    airseg::groundside::add_mqtt_options(table, o.fleet.mqtt, o.fleet.vehicle, [&o] { o.mqtt_given = true; });
     table.value("log-level", "LEVEL", "trace, debug, info, warn or error (default info)", text(o.log_level))
         .help_and_version();
     const Program program{"airseg-ground", [&table] { return kUsageHead + describe(table) + kUsageTail; }};
@@ -125,7 +125,7 @@ int main(int argc, char** argv) {
     if (!o.radio_given) {
         return usage_error(std::cerr, "airseg-ground", "no radio given (--link PATH or --udp HOST:PORT)");
     }
-    if (auto problem = airseg::client::validate(o.hub.radio); !problem.empty()) {
+    if (auto problem = airseg::groundside::validate(o.hub.radio); !problem.empty()) {
         return usage_error(std::cerr, "airseg-ground", problem);
     }
     if (auto problem = check_fleet(o); !problem.empty()) {

@@ -16,7 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "client/hub_client.hpp"
-#include "client/hub_wire.hpp"
+#include "groundside/hub_wire.hpp"
 #include "tests/support/control_client.hpp"
 #include "tests/support/ground_chain.hpp"
 #include "tests/support/json_lines.hpp"
@@ -335,7 +335,7 @@ class RawHubClient {
             }
             reader_.push(std::span(buf, static_cast<std::size_t>(n)));
             while (auto f = reader_.next()) {
-                if (f->type == client::hub::FrameType::Json) {
+                if (f->type == groundside::hub::FrameType::Json) {
                     out.push_back(Json::parse(f->payload, nullptr, false));
                 }
             }
@@ -348,7 +348,7 @@ class RawHubClient {
     int fd_ = -1;
     bool connected_ = false;
     bool closed_ = false;
-    client::hub::FrameReader reader_;
+    groundside::hub::FrameReader reader_;
 };
 
 // 64 clients that connect and say nothing: one more is refused with a line, and the silent ones are closed
@@ -379,7 +379,7 @@ TEST_F(GroundHubE2e, ClientsPastTheBoundAreRefusedAndSilentOnesAreClosed) {
     // A name cut at 64 bytes in the middle of a character, with a terminal escape: the hub escapes it for its
     // log and the link reports every client gets, and goes on.
     RawHubClient named(socket());
-    named.send(client::hub::encode_json(
+    named.send(groundside::hub::encode_json(
         {{"hello", {{"want", "monitor"}, {"name", std::string(63, 'a') + "\xc3\xa9\x1b[2J"}}}}));
     const auto welcome = named.read_until_closed(3s);
     EXPECT_FALSE(named.closed());

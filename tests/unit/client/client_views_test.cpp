@@ -4,12 +4,13 @@
 
 #include "client/stick_input.hpp"
 #include "client/vehicle_commands.hpp"
-#include "client/watch_view.hpp"
+#include "groundside/watch_view.hpp"
 
 namespace airseg::client {
 namespace {
 
 namespace proto = groundlink::protocol;
+using groundside::WatchState;
 
 std::vector<std::uint8_t> js_event(std::int16_t value, std::uint8_t type, std::uint8_t number) {
     const auto v = static_cast<std::uint16_t>(value);

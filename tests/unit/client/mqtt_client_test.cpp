@@ -3,11 +3,17 @@
 #include <gtest/gtest.h>
 
 #include "client/mqtt_client.hpp"
-#include "client/mqtt_options.hpp"
-#include "client/watch_view.hpp"
+#include "groundside/mqtt_options.hpp"
+#include "groundside/watch_view.hpp"
 
 namespace airseg::client {
 namespace {
+
+using groundside::check_vehicle_id;
+using groundside::MqttOptions;
+using groundside::parse_broker;
+using groundside::telemetry_json;
+using groundside::vehicle_topic;
 
 TEST(MqttClient, TelemetryJsonRoundTrips) {
     groundlink::protocol::Telemetry t;

@@ -19,7 +19,7 @@ report() {
 check() {
   local what=$1 pattern=$2 allowed=$3
   report "$what" "$(grep -rlE "$pattern" --include='*.cpp' --include='*.hpp' --include='*.h' \
-                      daemon services hal client tools 2>/dev/null | grep -vE "$allowed" || true)"
+                      daemon services hal groundside client tools 2>/dev/null | grep -vE "$allowed" || true)"
 }
 check "termios/ioctl serial headers" '#include <(termios\.h|asm/termbits\.h|sys/ioctl\.h|pty\.h)>' '^hal/'
 check "libgpiod" '#include <gpiod\.h>' '^hal/'
@@ -34,8 +34,16 @@ report "the ArduPilot driver or MAVLink library (linked by groundlink or flightp
   "$(grep -lE 'airseg_mavlink|airseg_autopilot([^_[:alnum:]]|$)' services/groundlink/CMakeLists.txt \
        services/flightplan/CMakeLists.txt || true)"
 # hal/ sits below the services and the programs; it may use base/ and itself only.
-report "services/, daemon/ or client/ headers (included by hal)" \
-  "$(grep -rlE '#include "(services|daemon|client)/' --include='*.cpp' --include='*.hpp' --include='*.h' hal || true)"
+report "services/, daemon/, groundside/ or client/ headers (included by hal)" \
+  "$(grep -rlE '#include "(services|daemon|groundside|client)/' --include='*.cpp' --include='*.hpp' --include='*.h' \
+       hal || true)"
+# groundside/ is the ground-side code airsegctl (client/) and airseg-ground (ground/) share: it includes
+# neither program's code, and neither program includes the other's.
+report "client/ or ground/ headers (included by groundside)" \
+  "$(grep -rlE '#include "(client|ground)/' --include='*.cpp' --include='*.hpp' --include='*.h' groundside || true)"
+report "the other program's headers (client/ included by ground, ground/ by client)" \
+  "$({ grep -rl '#include "client/' --include='*.cpp' --include='*.hpp' --include='*.h' ground
+       grep -rl '#include "ground/' --include='*.cpp' --include='*.hpp' --include='*.h' client; } || true)"
 # base/ is the bottom room: every other room may include it, so it includes none of them.
 report "headers of other rooms (included by base)" \
   "$(grep -rn '#include "' --include='*.cpp' --include='*.hpp' --include='*.h' base | grep -v '#include "base/' ||

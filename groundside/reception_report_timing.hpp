@@ -9,7 +9,7 @@
 #include "base/time.hpp"
 #include "services/groundlink/transport/transport.hpp"
 
-namespace airseg::client {
+namespace airseg::groundside {
 
 class ReportTiming {
   public:
@@ -33,4 +33,4 @@ class ReportTiming {
 /// The earliest probe deadline over the transport's paths (kNever when none is probed).
 TimePoint earliest_probe(const groundlink::Transport& transport);
 
-}  // namespace airseg::client
+}  // namespace airseg::groundside

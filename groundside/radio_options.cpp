@@ -1,9 +1,9 @@
-#include "client/radio_options.hpp"
+#include "groundside/radio_options.hpp"
 
 #include <climits>
 #include <string>
 
-namespace airseg::client {
+namespace airseg::groundside {
 
 void add_radio_options(cli::OptionTable& table, RadioOptions& radio, std::function<void()> chosen) {
     using namespace airseg::cli;
@@ -48,4 +48,4 @@ void add_radio_options(cli::OptionTable& table, RadioOptions& radio, std::functi
                });
 }
 
-}  // namespace airseg::client
+}  // namespace airseg::groundside

@@ -1,4 +1,4 @@
-#include "client/mqtt_session.hpp"
+#include "groundside/mqtt_session.hpp"
 
 #include <fmt/format.h>
 #include <mosquitto.h>
@@ -11,7 +11,7 @@
 
 #include "base/file_text.hpp"
 
-namespace airseg::client {
+namespace airseg::groundside {
 
 namespace {
 std::once_flag g_library;
@@ -192,4 +192,4 @@ void MqttSession::subscribe(const std::string& topic, int qos) {
     }
 }
 
-}  // namespace airseg::client
+}  // namespace airseg::groundside

@@ -5,9 +5,9 @@
 #include <array>
 #include <string>
 
-#include "client/hub_wire.hpp"
+#include "groundside/hub_wire.hpp"
 
-namespace airseg::client::hub {
+namespace airseg::groundside::hub {
 namespace {
 
 std::vector<std::uint8_t> bytes_of(const std::string& s) {
@@ -79,4 +79,4 @@ TEST(HubWire, HexRoundTripsAndRejectsWhatIsNotHex) {
 }
 
 }  // namespace
-}  // namespace airseg::client::hub
+}  // namespace airseg::groundside::hub

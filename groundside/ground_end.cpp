@@ -1,4 +1,4 @@
-#include "client/ground_end.hpp"
+#include "groundside/ground_end.hpp"
 
 #include <fmt/format.h>
 
@@ -9,7 +9,7 @@
 #include "hal/udp_socket.hpp"
 #include "services/groundlink/link/key_file.hpp"
 
-namespace airseg::client {
+namespace airseg::groundside {
 
 namespace gl = airseg::groundlink;
 namespace proto = airseg::groundlink::protocol;
@@ -251,4 +251,4 @@ void GroundEnd::on_delivered(gl::Delivered m) {
     }
 }
 
-}  // namespace airseg::client
+}  // namespace airseg::groundside

@@ -15,7 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
-namespace airseg::client::hub {
+namespace airseg::groundside::hub {
 
 enum class FrameType : std::uint8_t { Json = 1, Ground = 2 };
 
@@ -57,4 +57,4 @@ std::string to_hex(std::span<const std::uint8_t> bytes);
 /// Empty optional when `text` is not hexadecimal of an even length.
 std::optional<std::vector<std::uint8_t>> from_hex(std::string_view text);
 
-}  // namespace airseg::client::hub
+}  // namespace airseg::groundside::hub

@@ -10,7 +10,7 @@
 
 #include "services/common/asio.hpp"
 
-namespace airseg::client {
+namespace airseg::groundside {
 
 struct MqttOptions {
     std::string host = "localhost";
@@ -59,4 +59,4 @@ class MqttSession {
     std::shared_ptr<State> state_;
 };
 
-}  // namespace airseg::client
+}  // namespace airseg::groundside

@@ -1,11 +1,11 @@
-#include "client/hub_wire.hpp"
+#include "groundside/hub_wire.hpp"
 
 #include <fmt/format.h>
 #include <sodium.h>
 
 #include "base/little_endian.hpp"
 
-namespace airseg::client::hub {
+namespace airseg::groundside::hub {
 
 namespace {
 constexpr std::string_view kProofContext = "airseg-ground hub client v1";
@@ -98,4 +98,4 @@ std::optional<std::vector<std::uint8_t>> from_hex(std::string_view text) {
     return out;
 }
 
-}  // namespace airseg::client::hub
+}  // namespace airseg::groundside::hub

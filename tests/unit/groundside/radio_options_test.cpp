@@ -1,13 +1,13 @@
 // The radio options of airsegctl and airseg-ground: --radio reaches the ground end's profile, and a bad
 // value is one line naming the option and the key.
-#include "client/radio_options.hpp"
+#include "groundside/radio_options.hpp"
 
 #include <gtest/gtest.h>
 
 #include <string>
 #include <vector>
 
-namespace airseg::client {
+namespace airseg::groundside {
 namespace {
 
 using std::chrono::milliseconds;
@@ -86,4 +86,4 @@ TEST(RadioOptions, HelpListsRadio) {
 }
 
 }  // namespace
-}  // namespace airseg::client
+}  // namespace airseg::groundside

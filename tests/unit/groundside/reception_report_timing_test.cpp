@@ -1,7 +1,7 @@
 // The ground's reception report in simulated time (the groundlink SimLink: two transports over a 57600-baud
 // half-duplex radio): at least once a second, and in place of the uplink's keepalive when the ground has
 // nothing else to say.
-#include "client/reception_report_timing.hpp"
+#include "groundside/reception_report_timing.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include "services/groundlink/protocol/ground_protocol.hpp"
 #include "tests/unit/groundlink/sim_link.hpp"
 
-namespace airseg::client {
+namespace airseg::groundside {
 namespace {
 
 namespace gl = groundlink;
@@ -135,4 +135,4 @@ TEST(ReceptionReportTiming, NothingIsReportedWhileTheLinkIsDown) {
 }
 
 }  // namespace
-}  // namespace airseg::client
+}  // namespace airseg::groundside

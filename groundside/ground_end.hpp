@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "client/reception_report_timing.hpp"
+#include "groundside/reception_report_timing.hpp"
 #include "services/common/asio.hpp"
 #include "services/groundlink/link/link_driver.hpp"
 #include "services/groundlink/protocol/ground_protocol.hpp"
@@ -21,7 +21,7 @@ class SerialPort;
 class UdpSocket;
 }  // namespace airseg::hal
 
-namespace airseg::client {
+namespace airseg::groundside {
 
 struct RadioOptions {
     std::vector<std::string> ports;  // --link PATH[,PATH2], in the same pair order as the vehicle's ports
@@ -89,4 +89,4 @@ class GroundEnd {
     bool stopped_ = false;
 };
 
-}  // namespace airseg::client
+}  // namespace airseg::groundside

@@ -4,11 +4,11 @@
 #include <functional>
 
 #include "cli/command_line.hpp"
-#include "client/ground_end.hpp"
+#include "groundside/ground_end.hpp"
 
-namespace airseg::client {
+namespace airseg::groundside {
 
 /// Adds the radio options to `table`, writing into `radio`; `chosen` runs when --link or --udp is given.
 void add_radio_options(cli::OptionTable& table, RadioOptions& radio, std::function<void()> chosen);
 
-}  // namespace airseg::client
+}  // namespace airseg::groundside

@@ -1,8 +1,8 @@
-#include "client/mqtt_options.hpp"
+#include "groundside/mqtt_options.hpp"
 
 #include <algorithm>
 
-namespace airseg::client {
+namespace airseg::groundside {
 
 void add_mqtt_options(cli::OptionTable& table, MqttOptions& options, std::string& vehicle,
                       std::function<void()> chosen) {
@@ -52,4 +52,4 @@ std::string check_vehicle_id(const std::string& id) {
     return fit ? std::string{} : "vehicle id '" + id + "' is not 1 to 64 of A-Z a-z 0-9 _ -";
 }
 
-}  // namespace airseg::client
+}  // namespace airseg::groundside

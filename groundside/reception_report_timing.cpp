@@ -1,8 +1,8 @@
-#include "client/reception_report_timing.hpp"
+#include "groundside/reception_report_timing.hpp"
 
 #include <algorithm>
 
-namespace airseg::client {
+namespace airseg::groundside {
 
 TimePoint earliest_probe(const groundlink::Transport& transport) {
     TimePoint t = kNever;
@@ -40,4 +40,4 @@ TimePoint ReportTiming::next_check(TimePoint now, const groundlink::Transport& t
     return std::max({std::min(last_ + kPeriod, before_probe), last_ + kMinGap, now});
 }
 
-}  // namespace airseg::client
+}  // namespace airseg::groundside

@@ -1,10 +1,10 @@
-#include "client/watch_view.hpp"
+#include "groundside/watch_view.hpp"
 
 #include <fmt/format.h>
 
 #include "services/autopilot/ardupilot/rover_modes.hpp"
 
-namespace airseg::client {
+namespace airseg::groundside {
 
 namespace proto = groundlink::protocol;
 
@@ -176,4 +176,4 @@ nlohmann::json WatchState::to_json(Clock::time_point now) const {
     return j;
 }
 
-}  // namespace airseg::client
+}  // namespace airseg::groundside

@@ -1,6 +1,7 @@
 #pragma once
 // airsegctl watch over the radio: what the vehicle pushes (telemetry samples, its link statistics, events)
-// gathered into one picture, and that picture as a screen of text or as one JSON line.
+// gathered into one picture, and that picture as a screen of text or as one JSON line. The sample and event
+// in JSON (telemetry_json, event_severity_name) are also what airseg-ground's fleet bridge publishes.
 #include <chrono>
 #include <deque>
 #include <nlohmann/json.hpp>
@@ -9,7 +10,7 @@
 
 #include "services/groundlink/protocol/ground_protocol.hpp"
 
-namespace airseg::client {
+namespace airseg::groundside {
 
 class WatchState {
   public:
@@ -48,4 +49,4 @@ const char* event_severity_name(groundlink::protocol::Event::Severity s);
 /// An event as one line for people: "warning: text".
 std::string event_line(const groundlink::protocol::Event& e);
 
-}  // namespace airseg::client
+}  // namespace airseg::groundside

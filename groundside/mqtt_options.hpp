@@ -5,9 +5,9 @@
 #include <string>
 
 #include "cli/command_line.hpp"
-#include "client/mqtt_session.hpp"
+#include "groundside/mqtt_session.hpp"
 
-namespace airseg::client {
+namespace airseg::groundside {
 
 /// Adds the options to `table`, writing into `options` and `vehicle`; `chosen` runs when --mqtt is given.
 void add_mqtt_options(cli::OptionTable& table, MqttOptions& options, std::string& vehicle,
@@ -25,4 +25,4 @@ inline std::string vehicle_topic(const std::string& vehicle, const std::string& 
     return "airseg/" + vehicle + "/" + kind;
 }
 
-}  // namespace airseg::client
+}  // namespace airseg::groundside
