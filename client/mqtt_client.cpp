@@ -75,17 +75,19 @@ std::optional<proto::Telemetry> telemetry_from_json(const Json& v) {
     return t;
 }
 
-MqttClient::MqttClient(groundside::MqttOptions options, std::string vehicle) : vehicle_(std::move(vehicle)) {
+MqttClient::MqttClient(groundside::MqttOptions options, std::string vehicle)
+    : vehicle_(std::move(vehicle)), broker_(options.host, options.port) {
     std::random_device rd;
     options.client_id = fmt::format("airsegctl-{}-{:08x}", ::getpid(), rd());
     options.clean_session = true;
     session_ = std::make_unique<groundside::MqttSession>(
         io_.get_executor(), std::move(options),
         groundside::MqttSession::Handlers{
-            [this](bool up, const std::string& why) {
+            [this](bool up, const std::string& why, bool definitive) {
                 connected_ = up;
                 if (!up && !why.empty()) {
                     refused_ = why;
+                    definitive_ = definitive;
                 }
             },
             [this](const std::string& topic, const std::string& payload) { on_message(topic, payload); }});
@@ -106,8 +108,9 @@ std::string MqttClient::open(std::chrono::milliseconds timeout) {
     while (!connected_ && std::chrono::steady_clock::now() < deadline) {
         io_.run_for(std::chrono::milliseconds(20));
         io_.restart();
-        if (!refused_.empty() && refused_ != "connection lost" && refused_ != "disconnected") {
-            return "the MQTT broker refused the connection: " + refused_;
+        // A refusal or a TLS failure would only repeat: said at once. A broker not there yet may come.
+        if (definitive_) {
+            return fmt::format("MQTT broker {}:{}: {}", broker_.first, broker_.second, refused_);
         }
     }
     if (!connected_) {

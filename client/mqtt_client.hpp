@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "client/vehicle_link.hpp"
 #include "groundside/mqtt_session.hpp"
@@ -46,6 +47,8 @@ class MqttClient final : public VehicleLink {
     std::unique_ptr<groundside::MqttSession> session_;
     bool connected_ = false;
     std::string refused_;
+    bool definitive_ = false;             // refused_ would only repeat (a refusal, a TLS failure)
+    std::pair<std::string, int> broker_;  // host, port: for the messages
     nlohmann::json link_ = {{"link", "down"}};
     std::function<void(const groundlink::protocol::Message&)> on_message_;
     std::string awaiting_;

@@ -41,7 +41,7 @@ FleetBridge::FleetBridge(asio::any_io_executor strand, Hub& hub, FleetConfig con
     : hub_(hub),
       config_(std::move(config)),
       session_(strand, session_options(config_),
-               {.on_connection = [this](bool up, const std::string& why) { on_connection(up, why); },
+               {.on_connection = [this](bool up, const std::string& why, bool) { on_connection(up, why); },
                 .on_message =
                     [this](const std::string& topic, const std::string& payload) {
                         if (topic == this->topic("cmd")) {
@@ -109,7 +109,8 @@ void FleetBridge::on_connection(bool up, const std::string& why) {
         }
         return;
     }
-    // Refusals repeat on every retry; one line per change of reason is enough.
+    // Refusals (the broker's, TLS's) and a broker that is not there repeat on every retry; one line per
+    // change of reason is enough.
     if (connected_ || why != last_why_) {
         spdlog::warn("fleet: MQTT broker {}: {}{}", broker, why, connected_ ? "; reconnecting" : "");
     }

@@ -26,9 +26,14 @@ void add_mqtt_options(cli::OptionTable& table, MqttOptions& options, std::string
         .value("mqtt-password-file", "FILE",
                "the broker password, on the first line of FILE (with --mqtt-user)",
                text(options.password_file))
-        .value("mqtt-ca", "FILE", "TLS to the broker, trusting this CA certificate", text(options.ca_file))
-        .value("mqtt-cert", "FILE", "TLS client certificate (with --mqtt-key)", text(options.cert_file))
-        .value("mqtt-key", "FILE", "TLS client key", text(options.key_file));
+        .value("mqtt-ca", "FILE",
+               "TLS to the broker (give its TLS port, often 8883): its certificate must be signed by this CA "
+               "(PEM) and name the broker's host",
+               text(options.ca_file))
+        .value("mqtt-cert", "FILE", "TLS client certificate, PEM (with --mqtt-key and --mqtt-ca)",
+               text(options.cert_file))
+        .value("mqtt-key", "FILE", "the client certificate's private key, PEM, not encrypted",
+               text(options.key_file));
 }
 
 std::string check_mqtt_options(const MqttOptions& m) {

@@ -1,8 +1,9 @@
 #pragma once
 // One MQTT connection (libmosquitto, MQTT 3.1.1) for airseg-ground's fleet bridge and airsegctl --mqtt:
-// user/password and TLS (CA, client certificate), a last will, subscriptions renewed on every reconnect, and
-// reconnection with backoff by libmosquitto's own network thread. Every handler runs on the executor given,
-// never on that thread. docs/fleet.md.
+// user/password and TLS (CA, client certificate; the broker's certificate checked against the CA and the host
+// name), a last will, subscriptions renewed on every reconnect, and reconnection with backoff (after a TLS
+// failure too) by a network thread of its own. Every handler runs on the executor given, never on that
+// thread. docs/fleet.md.
 #include <functional>
 #include <memory>
 #include <string>
@@ -31,8 +32,10 @@ std::string parse_broker(std::string_view text, MqttOptions& options);
 class MqttSession {
   public:
     struct Handlers {
-        /// Connected (true), or the connection is gone or was refused (false, with the broker's reason).
-        std::function<void(bool connected, const std::string& why)> on_connection;
+        /// Connected (true), or the connection is gone or an attempt failed (false, with why: the broker's
+        /// refusal, a TLS failure, "connection lost", the system's "Connection refused"). `definitive` when
+        /// trying again fails the same way until someone changes something (a refusal, a certificate).
+        std::function<void(bool connected, const std::string& why, bool definitive)> on_connection;
         std::function<void(const std::string& topic, const std::string& payload)> on_message;
     };
 
@@ -44,7 +47,8 @@ class MqttSession {
     /// Before start(): what the broker publishes for us if we vanish.
     void set_will(const std::string& topic, const std::string& payload, int qos, bool retain);
     /// Starts connecting (and reconnecting, for as long as it runs); an error for people when the options
-    /// cannot work (a missing password file, TLS files), empty otherwise.
+    /// cannot work (a missing password file; a TLS file missing, unreadable, not PEM, a key not the
+    /// certificate's, naming the option and the file), empty otherwise.
     std::string start();
     void stop();
 

@@ -4,13 +4,14 @@ set -euo pipefail
 packages=(
   cmake ninja-build g++ pkg-config ccache
   libboost-dev libboost-program-options-dev libyaml-cpp-dev libspdlog-dev libfmt-dev
-  libgpiod-dev libsodium-dev nlohmann-json3-dev zlib1g-dev libmosquitto-dev
+  libgpiod-dev libsodium-dev nlohmann-json3-dev zlib1g-dev libmosquitto-dev libssl-dev
   libgtest-dev libgmock-dev libbenchmark-dev valgrind
   clang libclang-rt-14-dev clang-tidy
   # The ground map's page (Leaflet) and its browser test (headless chromium).
   libjs-leaflet chromium
-  # The fleet test's MQTT broker and its clients (mosquitto_sub, _pub, _passwd).
-  mosquitto mosquitto-clients
+  # The fleet test's MQTT broker and its clients (mosquitto_sub, _pub, _passwd); openssl makes the TLS test's
+  # certificates.
+  mosquitto mosquitto-clients openssl
 )
 sudo=""
 if [ "$(id -u)" -ne 0 ]; then
