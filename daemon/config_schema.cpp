@@ -567,6 +567,10 @@ std::vector<KeySpec> build_schema() {
     s.push_back(integer(
         "groundlink.radio.buffer", [](Config& c) -> std::size_t& { return c.groundlink.radio.buffer_bytes; },
         0, 1 << 24, "bytes the radio holds before they go on air; 0 = unknown"));
+    s.push_back(boolean(
+        "groundlink.radio.adapt", [](Config& c) -> bool& { return c.groundlink.radio.adapt; },
+        "pace to the air as measured from the link's own traffic (between a quarter of the rate the keys "
+        "above give and that rate), not only as configured; the measurement is in status either way"));
     // Flight plans
     s.push_back(integer(
         "flightplan.window", [](Config& c) -> int& { return c.flightplan.window; }, 3, 250,

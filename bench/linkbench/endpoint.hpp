@@ -34,6 +34,10 @@ struct EndpointSetup {
         std::size_t air_packet = 0;
         std::size_t air_packet_overhead = 0;
         std::size_t buffer = 0;
+        /// Told the turnaround and packets too (otherwise only the buffer: the rest at its defaults).
+        bool told = true;
+        /// Pacing follows the air as measured (groundlink.radio.adapt).
+        bool adapt = false;
     };
     std::optional<Radio> radio;
 };
@@ -56,6 +60,14 @@ class BenchEndpoint {
     virtual TimePoint poll_timeout() const = 0;
     /// Safe messages accepted and not yet acknowledged.
     virtual std::size_t safe_backlog() const = 0;
+
+    /// The air as the protocol measured it: payload bytes/s it paces for and the turnaround (ms, -1 when
+    /// not measured); nullopt for a protocol that does not measure.
+    struct AirMeasure {
+        double carried = 0.0;
+        double turnaround_ms = -1.0;
+    };
+    [[nodiscard]] virtual std::optional<AirMeasure> air_measure() const { return std::nullopt; }
 };
 
 /// The seed's protocol (bench/linkbench/seed_protocol.hpp).

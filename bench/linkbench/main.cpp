@@ -43,6 +43,7 @@ groundlink.radio tells it; without, it assumes 1 ms turnaround and no per-packet
   pkt32+8 [cfg]    32-byte air packets with 8 bytes of overhead each
   turn10ms [cfg]   10 ms turnaround (--turnaround-ms does not change these rows)
   turn20ms cfg     20 ms turnaround
+  ... adapt        told only the radio's buffer: the transport measures the air (groundlink.radio.adapt)
 
 )";
 
@@ -51,6 +52,7 @@ struct Knobs {
     Duration turnaround = std::chrono::milliseconds(1);
     double pacing_factor = 1.0;
     std::uint64_t seed = 1000;
+    bool adapt = false;
 };
 
 std::vector<Scenario> scenarios(const Knobs& k) {
@@ -64,6 +66,7 @@ std::vector<Scenario> scenarios(const Knobs& k) {
             base.turnaround = k.turnaround;
             base.pacing_factor = k.pacing_factor;
             base.seed = k.seed;
+            base.radio_adapt = k.adapt;
             list.push_back(base);
             for (auto [label, p] :
                  {std::pair{"corrupt=1e-5", 1e-5}, {"corrupt=1e-4", 1e-4}, {"corrupt=1e-3", 1e-3}}) {
@@ -114,21 +117,27 @@ std::vector<Scenario> scenarios(const Knobs& k) {
             }
             // Radios whose air is not their serial port: small air packets with their own overhead, and a
             // slow change of sender; each as the transport assumes it by default, then told (configured).
-            for (bool told : {false, true}) {
+            // Then told only the radio's buffer, measuring the rest (adapt).
+            for (auto [label, told, adapt] : {std::tuple{"pkt32+8", false, false},
+                                              {"pkt32+8 cfg", true, false},
+                                              {"pkt32+8 adapt", false, true}}) {
                 Scenario packets = base;
-                packets.impairment = told ? "pkt32+8 cfg" : "pkt32+8";
+                packets.impairment = label;
                 packets.air_packet = 32;
                 packets.air_packet_overhead = 8;
                 packets.radio_configured = told;
+                packets.radio_adapt = adapt || k.adapt;
                 list.push_back(packets);
             }
-            for (auto [label, ms, told] : {std::tuple{"turn10ms", 10, false},
-                                           {"turn10ms cfg", 10, true},
-                                           {"turn20ms cfg", 20, true}}) {
+            for (auto [label, ms, told, adapt] : {std::tuple{"turn10ms", 10, false, false},
+                                                  {"turn10ms cfg", 10, true, false},
+                                                  {"turn10ms adapt", 10, false, true},
+                                                  {"turn20ms cfg", 20, true, false}}) {
                 Scenario slow = base;
                 slow.impairment = label;
                 slow.turnaround = std::chrono::milliseconds(ms);
                 slow.radio_configured = told;
+                slow.radio_adapt = adapt || k.adapt;
                 list.push_back(slow);
             }
         }
@@ -168,6 +177,10 @@ int main(int argc, char** argv) {
                "seed of the radios' impairments (default 1000): the figures of one run are one draw of the "
                "radios' randomness; other seeds show how much a figure (a longest stall) varies",
                cli::number(knobs.seed, 0, std::numeric_limits<std::uint64_t>::max()))
+        .flag("adapt",
+              "every row with the transport's pacing following the air as it measures it (told the radio's "
+              "buffer): what groundlink.radio.adapt costs or gains on each kind of link",
+              [&] { knobs.adapt = true; })
         .flag("strict", "exit status 1 when a target fails", [&] { strict = true; })
         .help_and_version(false);
     const cli::Program program{"linkbench", [&] { return std::string(kUsage) + cli::describe(table); }};

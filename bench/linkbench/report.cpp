@@ -75,7 +75,8 @@ void print_diagnostics(std::ostream& os, const std::vector<Row>& rows) {
     os << std::left << std::setw(7) << "baud" << std::setw(8) << "mode" << std::setw(15) << "impairment"
        << std::right << std::setw(17) << "wire A %" << std::setw(17) << "wire B %" << std::setw(17)
        << "air busy %" << std::setw(21) << "FIFO overflow B" << std::setw(19) << "run 2 A->B %"
-       << std::setw(19) << "run 2 B->A %" << '\n';
+       << std::setw(19) << "run 2 B->A %" << std::setw(14) << "air est %" << std::setw(15) << "turnaround ms"
+       << '\n';
     for (const Row& r : rows) {
         os << std::left << std::setw(7) << r.scenario.baud << std::setw(8) << to_string(r.scenario.mode)
            << std::setw(15) << r.scenario.impairment << std::right << std::setw(17)
@@ -85,7 +86,9 @@ void print_diagnostics(std::ostream& os, const std::vector<Row>& rows) {
            << (fig(r.ours, static_cast<double>(r.ours.radio_overflow), 0) + " / " +
                fig(r.seed, static_cast<double>(r.seed.radio_overflow), 0))
            << std::setw(19) << pair(r, &ScenarioResult::fast_run_goodput_ab_pct, 1) << std::setw(19)
-           << pair(r, &ScenarioResult::fast_run_goodput_ba_pct, 1) << '\n';
+           << pair(r, &ScenarioResult::fast_run_goodput_ba_pct, 1) << std::setw(14)
+           << fig(r.ours, r.ours.air_carried_pct, 1) << std::setw(15)
+           << fig(r.ours, r.ours.air_turnaround_ms, 1) << '\n';
     }
 }
 
@@ -147,6 +150,23 @@ std::vector<TargetCheck> check_targets(const std::vector<Row>& rows) {
                 add(
                     "configured radio: no radio buffer overflow", find(rows, baud, mode, configured),
                     [](const ScenarioResult& r) { return r.radio_overflow == 0; },
+                    &ScenarioResult::goodput_pct);
+            }
+            // Told only the radio's buffer and measuring the rest: well above blind, far less overflow.
+            for (const char* radio : {"pkt32+8", "turn10ms"}) {
+                const Row* blind = find(rows, baud, mode, radio);
+                const Row* measured = find(rows, baud, mode, std::string(radio) + " adapt");
+                if (blind == nullptr || !blind->ours.ran || blind->scenario.radio_adapt) {
+                    continue;  // (with --adapt every row measures: there is no blind row to compare)
+                }
+                const ScenarioResult b = blind->ours;
+                add(
+                    "measured air: goodput >= 50 % and >= 1.5 x blind, radio overflow <= a third of blind",
+                    measured,
+                    [b](const ScenarioResult& r) {
+                        return r.goodput_pct >= 50.0 && r.goodput_pct >= 1.5 * b.goodput_pct &&
+                               3 * r.radio_overflow <= b.radio_overflow;
+                    },
                     &ScenarioResult::goodput_pct);
             }
             if (baud == 57600) {

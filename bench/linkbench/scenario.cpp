@@ -102,10 +102,10 @@ namespace {
 
 EndpointSetup setup(const Scenario& s, bool is_a, TimePoint t0) {
     EndpointSetup e{s.baud, s.mode, is_a, t0, s.pacing_factor, std::nullopt};
-    if (s.radio_configured) {
+    if (s.radio_configured || s.radio_adapt) {
         const auto radio = bench_radio(s, 0);
-        e.radio = EndpointSetup::Radio{radio.turnaround, radio.max_air_packet, radio.air_packet_overhead,
-                                       radio.radio_buffer};
+        e.radio = EndpointSetup::Radio{radio.turnaround,   radio.max_air_packet, radio.air_packet_overhead,
+                                       radio.radio_buffer, s.radio_configured,   s.radio_adapt};
     }
     return e;
 }
@@ -321,6 +321,9 @@ ScenarioResult run_pass(const Scenario& s, const EndpointFactory& make, bool wit
     result.fast_run_stall_ab_s = std::chrono::duration<double>(longest_gap[1]).count();
     result.fast_run_stall_ba_s = std::chrono::duration<double>(longest_gap[0]).count();
     result.air_utilisation_pct = 100.0 * pairs[0].air_utilisation(Side::A, end);
+    if (const auto air = ends[0]->air_measure()) {
+        result.air_carried_pct = 100.0 * air->carried / line;
+    }
     for (const auto& pair : pairs) {
         result.wire_ab_pct += 100.0 * static_cast<double>(pair.stats(Side::A).bytes_in) / (line * seconds);
         result.wire_ba_pct += 100.0 * static_cast<double>(pair.stats(Side::B).bytes_in) / (line * seconds);
@@ -407,6 +410,9 @@ void run_commands(const Scenario& s, const EndpointFactory& make, ScenarioResult
     }
     result.cmd_p50_s = percentile(rtt, 0.50);
     result.cmd_p90_s = percentile(rtt, 0.90);
+    if (const auto air = ends[0]->air_measure(); air && air->turnaround_ms >= 0.0) {
+        result.air_turnaround_ms = air->turnaround_ms;
+    }
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // One benchmark scenario: two protocol ends joined by one or two simulated radio pairs, driven in simulated
 // time by a fixed workload, with the figures the benchmark reports.
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -30,6 +31,9 @@ struct Scenario {
     /// The transport is told the radio as it is (air packets, overhead, turnaround, buffer), as
     /// groundlink.radio tells it; otherwise it assumes the defaults (1 ms turnaround, no packet overhead).
     bool radio_configured = false;
+    /// The transport's pacing follows the air as it measures it (groundlink.radio.adapt); told the radio's
+    /// buffer, and the rest only with radio_configured.
+    bool radio_adapt = false;
     double pacing_factor =
         1.0;                    ///< the transport's link_rate as a fraction of baud/10 (the seed never paces)
     std::uint64_t seed = 1000;  ///< of the radios' impairments: the same seed gives the same figures
@@ -62,6 +66,10 @@ struct ScenarioResult {
     double wire_ba_pct = 0.0;          ///< bytes B wrote, all pairs, % of one line's rate
     double air_utilisation_pct = 0.0;  ///< air busy on pair 0 (packets and turnarounds)
     std::uint64_t radio_overflow = 0;  ///< bytes dropped at a full radio FIFO, all pairs and directions
+    /// The air as A measured it (NaN when its protocol does not): the payload rate it paced for at the end
+    /// of run 1, as % of one line's rate, and the turnaround at the end of the command run (ms).
+    double air_carried_pct = std::numeric_limits<double>::quiet_NaN();
+    double air_turnaround_ms = std::numeric_limits<double>::quiet_NaN();
 };
 
 using EndpointFactory = std::function<std::unique_ptr<BenchEndpoint>(const EndpointSetup&)>;

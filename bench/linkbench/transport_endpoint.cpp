@@ -15,10 +15,13 @@ groundlink::TransportConfig bench_config(const EndpointSetup& setup) {
     c.link_rate_bytes_per_s = setup.pacing_factor * setup.baud / 10.0;
     c.half_duplex = true;
     if (setup.radio) {
-        c.air_turnaround = setup.radio->turnaround;
-        c.air_packet_payload = setup.radio->air_packet;
-        c.air_packet_overhead = setup.radio->air_packet_overhead;
+        if (setup.radio->told) {
+            c.air_turnaround = setup.radio->turnaround;
+            c.air_packet_payload = setup.radio->air_packet;
+            c.air_packet_overhead = setup.radio->air_packet_overhead;
+        }
         c.radio_buffer_bytes = setup.radio->buffer;
+        c.air_adapt = setup.radio->adapt;
     }
     if (setup.mode == LinkMode::Dual) {
         c.paths = 2;
@@ -63,6 +66,10 @@ class TransportBenchEndpoint final : public BenchEndpoint {
     }
     TimePoint poll_timeout() const override { return core_.poll_timeout(); }
     std::size_t safe_backlog() const override { return core_.safe_pending(kBulkPriority); }
+    std::optional<AirMeasure> air_measure() const override {
+        const auto& st = core_.stats();
+        return AirMeasure{st.air_carried, st.air_turnaround_ms};
+    }
 
   private:
     void drain_events() {

@@ -566,6 +566,16 @@ void GroundlinkService::publish_status() {
             g["goodput_bps"] = std::round(goodput);
             g["frame_payload"] = s.frame_payload;
             g["pacing"] = pacing;
+            // What the link's own traffic says the air carries, beside what it is configured to carry.
+            g["pacing"]["measured"] = {
+                {"adapt", s.air_adapt},
+                {"carried_bytes_per_s", std::round(s.air_carried * 10) / 10},
+                {"delivered_bytes_per_s", std::round(s.air_delivered * 10) / 10},
+                {"turnaround_ms", s.air_turnaround_ms < 0
+                                      ? nlohmann::json(nullptr)
+                                      : nlohmann::json(std::round(s.air_turnaround_ms * 10) / 10)},
+                {"base_rtt_ms", std::round(s.base_rtt_ms)},
+                {"overflows", s.air_overflows}};
             auto rate = [](double r) {
                 return r < 0 ? nlohmann::json(nullptr) : nlohmann::json(std::round(r * 1e6) / 1e6);
             };

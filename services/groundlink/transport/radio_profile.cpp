@@ -90,6 +90,7 @@ void RadioProfile::apply(TransportConfig& config, double serial_bytes_per_s) con
     config.air_turnaround = turnaround;
     config.half_duplex = half_duplex;
     config.radio_buffer_bytes = buffer_bytes;
+    config.air_adapt = adapt;
 }
 
 std::string parse_radio_profile(std::string_view text, RadioProfile& profile) {
@@ -123,15 +124,18 @@ std::string parse_radio_profile(std::string_view text, RadioProfile& profile) {
             p.half_duplex = value != "full";
         } else if (key == "buffer") {
             ok = parse_unsigned(value, p.buffer_bytes);
+        } else if (key == "adapt") {
+            ok = parse_switch(value, p.adapt);
         } else {
             return "--radio " + std::string(key) +
-                   ": unknown key (air_speed, ecc, packet, packet_overhead, turnaround, duplex, buffer)";
+                   ": unknown key (air_speed, ecc, packet, packet_overhead, turnaround, duplex, buffer, "
+                   "adapt)";
         }
         if (!ok) {
-            const char* expected = key == "ecc"          ? "expected on or off"
-                                   : key == "duplex"     ? "expected half or full"
-                                   : key == "turnaround" ? "expected milliseconds, e.g. 10ms"
-                                                         : "expected a whole number";
+            const char* expected = key == "ecc" || key == "adapt" ? "expected on or off"
+                                   : key == "duplex"              ? "expected half or full"
+                                   : key == "turnaround"          ? "expected milliseconds, e.g. 10ms"
+                                                                  : "expected a whole number";
             return key_error(key, value, expected);
         }
     }

@@ -26,6 +26,9 @@ struct RadioProfile {
     bool half_duplex = true;
     /// buffer: bytes the radio holds before the air (0 = unknown).
     std::size_t buffer_bytes = 0;
+    /// adapt: pace to the air as measured from the link's own traffic, between a quarter of what the keys
+    /// above describe and that (TransportConfig::air_adapt).
+    bool adapt = false;
 
     /// Empty when usable, else what is wrong, naming the key under `prefix` (groundlink.radio, --radio).
     std::string validate(std::string_view prefix) const;
@@ -35,8 +38,9 @@ struct RadioProfile {
     void apply(TransportConfig& config, double serial_bytes_per_s) const;
 };
 
-/// Parses "air_speed=64,ecc=on,packet=252,packet_overhead=8,turnaround=10ms,duplex=half,buffer=2048" (any
-/// subset, in any order) over `profile`. Empty when it parsed and validated, else the error, naming the key.
+/// Parses "air_speed=64,ecc=on,packet=252,packet_overhead=8,turnaround=10ms,duplex=half,buffer=2048,adapt=on"
+/// (any subset, in any order) over `profile`. Empty when it parsed and validated, else the error, naming the
+/// key.
 std::string parse_radio_profile(std::string_view text, RadioProfile& profile);
 
 }  // namespace airseg::groundlink

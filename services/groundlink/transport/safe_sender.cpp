@@ -94,10 +94,12 @@ void SafeSender::mark_acked(InFlight& s, AckResult& r, TimePoint now, TimePoint&
         --lost_count_;
     }
     ++r.newly_acked;
+    r.newly_acked_bytes += s.data.size();
     if (s.last_sent > newest_acked_send) {
         newest_acked_send = s.last_sent;
         // Karn: only a segment sent once gives an unambiguous sample.
         r.rtt_sample = s.transmissions == 1 ? std::optional<Duration>(now - s.last_sent) : std::nullopt;
+        r.rtt_sample_bytes = s.data.size();
     }
 }
 

@@ -46,9 +46,11 @@ class SafeSender {
 
     struct AckResult {
         std::size_t newly_acked = 0;
+        std::size_t newly_acked_bytes = 0;
         std::size_t newly_lost = 0;
         std::optional<Duration> rtt_sample;
-        bool progress = false;  ///< the lowest unacknowledged segment advanced
+        std::size_t rtt_sample_bytes = 0;  ///< data bytes of the segment the sample timed
+        bool progress = false;             ///< the lowest unacknowledged segment advanced
     };
     /// `reorder_slack`: a segment counts as lost only if one sent more than this later was acknowledged
     /// (frames on two paths may arrive out of order).

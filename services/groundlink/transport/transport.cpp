@@ -20,10 +20,15 @@ TransportConfig checked(TransportConfig c) {
     return c;
 }
 
+// Air packet of a SiK-class radio, when the configuration does not say (the largest at the default
+// settings): the stage of a frame's crossing that does not overlap the others.
+constexpr std::size_t kTypicalAirPacket = 252;
+
 }  // namespace
 
 Transport::Impl::Impl(TransportConfig config, TimePoint now)
     : cfg(checked(std::move(config))),
+      air_estimate(cfg.carried_rate_bytes_per_s(), now),
       current_time(now),
       reassembly(cfg.fast_reassembly_timeout, cfg.max_message_size),
       rtt(cfg.rto_initial, cfg.rto_min, cfg.rto_max, cfg.ack_delay, frame_time(cfg.max_frame_payload + 32)) {
@@ -106,6 +111,7 @@ void Transport::Impl::handle_timeout(TimePoint now) {
             if (lost > 0) {
                 backoff[l] = std::min(backoff[l] + 1, kMaxBackoff);
                 lost_window += static_cast<double>(lost);
+                air_estimate.on_lost(lost);
                 expired = true;
             }
         }
@@ -147,7 +153,34 @@ void Transport::Impl::update_link_state() {
     }
 }
 
+void Transport::Impl::measure_round_trip(Duration rtt_sample, std::size_t segment_bytes, TimePoint now) {
+    // A frame that fits one air packet crosses three stages one after the other: the sending host's serial
+    // port, the air, the receiving host's port (a longer frame's stages overlap in ways the sizes alone do
+    // not tell). A round trip is the segment's frame out and the acknowledging frame back.
+    const std::size_t packet = cfg.air_packet_payload != 0 ? cfg.air_packet_payload : kTypicalAirPacket;
+    const std::size_t data_frame =
+        segment_bytes + frame::frame_overhead(mac != nullptr) + frame::safe_chunk_overhead();
+    const bool timed = data_frame <= packet && frame_wire_bytes != 0 && frame_wire_bytes <= packet;
+    const auto crossing = [&](std::size_t bytes) {
+        const Duration serial = std::chrono::duration_cast<Duration>(
+            std::chrono::duration<double>(static_cast<double>(bytes) / cfg.link_rate_bytes_per_s));
+        return serial + configured_frame_time(bytes) + serial;
+    };
+    air_estimate.on_round_trip(
+        rtt_sample, timed ? std::optional(crossing(data_frame) + crossing(frame_wire_bytes)) : std::nullopt,
+        now);
+}
+
+void Transport::Impl::follow_air(TimePoint now) {
+    if (!air_estimate.update(now) || !cfg.air_adapt) {
+        return;
+    }
+    carried = air_estimate.carried();
+    air_rate_now = configured_air_rate() * carried / air_estimate.configured();
+}
+
 void Transport::Impl::refresh(TimePoint now) {
+    follow_air(now);
     refresh_transmit(now);
     TimePoint rto = kNever;
     for (std::size_t l = 0; l < senders.size(); ++l) {
@@ -193,6 +226,15 @@ void Transport::Impl::snapshot_stats() {
     stats.byte_error_rate = meter.byte_error_rate().value_or(-1.0);
     stats.peer_byte_error_rate = peer_error.value_or(-1.0);
     stats.frame_loss = sent_window > 0 ? std::min(1.0, lost_window / sent_window) : 0.0;
+    stats.air_carried = air_estimate.carried();
+    stats.air_delivered = air_estimate.delivered();
+    stats.air_turnaround_ms =
+        air_estimate.round_trips() == 0
+            ? -1.0
+            : std::chrono::duration<double, std::milli>(air_estimate.turnaround()).count();
+    stats.base_rtt_ms = std::chrono::duration<double, std::milli>(air_estimate.base_rtt()).count();
+    stats.air_overflows = air_estimate.overflows();
+    stats.air_adapt = cfg.air_adapt;
     std::uint64_t safe_depth = 0;
     std::uint64_t fast_depth = 0;
     for (std::size_t l = 0; l < senders.size(); ++l) {

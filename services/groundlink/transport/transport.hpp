@@ -66,6 +66,10 @@ struct TransportConfig {
     /// estimate of what waits in the radio under half of it, so the radio never drops bytes for a full
     /// buffer.
     std::size_t radio_buffer_bytes = 0;
+    /// air_adapt: pace to the air as measured from the link's own traffic (LinkStats::air_carried), between
+    /// a quarter of the configured carried rate and that rate. The measurement runs (and is reported)
+    /// either way.
+    bool air_adapt = false;
 
     /// max_frame_payload: chunk bytes per frame on a clean link.
     std::size_t max_frame_payload = 1024;
@@ -229,6 +233,16 @@ struct LinkStats {
     std::uint64_t fec_frames_repaired = 0;  ///< ... of which needed parity (a data shard was lost)
     std::uint64_t fec_shard_errors = 0;     ///< shards that failed their CRC-16
     double frame_loss = 0.0;                ///< fraction of sent Safe segments declared lost (moving average)
+    /// The air as measured (docs/ground-link.md, "Measured air"): the payload rate to pace for, the payload
+    /// rate delivered while this end was saturated (0 before it was), the turnaround beyond the frames' own
+    /// time (-1 before a round trip), the least recent round trip, the seconds with an overflow; air_adapt:
+    /// whether pacing follows air_carried.
+    double air_carried = 0.0;
+    double air_delivered = 0.0;
+    double air_turnaround_ms = -1.0;
+    double base_rtt_ms = 0.0;
+    std::uint64_t air_overflows = 0;
+    bool air_adapt = false;
 
     std::uint64_t frames_sent = 0;
     std::uint64_t frames_received = 0;  ///< valid, authenticated, not replayed

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "services/common/rtt_estimator.hpp"
+#include "services/groundlink/transport/air_estimate.hpp"
 #include "services/groundlink/transport/cobs.hpp"
 #include "services/groundlink/transport/erasure_code.hpp"
 #include "services/groundlink/transport/error_rate_meter.hpp"
@@ -111,15 +112,28 @@ class Transport::Impl {
     [[nodiscard]] double air_use(std::size_t path) const;
     /// The radio's own queue is estimated past half its buffer.
     [[nodiscard]] bool radio_full(std::size_t path) const;
-    /// Bytes per second the air carries (air_rate, else link_rate).
-    [[nodiscard]] double air_rate() const {
+    /// Bytes per second the air carries as configured (air_rate, else link_rate).
+    [[nodiscard]] double configured_air_rate() const {
         return cfg.air_rate_bytes_per_s > 0.0 ? cfg.air_rate_bytes_per_s : cfg.link_rate_bytes_per_s;
     }
+    /// Bytes per second the air carries as pacing takes it: measured with air_adapt, else configured.
+    [[nodiscard]] double air_rate() const { return air_rate_now; }
+    /// Feeds a round trip to the air measurement, with the time its two frames take without turnaround.
+    void measure_round_trip(Duration rtt_sample, std::size_t segment_bytes, TimePoint now);
+    /// Closes a measurement period when due and, with air_adapt, follows the new figures.
+    void follow_air(TimePoint now);
     /// Payload bytes per second the link carries (TransportConfig::carried_rate_bytes_per_s()).
     [[nodiscard]] double carried_rate() const { return carried; }
     /// Time `bytes` written as one frame occupy the link: the serial port's time or the air's with each air
     /// packet's overhead, whichever is longer; `scale` below 1 paces slower.
-    [[nodiscard]] Duration frame_time(std::size_t bytes, double scale = 1.0) const;
+    [[nodiscard]] Duration frame_time(std::size_t bytes, double scale = 1.0) const {
+        return frame_time_at(bytes, air_rate(), scale);
+    }
+    /// The same at the configured air rate: the bytes' own time, whatever else the air loses.
+    [[nodiscard]] Duration configured_frame_time(std::size_t bytes) const {
+        return frame_time_at(bytes, configured_air_rate(), 1.0);
+    }
+    [[nodiscard]] Duration frame_time_at(std::size_t bytes, double rate, double scale) const;
     /// Air time of `bytes` heard from the peer (a read is not a frame: overhead in proportion).
     [[nodiscard]] Duration heard_air_time(std::size_t bytes) const;
     [[nodiscard]] TimePoint ack_due() const;
@@ -148,7 +162,10 @@ class Transport::Impl {
     void mark_urgent(TimePoint now) { urgent_until = now + cfg.latency_hold; }
 
     TransportConfig cfg;
+    AirEstimate air_estimate;
+    double air_rate_now = configured_air_rate();
     double carried = cfg.carried_rate_bytes_per_s();  // asked at every air gate: computed once
+    std::size_t frame_wire_bytes = 0;                 // of the frame being read (its acks' round trips)
     // keys[0] from TransportConfig::key, keys[1] from second_key. `mac` is the session's key (keys[0] until a
     // handshake authenticated with keys[1] is accepted); null on an unkeyed link.
     std::array<std::unique_ptr<FrameMac>, 2> keys;
@@ -190,6 +207,9 @@ class Transport::Impl {
         double rx_rate = 0.0;                          // bytes/s heard on the path, moving average over ~1 s
         TimePoint rx_rate_time{};
         TimePoint air_debt{};  // half duplex: air budget of both ends together
+        // When this end's radio would have sent all it was given: its own frames at the air's pace, held
+        // back by the peer's air time while it holds any (the radio's queue, for radio_buffer).
+        TimePoint own_air_debt{};
         double tx_rate = 0.0;  // bytes/s written to the path, same average
         TimePoint tx_rate_time{};
         std::size_t last_frame = 0;  // bytes of the latest frame written

@@ -33,6 +33,9 @@ void Transport::Impl::handle_bytes(std::size_t path, std::span<const std::uint8_
         const Duration air = heard_air_time(bytes.size());
         ps.air_debt =
             std::max(ps.air_debt, current_time - air) + (peer_urgent ? air + air / 2 : air + air / 4);
+        if (ps.own_air_debt > current_time) {
+            ps.own_air_debt += air;  // this radio's queue waited while the peer's bytes had the air
+        }
     }
     // Each frame heard also cost the radios a change of sender and back.
     const auto turnaround = [&] {
@@ -126,6 +129,7 @@ void Transport::Impl::count_key_mismatch(std::span<const std::uint8_t> plain, bo
 
 void Transport::Impl::on_plain_frame(std::size_t path, std::span<const std::uint8_t> plain,
                                      std::size_t wire_bytes, TimePoint now) {
+    frame_wire_bytes = wire_bytes;
     const bool keyed = mac != nullptr;
     const auto kind = frame::kind_of(plain);
     const std::size_t tag_bytes = keyed ? kMacTagBytes : 0;
@@ -272,6 +276,7 @@ void Transport::Impl::on_safe(const frame::SafeChunk& c, TimePoint now) {
     ack.needed = true;
     switch (result) {
         case SafeReceiver::Accept::Fresh:
+            air_estimate.on_heard(c.data.size());
             ++ack.unacked;
             if (rx.has_gap() || ack.unacked >= cfg.ack_every) {
                 ack.immediate = true;
@@ -299,6 +304,7 @@ void Transport::Impl::on_fast(const frame::FastChunk& c, TimePoint now) {
         return;
     }
     ++stats.rx_fast.segments;
+    air_estimate.on_heard(c.data.size());
     std::optional<std::vector<std::uint8_t>> whole;
     if (!c.fragmented) {
         whole.emplace(c.data.begin(), c.data.end());
@@ -331,7 +337,10 @@ void Transport::Impl::on_ack(const frame::AckChunk& a, TimePoint now) {
     const auto r = senders[a.channel].on_ack(a, now, reorder_slack());
     if (r.rtt_sample) {
         rtt.sample(*r.rtt_sample);
+        measure_round_trip(*r.rtt_sample, r.rtt_sample_bytes, now);
     }
+    air_estimate.on_acked(r.newly_acked_bytes, r.newly_acked);
+    air_estimate.on_lost(r.newly_lost);
     if (r.progress) {
         backoff[a.channel] = 0;
     }

@@ -177,9 +177,10 @@ bool Transport::Impl::radio_full(std::size_t path) const {
     if (cfg.radio_buffer_bytes == 0) {
         return false;
     }
-    // What the air owes (both ends, from the shared budget) is at most what waits in this end's radio.
+    // Only this end's own bytes wait in its radio: a peer that talks much fills the air, not this radio
+    // (counting the shared budget here closed the lighter end for as long as the heavier one talked).
     const double owed =
-        std::chrono::duration<double>(paths[path].air_debt - current_time).count() * air_rate();
+        std::chrono::duration<double>(paths[path].own_air_debt - current_time).count() * air_rate();
     return owed > 0.5 * static_cast<double>(cfg.radio_buffer_bytes);
 }
 
@@ -192,17 +193,18 @@ TimePoint Transport::Impl::air_reopens(std::size_t path) const {
     const auto room = std::chrono::duration_cast<Duration>(
         std::chrono::duration<double>(0.5 * static_cast<double>(cfg.radio_buffer_bytes) / air_rate()));
     const double rate = air_use(path);
-    return rate >= kFairShare * carried_rate() ? ps.air_debt : std::max(current_time, ps.air_debt - room);
+    return rate >= kFairShare * carried_rate() ? std::max(ps.air_debt, ps.own_air_debt - room)
+                                               : std::max(current_time, ps.own_air_debt - room);
 }
 
-Duration Transport::Impl::frame_time(std::size_t bytes, double scale) const {
+Duration Transport::Impl::frame_time_at(std::size_t bytes, double rate, double scale) const {
     const double serial = static_cast<double>(bytes) / cfg.link_rate_bytes_per_s;
     double on_air = static_cast<double>(bytes);
     if (cfg.air_packet_payload != 0) {
         const std::size_t packets = (bytes + cfg.air_packet_payload - 1) / cfg.air_packet_payload;
         on_air += static_cast<double>(packets * cfg.air_packet_overhead);
     }
-    const double air = on_air / air_rate();
+    const double air = on_air / rate;
     return std::chrono::duration_cast<Duration>(std::chrono::duration<double>(std::max(serial, air) / scale));
 }
 
@@ -306,9 +308,11 @@ void Transport::Impl::account_sent(std::size_t path, std::size_t bytes, TimePoin
     const Duration air = frame_time(bytes, urgent ? cfg.urgent_pacing : 1.0);
     ps.next_free = std::max(ps.next_free, now) + air;
     ps.air_debt = std::max(ps.air_debt, now) + air;  // the shared-air budget counts both ends
+    ps.own_air_debt = std::max(ps.own_air_debt, now) + air;
     ps.tx_rate = decayed_rate(ps.tx_rate, ps.tx_rate_time, now) + static_cast<double>(bytes);
     ps.tx_rate_time = now;
     ps.last_frame = bytes;
+    air_estimate.on_sent(bytes, data_ready(true));
 
     ps.last_sent = now;
     ++stats.frames_sent;

@@ -13,7 +13,7 @@ using std::chrono::milliseconds;
 bool same(const RadioProfile& a, const RadioProfile& b) {
     return a.air_speed_kbps == b.air_speed_kbps && a.ecc == b.ecc && a.packet_bytes == b.packet_bytes &&
            a.packet_overhead == b.packet_overhead && a.turnaround == b.turnaround &&
-           a.half_duplex == b.half_duplex && a.buffer_bytes == b.buffer_bytes;
+           a.half_duplex == b.half_duplex && a.buffer_bytes == b.buffer_bytes && a.adapt == b.adapt;
 }
 
 TEST(GroundlinkRadioProfile, DefaultsAreValid) {
@@ -26,6 +26,23 @@ TEST(GroundlinkRadioProfile, DefaultsAreValid) {
     EXPECT_EQ(p.turnaround, milliseconds(1));
     EXPECT_TRUE(p.half_duplex);
     EXPECT_EQ(p.buffer_bytes, 0u);
+    EXPECT_FALSE(p.adapt);
+}
+
+TEST(GroundlinkRadioProfile, AdaptIsASwitchThatReachesTheTransport) {
+    RadioProfile p;
+    ASSERT_EQ(parse_radio_profile("adapt=on,buffer=2048", p), "");
+    EXPECT_TRUE(p.adapt);
+    TransportConfig c;
+    p.apply(c, 5760.0);
+    EXPECT_TRUE(c.air_adapt);
+    ASSERT_EQ(parse_radio_profile("adapt=off", p), "");
+    p.apply(c, 5760.0);
+    EXPECT_FALSE(c.air_adapt);
+    const std::string error = parse_radio_profile("adapt=sometimes", p);
+    EXPECT_NE(error.find("adapt=sometimes"), std::string::npos) << error;
+    EXPECT_NE(error.find("on or off"), std::string::npos) << error;
+    EXPECT_NE(parse_radio_profile("colour=blue", p).find("adapt"), std::string::npos);  // listed as known
 }
 
 TEST(GroundlinkRadioProfile, ParsesEveryKey) {
@@ -85,6 +102,7 @@ TEST(GroundlinkRadioProfile, EachErrorNamesTheKeyAndLeavesTheProfileAlone) {
         {"packet=4", "packet"},
         {"packet_overhead=300", "packet_overhead"},
         {"buffer=10", "buffer"},
+        {"adapt=maybe", "adapt=maybe"},
     };
     for (const auto& c : cases) {
         RadioProfile p;
