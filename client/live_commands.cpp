@@ -9,6 +9,7 @@
 
 #include "client/json_text.hpp"
 #include "client/stick_input.hpp"
+#include "groundside/event_wording.hpp"
 #include "groundside/watch_view.hpp"
 
 namespace airseg::client {
@@ -63,6 +64,7 @@ bool stop_requested() {
 
 int run_radio_watch(VehicleLink& radio, const LiveOptions& o) {
     groundside::WatchState state;
+    state.set_debug(o.debug);
     auto take = [&state](const proto::Message& m) { state.take(m, Clock::now()); };
     if (!wait_for_link(radio, o, take)) {
         return kNoLink;
@@ -103,19 +105,22 @@ int run_radio_watch(VehicleLink& radio, const LiveOptions& o) {
 }
 
 int run_log(VehicleLink& radio, const LiveOptions& o) {
-    auto print = [&o](const proto::Message& m) {
-        const auto* e = std::get_if<proto::Event>(&m);
-        if (e == nullptr) {
+    // Worded as watch and the map word them: in plan terms, each happening once.
+    groundside::EventWording wording;
+    auto print = [&o, &wording](const proto::Message& m) {
+        const auto e = wording.take(m, Clock::now());
+        if (!e || (e->debug && !o.debug)) {
             return;
         }
         if (o.json) {
-            const char* sev = e->severity == proto::Event::Severity::Error     ? "error"
-                              : e->severity == proto::Event::Severity::Warning ? "warning"
-                                                                               : "info";
-            std::cout << dump_text(nlohmann::json{{"severity", sev}, {"text", e->text}}) << "\n"
-                      << std::flush;
+            nlohmann::json j{{"severity", groundside::event_severity_name(e->severity)}, {"text", e->text}};
+            if (o.debug) {
+                j["raw"] = e->raw;
+                j["debug"] = e->debug;
+            }
+            std::cout << dump_text(j) << "\n" << std::flush;
         } else {
-            std::cout << groundside::event_line(*e) << "\n" << std::flush;
+            std::cout << groundside::event_line(*e, o.debug) << "\n" << std::flush;
         }
     };
     if (!wait_for_link(radio, o, print)) {

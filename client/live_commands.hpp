@@ -17,6 +17,9 @@ struct LiveOptions {
     std::chrono::milliseconds duration{0};
     /// watch --note: lines shown under the live view on every refresh (the demo's hints stay on screen).
     std::vector<std::string> notes;
+    /// watch and log --debug: also the events that say nothing new (groundside/event_wording.hpp), as the
+    /// vehicle sent them.
+    bool debug = false;
 };
 
 /// Exit codes as everywhere in airsegctl: 0 done, 1 refused, 2 usage, 3 no link.

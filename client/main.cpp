@@ -51,17 +51,20 @@ const char* const kUsageTail =
     "\n"
     "Commands:\n"
     "  status             health of every service and the vehicle's state\n"
-    "  watch [--interval MS] [--duration MS] [--note TEXT]...\n"
+    "  watch [--interval MS] [--duration MS] [--debug] [--note TEXT]...\n"
     "                     a live view refreshed in place until Ctrl-C: over the radio from the telemetry\n"
     "                     the vehicle pushes (state, position, speed, battery, plan, link, events), redrawn\n"
     "                     every --interval (default 500 ms), locally from the status document every\n"
     "                     --interval (default 1000 ms); each --note is a\n"
-    "                     line kept under the view\n"
+    "                     line kept under the view; --debug also lists the events said once already\n"
+    "                     or about the autopilot's mission slots, in the vehicle's own words\n"
     "  state STATE        PARKING | DIRECTED | MANUAL_NAVIGATION | WAYPOINT_NAVIGATION\n"
     "  param get NAME | param set NAME VALUE | param list\n"
     "                     the autopilot's parameters\n"
     "  rates [KIND=HZ ...]  show, or set, the pushed telemetry rates (kinds: vehicle, link_stats)\n"
-    "  log [--duration MS]  follow the vehicle's events and autopilot texts (radio or hub)\n"
+    "  log [--duration MS] [--debug]\n"
+    "                     follow the vehicle's events and autopilot texts (radio or hub), each once;\n"
+    "                     --debug as for watch\n"
     "  joystick [--device /dev/input/jsN] [--rate HZ] [--duration MS]\n"
     "                     drive in MANUAL_NAVIGATION from a joystick, or the keyboard without --device\n"
     "                     (w/s/a/d or arrows, space centres, q quits); inputs go at --rate (default 10 Hz)\n"
@@ -329,6 +332,9 @@ int live_command(const Options& o, Requester& client, airseg::client::VehicleLin
     // Each command's own options, after its name; the same parser and messages as the global ones.
     OptionTable table;
     table.value("duration", "MS", "", number(duration_ms, 1, 1e9));
+    if (cmd == "watch" || cmd == "log") {
+        table.flag("debug", "", [&live] { live.debug = true; });
+    }
     if (cmd == "watch") {
         table
             .value("interval", "MS", "",

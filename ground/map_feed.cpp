@@ -7,6 +7,37 @@ namespace airseg::ground {
 namespace proto = groundlink::protocol;
 using Json = nlohmann::json;
 
+namespace {
+
+/// The plan's shape (plan.geometry) with the counts of plan.show: "waypoints" (the expanded plan's count,
+/// null when endless) and "top" (its top-level elements: path, kind, name, waypoints).
+
+void with_counts(Json& geometry, const Json& show) {
+    Json top = Json::array();
+    std::uint64_t total = 0;
+    bool counted = true;
+    const auto elements = show.find("elements");
+    if (elements == show.end() || !elements->is_array()) {
+        return;
+    }
+    for (const auto& e : *elements) {
+        const auto n = e.find("waypoints");
+        if (n != e.end() && n->is_number_unsigned()) {
+            total += n->get<std::uint64_t>();
+        } else {
+            counted = false;  // an endless repeat: no count
+        }
+        top.push_back({{"path", e.value("path", Json())},
+                       {"kind", e.value("kind", Json())},
+                       {"name", e.value("name", Json())},
+                       {"waypoints", n != e.end() ? *n : Json()}});
+    }
+    geometry["top"] = std::move(top);
+    geometry["waypoints"] = counted ? Json(total) : Json();
+}
+
+}  // namespace
+
 MapFeed::MapFeed(asio::any_io_executor strand, Hub& hub, MapConfig config)
     : hub_(hub),
       map_(strand, std::move(config),
@@ -43,7 +74,7 @@ void MapFeed::on_vehicle(const proto::Message& message) {
             refresh_plan();
         }
     } else if (const auto* e = std::get_if<proto::Event>(&message)) {
-        map_.add_event(e->text);
+        map_.add_event(*e);
     }
 }
 
@@ -56,20 +87,35 @@ void MapFeed::refresh_plan() {
         return;
     }
     fetching_ = true;
-    hub_.command({{"cmd", "plan.geometry"}, {"max_points", kPlanPoints}}, [this](Json answer) {
+    const auto done = [this] {
         fetching_ = false;
-        if (stopped_) {
-            return;
-        }
-        if (answer.value("ok", false)) {
-            map_.set_plan(answer["result"]);
-        } else {
-            spdlog::warn("ground hub: the plan's shape for the map: {}", answer.value("error", "no answer"));
-        }
         if (fetch_again_) {
             fetch_again_ = false;
             refresh_plan();
         }
+    };
+    hub_.command({{"cmd", "plan.geometry"}, {"max_points", kPlanPoints}}, [this, done](Json answer) {
+        if (stopped_) {
+            return;
+        }
+        if (!answer.value("ok", false)) {
+            spdlog::warn("ground hub: the plan's shape for the map: {}", answer.value("error", "no answer"));
+            done();
+            return;
+        }
+        // Then the plan's counts (plan.show): the waypoints in plan terms ("waypoint 4 of 12") and the names
+        // of its top-level elements. Without them the map still draws the shape.
+        hub_.command({{"cmd", "plan.show"}},
+                     [this, done, geometry = std::move(answer["result"])](Json show) mutable {
+                         if (stopped_) {
+                             return;
+                         }
+                         if (show.value("ok", false) && show["result"].is_object()) {
+                             with_counts(geometry, show["result"]);
+                         }
+                         map_.set_plan(geometry);
+                         done();
+                     });
     });
 }
 

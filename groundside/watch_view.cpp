@@ -85,7 +85,28 @@ std::string event_line(const proto::Event& e) {
     return fmt::format("{}: {}", event_severity_name(e.severity), e.text);
 }
 
+std::string event_line(const WordedEvent& e, bool debug_view) {
+    const char* severity = event_severity_name(e.severity);
+    if (!debug_view) {
+        return fmt::format("{}: {}", severity, e.text);
+    }
+    if (e.debug) {
+        return fmt::format("{}: (debug) {}", severity, e.raw);
+    }
+    return e.raw == e.text ? fmt::format("{}: {}", severity, e.text)
+                           : fmt::format("{}: {} [{}]", severity, e.text, e.raw);
+}
+
 void WatchState::take(const proto::Message& message, Clock::time_point now) {
+    if (auto worded = wording_.take(message, now)) {
+        if (!worded->debug || debug_) {
+            events_.push_back(event_line(*worded, debug_));
+            while (events_.size() > kRecentEvents) {
+                events_.pop_front();
+            }
+        }
+        return;
+    }
     if (const auto* t = std::get_if<proto::Telemetry>(&message)) {
         latest_ = *t;
         latest_at_ = now;
@@ -96,11 +117,6 @@ void WatchState::take(const proto::Message& message, Clock::time_point now) {
         }
     } else if (const auto* s = std::get_if<proto::LinkStatsReport>(&message)) {
         vehicle_link_ = *s;
-    } else if (const auto* e = std::get_if<proto::Event>(&message)) {
-        events_.push_back(event_line(*e));
-        while (events_.size() > kRecentEvents) {
-            events_.pop_front();
-        }
     }
 }
 
@@ -134,8 +150,9 @@ std::string WatchState::render(Clock::time_point now) const {
             t.battery_pct ? fmt::format("{} %", *t.battery_pct) : std::string("remaining unknown"));
         out += fmt::format("gps         fix {}  {} satellites\n", t.gps_fix, t.satellites);
         if (t.plan_state != 0) {
-            out += fmt::format("plan        {}  element {}  next waypoint {}\n",
-                               plan_state_name(t.plan_state), t.plan_element, t.next_waypoint);
+            out += fmt::format("plan        {}  element {}  next waypoint {} (index {})\n",
+                               plan_state_name(t.plan_state), t.plan_element, t.next_waypoint + 1,
+                               t.next_waypoint);
         }
         out += fmt::format("telemetry   {:.1f} samples/s, last {:.1f} s ago, {} received\n", sample_rate(now),
                            seconds(now - latest_at_), samples_);

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "groundside/event_wording.hpp"
 #include "services/groundlink/protocol/ground_protocol.hpp"
 
 namespace airseg::groundside {
@@ -21,6 +22,8 @@ class WatchState {
     void take(const groundlink::protocol::Message& message, Clock::time_point now);
     /// The ground end's own view of the link (RadioClient::link_stats()).
     void set_ground_link(nlohmann::json stats) { ground_link_ = std::move(stats); }
+    /// Also list the events that say nothing new (debug lines, in the vehicle's own words).
+    void set_debug(bool on) { debug_ = on; }
 
     /// Samples per second over the last few seconds.
     [[nodiscard]] double sample_rate(Clock::time_point now) const;
@@ -37,6 +40,8 @@ class WatchState {
     std::uint64_t samples_ = 0;
     std::optional<groundlink::protocol::LinkStatsReport> vehicle_link_;
     std::deque<std::string> events_;
+    EventWording wording_;  // events in plan terms, each happening once
+    bool debug_ = false;
     nlohmann::json ground_link_ = nlohmann::json::object();
 };
 
@@ -48,5 +53,8 @@ nlohmann::json telemetry_json(const groundlink::protocol::Telemetry& t);
 const char* event_severity_name(groundlink::protocol::Event::Severity s);
 /// An event as one line for people: "warning: text".
 std::string event_line(const groundlink::protocol::Event& e);
+/// A worded event as one line: "info: waypoint 8 reached"; in a debug view, a debug line is marked and in
+/// the vehicle's words ("info: (debug) mission slot 3 reached"), a reworded one shows them after its own.
+std::string event_line(const WordedEvent& e, bool debug_view);
 
 }  // namespace airseg::groundside

@@ -1,11 +1,16 @@
 // Test-only: the map serving a fixed plan while a vehicle drives along it, for the browser test
 // (tests/integration/ground_map). Prints "listening on http://127.0.0.1:PORT/" once it serves.
 //
-//   airseg-map-fixture [--control] [--seconds N] [--fixless-first K] [--lose-fix-after K] [--web-dir DIR]
-//                      [--leaflet-dir DIR]
+//   airseg-map-fixture [--control] [--seconds N] [--fixless-first K] [--lose-fix-after K] [--outage-after K]
+//                      [--web-dir DIR] [--leaflet-dir DIR]
 // N (default 60): how long the vehicle drives and the event stream stays open, from the first browser
 // connection. --fixless-first K: the first K samples have no position (sent as 0,0, as the daemon does before
-// a GPS fix); --lose-fix-after K: every sample after the first K has none.
+// a GPS fix); --lose-fix-after K: every sample after the first K has none; --outage-after K: after K samples
+// the link goes down and no sample comes any more.
+//
+// The plan has 14 waypoints (plan.show's counts are in "waypoints" and "top", as the hub adds them); each
+// waypoint reached sends what an older vehicle sends (the board's "Reached waypoint #N", the window's slot, a
+// "Flight plan received") and the plan's own event, twice, plus a mode change that changes nothing.
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -40,18 +45,32 @@ Json fixture_plan() {
         {"path": "plan.elements[4]", "kind": "orbit", "name": null, "closed": false,
          "points": [[41.2761, 1.9887], [41.2760, 1.9888], [41.2759, 1.9887], [41.2760, 1.9886], [41.2761, 1.9887]]}
       ],
+      "waypoints": 14,
+      "top": [{"path": "plan.elements[0]", "kind": "waypoint", "name": "start", "waypoints": 1},
+              {"path": "plan.elements[1]", "kind": "waypoint", "name": "", "waypoints": 1},
+              {"path": "plan.elements[2]", "kind": "scan", "name": "field", "waypoints": 6},
+              {"path": "plan.elements[3]", "kind": "hold", "name": "wait", "waypoints": 1},
+              {"path": "plan.elements[4]", "kind": "orbit", "name": "", "waypoints": 5}],
       "no_fly": [{"name": "pond", "points": [[41.2770, 1.9890], [41.2770, 1.9896], [41.2766, 1.9896], [41.2766, 1.9890]]}]
     })");
 }
 
+struct RoutePoint {
+    double lat = 0;
+    double lon = 0;
+    std::uint16_t element = 0;  // the top-level element it belongs to
+};
+
 /// The route the simulated vehicle drives: every point of the plan in order, round and round.
-std::vector<std::pair<double, double>> route_of(const Json& plan) {
-    std::vector<std::pair<double, double>> route;
+std::vector<RoutePoint> route_of(const Json& plan) {
+    std::vector<RoutePoint> route;
+    std::uint16_t element = 0;
     for (const auto& e : plan["elements"]) {
         const auto& pts = e.contains("lines") ? e["lines"] : e["points"];
         for (const auto& p : pts) {
-            route.emplace_back(p[0].get<double>(), p[1].get<double>());
+            route.push_back({p[0].get<double>(), p[1].get<double>(), element});
         }
+        ++element;
     }
     return route;
 }
@@ -64,6 +83,7 @@ int main(int argc, char** argv) {
     double seconds = 60;
     long fixless_first = 0;
     long lose_fix_after = -1;
+    long outage_after = -1;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         const bool has_value = i + 1 < argc;
@@ -75,6 +95,8 @@ int main(int argc, char** argv) {
             fixless_first = std::stol(argv[++i]);
         } else if (arg == "--lose-fix-after" && has_value) {
             lose_fix_after = std::stol(argv[++i]);
+        } else if (arg == "--outage-after" && has_value) {
+            outage_after = std::stol(argv[++i]);
         } else if (arg == "--web-dir" && has_value) {
             config.web_dir = argv[++i];
         } else if (arg == "--leaflet-dir" && has_value) {
@@ -117,33 +139,6 @@ int main(int argc, char** argv) {
     bool end_armed = false;
     long samples = 0;
     std::function<void()> drive = [&] {
-        const auto [lat0, lon0] = route[leg % route.size()];
-        const auto [lat1, lon1] = route[(leg + 1) % route.size()];
-        airseg::groundlink::protocol::Telemetry t;
-        t.lat_deg = lat0 + (lat1 - lat0) * along;
-        t.lon_deg = lon0 + (lon1 - lon0) * along;
-        t.alt_m = 10;
-        t.ground_speed_mps = 1.5;
-        t.heading_deg = std::fmod(
-            std::atan2((lon1 - lon0) * std::cos(lat0 * M_PI / 180.0), lat1 - lat0) * 180.0 / M_PI + 360.0,
-            360.0);
-        t.battery_v = 12.4;
-        t.battery_pct = 80;
-        t.plan_state = 1;
-        t.gps_fix = 3;
-        const long n = samples++;
-        if (n < fixless_first || (lose_fix_after >= 0 && n >= lose_fix_after)) {
-            t.no_position = true;
-            t.lat_deg = 0;
-            t.lon_deg = 0;
-            t.gps_fix = 1;
-        }
-        map.add_position(t, std::chrono::system_clock::now());
-        along += 0.25;
-        if (along >= 1.0) {
-            along = 0.0;
-            ++leg;
-        }
         if (!end_armed && map.connections_accepted() > 0) {
             // The run is counted from the browser's first request: a browser slow to start (a loaded
             // machine) finds the page served all the same.
@@ -156,6 +151,61 @@ int main(int argc, char** argv) {
                     signals.cancel();
                 }
             });
+        }
+        const auto [lat0, lon0, element0] = route[leg % route.size()];
+        const auto [lat1, lon1, element1] = route[(leg + 1) % route.size()];
+        (void)element0;
+        airseg::groundlink::protocol::Telemetry t;
+        t.next_waypoint = static_cast<std::uint32_t>((leg + 1) % route.size());
+        t.plan_element = element1;
+        t.lat_deg = lat0 + (lat1 - lat0) * along;
+        t.lon_deg = lon0 + (lon1 - lon0) * along;
+        t.alt_m = 10;
+        t.ground_speed_mps = 1.5;
+        t.heading_deg = std::fmod(
+            std::atan2((lon1 - lon0) * std::cos(lat0 * M_PI / 180.0), lat1 - lat0) * 180.0 / M_PI + 360.0,
+            360.0);
+        t.battery_v = 12.4;
+        t.battery_pct = 80;
+        t.plan_state = 1;
+        t.gps_fix = 3;
+        const long n = samples++;
+        if (outage_after >= 0 && n >= outage_after) {
+            if (n == outage_after) {
+                map.set_link({{"link", "down"}, {"rtt_ms", 84}, {"loss", 0.0}});
+            }
+            step.expires_after(std::chrono::milliseconds(100));
+            step.async_wait([&](boost::system::error_code ec) {
+                if (!ec) {
+                    drive();
+                }
+            });
+            return;
+        }
+        if (n < fixless_first || (lose_fix_after >= 0 && n >= lose_fix_after)) {
+            t.no_position = true;
+            t.lat_deg = 0;
+            t.lon_deg = 0;
+            t.gps_fix = 1;
+        }
+        map.add_position(t, std::chrono::system_clock::now());
+        along += 0.25;
+        if (along >= 1.0) {
+            along = 0.0;
+            ++leg;
+            // The waypoint just reached, as an older vehicle tells it and as the plan does.
+            using airseg::groundlink::protocol::Event;
+            const auto reached = leg % route.size();
+            const auto slot = 2 + leg % 6;
+            for (const std::string& text :
+                 {"autopilot: Reached waypoint #" + std::to_string(slot) + " dist 1m",
+                  "mission slot " + std::to_string(slot) + " reached",
+                  std::string("autopilot: Flight plan received"),
+                  "plan waypoint " + std::to_string(reached) + " reached",
+                  "plan waypoint " + std::to_string(reached) + " reached",
+                  std::string("autopilot mode AUTO -> AUTO")}) {
+                map.add_event(Event{Event::Severity::Info, text});
+            }
         }
         step.expires_after(std::chrono::milliseconds(100));
         step.async_wait([&](boost::system::error_code ec) {

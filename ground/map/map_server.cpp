@@ -4,6 +4,7 @@
 #include <array>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <deque>
 #include <filesystem>
 #include <set>
@@ -14,6 +15,7 @@
 #include "ground/map/http.hpp"
 #include "ground/map/plan_export.hpp"
 #include "ground/map/request_guard.hpp"
+#include "groundside/watch_view.hpp"
 #include "services/common/limited_log.hpp"
 
 namespace airseg::ground {
@@ -216,7 +218,13 @@ struct MapServer::Impl : std::enable_shared_from_this<MapServer::Impl> {
     RequestGuard guard;
     LimitedLog log;  // refusals: any page the operator opens can make them
     Json link;
+    std::optional<std::chrono::system_clock::time_point> down_since;
+    Json last_up;  // the link's figures the last time it was up
+    std::chrono::steady_clock::time_point last_position_at{};
+    groundside::EventWording wording;
     std::deque<Json> events;
+
+    void push_event(Json e);
 };
 
 class Session : public std::enable_shared_from_this<Session> {
@@ -559,9 +567,18 @@ Json MapServer::Impl::state() const {
     for (const auto& p : track) {
         points.push_back(Json::array({p.lat, p.lon}));
     }
+    Json position = last_position;
+    if (position.is_object()) {
+        // Its age as the hub sees it: the page counts on from there with its own clock.
+        position["age_s"] =
+            std::round(
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - last_position_at).count() *
+                10.0) /
+            10.0;
+    }
     Json out = {{"plan", plan},
                 {"track", std::move(points)},
-                {"position", last_position},
+                {"position", std::move(position)},
                 {"fix", fix},
                 {"link", link},
                 {"events", Json(events)},
@@ -649,12 +666,17 @@ MapServer::Counts MapServer::counts() const {
 
 void MapServer::set_plan(const Json& geometry) {
     impl_->plan = geometry.is_object() ? geometry : empty_plan();
+    const auto count = impl_->plan.find("waypoints");
+    impl_->wording.set_waypoints(count != impl_->plan.end() && count->is_number_unsigned()
+                                     ? std::optional<std::uint64_t>(count->get<std::uint64_t>())
+                                     : std::nullopt);
     impl_->broadcast("plan", impl_->plan);
 }
 
 void MapServer::add_position(const groundlink::protocol::Telemetry& t,
                              std::chrono::system_clock::time_point at) {
     auto& s = *impl_;
+    s.wording.set_plan_state(t.plan_state);
     if (t.no_position) {
         // No place to show: the vehicle and its track stay where they were last known, and the page says
         // "no fix" from the first such sample until the next position.
@@ -677,23 +699,60 @@ void MapServer::add_position(const groundlink::protocol::Telemetry& t,
     j["satellites"] = t.satellites;
     j["plan_state"] = t.plan_state;
     j["next_waypoint"] = t.next_waypoint;
+    j["plan"] = groundside::plan_state_name(t.plan_state);
+    j["plan_element"] = t.plan_element;
+    j["state"] = groundlink::protocol::vehicle_state_name(t.vehicle_state);
     s.last_position = j;
+    s.last_position_at = std::chrono::steady_clock::now();
     s.broadcast("position", j);
 }
 
 void MapServer::set_link(const Json& link) {
-    impl_->link = link;
-    impl_->broadcast("link", link);
+    auto& s = *impl_;
+    Json j = link.is_object() ? link : Json::object();
+    if (j.value("link", std::string()) == "up") {
+        s.down_since.reset();
+        s.last_up = j;
+    } else {
+        if (!s.down_since) {
+            s.down_since = std::chrono::system_clock::now();
+        }
+        j["down_since"] = utc_time(*s.down_since);
+        j["last"] = s.last_up.is_object() ? Json{{"rtt_ms", s.last_up.value("rtt_ms", Json())},
+                                                 {"loss", s.last_up.value("loss", Json())}}
+                                          : Json();
+    }
+    s.link = j;
+    s.broadcast("link", j);
+}
+
+void MapServer::Impl::push_event(Json e) {
+    events.push_back(e);
+    if (events.size() > kEventsKept) {
+        events.pop_front();
+    }
+    broadcast("event", e);
+}
+
+void MapServer::add_event(const groundlink::protocol::Event& e) {
+    auto& s = *impl_;
+    const auto worded = s.wording.word(e, std::chrono::steady_clock::now());
+    s.push_event(
+        {{"t", utc_time(std::chrono::system_clock::now())},
+         {"text", worded.text},
+         {"raw", worded.raw},
+         {"debug", worded.debug},
+         {"severity", worded.severity == groundlink::protocol::Event::Severity::Error     ? "error"
+                      : worded.severity == groundlink::protocol::Event::Severity::Warning ? "warning"
+                                                                                          : "info"}});
 }
 
 void MapServer::add_event(const std::string& text) {
-    auto& s = *impl_;
-    Json e = {{"t", utc_time(std::chrono::system_clock::now())}, {"text", text}};
-    s.events.push_back(e);
-    if (s.events.size() > kEventsKept) {
-        s.events.pop_front();
-    }
-    s.broadcast("event", e);
+    impl_->push_event({{"t", utc_time(std::chrono::system_clock::now())},
+                       {"text", text},
+                       {"raw", text},
+                       {"debug", false},
+                       {"severity", "info"}});
 }
 
 }  // namespace airseg::ground

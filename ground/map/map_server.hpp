@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "groundside/event_wording.hpp"
 #include "services/common/asio.hpp"
 #include "services/groundlink/protocol/ground_protocol.hpp"
 
@@ -69,9 +70,17 @@ class MapServer {
     Counts counts() const;
 
     // Fed by the hub, on the strand:
-    void set_plan(const nlohmann::json& geometry);  // the answer of plan.geometry
+    /// The answer of plan.geometry, with what plan.show adds when known: "waypoints" (the expanded plan's
+    /// count, null when endless) and "top" (the top-level elements: path, kind, name, waypoints).
+    void set_plan(const nlohmann::json& geometry);
     void add_position(const groundlink::protocol::Telemetry& t, std::chrono::system_clock::time_point at);
-    void set_link(const nlohmann::json& link);  // {"link":"up","rtt_ms":..,"loss":..,...}
+    /// {"link":"up","rtt_ms":..,"loss":..,...}. While it is not up, the map adds "down_since" (when it went
+    /// down, or when the map first heard of it) and "last" (the figures of the last time it was up).
+    void set_link(const nlohmann::json& link);
+    /// A vehicle event, worded in plan terms and de-duplicated (groundside/event_wording.hpp): the page
+    /// lists the lines that are no debug line, and all of them in its debug view.
+    void add_event(const groundlink::protocol::Event& e);
+    /// A note of the map's own (info, never a debug line).
     void add_event(const std::string& text);
 
     struct Impl;

@@ -34,6 +34,18 @@
   let planName = null;
   let linkState = null;
   let eventCount = 0;
+  let debugView = false;
+  let eventLog = [];        // every event the hub sent, debug lines included (the debug view shows them)
+  let planWaypoints = null; // the expanded plan's count when known (the hub's plan.show), else null
+  let planTop = [];         // the plan's top-level elements: path, kind, name, waypoints
+  let route = [];           // the plan's waypoints in plan order, [lat, lon], when numbered (see drawPlan)
+  let wpMarkers = [];       // their numbered markers (those drawn)
+  let nextIndex = null;     // the plan's next waypoint (0-based index), from the telemetry
+  let progressText = '';
+  let positionAt = null;    // when the last position was new, by this page's clock (ms)
+  let positionAge = null;   // seconds, once older than kStaleSeconds
+  const kStaleSeconds = 3;
+  const kMostLabels = 300;  // more numbered waypoints than this: only the next target is labelled
 
   function trackLength() {
     const pts = trackLine.getLatLngs();
@@ -56,8 +68,15 @@
       vehicle: lastPosition ? { lat: lastPosition.lat, lon: lastPosition.lon, heading: lastPosition.heading } : null,
       link: linkState,
       events: eventCount,
+      events_shown: document.getElementById('events').children.length,
+      debug: debugView,
       control: control,
-      no_fix: noFix
+      no_fix: noFix,
+      waypoints: planWaypoints,
+      numbered: route.length,
+      next_waypoint: nextIndex,
+      progress: progressText,
+      position_age_s: positionAge
     };
   }
   // Mirrored into the page so that a headless browser's DOM dump shows what is drawn.
@@ -70,10 +89,52 @@
     return (points || []).filter(p => Array.isArray(p) && p.length >= 2).map(p => [p[0], p[1]]);
   }
 
+  // The plan's waypoints in plan order, as the vehicle numbers them: the points of the main list's
+  // elements (a scan's lines), when they are exactly the plan's waypoint count (no repeat or jump expands
+  // them otherwise, nothing truncated). Otherwise none: no number is better than a wrong one.
+  function planRoute(plan) {
+    if (!plan || plan.truncated || typeof plan.waypoints !== 'number') {
+      return [];
+    }
+    const pts = [];
+    (plan.elements || []).forEach(e => {
+      if (!String(e.path || '').startsWith('plan.blocks')) {
+        latlngs(e.closed ? e.lines : e.points).forEach(p => pts.push(p));
+      }
+    });
+    return pts.length === plan.waypoints ? pts : [];
+  }
+
+  function waypointIcon(n, next) {
+    return L.divIcon({ className: 'airseg-wp' + (next ? ' airseg-wp-next' : ''), html: String(n),
+                       iconSize: next ? [26, 26] : [18, 18], iconAnchor: next ? [13, 13] : [9, 9] });
+  }
+
+  function drawNumbers() {
+    wpMarkers.forEach(m => planLayer.removeLayer(m));
+    wpMarkers = [];
+    const label = (i) => {
+      const next = i === nextIndex;
+      const m = L.marker(route[i], { icon: waypointIcon(i + 1, next), keyboard: false, interactive: false,
+                                     zIndexOffset: next ? 1000 : 0 }).addTo(planLayer);
+      m.getElement().dataset.index = String(i);
+      wpMarkers.push(m);
+    };
+    if (route.length <= kMostLabels) {
+      route.forEach((_, i) => label(i));
+    } else if (nextIndex != null && nextIndex < route.length) {
+      label(nextIndex);
+    }
+  }
+
   function drawPlan(plan) {
     planLayer.clearLayers();
+    wpMarkers = [];
     Object.keys(counts).forEach(k => { counts[k] = 0; });
     planName = plan && plan.name ? plan.name : null;
+    planWaypoints = plan && typeof plan.waypoints === 'number' ? plan.waypoints : null;
+    planTop = (plan && plan.top) || [];
+    route = planRoute(plan);
     document.getElementById('plan-name').textContent = planName ? planName : 'no plan';
     const bounds = L.latLngBounds([]);
     const mainRoute = [];
@@ -134,7 +195,48 @@
       map.fitBounds(bounds.pad(0.15));
       fitted = true;
     }
+    drawNumbers();
+    showProgress();
     publish();
+  }
+
+  function metres(m) {
+    return m >= 1000 ? (m / 1000).toFixed(1) + ' km' : Math.round(m) + ' m';
+  }
+
+  // "running — waypoint 4 of 12 — scan 'north field' — 2.1 km left": where the plan is, in plan terms.
+  function showProgress() {
+    const p = lastPosition;
+    const box = document.getElementById('plan-progress');
+    if (!p || !p.plan || p.plan === 'none') {
+      progressText = planName ? 'no plan running' : '';
+      box.textContent = progressText;
+      return;
+    }
+    const parts = [p.plan];
+    const driving = p.plan === 'running' || p.plan === 'paused';
+    if (driving && nextIndex != null) {
+      parts.push('waypoint ' + (nextIndex + 1) + (planWaypoints != null && nextIndex < planWaypoints
+        ? ' of ' + planWaypoints : ''));
+    }
+    const el = planTop[p.plan_element];
+    if (driving && el) {
+      parts.push(el.kind + (el.name ? " '" + el.name + "'" : ' ' + el.path));
+    }
+    if (driving && route.length && nextIndex != null && nextIndex < route.length) {
+      let left = map.distance([p.lat, p.lon], route[nextIndex]);
+      for (let i = nextIndex + 1; i < route.length; i += 1) {
+        left += map.distance(route[i - 1], route[i]);
+      }
+      let text = metres(left) + ' left';
+      if (p.speed > 0.3) {
+        const s = left / p.speed;  // at the present speed
+        text += ' (about ' + (s < 90 ? Math.max(1, Math.round(s)) + ' s' : Math.round(s / 60) + ' min') + ')';
+      }
+      parts.push(text);
+    }
+    progressText = parts.join(' — ');
+    box.textContent = progressText;
   }
 
   function vehicleIcon(heading) {
@@ -146,6 +248,12 @@
   function setPosition(p, addToTrack) {
     lastPosition = p;
     noFix = false;
+    positionAt = Date.now() - 1000 * (p.age_s || 0);
+    const next = p.plan === 'running' || p.plan === 'paused' ? p.next_waypoint : null;
+    if (next !== nextIndex) {
+      nextIndex = next;
+      drawNumbers();
+    }
     const ll = [p.lat, p.lon];
     if (!vehicle) {
       vehicle = L.marker(ll, { icon: vehicleIcon(p.heading), keyboard: false }).addTo(map);
@@ -170,8 +278,23 @@
       parts.push('battery ' + p.battery_pct + ' %');
     }
     document.getElementById('vehicle-text').textContent = parts.join(' · ');
+    positionAge = null;
+    showAge();
+    showProgress();
     publish();
   }
+
+  // Once the last position is older than a couple of seconds, it says how old, and the marker greys.
+  function showAge() {
+    const age = positionAt == null ? null : Math.floor((Date.now() - positionAt) / 1000);
+    const stale = age != null && age >= kStaleSeconds;
+    positionAge = stale ? age : null;
+    document.getElementById('vehicle-age').textContent = stale ? 'position ' + age + ' s old' : '';
+    if (vehicle) {
+      vehicle.getElement().classList.toggle('airseg-stale', stale);
+    }
+  }
+  setInterval(() => { showAge(); publish(); }, 1000);
 
   // A sample without a fix: the vehicle stays where it was last known, greyed, and says so.
   function setNoFix(fix) {
@@ -183,37 +306,82 @@
                                 lastPosition.lon.toFixed(6) + ' at ' + lastPosition.t : '';
     document.getElementById('vehicle-text').textContent =
       'no fix (GPS fix type ' + fix.gps_fix + ')' + last;
+    showAge();
     publish();
   }
 
+  // Up: its figures. Down: since when, and the last figures greyed (they are history, not the link now).
   function setLink(link) {
     linkState = link;
     const box = document.getElementById('link');
     const up = link && link.link;
     box.className = 'link-' + (up || 'unknown');
-    const parts = [up || 'unknown'];
-    if (link && link.rtt_ms != null) {
-      parts.push('rtt ' + link.rtt_ms + ' ms');
+    const figures = (l) => {
+      const parts = [];
+      if (l && l.rtt_ms != null) {
+        parts.push('rtt ' + l.rtt_ms + ' ms');
+      }
+      if (l && l.loss != null) {
+        parts.push('loss ' + (100 * l.loss).toFixed(1) + ' %');
+      }
+      return parts.join(' · ');
+    };
+    const text = document.getElementById('link-text');
+    const last = document.getElementById('link-last');
+    if (up === 'up' || up === 'degraded') {
+      text.textContent = [up, figures(link)].filter(Boolean).join(' · ');
+      last.textContent = '';
+    } else if (link && link.down_since) {
+      text.textContent = 'down since ' + link.down_since.substring(11, 19);
+      const was = figures(link.last);
+      last.textContent = was ? 'last: ' + was : '';
+    } else {
+      text.textContent = (up || 'unknown') + (link && link.note ? ' · ' + link.note : '');
+      last.textContent = '';
     }
-    if (link && link.loss != null) {
-      parts.push('loss ' + (100 * link.loss).toFixed(1) + ' %');
-    }
-    document.getElementById('link-text').textContent = parts.join(' · ');
     publish();
   }
 
-  function addEvent(e) {
+  // Events in plan terms, once per happening (the hub words them: groundside/event_wording.hpp); the debug
+  // view lists every event in the vehicle's own words, slot numbers and all.
+  function eventItem(e) {
     const li = document.createElement('li');
-    li.className = 'airseg-event';
-    li.textContent = (e.t ? e.t.substring(11, 19) + ' ' : '') + e.text;
-    const list = document.getElementById('events');
-    list.insertBefore(li, list.firstChild);
-    while (list.children.length > 200) {
-      list.removeChild(list.lastChild);
+    li.className = 'airseg-event' + (e.debug ? ' airseg-event-debug' : '') +
+                   (e.severity && e.severity !== 'info' ? ' airseg-event-' + e.severity : '');
+    const words = debugView && e.raw && e.raw !== e.text && !e.debug ? e.text + ' [' + e.raw + ']'
+                : debugView && e.debug ? e.raw || e.text : e.text;
+    li.textContent = (e.t ? e.t.substring(11, 19) + ' ' : '') + words;
+    return li;
+  }
+
+  function addEvent(e) {
+    eventLog.push(e);
+    if (eventLog.length > 400) {
+      eventLog.shift();
     }
     eventCount += 1;
+    if (!e.debug || debugView) {
+      const list = document.getElementById('events');
+      list.insertBefore(eventItem(e), list.firstChild);
+      while (list.children.length > 200) {
+        list.removeChild(list.lastChild);
+      }
+    }
     publish();
   }
+
+  function showEvents() {
+    const list = document.getElementById('events');
+    list.textContent = '';
+    eventLog.filter(e => !e.debug || debugView).slice(-200).forEach(e => {
+      list.insertBefore(eventItem(e), list.firstChild);
+    });
+    publish();
+  }
+  document.getElementById('debug-view').onchange = (ev) => {
+    debugView = ev.target.checked;
+    showEvents();
+  };
 
   function setControl(on) {
     control = on;
@@ -248,12 +416,13 @@
   document.getElementById('btn-pause').onclick = () => command({ cmd: 'plan.pause' });
   document.getElementById('btn-resume').onclick = () => command({ cmd: 'plan.resume' });
   document.getElementById('btn-skip').onclick = () => {
-    const target = window.prompt('Skip to a waypoint number or an element name');
+    const target = window.prompt('Skip to a waypoint number (as numbered on the map) or an element name');
     if (target === null || target.trim() === '') {
       return;
     }
     const t = target.trim();
-    command(/^\d+$/.test(t) ? { cmd: 'plan.skip', index: Number(t) } : { cmd: 'plan.skip', element: t });
+    // The map numbers waypoints from 1; the vehicle's index counts from 0.
+    command(/^[1-9]\d*$/.test(t) ? { cmd: 'plan.skip', index: Number(t) - 1 } : { cmd: 'plan.skip', element: t });
   };
   document.getElementById('btn-load').onchange = async (ev) => {
     const file = ev.target.files[0];
@@ -265,10 +434,16 @@
 
   setBackground('');
   setControl(false);
+  // ?debug=1: the debug view from the start (every event as the vehicle sent it).
+  const params = new URLSearchParams(location.search);
+  if (params.get('debug') === '1') {
+    debugView = true;
+    document.getElementById('debug-view').checked = true;
+  }
   publish();
 
   // ?for=S: follow the vehicle for S seconds, then keep the picture (a snapshot; no reconnecting).
-  const follow = new URLSearchParams(location.search).get('for');
+  const follow = params.get('for');
   const events = new EventSource('/events' + (follow ? '?for=' + encodeURIComponent(follow) : ''));
   events.addEventListener('state', ev => {
     const s = JSON.parse(ev.data);
@@ -286,6 +461,7 @@
     setLink(s.link);
     document.getElementById('events').textContent = '';
     eventCount = 0;
+    eventLog = [];
     (s.events || []).forEach(addEvent);
   });
   events.addEventListener('plan', ev => drawPlan(JSON.parse(ev.data)));
@@ -298,6 +474,7 @@
       events.close();
       return;
     }
-    setLink({ link: 'down', note: 'no connection to the hub' });
+    setLink({ link: 'down', note: 'no connection to the hub', down_since: linkState && linkState.down_since,
+              last: linkState && linkState.link === 'up' ? linkState : linkState && linkState.last });
   };
 })();

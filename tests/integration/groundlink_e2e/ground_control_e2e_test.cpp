@@ -2,6 +2,7 @@
 // (57600 baud) ⇄ airsegctl. Pushed telemetry, roles by key, joystick driving, and a lossy link.
 #include <fcntl.h>
 #include <gtest/gtest.h>
+
 #include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
@@ -9,12 +10,14 @@
 #include <sys/stat.h>
 #include <sys/un.h>
 #include <unistd.h>
+#include <map>
 
 #include <array>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -258,19 +261,23 @@ TEST_F(GroundControlE2e, APlanLoadedOverTheRadioIsDrivenPausedResumedAndSkipped)
         }
     }
     EXPECT_GT(running, 0) << "no sample of the running plan in the watch:\n" << watch.out;
-    // Events in plan terms, once per waypoint: not the window's slots, nor the board's texts about them.
+    // Events in plan terms, once per waypoint: not the window's slots, nor the board's texts about them,
+    // in the words the map uses too (groundside/event_wording.hpp): "waypoint 11 reached", numbered from 1.
     // `log` follows the events until two waypoints are reached: by then the board's slot events and texts
-    // of those reaches would have come too.
+    // of those reaches would have come too. `watch` runs alongside and lists the same lines.
     Subprocess log({binary("client/airsegctl"), "--link", ground(), "--json", "log", "--duration", "120000"},
                    {}, dir.path());
-    const auto plan_events_in = [&](const std::string& out) {
-        int n = 0;
+    const auto reached_in = [&](const std::string& out) {
+        std::map<std::string, int> per_waypoint;  // "waypoint 11 reached" -> lines
         for (const auto& e : json_lines(out)) {
-            n += e.value("text", "").starts_with("plan waypoint") ? 1 : 0;
+            const auto text = e.value("text", "");
+            if (text.starts_with("waypoint ") && text.ends_with(" reached")) {
+                ++per_waypoint[text];
+            }
         }
-        return n;
+        return per_waypoint;
     };
-    EXPECT_TRUE(wait_until([&] { return plan_events_in(log.out()) >= 2; }, kGenerous, 500ms)) << log.out();
+    EXPECT_TRUE(wait_until([&] { return reached_in(log.out()).size() >= 2; }, kGenerous, 500ms)) << log.out();
     log.signal(SIGTERM);
     ASSERT_TRUE(log.wait_exit(kGenerous));
     for (const auto& e : json_lines(log.out())) {
@@ -278,8 +285,16 @@ TEST_F(GroundControlE2e, APlanLoadedOverTheRadioIsDrivenPausedResumedAndSkipped)
         EXPECT_EQ(text.find("mission slot"), std::string::npos) << text;
         EXPECT_EQ(text.find("Reached waypoint #"), std::string::npos) << text;
         EXPECT_EQ(text.find("flight plan received"), std::string::npos) << text;
+        EXPECT_EQ(text.find("plan waypoint"), std::string::npos) << "the vehicle's words, reworded: " << text;
+        EXPECT_FALSE(e.contains("raw")) << "the vehicle's own words only with --debug";
     }
-    EXPECT_GE(plan_events_in(log.out()), 2) << log.out() << log.err();
+    const auto per_waypoint = reached_in(log.out());
+    EXPECT_GE(per_waypoint.size(), 2u) << log.out() << log.err();
+    for (const auto& [line, n] : per_waypoint) {
+        EXPECT_EQ(n, 1) << "one line per waypoint: " << line << "\n" << log.out();
+        // Numbered in plan terms: past the skip to index 9, the first reached is waypoint 10 or later.
+        EXPECT_GE(std::stoi(line.substr(9)), 10) << line;
+    }
     const auto folded = status_doc()["groundlink"].value("events_folded", 0);
     EXPECT_GT(folded, 0) << "the board's slot events and texts are counted";
 }

@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "ground/map/map_server.hpp"
+#include "ground/map/plan_export.hpp"
 
 namespace airseg::ground {
 namespace {
@@ -398,6 +399,78 @@ TEST(MapServer, ABusyPortIsReportedForPeople) {
     bad.listen = "nowhere";
     MapServer third(io.get_executor(), bad, {});
     EXPECT_EQ(third.start(), "cannot listen on nowhere: give HOST:PORT");
+}
+
+// The map words the vehicle's events as watch and log do: in plan terms, once per waypoint; the window's
+// slot events go to the page as debug lines only. The link, once down, says since when and keeps its last
+// figures apart; the position's age counts from when the hub had it.
+TEST(MapServer, EventsInPlanTermsTheLinkDownSinceAndThePositionsAge) {
+    Rig rig;
+    groundlink::protocol::Telemetry t;
+    t.lat_deg = 41.5;
+    t.lon_deg = 2.5;
+    t.plan_state = 1;
+    t.next_waypoint = 4;
+    t.plan_element = 2;
+    using groundlink::protocol::Event;
+    rig.on_strand([&] {
+        rig.map->set_plan(Json::parse(R"({"name":"p","elements":[],"no_fly":[],"waypoints":12})"));
+        rig.map->add_position(t, std::chrono::system_clock::now());
+        rig.map->set_link({{"link", "up"}, {"rtt_ms", 84}, {"loss", 0.02}});
+        for (const char* text : {"autopilot: Reached waypoint #5 dist 1m", "mission slot 5 reached",
+                                 "autopilot: Flight plan received", "plan waypoint 3 reached",
+                                 "plan waypoint 3 reached", "autopilot mode AUTO -> AUTO"}) {
+            rig.map->add_event(Event{Event::Severity::Info, text});
+        }
+        rig.map->set_link({{"link", "down"}, {"rtt_ms", 84}, {"loss", 0.0}});
+    });
+    const auto state_now = [&] {
+        asio::io_context client;
+        tcp::socket s(client);
+        s.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), rig.map->port()));
+        asio::write(s, asio::buffer(std::string("GET /events HTTP/1.1\r\nHost: localhost\r\n\r\n")));
+        std::string buffer;
+        asio::read_until(s, asio::dynamic_buffer(buffer), "\r\n\r\n");
+        buffer.erase(0, buffer.find("\r\n\r\n") + 4);
+        return read_events(s, buffer, 1).at(0).second;
+    };
+    const auto state = state_now();
+    const auto& events = state["events"];
+    ASSERT_EQ(events.size(), 6u) << events.dump();
+    std::vector<std::string> shown;
+    for (const auto& e : events) {
+        if (!e["debug"].get<bool>()) {
+            shown.push_back(e["text"]);
+        }
+    }
+    ASSERT_EQ(shown.size(), 1u) << events.dump();
+    EXPECT_EQ(shown[0], "waypoint 4 of 12 reached");
+    EXPECT_EQ(events[1]["raw"], "mission slot 5 reached") << "the debug view's words";
+    EXPECT_EQ(events[3]["raw"], "plan waypoint 3 reached");
+
+    EXPECT_EQ(state["link"]["link"], "down");
+    ASSERT_TRUE(state["link"]["down_since"].is_string()) << state["link"].dump();
+    EXPECT_EQ(state["link"]["last"]["rtt_ms"], 84) << "the figures of the link when it was up";
+    EXPECT_EQ(state["link"]["last"]["loss"], 0.02);
+    EXPECT_GE(state["position"]["age_s"].get<double>(), 0.0);
+    EXPECT_EQ(state["position"]["plan"], "running");
+    EXPECT_EQ(state["position"]["next_waypoint"], 4);
+    EXPECT_EQ(state["position"]["plan_element"], 2);
+
+    // Down since the first report of it, not the latest: wait until the clock shows another second.
+    const auto since = state["link"]["down_since"].get<std::string>();
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (utc_time(std::chrono::system_clock::now()) == since &&
+           std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    rig.on_strand([&] { rig.map->set_link({{"link", "down"}}); });
+    const auto later = state_now();
+    EXPECT_EQ(later["link"]["down_since"], since);
+    rig.on_strand([&] { rig.map->set_link({{"link", "up"}, {"rtt_ms", 90}}); });
+    const auto up = state_now();
+    EXPECT_FALSE(up["link"].contains("down_since")) << up["link"].dump();
+    EXPECT_EQ(up["link"]["rtt_ms"], 90);
 }
 
 }  // namespace
