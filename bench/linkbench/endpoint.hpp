@@ -26,6 +26,8 @@ struct EndpointSetup {
     std::uint32_t baud = 57600;
     LinkMode mode = LinkMode::Single;
     bool is_a = true;  ///< end A transmits on path 0 in dual mode, end B on path 1
+    /// Which start of the end's program this is (a client started again is a new process: a new session).
+    std::uint32_t incarnation = 0;
     TimePoint now{};
     double pacing_factor = 1.0;  ///< a pacing protocol's link rate as a fraction of baud/10
     /// What the radio does on air, for a protocol that can be told (nullopt: it assumes its defaults).
@@ -68,6 +70,9 @@ class BenchEndpoint {
         double turnaround_ms = -1.0;
     };
     [[nodiscard]] virtual std::optional<AirMeasure> air_measure() const { return std::nullopt; }
+    /// Whether the application on this protocol names commands with request ids, which the vehicle's
+    /// record of recent commands runs at most once (airseg's ground protocol does; the seed's did not).
+    [[nodiscard]] virtual bool request_ids() const { return true; }
 };
 
 /// The seed's protocol (bench/linkbench/seed_protocol.hpp).

@@ -38,6 +38,10 @@ Scenarios, for 57600 and 115200 baud, single pair and dual pair (split: each end
   bidir            bulk Safe both ways (dual/single ratio of this row is a target)
   bidir+fast       bulk Safe both ways, and in run 2 Fast both ways: each direction's share of the air
   telemetry        the clean row while B sends airsegd's telemetry (48 B at 2 Hz, 37 B at 1 Hz, Fast)
+Single pair only:
+  lost answer      run 3 with request ids, B running commands through the vehicle's record of recent
+                   commands: the answer to every fourth is lost (B's radio silent 6 s as it arrives), the
+                   client gives up after 3 s, starts again and sends it again: none may run twice
 Single pair only, radios whose air differs from their serial port ("cfg": the transport is told the radio, as
 groundlink.radio tells it; without, it assumes 1 ms turnaround and no per-packet overhead):
   pkt32+8 [cfg]    32-byte air packets with 8 bytes of overhead each
@@ -115,6 +119,10 @@ std::vector<Scenario> scenarios(const Knobs& k) {
             if (mode != LinkMode::Single) {
                 continue;
             }
+            Scenario retried = base;
+            retried.impairment = "lost answer";
+            retried.lost_answers = true;
+            list.push_back(retried);
             // Radios whose air is not their serial port: small air packets with their own overhead, and a
             // slow change of sender; each as the transport assumes it by default, then told (configured).
             // Then told only the radio's buffer, measuring the rest (adapt).

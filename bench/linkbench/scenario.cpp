@@ -5,8 +5,11 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <set>
+#include <string>
 #include <vector>
 
+#include "services/common/command_record.hpp"
 #include "tools/linksim/radio_model.hpp"
 
 namespace airseg::linkbench {
@@ -22,6 +25,9 @@ constexpr std::uint16_t kFastStreams = 8;
 constexpr std::uint32_t kFastBackBit = 1U << 30;  // Fast ids sent B→A
 constexpr std::size_t kBulkBacklog = 24;          // Safe messages the application keeps offered
 constexpr Duration kStep = std::chrono::milliseconds(1);
+// lost_answers: how long B's radio is silent as the command arrives, and how long its client waits.
+constexpr Duration kLostAnswerOutage = std::chrono::seconds(6);
+constexpr Duration kClientGivesUp = std::chrono::seconds(3);
 
 // Message content: a 4-byte id (little-endian) then bytes derived from it, so damage is detectable.
 std::vector<std::uint8_t> make_payload(std::uint32_t id, std::size_t size, std::uint8_t salt) {
@@ -100,8 +106,8 @@ linksim::RadioConfig bench_radio(const Scenario& s, std::uint64_t seed) {
 
 namespace {
 
-EndpointSetup setup(const Scenario& s, bool is_a, TimePoint t0) {
-    EndpointSetup e{s.baud, s.mode, is_a, t0, s.pacing_factor, std::nullopt};
+EndpointSetup setup(const Scenario& s, bool is_a, TimePoint t0, std::uint32_t incarnation = 0) {
+    EndpointSetup e{s.baud, s.mode, is_a, incarnation, t0, s.pacing_factor, std::nullopt};
     if (s.radio_configured || s.radio_adapt) {
         const auto radio = bench_radio(s, 0);
         e.radio = EndpointSetup::Radio{radio.turnaround,   radio.max_air_packet, radio.air_packet_overhead,
@@ -120,6 +126,16 @@ struct Wiring {
         }
     }
     [[nodiscard]] bool ready() const { return ends[0] && ends[1]; }
+
+    /// The end at `side` as a program started again: a new session, and nothing of the old one's half-written
+    /// frame.
+    void restart(Side side, const Scenario& s, const EndpointFactory& make, TimePoint now,
+                 std::uint32_t incarnation) {
+        ends[linksim::index(side)] = make(setup(s, side == Side::A, now, incarnation));
+        for (auto& w : pending[linksim::index(side)]) {
+            w = PendingWrite{};
+        }
+    }
 
     /// Radio output to the ends, due timeouts, then every delivered message to `on_message(side, m, now)`.
     template <typename OnMessage>
@@ -341,13 +357,39 @@ void run_commands(const Scenario& s, const EndpointFactory& make, ScenarioResult
 
     std::uint32_t next_id = 0;
     bool in_flight = false;
-    TimePoint sent_at = t0;  // of the command in flight
+    TimePoint sent_at = t0;    // of the command in flight, first sent
+    TimePoint resend_at = t0;  // when its client gives up and starts again (lost_answers)
+    bool retried = false;      // the command in flight was sent again
+    std::uint32_t incarnation = 0;
     TimePoint next_command = t0 + std::chrono::seconds(2);
     std::vector<double> rtt;
     std::vector<std::uint32_t> to_answer;
     TimePoint next_vehicle = t0;
     TimePoint next_link_stats = t0;
     std::uint32_t telemetry_id = 0;
+    const bool with_record = ends[1]->request_ids();
+    CommandRecord record;
+    std::map<std::uint32_t, int> applied;  // by command id: times the vehicle ran it
+    std::set<std::uint32_t> silenced;      // commands whose answer the radio lost
+
+    // The vehicle: each command once per request id when it keeps a record, every time it arrives without.
+    auto run_command = [&](std::uint32_t id, TimePoint now) {
+        if (s.lost_answers && id % 4 == 1 && silenced.insert(id).second) {
+            wiring.pairs[0].add_outage(Side::B, now, kLostAnswerOutage);
+        }
+        if (!with_record) {
+            ++applied[id];
+            to_answer.push_back(id);
+            return;
+        }
+        const auto admit = record.admit(std::to_string(id), id, now,
+                                        [&to_answer, id](const CommandResult&) { to_answer.push_back(id); });
+        if (admit == CommandRecord::Admit::Run) {
+            ++applied[id];
+            record.finish(std::to_string(id), id, CommandResult::ok(), now);
+            to_answer.push_back(id);
+        }
+    };
 
     auto on_message = [&](Side to, const BenchMessage& m, TimePoint now) {
         if (!m.safe) {
@@ -355,7 +397,7 @@ void run_commands(const Scenario& s, const EndpointFactory& make, ScenarioResult
         }
         if (to == Side::B) {
             if (auto id = check_payload(m.bytes, kCommandBytes, kSaltCommand)) {
-                to_answer.push_back(*id);
+                run_command(*id, now);
             } else {
                 ++result.damaged_deliveries;
             }
@@ -369,6 +411,9 @@ void run_commands(const Scenario& s, const EndpointFactory& make, ScenarioResult
         if (in_flight && *id + 1 == next_id) {
             rtt.push_back(std::chrono::duration<double>(now - sent_at).count());
             ++result.cmd_answered;
+            if (retried) {
+                ++result.cmd_retried_answered;
+            }
             in_flight = false;
             next_command = now + kCommandPause;
         }
@@ -385,8 +430,20 @@ void run_commands(const Scenario& s, const EndpointFactory& make, ScenarioResult
                 ++next_id;
                 ++result.cmd_sent;
                 in_flight = true;
+                retried = false;
                 sent_at = now;
+                resend_at = now + kClientGivesUp;
             }
+        }
+        if (s.lost_answers && in_flight && now >= resend_at) {
+            // The operator's client timed out: started again, it sends the same command, same request id.
+            wiring.restart(Side::A, s, make, now, ++incarnation);
+            ends[0]->send_urgent(make_payload(next_id - 1, kCommandBytes, kSaltCommand), now);
+            if (!retried) {
+                ++result.cmd_retried;
+            }
+            retried = true;
+            resend_at = now + kClientGivesUp;
         }
         while (next_vehicle <= now) {
             ends[1]->send_fast(0, make_payload(telemetry_id++, 48, kSaltFast), now);
@@ -401,9 +458,17 @@ void run_commands(const Scenario& s, const EndpointFactory& make, ScenarioResult
             {now + kStep, next_vehicle, next_link_stats, ends[0]->poll_timeout(), ends[1]->poll_timeout()});
         if (!in_flight) {
             next = std::min(next, next_command);
+        } else if (s.lost_answers) {
+            next = std::min(next, resend_at);
         }
         now = std::max(next, now + std::chrono::microseconds(10));
     }
+    for (const auto& [id, times] : applied) {
+        if (times > 1) {
+            ++result.cmd_applied_twice;
+        }
+    }
+    result.cmd_twice = static_cast<double>(result.cmd_applied_twice);
     // A command still unanswered long after it was sent counts; one sent just before the end does not.
     if (in_flight && end - sent_at > std::chrono::seconds(5)) {
         rtt.push_back(std::numeric_limits<double>::infinity());

@@ -31,6 +31,11 @@ struct Scenario {
     /// The transport is told the radio as it is (air packets, overhead, turnaround, buffer), as
     /// groundlink.radio tells it; otherwise it assumes the defaults (1 ms turnaround, no packet overhead).
     bool radio_configured = false;
+    /// Commands carry a request id and B runs them through the vehicle's record of recent commands
+    /// (services/common/command_record.hpp; the seed had none). The answer to every fourth is lost: B's
+    /// radio goes silent for 6 s as the command arrives; the client gives up after 3 s, starts again (a new
+    /// session) and sends the same command again.
+    bool lost_answers = false;
     /// The transport's pacing follows the air as it measures it (groundlink.radio.adapt); told the radio's
     /// buffer, and the rest only with radio_configured.
     bool radio_adapt = false;
@@ -59,6 +64,10 @@ struct ScenarioResult {
     double cmd_p90_s = 0.0;
     std::uint64_t cmd_sent = 0;
     std::uint64_t cmd_answered = 0;
+    std::uint64_t cmd_retried = 0;           ///< lost_answers: commands sent again by a client started again
+    std::uint64_t cmd_retried_answered = 0;  ///< ... and answered after that
+    std::uint64_t cmd_applied_twice = 0;     ///< lost_answers: commands the vehicle ran more than once
+    double cmd_twice = 0.0;                  ///< cmd_applied_twice, as a figure for the table
     std::uint64_t safe_messages = 0;
     std::uint64_t damaged_deliveries = 0;  ///< messages whose content differs from what was sent
     // Where the bytes went (diagnostics printed by --verbose):

@@ -41,6 +41,7 @@ class SeedBenchEndpoint final : public BenchEndpoint {
     }
     TimePoint poll_timeout() const override { return seed_.poll_timeout(); }
     std::size_t safe_backlog() const override { return seed_.safe_pending(); }
+    bool request_ids() const override { return false; }
 
   private:
     seed::SeedEndpoint seed_;

@@ -28,7 +28,7 @@ groundlink::TransportConfig bench_config(const EndpointSetup& setup) {
         c.path_mode = groundlink::PathMode::Split;
         c.split_tx_path = setup.is_a ? 0 : 1;
     }
-    c.boot_nonce = setup.is_a ? 0xA11CE : 0xB0B;
+    c.boot_nonce = (setup.is_a ? 0xA11CE : 0xB0B) + 0x10000ULL * setup.incarnation;
     return c;
 }
 

@@ -3,6 +3,8 @@
 // what the air carries and never overflows the radio's buffer; two ends loaded both ways share the air.
 #include <gtest/gtest.h>
 
+#include <memory>
+
 #include "bench/linkbench/scenario.hpp"
 
 namespace airseg::linkbench {
@@ -115,6 +117,54 @@ TEST(RadioOnAir, BulkAndFastTrafficBothWaysLeaveEachDirectionAThirdOfTheAir) {
               << both.fast_run_goodput_ba_pct << " % (one direction alone " << alone.goodput_pct
               << " %); longest waits " << both.fast_run_stall_ab_s << " s / " << both.fast_run_stall_ba_s
               << " s\n";
+}
+
+// The transport's end, as an application that names no command with a request id would use it.
+class WithoutRequestIds final : public BenchEndpoint {
+  public:
+    explicit WithoutRequestIds(std::unique_ptr<BenchEndpoint> inner) : inner_(std::move(inner)) {}
+    bool send_safe(std::span<const std::uint8_t> m, TimePoint now) override {
+        return inner_->send_safe(m, now);
+    }
+    bool send_urgent(std::span<const std::uint8_t> m, TimePoint now) override {
+        return inner_->send_urgent(m, now);
+    }
+    void send_fast(std::uint16_t stream, std::span<const std::uint8_t> m, TimePoint now) override {
+        inner_->send_fast(stream, m, now);
+    }
+    void handle_bytes(std::size_t path, std::span<const std::uint8_t> b, TimePoint now) override {
+        inner_->handle_bytes(path, b, now);
+    }
+    void handle_timeout(TimePoint now) override { inner_->handle_timeout(now); }
+    std::optional<std::vector<std::uint8_t>> poll_transmit(std::size_t path, TimePoint now) override {
+        return inner_->poll_transmit(path, now);
+    }
+    std::optional<BenchMessage> poll_message() override { return inner_->poll_message(); }
+    TimePoint poll_timeout() const override { return inner_->poll_timeout(); }
+    std::size_t safe_backlog() const override { return inner_->safe_backlog(); }
+    bool request_ids() const override { return false; }
+
+  private:
+    std::unique_ptr<BenchEndpoint> inner_;
+};
+
+TEST(RadioOnAir, ACommandWhoseAnswerWasLostRunsOnceWhenANewClientSendsItAgain) {
+    Scenario s = scenario("lost answer");
+    s.lost_answers = true;
+    s.duration = std::chrono::seconds(40);
+    const auto r = run_scenario(s, make_transport_endpoint);
+    ASSERT_TRUE(r.ran);
+    EXPECT_GE(r.cmd_retried, 2u);
+    EXPECT_GE(r.cmd_retried_answered + 1, r.cmd_retried);  // the last may still be on its way
+    EXPECT_EQ(r.cmd_applied_twice, 0u);
+    // The same radio and clients without the vehicle's record: the retried commands run twice.
+    const auto unrecorded = run_scenario(s, [](const EndpointSetup& e) -> std::unique_ptr<BenchEndpoint> {
+        return std::make_unique<WithoutRequestIds>(make_transport_endpoint(e));
+    });
+    EXPECT_GE(unrecorded.cmd_applied_twice, 1u);
+    std::cout << "[ figures ] lost answers: " << r.cmd_retried << " commands sent again by a new client, "
+              << r.cmd_applied_twice << " run twice (" << unrecorded.cmd_applied_twice
+              << " without the record); command p90 " << r.cmd_p90_s << " s\n";
 }
 
 TEST(RadioOnAir, TheVehiclesTelemetryTrickleCostsBulkLittle) {
