@@ -348,6 +348,7 @@ void MissionClient::transmit(WorkItem& w, TimePoint now, bool retry) {
         case Step::NotStarted:
             return;
     }
+    ++w.sends;
     if (retry) {
         ++stats_.retransmissions;
         stray_items_ += item_sent ? 1 : 0;
@@ -647,6 +648,16 @@ void MissionClient::on_ack(std::uint8_t type, TimePoint now) {
     if (type == mav::kMissionError && !w.any_request && w.restarts > 0) {
         ++stats_.ignored_frames;  // the answer to an item of the abandoned attempt, still on the link
         return;
+    }
+    if (type == mav::kMissionError && !w.any_request && uploading) {
+        // A verdict on the request comes again when the request is repeated (on the next timeout); an
+        // answer to an earlier transfer's item does not, and the request's own answer follows it.
+        const bool repeated_verdict = w.error_at_send.has_value() && *w.error_at_send != w.sends;
+        if (!repeated_verdict) {
+            w.error_at_send = w.sends;
+            ++stats_.unconfirmed_errors;
+            return;
+        }
     }
     const bool vehicle_lost_track =
         type == mav::kMissionOperationCancelled || (type == mav::kMissionError && w.any_request);

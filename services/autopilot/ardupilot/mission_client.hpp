@@ -23,10 +23,13 @@
 // and again for an item sent as MISSION_ITEM_INT without ever having taken one (a MAVLink-1-era board does
 // not know the message and drops it), gets MISSION_ITEM and float requests from then on; the upload starts
 // again. A refusal of the float form is final: the operation ends Denied with the board's answer.
-// MAV_MISSION_INVALID_SEQUENCE during an upload means a duplicate item crossed a request on the link; it is
-// counted and the transfer goes on. MAV_MISSION_OPERATION_CANCELLED during an upload (the vehicle gave up on
-// a bad link) starts the upload again, up to `retries` times in a row without an attempt getting further
-// than the attempts before it.
+// MAV_MISSION_ERROR before an upload's first request is final only when the vehicle says it again to the
+// repeated MISSION_COUNT / MISSION_WRITE_PARTIAL_LIST: an item of an earlier transfer that reached the
+// vehicle after that transfer had ended (a link outage, a stall of either end) is answered with the same
+// ERROR, and such an answer can arrive just after the next request went out. MAV_MISSION_INVALID_SEQUENCE
+// during an upload means a duplicate item crossed a request on the link; it is counted and the transfer goes
+// on. MAV_MISSION_OPERATION_CANCELLED during an upload (the vehicle gave up on a bad link) starts the upload
+// again, up to `retries` times in a row without an attempt getting further than the attempts before it.
 //
 // Contract: enqueue with upload()/download()/write_partial()/set_current()/clear(); feed every frame from the
 // autopilot to handle_frame(); call handle_timeout(now) when poll_timeout() is due; after each input drain
@@ -83,10 +86,12 @@ struct MissionClientStats {
     std::uint64_t retransmissions = 0;
     std::uint64_t duplicate_requests = 0;  // the vehicle asked again for an item already sent
     std::uint64_t invalid_sequence_acks = 0;
-    std::uint64_t ignored_frames = 0;   // mission frames that matched no running operation
-    std::uint64_t restarts = 0;         // uploads started again after the vehicle cancelled them
-    std::uint64_t float_fallbacks = 0;  // boards found not to take MISSION_ITEM_INT
-    std::uint64_t stray_errors = 0;     // ERRORs answering an item repeated after its transfer ended
+    std::uint64_t ignored_frames = 0;      // mission frames that matched no running operation
+    std::uint64_t restarts = 0;            // uploads started again after the vehicle cancelled them
+    std::uint64_t float_fallbacks = 0;     // boards found not to take MISSION_ITEM_INT
+    std::uint64_t stray_errors = 0;        // ERRORs answering an item repeated after its transfer ended
+    std::uint64_t unconfirmed_errors = 0;  // ERRORs before a transfer's first request, not repeated when
+                                           // the request was (an earlier transfer's answer, not a verdict)
 };
 
 class MissionClient {
@@ -167,6 +172,8 @@ class MissionClient {
         TimePoint last_heard{};    // upload / partial: the last request of any kind for this transfer
         bool sent_int = false;     // upload / partial: this attempt answered with MISSION_ITEM_INT
         unsigned int_repeats = 0;  // requests repeated for an item answered as MISSION_ITEM_INT
+        unsigned sends = 0;        // transmissions of any kind for this work item
+        std::optional<unsigned> error_at_send;  // `sends` when an ERROR came before the first request
     };
 
     Duration current_timeout(const WorkItem& w) const;

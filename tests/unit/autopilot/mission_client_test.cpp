@@ -5,6 +5,7 @@
 
 #include <sstream>
 
+#include "services/autopilot/mavlink/enums.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
 #include "tests/unit/autopilot/fake_rover.hpp"
 #include "tests/unit/autopilot/sim_harness.hpp"
@@ -260,6 +261,46 @@ TEST(MissionClient, AnErrorAnsweringARepeatedItemDoesNotRefuseTheNextTransfer) {
     EXPECT_EQ(fx.ground.completions[5].result, MissionResult::Success) << fx.ground.completions[5].detail;
     EXPECT_EQ(fx.ground.completions[6].result, MissionResult::Denied);
     EXPECT_NE(fx.ground.completions[6].detail.find("MAV_MISSION_ERROR"), std::string::npos);
+}
+
+// Items still on the link when it went down reach a vehicle that has ended their transfer, and its ERRORs
+// can arrive just after the next window write went out, before that write's first request, with no repeat
+// outstanding to blame. They are not the vehicle's verdict on the write: it goes on and lands.
+TEST(MissionClient, ErrorsBeforeTheFirstRequestThatAreNotRepeatedDoNotRefuseTheWrite) {
+    LinkModel radio;
+    radio.latency = milliseconds(100);
+    Fixture fx(radio, 11);
+    auto items = make_items(8);
+    items.insert(items.begin(), fx.rover.mission()[0]);
+    fx.ground.client.upload(items, fx.harness.now());
+    ASSERT_TRUE(fx.run_until_done(1));
+    ASSERT_EQ(fx.ground.completions[0].result, MissionResult::Success) << fx.ground.completions[0].detail;
+
+    auto patch = make_items(2);
+    patch[0].x = 777;
+    fx.ground.client.write_partial(3, patch, fx.harness.now());
+    // Two ERRORs from the vehicle, as after an outage, read before the write's first request.
+    Outbox vehicle(1, 1, mav::Version::V2);
+    mav::MissionAck stray;
+    stray.target_system = 255;
+    stray.target_component = 190;
+    stray.type = mav::kMissionError;
+    vehicle.send(stray);
+    vehicle.send(stray);
+    auto receive = fx.ground.party().receive;
+    while (auto bytes = vehicle.poll_transmit()) {
+        receive(*bytes, fx.harness.now());
+    }
+    ASSERT_TRUE(fx.run_until_done(2));
+    EXPECT_EQ(fx.ground.completions[1].result, MissionResult::Success) << fx.ground.completions[1].detail;
+    EXPECT_EQ(fx.rover.mission()[3].x, 777);
+    EXPECT_EQ(fx.ground.client.stats().unconfirmed_errors, 2u);
+
+    // A vehicle that refuses the write says so again to the repeated request: that is final.
+    fx.ground.client.write_partial(40, make_items(1), fx.harness.now());
+    ASSERT_TRUE(fx.run_until_done(3));
+    EXPECT_EQ(fx.ground.completions[2].result, MissionResult::Denied);
+    EXPECT_NE(fx.ground.completions[2].detail.find("MAV_MISSION_ERROR"), std::string::npos);
 }
 
 TEST(MissionClient, SetCurrentIsConfirmedByMissionCurrent) {
