@@ -294,7 +294,8 @@ std::optional<std::vector<std::uint8_t>> hex_bytes(const std::string& hex) {
 }  // namespace
 
 std::string frame_to_json(const mavlink::Frame& frame, std::optional<std::uint64_t> timestamp_us) {
-    const mavlink::MessageInfo* info = frame.checksum_verified ? mavlink::find_message(frame.msgid) : nullptr;
+    const mavlink::MessageInfo* info =
+        frame.checksum_verified ? mavlink::find_dialect_message(frame.msgid) : nullptr;
     std::string out;
     out.reserve(256);
     out += '{';
@@ -346,6 +347,41 @@ std::string frame_to_json(const mavlink::Frame& frame, std::optional<std::uint64
     return out;
 }
 
+std::string message_to_json(const mavlink::MessageInfo& message) {
+    std::string out = "{\"name\":\"";
+    out += message.name;
+    out += "\",\"msgid\":";
+    append_number(out, message.id);
+    out += ",\"crc_extra\":";
+    append_number(out, message.crc_extra);
+    out += ",\"min_length\":";
+    append_number(out, message.base_length);
+    out += ",\"length\":";
+    append_number(out, message.length);
+    out += message.typed ? ",\"typed\":true" : ",\"typed\":false";
+    out += ",\"fields\":[";
+    bool first = true;
+    for (std::uint8_t index : message.declaration_order) {
+        const FieldInfo& field = message.fields[index];
+        out += first ? "{\"name\":\"" : ",{\"name\":\"";
+        first = false;
+        out += field.name;
+        out += "\",\"type\":\"";
+        out += mavlink::type_name(field.type);
+        out += '"';
+        if (field.array_length > 0) {
+            out += ",\"length\":";
+            append_number(out, field.array_length);
+        }
+        if (field.extension) {
+            out += ",\"extension\":true";
+        }
+        out += '}';
+    }
+    out += "]}";
+    return out;
+}
+
 JsonFrameEncoder::Result JsonFrameEncoder::encode_line(std::string_view line) {
     Result r;
     std::string json_error;
@@ -369,7 +405,7 @@ JsonFrameEncoder::Result JsonFrameEncoder::encode_line(std::string_view line) {
             return r;
         }
         const auto& name_text = name->get_ref<const std::string&>();
-        info = mavlink::find_message(name_text);
+        info = mavlink::find_dialect_message(name_text);
         if (info == nullptr && msgid_value == nullptr) {
             r.error = "unknown message name \"" + name_text + "\" (give \"msgid\" to send it raw)";
             return r;
@@ -388,7 +424,7 @@ JsonFrameEncoder::Result JsonFrameEncoder::encode_line(std::string_view line) {
         }
         msgid = *id;
         if (info == nullptr) {
-            info = mavlink::find_message(msgid);
+            info = mavlink::find_dialect_message(msgid);
         }
     } else if (info != nullptr) {
         msgid = info->id;

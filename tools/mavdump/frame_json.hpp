@@ -4,7 +4,8 @@
 // Field names are the specification's, in declaration order; char[] fields are strings (up to the first
 // NUL) whose bytes 0x80-0xFF are written \u0080-\u00FF and read back as single bytes, other arrays JSON
 // arrays; float NaN and infinities are the strings "nan", "inf", "-inf".
-// A message id without a declaration comes out as {"name":"UNKNOWN_<id>",...,"payload":"<hex>"}.
+// Every message of ArduPilot's dialect (message_table.hpp, find_dialect_message) is decoded field by field; a
+// message id outside it comes out as {"name":"UNKNOWN_<id>",...,"payload":"<hex>"}.
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -14,12 +15,20 @@
 #include <vector>
 
 #include "services/autopilot/mavlink/frame.hpp"
+#include "services/autopilot/mavlink/message_table.hpp"
 
 namespace airseg::mavdump {
 
 /// One JSON line (without the newline) for `frame`; tlog records add "timestamp_us" first.
 std::string frame_to_json(const mavlink::Frame& frame,
                           std::optional<std::uint64_t> timestamp_us = std::nullopt);
+
+/// One JSON line describing a message of the dialect table, for tools that generate or check traffic:
+///   {"name":"MISSION_COUNT","msgid":44,"crc_extra":221,"min_length":4,"length":9,"typed":true,
+///    "fields":[{"name":"target_system","type":"uint8_t"},...,{"name":"opaque_id","type":"uint32_t",
+///    "extension":true}]}
+/// Fields in declaration order; arrays add "length"; "typed": the daemon decodes it (messages.def).
+std::string message_to_json(const mavlink::MessageInfo& message);
 
 /// Turns JSON lines back into frames. Keys: "name" or "msgid" (required; both must agree when given),
 /// "v" (1 or 2, default 2), "sysid" (default 255), "compid" (default 190), "seq" (default: the next number of

@@ -24,8 +24,8 @@ Decodes a MAVLink v1/v2 byte stream into one JSON object per line on standard ou
   {"name":"HEARTBEAT","msgid":0,"sysid":1,"compid":1,"seq":7,"v":2,"fields":{"type":10,...}}
 Field names are those of the MAVLink specification; char[] fields are strings, arrays are JSON arrays,
 float NaN and infinities are "nan", "inf", "-inf". Signed frames carry "signed":true (the signature is
-not checked). A message id airseg does not declare is printed as "name":"UNKNOWN_<id>" with its raw
-"payload" in hex (its checksum cannot be verified). A summary of good and bad frames goes to standard
+not checked). Every message of ArduPilot's dialect is decoded (its checksum verified); an id outside it
+is printed as "name":"UNKNOWN_<id>" with its raw "payload" in hex (its checksum cannot be verified). A summary of good and bad frames goes to standard
 error as the last line: {"summary":{...}}.
 
 FILE is read instead of standard input when given ("-" is standard input). A FILE ending in .tlog is read
@@ -36,6 +36,7 @@ with "timestamp_us".
 
 struct Options {
     bool encode = false;
+    bool list_messages = false;
     enum class Format { Auto, Raw, Tlog } format = Format::Auto;
     std::string input = "-";
     std::string output = "-";
@@ -140,6 +141,11 @@ int main(int argc, char** argv) {
               "encoded are reported on standard error with their line number and skipped; the exit status "
               "is then 1.",
               [&] { opt.encode = true; })
+        .flag("messages",
+              "list the messages it knows, ArduPilot's dialect, one JSON line each: name, msgid, crc_extra, "
+              "min_length, length, typed (decoded by the daemon) and the fields in declaration order (name, "
+              "type, \"length\" for arrays, \"extension\":true for extensions)",
+              [&] { opt.list_messages = true; })
         .value(",o", "OUTPUT", "write to OUTPUT instead of standard output", airseg::cli::text(opt.output))
         .help_and_version(false);
     const airseg::cli::Program program{
@@ -159,7 +165,12 @@ int main(int argc, char** argv) {
         return 1;
     }
     int status = 0;
-    if (opt.encode) {
+    if (opt.list_messages) {
+        for (const auto& m : airseg::mavlink::dialect_messages()) {
+            const std::string text = airseg::mavdump::message_to_json(m) + '\n';
+            std::fwrite(text.data(), 1, text.size(), out);
+        }
+    } else if (opt.encode) {
         if (opt.input == "-") {
             status = encode(opt, std::cin, out);
         } else {

@@ -120,7 +120,10 @@ void Driver::handle_bytes(std::span<const std::uint8_t> bytes, TimePoint now) {
         if (!f.checksum_verified) {
             return;
         }
-        tap_incoming(f);
+        tap_incoming(f);  // any verified frame of the dialect may be forwarded
+        if (!f.typed) {
+            return;  // the driver acts only on the messages it declares (messages.def)
+        }
         on_frame(f, now);
         // A request's result goes out in its place among the board's reports: the board reports its target
         // in order with its answers to the writes, and the flight plan tells by that order whether a target

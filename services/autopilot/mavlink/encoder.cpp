@@ -69,7 +69,7 @@ std::size_t encode_message(const FrameHeader& header, const MessageInfo& info,
 }
 
 std::vector<std::uint8_t> reencode(const Frame& frame) {
-    const MessageInfo* info = find_message(frame.msgid);
+    const MessageInfo* info = find_dialect_message(frame.msgid);
     if (!info) {
         return {};
     }

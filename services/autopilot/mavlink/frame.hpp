@@ -34,7 +34,8 @@ struct Frame {
     std::uint8_t wire_length = 0;     // payload bytes as received
     std::uint8_t payload_length = 0;  // bytes of payload_view(): the message's full length when it is known
     bool is_signed = false;           // carried a signature (skipped, not verified)
-    bool checksum_verified = false;   // false only for message ids without a known CRC_EXTRA
+    bool checksum_verified = false;   // false only for message ids outside the dialect (no CRC_EXTRA known)
+    bool typed = false;               // a message of messages.def: the only ones the daemon acts on
     std::array<std::uint8_t, kMaxPayload> payload{};  // zero beyond wire_length: MAVLink 2 zero-extension
 
     std::span<const std::uint8_t> payload_view() const { return std::span(payload).first(payload_length); }

@@ -57,13 +57,22 @@ constexpr std::uint8_t crc_extra_of(std::string_view message_name, std::span<con
     return static_cast<std::uint8_t>((crc.value() & 0xFF) ^ (crc.value() >> 8));
 }
 
-template <std::size_t N>
-constexpr MessageLayout<N> make_layout(std::string_view message_name, std::span<const FieldDecl> decls) {
-    struct Entry {
-        FieldInfo info;
-        std::size_t decl_index = 0;
-    };
-    std::array<Entry, N> entries{};
+/// What lay_out() derives besides the field placement.
+struct LayoutSummary {
+    std::uint8_t crc_extra = 0;
+    std::uint8_t base_length = 0;
+    std::uint8_t length = 0;
+};
+
+/// Lays out one message: `wire` (one entry per real field of `decls`) receives the fields in wire order with
+/// their offsets, `wire_index_by_decl` the wire position of each declared field. Shared by the typed messages
+/// (make_layout) and the dialect table (dialect_table.cpp), so both follow one reading of the rules.
+constexpr LayoutSummary lay_out(std::string_view message_name, std::span<const FieldDecl> decls,
+                                std::span<FieldInfo> wire, std::span<std::uint8_t> wire_index_by_decl) {
+    if (wire.size() != field_count(decls) || wire_index_by_decl.size() != wire.size()) {
+        throw "declaration does not hold the expected number of fields";
+    }
+    // wire_index_by_decl first holds, for each wire slot, the declared index of its field (sorted along).
     std::size_t count = 0;
     std::size_t base_count = 0;
     bool in_extensions = false;
@@ -72,40 +81,56 @@ constexpr MessageLayout<N> make_layout(std::string_view message_name, std::span<
             in_extensions = true;
             continue;
         }
-        entries[count] = Entry{FieldInfo{d.name, d.type, d.array_length, 0, in_extensions}, count};
+        wire[count] = FieldInfo{d.name, d.type, d.array_length, 0, in_extensions};
+        wire_index_by_decl[count] = static_cast<std::uint8_t>(count);
         ++count;
         base_count += in_extensions ? 0 : 1;
     }
-    if (count != N) {
-        throw "declaration does not hold the expected number of fields";
-    }
     // Stable insertion sort of the base fields, largest element size first.
     for (std::size_t i = 1; i < base_count; ++i) {
-        Entry moving = entries[i];
+        const FieldInfo moving = wire[i];
+        const std::uint8_t moving_decl = wire_index_by_decl[i];
         std::size_t j = i;
-        while (j > 0 && type_size(entries[j - 1].info.type) < type_size(moving.info.type)) {
-            entries[j] = entries[j - 1];
+        while (j > 0 && type_size(wire[j - 1].type) < type_size(moving.type)) {
+            wire[j] = wire[j - 1];
+            wire_index_by_decl[j] = wire_index_by_decl[j - 1];
             --j;
         }
-        entries[j] = moving;
+        wire[j] = moving;
+        wire_index_by_decl[j] = moving_decl;
     }
-    MessageLayout<N> layout{};
+    std::array<std::uint8_t, kMaxPayload> decl_by_wire{};  // a message has at most 255 fields of a byte
+    LayoutSummary summary{};
     std::size_t offset = 0;
-    for (std::size_t i = 0; i < N; ++i) {
-        entries[i].info.offset = static_cast<std::uint8_t>(offset);
-        offset += entries[i].info.size();
+    for (std::size_t i = 0; i < count; ++i) {
+        wire[i].offset = static_cast<std::uint8_t>(offset);
+        offset += wire[i].size();
         if (offset > kMaxPayload) {
             throw "message payload longer than 255 bytes";
         }
         if (i + 1 == base_count) {
-            layout.base_length = static_cast<std::uint8_t>(offset);
+            summary.base_length = static_cast<std::uint8_t>(offset);
         }
-        layout.wire[i] = entries[i].info;
-        layout.offset_by_decl[entries[i].decl_index] = entries[i].info.offset;
-        layout.wire_index_by_decl[entries[i].decl_index] = static_cast<std::uint8_t>(i);
+        decl_by_wire[i] = wire_index_by_decl[i];
     }
-    layout.length = static_cast<std::uint8_t>(offset);
-    layout.crc_extra = crc_extra_of(message_name, layout.wire);
+    for (std::size_t i = 0; i < count; ++i) {
+        wire_index_by_decl[decl_by_wire[i]] = static_cast<std::uint8_t>(i);
+    }
+    summary.length = static_cast<std::uint8_t>(offset);
+    summary.crc_extra = crc_extra_of(message_name, wire.first(count));
+    return summary;
+}
+
+template <std::size_t N>
+constexpr MessageLayout<N> make_layout(std::string_view message_name, std::span<const FieldDecl> decls) {
+    MessageLayout<N> layout{};
+    const LayoutSummary summary = lay_out(message_name, decls, layout.wire, layout.wire_index_by_decl);
+    for (std::size_t d = 0; d < N; ++d) {
+        layout.offset_by_decl[d] = layout.wire[layout.wire_index_by_decl[d]].offset;
+    }
+    layout.crc_extra = summary.crc_extra;
+    layout.base_length = summary.base_length;
+    layout.length = summary.length;
     return layout;
 }
 

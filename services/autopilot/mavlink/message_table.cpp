@@ -11,8 +11,8 @@ namespace {
 template <Message M>
 constexpr MessageInfo info_of() {
     constexpr auto& layout = MessageTraits<M>::layout;
-    return MessageInfo{M::kId,        M::kName,    layout.crc_extra,         layout.base_length,
-                       layout.length, layout.wire, layout.wire_index_by_decl};
+    return MessageInfo{M::kId,        M::kName,    layout.crc_extra,          layout.base_length,
+                       layout.length, layout.wire, layout.wire_index_by_decl, true};
 }
 
 constexpr auto kMessages = [] {

@@ -1,7 +1,12 @@
 #pragma once
-// The run-time catalogue of the messages in messages.def: what a generic tool (airseg-mavdump) or the parser
-// needs to know about a message id without its C++ type. Built at compile time from the same declarations as
-// the typed structs of messages.hpp.
+// The run-time catalogues of MAVLink messages: what a generic tool (airseg-mavdump) or the parser needs to
+// know about a message id without its C++ type. Two, both built at compile time:
+//  - the typed messages (all_messages, find_message): those of messages.def, from the same declarations as
+//    the structs of messages.hpp; the code that acts on messages uses these;
+//  - ArduPilot's whole dialect (dialect_messages, find_dialect_message): dialect.def, generated from the
+//    MAVLink definition XML. The parser verifies every frame of it, so any of its frames can be checked and
+//    forwarded; only those with `typed` set are decoded by the daemon. Every typed message is also a dialect
+//    message with the same layout (tests/unit/mavlink/dialect_test.cpp checks it).
 #include <cstdint>
 #include <span>
 #include <string_view>
@@ -18,6 +23,7 @@ struct MessageInfo {
     std::uint8_t length = 0;            // bytes of all fields
     std::span<const FieldInfo> fields;  // wire order
     std::span<const std::uint8_t> declaration_order;  // indices into `fields`, in XML declaration order
+    bool typed = false;  // declared in messages.def: a struct of messages.hpp decodes it
 
     /// The field called `name`, or nullptr.
     const FieldInfo* find_field(std::string_view field_name) const;
@@ -29,5 +35,12 @@ std::span<const MessageInfo> all_messages();
 const MessageInfo* find_message(std::uint32_t id);
 /// The message with this name ("HEARTBEAT"), or nullptr.
 const MessageInfo* find_message(std::string_view name);
+
+/// Every message of ArduPilot's dialect, ordered by id.
+std::span<const MessageInfo> dialect_messages();
+/// The dialect message with this id, or nullptr: the parser verifies a frame only when this finds its id.
+const MessageInfo* find_dialect_message(std::uint32_t id);
+/// The dialect message with this name, or nullptr.
+const MessageInfo* find_dialect_message(std::string_view name);
 
 }  // namespace airseg::mavlink

@@ -179,7 +179,7 @@ Parser::Head Parser::head() const {
         return Head::Incomplete;  // looked at again as bytes arrive
     } else {
         const Header h = read_header(buf_.data());
-        head_info_ = find_message(h.msgid);
+        head_info_ = find_dialect_message(h.msgid);
         head_checked_length_ = h.checked_length();
         head_cache_ = head_info_ != nullptr ? Head::Known
                       : h.unknown_flags()   ? Head::Unacceptable
@@ -248,7 +248,7 @@ std::size_t Parser::pending_end(std::size_t first, std::size_t end, std::size_t 
             continue;
         }
         const Header h = read_header(buf_.data() + k);
-        const MessageInfo* info = find_message(h.msgid);
+        const MessageInfo* info = find_dialect_message(h.msgid);
         if (info != nullptr && plausible_inner(h, *info)) {
             need = std::max(need, k + h.checked_length());
         }
@@ -300,7 +300,7 @@ bool Parser::resync_inside_candidate(Sink sink, std::size_t need) {
         if (end == 0) {
             if (len_ - k >= header_length(buf_[k])) {
                 const Header h = read_header(buf_.data() + k);
-                const MessageInfo* info = find_message(h.msgid);
+                const MessageInfo* info = find_dialect_message(h.msgid);
                 if (info == nullptr || !plausible_inner(h, *info)) {
                     continue;  // can never be verified: dropped
                 }
@@ -311,7 +311,7 @@ bool Parser::resync_inside_candidate(Sink sink, std::size_t need) {
         // one that fails its checksum is dropped.
         if (end != 0 && end < found_end) {
             const Header h = read_header(buf_.data() + k);
-            if (!checksum_matches(buf_.data() + k, h, *find_message(h.msgid))) {
+            if (!checksum_matches(buf_.data() + k, h, *find_dialect_message(h.msgid))) {
                 continue;
             }
             found = true;
@@ -448,6 +448,7 @@ void Parser::deliver(Sink sink, std::size_t frame_length, const MessageInfo* inf
     frame_.payload_length = info != nullptr ? std::max(h.payload_length, info->length) : h.payload_length;
     frame_.is_signed = h.is_signed();
     frame_.checksum_verified = info != nullptr;
+    frame_.typed = info != nullptr && info->typed;
     // The payload stays zero beyond wire_length: only what the previous frames wrote there is cleared.
     std::memcpy(frame_.payload.data(), buf_.data() + h.header_length, h.payload_length);
     if (payload_dirty_ > h.payload_length) {

@@ -7,7 +7,8 @@
 // 2 * kMaxFrameLength bytes and never allocates after construction; it never reads a clock.
 //
 // What it accepts and how it recovers. The rule behind it: a verified frame (known id, matching checksum) is
-// never given up for bytes that cannot be verified.
+// never given up for bytes that cannot be verified. A known id is one of ArduPilot's dialect
+// (find_dialect_message, dialect.def); Frame::typed tells which of them messages.def declares.
 //  - A frame with a known message id is delivered only when its checksum (with the message's CRC_EXTRA)
 //    matches. A MAVLink 2 payload shorter than the message is zero-extended (payload_view() has the full
 //    length); a longer one (fields of a newer definition) is delivered as received.

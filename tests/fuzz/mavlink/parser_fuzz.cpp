@@ -13,8 +13,8 @@
 
 #include "services/autopilot/mavlink/encoder.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
-#include "tools/mavdump/frame_json.hpp"
 #include "tests/fuzz/require.hpp"
+#include "tools/mavdump/frame_json.hpp"
 
 namespace {
 
@@ -36,8 +36,9 @@ bool same_stats(const ParserStats& a, const ParserStats& b) {
 
 void check_frame(const Frame& f) {
     require(f.payload_length >= f.wire_length);
-    const MessageInfo* info = find_message(f.msgid);
+    const MessageInfo* info = find_dialect_message(f.msgid);
     require(f.checksum_verified == (info != nullptr));
+    require(f.typed == (find_message(f.msgid) != nullptr && f.checksum_verified));
     require(info == nullptr || f.payload_length >= info->length);
     require((f.incompat_flags & ~kIncompatSigned) == 0);
     require(f.is_signed == ((f.incompat_flags & kIncompatSigned) != 0));

@@ -3,7 +3,10 @@
 //     field to the values node-mavlink was given;
 //  2. JSON lines with the same values, turned into frames by airseg-mavdump --encode, are accepted by
 //     node-mavlink's splitter (checksum with its own CRC_EXTRA table) and deserialize to the same values.
-// Every message airseg declares is covered, with seeded random values across each type's full range.
+// Every message of the dialect airseg-mavdump knows (airseg-mavdump --messages: ArduPilot's whole dialect) is
+// covered, with seeded random values across each type's full range. A message node-mavlink does not define
+// with the same id and CRC_EXTRA (newer definitions than its own) is still round-tripped through
+// airseg-mavdump --encode and back, and reported as not cross-checked.
 //   node interop.js PATH/TO/airseg-mavdump PATH/TO/node_modules
 'use strict';
 const path = require('path');
@@ -25,20 +28,9 @@ try {
 const { minimal, common, ardupilotmega, MavLinkProtocolV1, MavLinkProtocolV2, MavLinkPacketSplitter,
         MavLinkPacketParser, MavLinkPacketSignature } = mavlink;
 
-// The messages airseg declares (services/autopilot/mavlink/messages.def).
-const MESSAGES = [
-    'HEARTBEAT', 'SYS_STATUS', 'SYSTEM_TIME', 'SET_MODE', 'PARAM_REQUEST_READ', 'PARAM_REQUEST_LIST', 'PARAM_VALUE',
-    'PARAM_SET', 'GPS_RAW_INT', 'ATTITUDE', 'GLOBAL_POSITION_INT', 'RC_CHANNELS_RAW', 'SERVO_OUTPUT_RAW',
-    'MISSION_WRITE_PARTIAL_LIST', 'MISSION_ITEM', 'MISSION_REQUEST', 'MISSION_SET_CURRENT', 'MISSION_CURRENT',
-    'MISSION_REQUEST_LIST', 'MISSION_COUNT', 'MISSION_CLEAR_ALL', 'MISSION_ITEM_REACHED', 'MISSION_ACK',
-    'MISSION_REQUEST_INT', 'NAV_CONTROLLER_OUTPUT', 'RC_CHANNELS', 'REQUEST_DATA_STREAM', 'RC_CHANNELS_OVERRIDE',
-    'MISSION_ITEM_INT', 'VFR_HUD', 'COMMAND_LONG', 'COMMAND_ACK', 'RADIO_STATUS', 'BATTERY_STATUS',
-    'AUTOPILOT_VERSION', 'HOME_POSITION', 'STATUSTEXT',
-];
-
 const registry = {};
-for (const dialect of [minimal, common, ardupilotmega, mavlink.standard].filter(Boolean)) {
-    for (const clazz of Object.values(dialect.REGISTRY)) registry[clazz.MSG_NAME] = clazz;
+for (const dialect of Object.values(mavlink).filter(d => d && typeof d === 'object' && d.REGISTRY)) {
+    for (const clazz of Object.values(dialect.REGISTRY)) registry[clazz.MSG_NAME] = registry[clazz.MSG_NAME] || clazz;
 }
 
 // Seeded PRNG (mulberry32): the same values on every run.
@@ -90,9 +82,9 @@ function randText(length) {
     return s;
 }
 // Values for one message; `sparse` leaves the trailing fields at zero so that v2 truncation is exercised.
-function randomValues(clazz, sparse) {
+function randomValues(spec, sparse) {
     const values = {};
-    const fields = clazz.FIELDS;
+    const fields = spec.FIELDS;
     const keep = sparse ? randInt(1, fields.length) : fields.length;
     fields.forEach((f, i) => {
         const zero = i >= keep;
@@ -104,6 +96,19 @@ function randomValues(clazz, sparse) {
 }
 function zeroOf(type) { return baseType(type).endsWith('64_t') ? 0n : 0; }
 
+// A message as airseg-mavdump --messages lists it, in the shape of a node-mavlink class (FIELDS in wire
+// order: base fields by element size, stable, then extensions), for messages node-mavlink does not define.
+const TYPE_SIZE = { char: 1, uint8_t: 1, int8_t: 1, uint16_t: 2, int16_t: 2, uint32_t: 4, int32_t: 4, float: 4,
+                    uint64_t: 8, int64_t: 8, double: 8 };
+function specOf(m) {
+    const fields = m.fields.map(f => ({ source: f.name, name: f.name, type: f.type + (f.length ? '[]' : ''),
+                                        length: f.length || 0, extension: Boolean(f.extension) }));
+    const base = fields.filter(f => !f.extension);
+    const wire = base.map((f, i) => [f, i]).sort((x, y) => TYPE_SIZE[baseType(y[0].type)] - TYPE_SIZE[baseType(x[0].type)] || x[1] - y[1])
+                     .map(x => x[0]);
+    return { MSG_ID: m.msgid, MSG_NAME: m.name, MAGIC_NUMBER: m.crc_extra, FIELDS: wire.concat(fields.filter(f => f.extension)) };
+}
+
 function toNodeMessage(clazz, values) {
     const msg = new clazz();
     for (const f of clazz.FIELDS) msg[f.name] = values[f.source];
@@ -112,8 +117,9 @@ function toNodeMessage(clazz, values) {
 
 // airseg-mavdump's JSON, with integers beyond 2^53 kept exact as BigInt.
 function parseJsonLine(line) {
-    const quoted = line.replace(/([:\[,])(-?\d{16,})(?=[,\]}])/g, '$1"#$2"');
-    return JSON.parse(quoted, (k, v) => (typeof v === 'string' && /^#-?\d+$/.test(v) ? BigInt(v.slice(1)) : v));
+    // Marked with U+0001, which the generated strings (printable ASCII) never hold.
+    const quoted = line.replace(/([:\[,])(-?\d{16,})(?=[,\]}])/g, '$1"\\u0001$2"');
+    return JSON.parse(quoted, (k, v) => (typeof v === 'string' && /^\u0001-?\d+$/.test(v) ? BigInt(v.slice(1)) : v));
 }
 // Values as airseg-mavdump writes them in JSON.
 function toJsonValue(type, v) {
@@ -126,6 +132,7 @@ function toJsonValue(type, v) {
     return JSON.stringify(v);
 }
 
+const show = v => JSON.stringify(v, (k, x) => (typeof x === 'bigint' ? x.toString() : x));
 let failures = 0;
 function fail(msg) {
     failures++;
@@ -147,10 +154,10 @@ function sameScalar(type, expected, actual) {
 }
 function compareField(where, f, expected, actual) {
     if (f.type === 'char[]') {
-        if (expected !== actual) fail(`${where}.${f.source}: expected ${JSON.stringify(expected)}, got ${JSON.stringify(actual)}`);
+        if (expected !== actual) fail(`${where}.${f.source}: expected ${show(expected)}, got ${show(actual)}`);
     } else if (f.type.endsWith('[]')) {
         if (!Array.isArray(actual) || actual.length !== expected.length) {
-            fail(`${where}.${f.source}: expected an array of ${expected.length}, got ${JSON.stringify(String(actual))}`);
+            fail(`${where}.${f.source}: expected an array of ${expected.length}, got ${show(actual)}`);
             return;
         }
         expected.forEach((e, i) => {
@@ -192,17 +199,81 @@ async function nodeDecode(bytes) {
     return { packets, valid: splitter.validPackages, invalid: splitter.invalidPackages, unknown: splitter.unknownPackagesCount };
 }
 
-async function main() {
-    const cases = [];
-    const key = MavLinkPacketSignature.key('airseg interop');
-    for (let round = 0; round < 12; round++) {
-        for (const name of MESSAGES) {
-            const clazz = registry[name];
-            if (!clazz) { fail(`node-mavlink has no ${name}`); continue; }
-            cases.push({ name, clazz, values: randomValues(clazz, round % 3 === 2), version: round % 4 === 1 ? 1 : 2,
-                         signed: round % 4 === 3, seq: cases.length % 256, sysid: randInt(1, 255), compid: randInt(0, 255) });
+// The dialect airseg-mavdump decodes, split into the messages node-mavlink defines identically (same id and
+// CRC_EXTRA; it may lack extension fields added since) and those it does not.
+function dialect() {
+    const r = runMavdump(['--messages'], '');
+    if (r.status !== 0) throw new Error(`airseg-mavdump --messages exited ${r.status}: ${r.stderr}`);
+    const messages = r.stdout.toString().split('\n').filter(l => l.length > 0).map(l => JSON.parse(l));
+    const shared = [];
+    const ownOnly = [];
+    for (const m of messages) {
+        const clazz = registry[m.name];
+        if (clazz && clazz.MSG_ID === m.msgid && clazz.MAGIC_NUMBER === m.crc_extra) {
+            const missing = m.fields.filter(f => !clazz.FIELDS.some(g => g.source === f.name));
+            if (missing.some(f => !f.extension)) fail(`${m.name}: node-mavlink lacks base fields ${missing.map(f => f.name)}`);
+            shared.push({ name: m.name, clazz, own: m });
+        } else {
+            ownOnly.push({ name: m.name, clazz: specOf(m), own: m });
         }
     }
+    return { messages, shared, ownOnly };
+}
+
+function makeCases(list, rounds, start) {
+    const cases = [];
+    for (let round = 0; round < rounds; round++) {
+        for (const { name, clazz, own } of list) {
+            cases.push({ name, clazz, own, values: randomValues(clazz, round % 3 === 2), version: round % 4 === 1 && clazz.MSG_ID < 256 ? 1 : 2,
+                         signed: round % 4 === 3, seq: (start + cases.length) % 256, sysid: randInt(1, 255), compid: randInt(0, 255) });
+        }
+    }
+    return cases;
+}
+
+// airseg-mavdump's decoding of frames built from `cases`, checked field for field against their values.
+function checkDecoded(label, cases, bytes, expectedOf) {
+    const decoded = runMavdump([], bytes);
+    const lines = decoded.stdout.toString().split('\n').filter(l => l.length > 0);
+    if (lines.length !== cases.length) fail(`${label}: ${cases.length} frames in, ${lines.length} JSON lines out; stderr: ${decoded.stderr}`);
+    lines.slice(0, cases.length).forEach((line, i) => {
+        const c = cases[i];
+        const where = `${label} #${i} ${c.name} v${c.version}${c.signed ? ' signed' : ''}`;
+        const j = parseJsonLine(line);
+        if (j.name !== c.name || j.msgid !== c.clazz.MSG_ID || j.sysid !== c.sysid || j.compid !== c.compid ||
+            j.seq !== c.seq || j.v !== c.version || Boolean(j.signed) !== c.signed || !j.fields) {
+            fail(`${where}: header ${line.slice(0, 120)}`);
+            return;
+        }
+        const expected = expectedOf(c);
+        for (const f of c.clazz.FIELDS) compareField(where, f, expected[f.source], j.fields[f.source]);
+        // Extension fields added after node-mavlink's definitions: not sent by it, so zero.
+        for (const f of c.own.fields) {
+            if (c.clazz.FIELDS.some(g => g.source === f.name)) continue;
+            const zero = f.type === 'char' && f.length ? '' : f.length ? Array(f.length).fill(0) : 0;
+            if (show(j.fields[f.name]) !== show(zero)) fail(`${where}: ${f.name} expected zero, got ${show(j.fields[f.name])}`);
+        }
+        const extra = Object.keys(j.fields).filter(k => !c.own.fields.some(f => f.name === k));
+        if (extra.length) fail(`${where}: fields the dialect does not list: ${extra}`);
+    });
+    const summary = decoded.stderr.toString();
+    if (!summary.includes(`"frames_ok":${cases.length},`) || !summary.includes('"bad_checksum":0,') ||
+        !summary.includes('"unknown_msgid":0,')) fail(`${label} summary: ${summary}`);
+    if (!summary.includes(`"signed_frames":${cases.filter(c => c.signed).length},`)) fail(`${label} signed count: ${summary}`);
+}
+
+function jsonLines(cases) {
+    return cases.map(c => {
+        const fields = c.clazz.FIELDS.map(f => `"${f.source}":${toJsonValue(f.type, c.values[f.source])}`).join(',');
+        return `{"name":"${c.name}","sysid":${c.sysid},"compid":${c.compid},"seq":${c.seq},"v":${c.version},"fields":{${fields}}}`;
+    }).join('\n') + '\n';
+}
+
+async function main() {
+    const key = MavLinkPacketSignature.key('airseg interop');
+    const { messages, shared, ownOnly } = dialect();
+    if (messages.length < 300 || shared.length < 250) fail(`dialect: ${messages.length} messages, ${shared.length} shared with node-mavlink`);
+    const cases = makeCases(shared, 12, 0);
 
     // 1. node-mavlink -> airseg-mavdump
     const chunks = cases.map(c => {
@@ -211,33 +282,10 @@ async function main() {
         const frame = protocol.serialize(toNodeMessage(c.clazz, c.values), c.seq);
         return c.signed ? protocol.sign(frame, 1, key) : frame;
     });
-    const decoded = runMavdump([], Buffer.concat(chunks));
-    const lines = decoded.stdout.toString().split('\n').filter(l => l.length > 0);
-    if (lines.length !== cases.length) fail(`decode: ${cases.length} frames in, ${lines.length} JSON lines out; stderr: ${decoded.stderr}`);
-    lines.slice(0, cases.length).forEach((line, i) => {
-        const c = cases[i];
-        const where = `decode #${i} ${c.name} v${c.version}${c.signed ? ' signed' : ''}`;
-        const j = parseJsonLine(line);
-        if (j.name !== c.name || j.msgid !== c.clazz.MSG_ID || j.sysid !== c.sysid || j.compid !== c.compid ||
-            j.seq !== c.seq || j.v !== c.version || Boolean(j.signed) !== c.signed) {
-            fail(`${where}: header ${line.slice(0, 120)}`);
-            return;
-        }
-        // node-mavlink's MAVLink 1 frames carry the extensions too; airseg reads what is on the wire.
-        for (const f of c.clazz.FIELDS) compareField(where, f, c.values[f.source], j.fields[f.source]);
-        const extra = Object.keys(j.fields).filter(k => !c.clazz.FIELDS.some(f => f.source === k));
-        if (extra.length) fail(`${where}: fields node-mavlink does not know: ${extra}`);
-    });
-    const summary = decoded.stderr.toString();
-    if (!summary.includes(`"frames_ok":${cases.length},`) || !summary.includes('"bad_checksum":0,')) fail(`decode summary: ${summary}`);
-    if (!summary.includes(`"signed_frames":${cases.filter(c => c.signed).length},`)) fail(`signed count: ${summary}`);
+    checkDecoded('decode', cases, Buffer.concat(chunks), c => c.values);
 
     // 2. airseg-mavdump --encode -> node-mavlink
-    const input = cases.map(c => {
-        const fields = c.clazz.FIELDS.map(f => `"${f.source}":${toJsonValue(f.type, c.values[f.source])}`).join(',');
-        return `{"name":"${c.name}","sysid":${c.sysid},"compid":${c.compid},"seq":${c.seq},"v":${c.version},"fields":{${fields}}}`;
-    }).join('\n') + '\n';
-    const encoded = runMavdump(['--encode'], input);
+    const encoded = runMavdump(['--encode'], jsonLines(cases));
     if (encoded.status !== 0) fail(`--encode exited ${encoded.status}: ${encoded.stderr}`);
     const result = await nodeDecode(encoded.stdout);
     if (result.invalid !== 0 || result.unknown !== 0) fail(`node-mavlink rejected frames: ${result.invalid} bad checksum, ${result.unknown} unknown`);
@@ -256,13 +304,22 @@ async function main() {
         for (const f of c.clazz.FIELDS) compareField(where, f, expected[f.source], data[f.name]);
     });
 
-    const fieldCount = cases.reduce((n, c) => n + c.clazz.FIELDS.length, 0);
+    // 3. Messages node-mavlink does not define as airseg does: airseg-mavdump --encode, then airseg-mavdump.
+    const own = makeCases(ownOnly, 12, cases.length);
+    for (const c of own) c.signed = false;  // --encode writes unsigned frames
+    const ownEncoded = runMavdump(['--encode'], jsonLines(own));
+    if (ownEncoded.status !== 0) fail(`--encode (own) exited ${ownEncoded.status}: ${ownEncoded.stderr}`);
+    checkDecoded('own', own, ownEncoded.stdout, c => expectedFor(c.clazz, c.values, c.version));
+
+    const fieldCount = shared.reduce((n, m) => n + m.clazz.FIELDS.length, 0);
     if (failures) {
         console.error(`mavlink_interop: ${failures} mismatches`);
         process.exit(1);
     }
-    console.log(`mavlink_interop: ${cases.length} frames (${MESSAGES.length} messages, ${fieldCount} fields) ` +
-                'decoded field for field from node-mavlink and accepted back by it');
+    console.log(`mavlink_interop: ${messages.length} dialect messages; ${shared.length} (${fieldCount} fields) in ` +
+                `${cases.length} frames decoded field for field from node-mavlink and accepted back by it; ` +
+                `${ownOnly.length} that node-mavlink does not define alike round-tripped through airseg-mavdump ` +
+                `alone: ${ownOnly.map(m => m.name).join(' ')}`);
 }
 
 main().catch(e => { console.error(e); process.exit(1); });

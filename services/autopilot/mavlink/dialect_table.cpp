@@ -1,0 +1,137 @@
+// The dialect catalogue (message_table.hpp): dialect.def laid out once, at compile time, by the rules of
+// layout.hpp. Kept apart from message_table.cpp so that the typed structs are not compiled again for it.
+#include <algorithm>
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "services/autopilot/mavlink/layout.hpp"
+#include "services/autopilot/mavlink/message_table.hpp"
+
+namespace airseg::mavlink {
+// Named apart from message_table.cpp's internals: a unity build compiles both in one translation unit.
+namespace dialect_table {
+namespace {
+
+using std::int16_t;
+using std::int32_t;
+using std::int64_t;
+using std::int8_t;
+using std::uint16_t;
+using std::uint32_t;
+using std::uint64_t;
+using std::uint8_t;
+
+// Every declaration of the dialect, message after message, each in XML order with its extensions marker.
+constexpr FieldDecl kDecls[] = {
+#define AIRSEG_MAVLINK_DIALECT_MESSAGE(id_, name_)
+#define AIRSEG_MAVLINK_DIALECT_FIELD(type_, name_, length_) \
+    FieldDecl{name_, FieldTypeOf<type_>::value, length_, false},
+#define AIRSEG_MAVLINK_DIALECT_EXTENSIONS() FieldDecl{"", FieldType::Uint8, 0, true},
+#define AIRSEG_MAVLINK_DIALECT_END()
+#include "services/autopilot/mavlink/dialect.def"
+};
+
+struct Head {
+    std::uint32_t id;
+    std::string_view name;
+    std::size_t decl_count;  // entries in kDecls, the extensions marker included
+};
+constexpr Head kHeads[] = {
+#define AIRSEG_MAVLINK_DIALECT_MESSAGE(id_, name_) \
+    Head {                                         \
+        id_, name_, 0
+#define AIRSEG_MAVLINK_DIALECT_FIELD(type_, name_, length_) +1
+#define AIRSEG_MAVLINK_DIALECT_EXTENSIONS() +1
+#define AIRSEG_MAVLINK_DIALECT_END() \
+    }                                \
+    ,
+#include "services/autopilot/mavlink/dialect.def"
+};
+constexpr std::size_t kMessageCount = std::size(kHeads);
+
+constexpr std::uint32_t kTypedIds[] = {
+#define AIRSEG_MAVLINK_MESSAGE(id_, NAME_, Type_) id_,
+#define AIRSEG_MAVLINK_FIELD(type_, name_)
+#define AIRSEG_MAVLINK_ARRAY(type_, name_, length_)
+#define AIRSEG_MAVLINK_VERSION_FIELD(name_)
+#define AIRSEG_MAVLINK_EXTENSIONS()
+#define AIRSEG_MAVLINK_END()
+#include "services/autopilot/mavlink/messages.def"
+};
+
+constexpr std::size_t kFieldCount = field_count(kDecls);
+
+// The laid-out fields of all messages, message after message in kHeads order, with the declaration order of
+// each message's fields and the summaries.
+struct Laid {
+    std::array<FieldInfo, kFieldCount> wire{};
+    std::array<std::uint8_t, kFieldCount> wire_index_by_decl{};
+    std::array<LayoutSummary, kMessageCount> summary{};
+    std::array<std::size_t, kMessageCount> first_field{};
+};
+
+constexpr Laid lay_out_all() {
+    Laid laid{};
+    std::size_t decl = 0;
+    std::size_t field = 0;
+    for (std::size_t m = 0; m < kMessageCount; ++m) {
+        const std::span<const FieldDecl> decls = std::span(kDecls).subspan(decl, kHeads[m].decl_count);
+        const std::size_t n = field_count(decls);
+        laid.first_field[m] = field;
+        laid.summary[m] = lay_out(kHeads[m].name, decls, std::span(laid.wire).subspan(field, n),
+                                  std::span(laid.wire_index_by_decl).subspan(field, n));
+        decl += decls.size();
+        field += n;
+    }
+    if (decl != std::size(kDecls) || field != kFieldCount) {
+        throw "dialect.def is not read whole";
+    }
+    return laid;
+}
+constexpr Laid kLaid = lay_out_all();
+
+constexpr std::size_t field_count_of(std::size_t m) {
+    return (m + 1 < kMessageCount ? kLaid.first_field[m + 1] : kFieldCount) - kLaid.first_field[m];
+}
+
+template <std::size_t... M>
+constexpr std::array<MessageInfo, kMessageCount> make_infos(std::index_sequence<M...>) {
+    return {MessageInfo{
+        kHeads[M].id, kHeads[M].name, kLaid.summary[M].crc_extra, kLaid.summary[M].base_length,
+        kLaid.summary[M].length, std::span(kLaid.wire).subspan(kLaid.first_field[M], field_count_of(M)),
+        std::span(kLaid.wire_index_by_decl).subspan(kLaid.first_field[M], field_count_of(M)),
+        std::find(std::begin(kTypedIds), std::end(kTypedIds), kHeads[M].id) != std::end(kTypedIds)}...};
+}
+constexpr auto kDialect = make_infos(std::make_index_sequence<kMessageCount>{});
+
+constexpr bool ordered_by_unique_id() {
+    for (std::size_t i = 1; i < kDialect.size(); ++i) {
+        if (kDialect[i - 1].id >= kDialect[i].id) {
+            return false;
+        }
+    }
+    return true;
+}
+static_assert(ordered_by_unique_id(), "dialect.def must list each message id once, in ascending order");
+
+}  // namespace
+}  // namespace dialect_table
+
+std::span<const MessageInfo> dialect_messages() {
+    return dialect_table::kDialect;
+}
+
+const MessageInfo* find_dialect_message(std::uint32_t id) {
+    const auto it = std::lower_bound(dialect_table::kDialect.begin(), dialect_table::kDialect.end(), id,
+                                     [](const MessageInfo& m, std::uint32_t value) { return m.id < value; });
+    return it != dialect_table::kDialect.end() && it->id == id ? &*it : nullptr;
+}
+
+const MessageInfo* find_dialect_message(std::string_view name) {
+    const auto it = std::find_if(dialect_table::kDialect.begin(), dialect_table::kDialect.end(),
+                                 [&](const MessageInfo& m) { return m.name == name; });
+    return it == dialect_table::kDialect.end() ? nullptr : &*it;
+}
+
+}  // namespace airseg::mavlink
