@@ -2,7 +2,9 @@
 
 #include <array>
 #include <optional>
+#include <string_view>
 
+#include "services/autopilot/mavftp.hpp"
 #include "services/autopilot/mavlink/enums.hpp"
 #include "services/autopilot/mavlink/messages.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
@@ -55,6 +57,39 @@ std::optional<Target> mission_write(const mav::Frame& f) {
     }
 }
 
+/// Commands that move or rewrite the mission, refused in COMMAND_LONG and COMMAND_INT alike: the command
+/// form of MISSION_SET_CURRENT moves the mission as much as the message does.
+bool command_writes_mission(std::uint16_t command) {
+    return command == mav::kCmdDoSetMissionCurrent;
+}
+
+/// A path of ArduPilot's @MISSION file system whose writing replaces the mission. Its fence.dat and
+/// rally.dat pass, as fence and rally uploads by message do. A leading '/' is ignored, as ArduPilot's FTP
+/// server ignores it.
+bool is_mission_file(std::string_view path) {
+    while (!path.empty() && path.front() == '/') {
+        path.remove_prefix(1);
+    }
+    constexpr std::string_view kRoot = "@MISSION";
+    if (path.substr(0, kRoot.size()) != kRoot) {
+        return false;
+    }
+    return path != "@MISSION/fence.dat" && path != "@MISSION/rally.dat";
+}
+
+/// A MAVFTP request that would create, change or remove a mission file.
+bool ftp_writes_mission(const mavftp::Packet& p) {
+    if (!mavftp::writes_path(p.opcode)) {
+        return false;
+    }
+    if (is_mission_file(p.path())) {
+        return true;
+    }
+    // Rename: "old\0new"; either end in @MISSION moves the mission.
+    const auto first = p.path();
+    return p.opcode == mavftp::Opcode::Rename && is_mission_file(p.path(first.size() + 1));
+}
+
 }  // namespace
 
 ForwardedFrame::Delivery delivery_of(std::uint32_t msgid) {
@@ -70,6 +105,9 @@ ForwardedFrame::Delivery delivery_of(std::uint32_t msgid) {
         case mav::MissionItemReached::kId:
         case mav::MissionRequestInt::kId:
         case mav::MissionItemInt::kId:
+        // Each MAVFTP reply and TIMESYNC reply answers one request: none may stand in for another.
+        case mav::FileTransferProtocol::kId:
+        case mav::Timesync::kId:
             return ForwardedFrame::Delivery::Reliable;
         default:
             // MISSION_CURRENT is telemetry: the current slot, repeated at a stream rate.
@@ -120,24 +158,49 @@ GcsGate::Output GcsGate::from_ground(std::span<const std::uint8_t> frames, TimeP
     return out;
 }
 
+bool GcsGate::addressed_to_autopilot(std::uint8_t target_system) const {
+    return target_system == sysid_ || target_system == 0;
+}
+
 bool GcsGate::refuse(const mav::Frame& f, Output& out) {
-    if (f.msgid == mav::CommandLong::kId) {
-        // The command form of MISSION_SET_CURRENT moves the mission as much as the message does.
-        const auto cmd = mav::decode_payload<mav::CommandLong>(f.payload_view());
-        if (cmd.command != mav::kCmdDoSetMissionCurrent ||
-            (cmd.target_system != sysid_ && cmd.target_system != 0)) {
+    if (f.msgid == mav::CommandLong::kId || f.msgid == mav::CommandInt::kId) {
+        std::uint16_t command = 0;
+        std::uint8_t target = 0;
+        if (f.msgid == mav::CommandLong::kId) {
+            const auto cmd = mav::decode_payload<mav::CommandLong>(f.payload_view());
+            command = cmd.command;
+            target = cmd.target_system;
+        } else {
+            const auto cmd = mav::decode_payload<mav::CommandInt>(f.payload_view());
+            command = cmd.command;
+            target = cmd.target_system;
+        }
+        if (!command_writes_mission(command) || !addressed_to_autopilot(target)) {
             return false;
         }
         mav::CommandAck ack;
-        ack.command = cmd.command;
+        ack.command = command;
         ack.result = mav::kResultDenied;
         ack.target_system = f.sysid;
         ack.target_component = f.compid;
         out.to_ground.push_back(
             {mav::CommandAck::kId, ForwardedFrame::Delivery::Reliable, answers_.encode(ack)});
+    } else if (f.msgid == mav::FileTransferProtocol::kId) {
+        const auto m = mav::decode_payload<mav::FileTransferProtocol>(f.payload_view());
+        const auto request = mavftp::decode(m.payload);
+        if (!addressed_to_autopilot(m.target_system) || !ftp_writes_mission(request)) {
+            return false;
+        }
+        mav::FileTransferProtocol nak;
+        nak.target_system = f.sysid;
+        nak.target_component = f.compid;
+        nak.payload = mavftp::encode(mavftp::nak(request, mavftp::Error::FileProtected));
+        out.to_ground.push_back(
+            {mav::FileTransferProtocol::kId, ForwardedFrame::Delivery::Reliable, answers_.encode(nak)});
+        ++stats_.ftp_refused;
     } else {
         const auto target = mission_write(f);
-        if (!target || (target->system != sysid_ && target->system != 0) ||
+        if (!target || !addressed_to_autopilot(target->system) ||
             target->mission_type != mav::kMissionTypeMission) {
             return false;
         }

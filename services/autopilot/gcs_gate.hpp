@@ -6,12 +6,15 @@
 // The flight plan manager owns the autopilot's mission: it feeds it a window at a time and must know every
 // slot. A ground station writing the mission behind its back would break the plan, so mission writes
 // (MISSION_COUNT, MISSION_ITEM(_INT), MISSION_CLEAR_ALL, MISSION_SET_CURRENT, MISSION_WRITE_PARTIAL_LIST for
-// the mission itself; fences and rally points pass; and COMMAND_LONG MAV_CMD_DO_SET_MISSION_CURRENT) never
-// reach the autopilot: the gate answers the ground station itself, as the autopilot, with MISSION_ACK
-// MAV_MISSION_DENIED (COMMAND_ACK MAV_RESULT_DENIED for the command) and STATUSTEXTs saying why and what to
-// do. With receive_uploads(), a mission upload goes to a MissionReceiver instead, which answers in the
-// autopilot's name and hands the mission to the flight plan manager. Reading the mission, parameters,
-// commands and everything else pass unchanged.
+// the mission itself; fences and rally points pass; MAV_CMD_DO_SET_MISSION_CURRENT in COMMAND_LONG or
+// COMMAND_INT; and MAVFTP requests that create, open for writing, truncate, rename or remove a file of
+// ArduPilot's @MISSION file system but for its fence.dat and rally.dat) never reach the autopilot: the gate
+// answers the ground station itself, as the autopilot, with MISSION_ACK MAV_MISSION_DENIED (COMMAND_ACK
+// MAV_RESULT_DENIED for the command, a MAVFTP NAK FileProtected for the file) and STATUSTEXTs saying why
+// and what to do. With receive_uploads(), a mission upload goes to a MissionReceiver instead, which answers
+// in the autopilot's name and hands the mission to the flight plan manager. Reading the mission, parameters
+// (by message or MAVFTP), every other command (COMMAND_LONG and COMMAND_INT), TIMESYNC, position targets and
+// everything else pass unchanged.
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -38,7 +41,8 @@ std::span<const char* const> mission_refusal_texts();
 struct GcsGateStats {
     std::uint64_t frames = 0;            // valid frames from ground stations
     std::uint64_t passed = 0;            // of those, written to the autopilot
-    std::uint64_t missions_refused = 0;  // mission writes answered with MAV_MISSION_DENIED
+    std::uint64_t missions_refused = 0;  // mission writes answered with a refusal (ftp_refused included)
+    std::uint64_t ftp_refused = 0;       // of those, MAVFTP writes to @MISSION answered with a NAK
     std::uint64_t upload_frames = 0;     // mission upload frames handed to the MissionReceiver
     std::uint64_t invalid = 0;           // bytes that were no valid frame of a known message
 };
@@ -63,6 +67,7 @@ class GcsGate {
 
   private:
     bool refuse(const mavlink::Frame& f, Output& out);
+    [[nodiscard]] bool addressed_to_autopilot(std::uint8_t target_system) const;
 
     std::uint8_t sysid_;
     mavlink::Encoder answers_;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cstring>
+#include <iterator>
 #include <string>
 #include <utility>
 
@@ -219,7 +220,9 @@ class Generator {
         for (std::size_t i = e.max_msg_len & ~std::size_t{3}; i < e.max_msg_len; ++i) {
             fill(payload.data() + i, 1, false);
         }
-        emit(from, id, e.crc_extra, payload.data(), e.min_msg_len, e.max_msg_len, false, false);
+        // Some are declared by now (TIMESYNC, POSITION_TARGET_GLOBAL_INT): their frames count as declared.
+        emit(from, id, e.crc_extra, payload.data(), e.min_msg_len, e.max_msg_len, find_message(id) != nullptr,
+             false);
     }
 
     void emit(Sender& from, std::uint32_t id, std::uint8_t crc_extra, const std::uint8_t* payload,
@@ -350,7 +353,8 @@ std::vector<reference::MsgEntry> declared_entries() {
 
 std::vector<reference::MsgEntry> ardupilot_entries() {
     std::vector<reference::MsgEntry> out = declared_entries();
-    out.insert(out.end(), kUndeclared.begin(), kUndeclared.end());
+    std::copy_if(kUndeclared.begin(), kUndeclared.end(), std::back_inserter(out),
+                 [](const reference::MsgEntry& e) { return find_message(e.msgid) == nullptr; });
     std::sort(out.begin(), out.end(),
               [](const reference::MsgEntry& a, const reference::MsgEntry& b) { return a.msgid < b.msgid; });
     return out;

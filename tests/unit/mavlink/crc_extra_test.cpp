@@ -25,7 +25,7 @@ struct Published {
 };
 
 // clang-format off
-constexpr std::array<Published, 37> kPublished{{
+constexpr std::array<Published, 42> kPublished{{
     {0, 50, 9, 9, 0, 0, 0},       {1, 124, 31, 43, 0, 0, 0},    {2, 137, 12, 12, 0, 0, 0},
     {11, 89, 6, 6, 1, 4, 0},      {20, 214, 20, 20, 3, 2, 3},   {21, 159, 2, 2, 3, 0, 1},
     {22, 220, 25, 25, 0, 0, 0},   {23, 168, 23, 23, 3, 4, 5},   {24, 24, 30, 52, 0, 0, 0},
@@ -39,6 +39,9 @@ constexpr std::array<Published, 37> kPublished{{
     {76, 152, 33, 33, 3, 30, 31}, {77, 143, 3, 10, 3, 8, 9},    {109, 185, 9, 9, 0, 0, 0},
     {147, 154, 36, 54, 0, 0, 0},  {148, 178, 60, 78, 0, 0, 0},  {242, 104, 52, 60, 0, 0, 0},
     {253, 83, 51, 54, 0, 0, 0},
+    // COMMAND_INT, SET_POSITION_TARGET_GLOBAL_INT, POSITION_TARGET_GLOBAL_INT, FILE_TRANSFER_PROTOCOL, TIMESYNC
+    {75, 158, 35, 35, 3, 30, 31}, {86, 5, 53, 53, 3, 50, 51},   {87, 150, 51, 51, 0, 0, 0},
+    {110, 84, 254, 254, 3, 1, 2}, {111, 34, 16, 18, 3, 16, 17},
 }};
 // clang-format on
 
