@@ -215,7 +215,8 @@ TEST(MavlinkReference, DecodesEveryIntactFrameTheCLibraryDecodes) {
         "frames sent: %zu (%zu declared, %zu not); intact: %zu declared, %zu not\n"
         "intact declared frames decoded: C library %zu, C library with MAVLINK_CHECK_MESSAGE_LENGTH %zu, "
         "C library for ArduPilot's dialect %zu, airseg %zu\n"
-        "intact undeclared frames decoded: C library for ArduPilot's dialect %zu, airseg (unverified) %zu\n"
+        "intact undeclared frames decoded: C library for ArduPilot's dialect %zu, airseg %zu verified, "
+        "%zu unverified\n"
         "delivered from a damaged frame, its content as sent: C library %zu, airseg %zu verified and %zu "
         "unverified; with content never sent: C library %zu, airseg %zu verified and %zu unverified\n"
         "airseg counters: frames_ok %llu, unknown_msgid %llu, bad_checksum %llu, truncated %llu, "
@@ -224,10 +225,10 @@ TEST(MavlinkReference, DecodesEveryIntactFrameTheCLibraryDecodes) {
         sent_declared, s.frames.size() - sent_declared, intact_declared, intact_other,
         ref.count(true, kVerified, s.frames), ref_checked.count(true, kVerified, s.frames),
         ref_full.count(true, kVerified, s.frames), ours.count(true, kVerified, s.frames),
-        ref_full.count(false, kVerified, s.frames), ours.count(false, kUnverified, s.frames),
-        ref.not_intact[kVerified], ours.not_intact[kVerified], ours.not_intact[kUnverified],
-        ref.unmatched[kVerified], ours.unmatched[kVerified], ours.unmatched[kUnverified],
-        static_cast<unsigned long long>(stats.frames_ok),
+        ref_full.count(false, kVerified, s.frames), ours.count(false, kVerified, s.frames),
+        ours.count(false, kUnverified, s.frames), ref.not_intact[kVerified], ours.not_intact[kVerified],
+        ours.not_intact[kUnverified], ref.unmatched[kVerified], ours.unmatched[kVerified],
+        ours.unmatched[kUnverified], static_cast<unsigned long long>(stats.frames_ok),
         static_cast<unsigned long long>(stats.unknown_msgid),
         static_cast<unsigned long long>(stats.bad_checksum), static_cast<unsigned long long>(stats.truncated),
         static_cast<unsigned long long>(stats.garbage_bytes),
