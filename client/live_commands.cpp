@@ -24,6 +24,7 @@ volatile std::sig_atomic_t g_stop = 0;
 constexpr int kDone = 0;
 constexpr int kRefused = 1;
 constexpr int kNoLink = 3;
+constexpr int kRoutePoints = 300;
 
 bool expired(const LiveOptions& o, Clock::time_point started) {
     return o.duration.count() > 0 && Clock::now() - started >= o.duration;
@@ -41,6 +42,29 @@ bool wait_for_link(VehicleLink& radio, const LiveOptions& o,
         radio.run_for(std::chrono::milliseconds(50), on_message);
     }
     return true;
+}
+
+bool drives(std::uint8_t plan_state) {
+    return plan_state == 1 || plan_state == 2;  // running, paused
+}
+
+/// What the vehicle says of its plan (plan.show; with `route`, plan.geometry for the distance left): the
+/// plan's count and element names, so progress and events read "waypoint 4 of 12" as on the map. Blocking:
+/// the link's pushes in the meantime are not seen, so only watch asks it whenever a plan starts.
+groundside::PlanFacts ask_plan(VehicleLink& radio, const LiveOptions& o, bool route) {
+    const auto show = radio.request({{"cmd", "plan.show"}}, o.timeout);
+    if (!show.answer || !show.answer->value("ok", false)) {
+        return {};
+    }
+    nlohmann::json geometry;
+    if (route) {
+        // Few points: the answer crosses the radio; a longer plan is drawn in part and has no distance left.
+        auto shape = radio.request({{"cmd", "plan.geometry"}, {"max_points", kRoutePoints}}, o.timeout);
+        if (shape.answer && shape.answer->value("ok", false)) {
+            geometry = std::move((*shape.answer)["result"]);
+        }
+    }
+    return groundside::plan_facts((*show.answer)["result"], geometry);
 }
 
 }  // namespace
@@ -65,7 +89,19 @@ bool stop_requested() {
 int run_radio_watch(VehicleLink& radio, const LiveOptions& o) {
     groundside::WatchState state;
     state.set_debug(o.debug);
-    auto take = [&state](const proto::Message& m) { state.take(m, Clock::now()); };
+    // The plan's facts are asked again whenever a plan starts to drive (a new one, or the first seen).
+    std::optional<std::uint8_t> asked_for;
+    bool ask = false;
+    auto take = [&](const proto::Message& m) {
+        state.take(m, Clock::now());
+        if (const auto* t = std::get_if<proto::Telemetry>(&m)) {
+            if (drives(t->plan_state) && !(asked_for && drives(*asked_for))) {
+                state.set_plan({});  // the last plan's facts are not this one's
+                ask = true;
+            }
+            asked_for = t->plan_state;
+        }
+    };
     if (!wait_for_link(radio, o, take)) {
         return kNoLink;
     }
@@ -78,6 +114,10 @@ int run_radio_watch(VehicleLink& radio, const LiveOptions& o) {
     while (g_stop == 0 && !expired(o, started)) {
         const auto next = Clock::now() + o.refresh;
         radio.run_for(o.refresh, take);
+        if (ask) {
+            ask = false;
+            state.set_plan(ask_plan(radio, o, true));
+        }
         // The view is redrawn at its interval only, even over a link that returns early (nothing to wait on).
         std::this_thread::sleep_until(next);
         state.set_ground_link(radio.link_stats());
@@ -107,7 +147,15 @@ int run_radio_watch(VehicleLink& radio, const LiveOptions& o) {
 int run_log(VehicleLink& radio, const LiveOptions& o) {
     // Worded as watch and the map word them: in plan terms, each happening once.
     groundside::EventWording wording;
-    auto print = [&o, &wording](const proto::Message& m) {
+    std::optional<std::uint8_t> plan_state;  // none before the first sample
+    auto print = [&o, &wording, &plan_state](const proto::Message& m) {
+        if (const auto* t = std::get_if<proto::Telemetry>(&m)) {
+            if (plan_state && !drives(*plan_state) && drives(t->plan_state)) {
+                // A plan started: its count is not known, and no count is better than a wrong one.
+                wording.set_waypoints(std::nullopt);
+            }
+            plan_state = t->plan_state;
+        }
         const auto e = wording.take(m, Clock::now());
         if (!e || (e->debug && !o.debug)) {
             return;
@@ -125,6 +173,12 @@ int run_log(VehicleLink& radio, const LiveOptions& o) {
     };
     if (!wait_for_link(radio, o, print)) {
         return kNoLink;
+    }
+    // The running plan's count, asked once as the log starts ("waypoint 8 of 12 reached"); asking again
+    // later would lose the events pushed meanwhile, so a plan started after it is numbered without "of N".
+    const auto plan = ask_plan(radio, o, false);
+    if (plan.waypoints) {
+        wording.set_waypoints(plan.waypoints);
     }
     const auto started = Clock::now();
     while (g_stop == 0 && !expired(o, started)) {

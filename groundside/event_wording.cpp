@@ -4,6 +4,9 @@
 
 #include <cctype>
 #include <charconv>
+#include <cmath>
+
+#include "groundside/watch_view.hpp"
 
 namespace airseg::groundside {
 
@@ -97,7 +100,120 @@ bool same_mode(std::string_view s) {
     return !from.empty() && from == to;
 }
 
+/// Great-circle metres on Leaflet's sphere (radius 6371000 m, its map.distance): the map's measure, so the
+/// distance left reads the same on the map and in a terminal.
+double map_distance(std::pair<double, double> a, std::pair<double, double> b) {
+    constexpr double kRadius = 6371000.0;
+    constexpr double kRad = M_PI / 180.0;
+    const double dlat = (b.first - a.first) * kRad;
+    const double dlon = (b.second - a.second) * kRad;
+    const double h = std::sin(dlat / 2) * std::sin(dlat / 2) + std::cos(a.first * kRad) *
+                                                                   std::cos(b.first * kRad) *
+                                                                   std::sin(dlon / 2) * std::sin(dlon / 2);
+    return 2.0 * kRadius * std::atan2(std::sqrt(h), std::sqrt(1.0 - h));
+}
+
+std::string text_of(const nlohmann::json& j, const char* key) {
+    const auto it = j.find(key);
+    return it != j.end() && it->is_string() ? it->get<std::string>() : std::string();
+}
+
+/// [[lat, lon], ...] as pairs; false if any point is malformed.
+bool points_of(const nlohmann::json& j, std::vector<std::pair<double, double>>& out) {
+    if (!j.is_array()) {
+        return false;
+    }
+    for (const auto& p : j) {
+        if (!p.is_array() || p.size() < 2 || !p[0].is_number() || !p[1].is_number()) {
+            return false;
+        }
+        out.emplace_back(p[0].get<double>(), p[1].get<double>());
+    }
+    return true;
+}
+
+/// The plan's waypoints in plan order as the map numbers them (map.js planRoute): the points of the main
+/// list's elements (a scan's lines), when they are exactly the plan's count; otherwise none.
+std::vector<std::pair<double, double>> route_of(const nlohmann::json& geometry, std::uint64_t waypoints) {
+    std::vector<std::pair<double, double>> route;
+    const auto elements = geometry.find("elements");
+    if (!geometry.is_object() || geometry.value("truncated", true) || elements == geometry.end() ||
+        !elements->is_array()) {
+        return {};
+    }
+    for (const auto& e : *elements) {
+        if (!e.is_object() || text_of(e, "path").starts_with("plan.blocks")) {
+            continue;
+        }
+        const auto pts = e.find(e.value("closed", false) ? "lines" : "points");
+        if (pts == e.end() || !points_of(*pts, route) || route.size() > waypoints) {
+            return {};
+        }
+    }
+    return route.size() == waypoints ? route : std::vector<std::pair<double, double>>{};
+}
+
 }  // namespace
+
+PlanFacts plan_facts(const nlohmann::json& show, const nlohmann::json& geometry) {
+    PlanFacts facts;
+    const auto elements = show.is_object() ? show.find("elements") : show.end();
+    if (!show.is_object() || elements == show.end() || !elements->is_array()) {
+        return facts;
+    }
+    std::uint64_t total = 0;
+    bool counted = true;
+    for (const auto& e : *elements) {
+        if (!e.is_object()) {
+            return {};
+        }
+        facts.top.push_back({text_of(e, "path"), text_of(e, "kind"), text_of(e, "name")});
+        const auto n = e.find("waypoints");
+        if (n != e.end() && n->is_number_unsigned()) {
+            total += n->get<std::uint64_t>();
+        } else {
+            counted = false;  // an endless repeat: no count
+        }
+    }
+    if (counted) {
+        facts.waypoints = total;
+        facts.route = route_of(geometry, total);
+    }
+    return facts;
+}
+
+std::string distance_words(double metres) {
+    return metres >= 1000 ? fmt::format("{:.1f} km", metres / 1000)
+                          : fmt::format("{} m", std::lround(metres));
+}
+
+std::string progress_words(const proto::Telemetry& t, const PlanFacts& plan) {
+    if (t.plan_state == 0) {
+        return "no plan running";
+    }
+    std::string out = plan_state_name(t.plan_state);
+    if (!plan_drives(t.plan_state)) {
+        return out;
+    }
+    out += " — " + waypoint_words(t.next_waypoint, plan.waypoints);
+    if (t.plan_element < plan.top.size()) {
+        const auto& e = plan.top[t.plan_element];
+        out += " — " + e.kind + (e.name.empty() ? " " + e.path : " '" + e.name + "'");
+    }
+    if (!t.no_position && t.next_waypoint < plan.route.size()) {
+        double left = map_distance({t.lat_deg, t.lon_deg}, plan.route[t.next_waypoint]);
+        for (std::size_t i = t.next_waypoint + 1; i < plan.route.size(); ++i) {
+            left += map_distance(plan.route[i - 1], plan.route[i]);
+        }
+        out += " — " + distance_words(left) + " left";
+        if (t.ground_speed_mps > 0.3) {
+            const double s = left / t.ground_speed_mps;  // at the present speed
+            out += s < 90 ? fmt::format(" (about {} s)", std::max(1L, std::lround(s)))
+                          : fmt::format(" (about {} min)", std::lround(s / 60));
+        }
+    }
+    return out;
+}
 
 std::string waypoint_words(std::uint64_t index, std::optional<std::uint64_t> waypoints) {
     if (waypoints && index < *waypoints) {

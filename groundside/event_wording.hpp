@@ -13,11 +13,18 @@
 // - The same words again within a few seconds, or a waypoint already said reached, are debug lines.
 //
 // A debug line keeps the vehicle's own text (slot numbers and all): shown only in a debug view.
+//
+// Where the plan is, said as the map says it (ground/map/web/map.js showProgress): "running — waypoint 4 of
+// 12 — scan 'north field' — 2.1 km left (about 3 min)". The telemetry gives the state, the next waypoint's
+// index and the top-level element; the plan's count and its elements' names come from plan.show, its
+// waypoints (for the distance left) from plan.geometry: PlanFacts holds what is known of them.
 #include <chrono>
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "services/groundlink/protocol/ground_protocol.hpp"
 
@@ -37,6 +44,32 @@ WordedEvent word_event(const groundlink::protocol::Event& e, std::uint8_t plan_s
 
 /// "waypoint 8 of 12" (index 7, 12 waypoints), "waypoint 8" without a count: the plan's numbering.
 std::string waypoint_words(std::uint64_t index, std::optional<std::uint64_t> waypoints);
+
+/// What the ground knows of the running plan beyond the telemetry; each part may be missing.
+struct PlanFacts {
+    struct Element {
+        std::string path;  // "plan.elements[2]"
+        std::string kind;  // waypoint, scan, hold, orbit
+        std::string name;  // empty when it has none
+    };
+    /// The expanded plan's waypoint count (none when unknown or endless).
+    std::optional<std::uint64_t> waypoints;
+    /// Its top-level elements in order: the telemetry's plan_element indexes them.
+    std::vector<Element> top;
+    /// Its waypoints in plan order, {lat, lon}, when they number exactly `waypoints` (else empty).
+    std::vector<std::pair<double, double>> route;
+};
+
+/// The facts in plan.show's result (its "elements", each with "waypoints": null when endless) and, when
+/// given, plan.geometry's result (its elements' points, a scan's lines); anything malformed is left out.
+PlanFacts plan_facts(const nlohmann::json& show, const nlohmann::json& geometry = nlohmann::json());
+
+/// "running — waypoint 4 of 12 — scan 'north field' — 2.1 km left (about 3 min)" from a telemetry sample
+/// and what is known of its plan: the parts not known are left out; "no plan running" without a plan.
+std::string progress_words(const groundlink::protocol::Telemetry& t, const PlanFacts& plan);
+
+/// "2.1 km", "140 m": a distance as the map says it.
+std::string distance_words(double metres);
 
 /// The events of one vehicle in order, worded and de-duplicated: each happening once.
 class EventWording {

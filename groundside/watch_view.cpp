@@ -97,6 +97,11 @@ std::string event_line(const WordedEvent& e, bool debug_view) {
                            : fmt::format("{}: {} [{}]", severity, e.text, e.raw);
 }
 
+void WatchState::set_plan(PlanFacts plan) {
+    wording_.set_waypoints(plan.waypoints);
+    plan_ = std::move(plan);
+}
+
 void WatchState::take(const proto::Message& message, Clock::time_point now) {
     if (auto worded = wording_.take(message, now)) {
         if (!worded->debug || debug_) {
@@ -150,9 +155,12 @@ std::string WatchState::render(Clock::time_point now) const {
             t.battery_pct ? fmt::format("{} %", *t.battery_pct) : std::string("remaining unknown"));
         out += fmt::format("gps         fix {}  {} satellites\n", t.gps_fix, t.satellites);
         if (t.plan_state != 0) {
+            // The numbers plan.skip takes (the index counts from 0), then the plan in plan terms as the map
+            // says it.
             out += fmt::format("plan        {}  element {}  next waypoint {} (index {})\n",
                                plan_state_name(t.plan_state), t.plan_element, t.next_waypoint + 1,
                                t.next_waypoint);
+            out += fmt::format("progress    {}\n", progress_words(t, plan_));
         }
         out += fmt::format("telemetry   {:.1f} samples/s, last {:.1f} s ago, {} received\n", sample_rate(now),
                            seconds(now - latest_at_), samples_);
@@ -183,6 +191,11 @@ std::string WatchState::render(Clock::time_point now) const {
 nlohmann::json WatchState::to_json(Clock::time_point now) const {
     nlohmann::json j{{"samples", samples_}, {"sample_rate", sample_rate(now)}, {"ground_link", ground_link_}};
     j["vehicle"] = latest_ ? telemetry_json(*latest_) : nlohmann::json();
+    if (latest_ && latest_->plan_state != 0) {
+        j["vehicle"]["plan"]["progress"] = progress_words(*latest_, plan_);
+        j["vehicle"]["plan"]["waypoints"] =
+            plan_.waypoints ? nlohmann::json(*plan_.waypoints) : nlohmann::json();
+    }
     if (vehicle_link_) {
         j["vehicle_link"] = {{"rtt_ms", vehicle_link_->rtt_ms},
                              {"loss_permille", vehicle_link_->loss_permille},

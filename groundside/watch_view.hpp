@@ -22,6 +22,10 @@ class WatchState {
     void take(const groundlink::protocol::Message& message, Clock::time_point now);
     /// The ground end's own view of the link (RadioClient::link_stats()).
     void set_ground_link(nlohmann::json stats) { ground_link_ = std::move(stats); }
+    /// What is known of the plan beyond the telemetry (plan.show, plan.geometry): its progress is then said
+    /// as the map says it ("waypoint 4 of 12", the element by name, the distance left), and its events too.
+    void set_plan(PlanFacts plan);
+    [[nodiscard]] const PlanFacts& plan() const { return plan_; }
     /// Also list the events that say nothing new (debug lines, in the vehicle's own words).
     void set_debug(bool on) { debug_ = on; }
 
@@ -41,6 +45,7 @@ class WatchState {
     std::optional<groundlink::protocol::LinkStatsReport> vehicle_link_;
     std::deque<std::string> events_;
     EventWording wording_;  // events in plan terms, each happening once
+    PlanFacts plan_;
     bool debug_ = false;
     nlohmann::json ground_link_ = nlohmann::json::object();
 };
