@@ -2,11 +2,17 @@
 // (tests/integration/ground_map). Prints "listening on http://127.0.0.1:PORT/" once it serves.
 //
 //   airseg-map-fixture [--control] [--seconds N] [--fixless-first K] [--lose-fix-after K] [--outage-after K]
-//                      [--web-dir DIR] [--leaflet-dir DIR]
+//                      [--hold-after K] [--moment start|mid-scan|outage] [--web-dir DIR] [--leaflet-dir DIR]
 // N (default 60): how long the vehicle drives and the event stream stays open, from the first browser
 // connection. --fixless-first K: the first K samples have no position (sent as 0,0, as the daemon does before
 // a GPS fix); --lose-fix-after K: every sample after the first K has none; --outage-after K: after K samples
-// the link goes down and no sample comes any more.
+// the link goes down and no sample comes any more; --hold-after K: after K samples the vehicle sends its K-th
+// sample again and again (the picture stays at that moment, fresh, however late the browser comes).
+//
+// --moment puts the survey at one moment of the pictures in docs/images (4 samples a leg):
+//   start     holds after 3 samples: leaving the start, heading for waypoint 2 of 14;
+//   mid-scan  holds after 18 samples: on the scan's second line, heading for waypoint 6 of 14;
+//   outage    the link goes down after 26 samples: on the scan's third line, heading for waypoint 8 of 14.
 //
 // The plan has 14 waypoints (plan.show's counts are in "waypoints" and "top", as the hub adds them); each
 // waypoint reached sends what an older vehicle sends (the board's "Reached waypoint #N", the window's slot, a
@@ -84,6 +90,7 @@ int main(int argc, char** argv) {
     long fixless_first = 0;
     long lose_fix_after = -1;
     long outage_after = -1;
+    long hold_after = -1;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         const bool has_value = i + 1 < argc;
@@ -97,6 +104,21 @@ int main(int argc, char** argv) {
             lose_fix_after = std::stol(argv[++i]);
         } else if (arg == "--outage-after" && has_value) {
             outage_after = std::stol(argv[++i]);
+        } else if (arg == "--hold-after" && has_value) {
+            hold_after = std::stol(argv[++i]);
+        } else if (arg == "--moment" && has_value) {
+            const std::string moment = argv[++i];
+            if (moment == "start") {
+                hold_after = 3;
+            } else if (moment == "mid-scan") {
+                hold_after = 18;
+            } else if (moment == "outage") {
+                outage_after = 26;
+            } else {
+                std::fprintf(stderr, "airseg-map-fixture: unknown moment %s (start, mid-scan, outage)\n",
+                             moment.c_str());
+                return 2;
+            }
         } else if (arg == "--web-dir" && has_value) {
             config.web_dir = argv[++i];
         } else if (arg == "--leaflet-dir" && has_value) {
@@ -138,6 +160,7 @@ int main(int argc, char** argv) {
     airseg::asio::signal_set signals(io, SIGINT, SIGTERM);
     bool end_armed = false;
     long samples = 0;
+    airseg::groundlink::protocol::Telemetry held;  // the last sample sent, sent again while holding
     std::function<void()> drive = [&] {
         if (!end_armed && map.connections_accepted() > 0) {
             // The run is counted from the browser's first request: a browser slow to start (a loaded
@@ -170,6 +193,16 @@ int main(int argc, char** argv) {
         t.plan_state = 1;
         t.gps_fix = 3;
         const long n = samples++;
+        if (hold_after > 0 && n >= hold_after) {
+            map.add_position(held, std::chrono::system_clock::now());
+            step.expires_after(std::chrono::milliseconds(100));
+            step.async_wait([&](boost::system::error_code ec) {
+                if (!ec) {
+                    drive();
+                }
+            });
+            return;
+        }
         if (outage_after >= 0 && n >= outage_after) {
             if (n == outage_after) {
                 map.set_link({{"link", "down"}, {"rtt_ms", 84}, {"loss", 0.0}});
@@ -189,6 +222,7 @@ int main(int argc, char** argv) {
             t.gps_fix = 1;
         }
         map.add_position(t, std::chrono::system_clock::now());
+        held = t;
         along += 0.25;
         if (along >= 1.0) {
             along = 0.0;

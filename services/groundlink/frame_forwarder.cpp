@@ -62,6 +62,34 @@ void FrameForwarder::offer(const autopilot::ForwardedFrame& frame, [[maybe_unuse
     slot.interval = std::chrono::duration_cast<Duration>(std::chrono::duration<double>(1.0 / hz));
 }
 
+void FrameForwarder::link_down() {
+    for (auto& [id, slot] : slots_) {
+        if (slot.pending) {
+            ++stats_.stale;
+            slot.pending = false;
+            slot.bytes.clear();
+        }
+    }
+}
+
+void FrameForwarder::put_back(Out out) {
+    if (out.delivery != Delivery::Reliable) {
+        return;
+    }
+    --stats_.forwarded;
+    stats_.forwarded_bytes -= out.bytes.size();
+    tokens_ += static_cast<double>(out.bytes.size()) + config_.overhead_bytes;
+    reliable_bytes_ += out.bytes.size();
+    reliable_.push_front(std::move(out));
+}
+
+FrameForwarderStats FrameForwarder::stats() const {
+    FrameForwarderStats s = stats_;
+    s.reliable_queued = reliable_.size();
+    s.reliable_queued_bytes = reliable_bytes_;
+    return s;
+}
+
 void FrameForwarder::clear() {
     stats_.dropped += reliable_.size();
     reliable_.clear();

@@ -3,14 +3,17 @@
 // when. Sans-IO: frames and time in, frames to send out.
 //
 // Contract: the caller passes `now` to every call and never lets it go backwards.
-//   inputs   offer(frame, now) for each autopilot::ForwardedFrame; clear() when the link goes down (what
-//            waits would be stale when it comes back).
-//   outputs  poll(now): one frame to send now, or nothing (call until nothing); poll_timeout(): when the
-//            next one may be due; stats().
+//   inputs   offer(frame, now) for each autopilot::ForwardedFrame, link up or down; link_down() when the
+//            link goes down (freshest frames waiting would be stale when it comes back; reliable ones stay
+//            queued and go once it is up again); put_back(out) for a reliable frame the transport could not
+//            take yet.
+//   outputs  poll(now): one frame to send now, or nothing (call until nothing, and only while the link is
+//            up); poll_timeout(): when the next one may be due; stats().
 //
 // Freshest frames are rate-limited per message id: at most rate_hz of an id per second, and a newer frame of
-// an id replaces one not yet sent (counted as replaced). Reliable frames queue in order (beyond
-// reliable_queue_bytes a new one is dropped and counted). Everything sent shares one byte budget (a token
+// an id replaces one not yet sent (counted as replaced). Reliable frames (parameters, command and mission
+// answers, status texts) queue in order, through a link outage too (beyond reliable_queue_bytes a new one is
+// dropped and counted as overflow). Everything sent shares one byte budget (a token
 // bucket with budget_bytes_per_s, at most burst_s of it saved up): when it is spent, nothing goes until it
 // refills, so airseg's own telemetry keeps its share of the link. While both kinds wait, they take turns.
 #include <cstddef>
@@ -38,8 +41,10 @@ struct FrameForwarderConfig {
     double default_hz = 1.0;
     /// Bytes the transport adds to each forwarded message (chunk header, the frame's share of framing).
     double overhead_bytes = 8.0;
-    /// Reliable frames waiting, at most this many bytes.
-    std::size_t reliable_queue_bytes = 16 * 1024;
+    /// Reliable frames waiting, at most this many bytes. A full parameter download of ArduPilot Rover (about
+    /// 280 PARAM_VALUE frames of 37 bytes at most, 10.4 kB) fits three times, with the mission's answers
+    /// and status texts beside it, through an outage of the radio.
+    std::size_t reliable_queue_bytes = 32 * 1024;
     /// Budget saved up while idle, in seconds of budget.
     double burst_s = 0.5;
 
@@ -53,7 +58,10 @@ struct FrameForwarderStats {
     std::uint64_t forwarded_bytes = 0;
     std::uint64_t replaced = 0;  // freshest frames replaced by a newer one of their id before going out
     std::uint64_t filtered = 0;  // freshest frames of an id whose rate is 0
-    std::uint64_t dropped = 0;   // reliable frames refused by a full queue, or cleared by clear()
+    std::uint64_t dropped = 0;   // reliable frames refused by a full queue (overflow), or cleared by clear()
+    std::uint64_t stale = 0;     // freshest frames waiting when the link went down, dropped by link_down()
+    std::size_t reliable_queued = 0;        // reliable frames waiting now
+    std::size_t reliable_queued_bytes = 0;  // ... their bytes
 };
 
 class FrameForwarder {
@@ -62,7 +70,9 @@ class FrameForwarder {
     FrameForwarder(FrameForwarderConfig config, double link_rate_bytes_per_s, TimePoint now);
 
     void offer(const autopilot::ForwardedFrame& frame, TimePoint now);
-    /// Drops everything waiting (counted as dropped for reliable frames, replaced for freshest ones).
+    /// The link went down: freshest frames waiting are dropped (counted as stale); reliable ones stay.
+    void link_down();
+    /// Drops everything waiting (counted as dropped).
     void clear();
 
     struct Out {
@@ -71,9 +81,12 @@ class FrameForwarder {
         std::vector<std::uint8_t> bytes;
     };
     std::optional<Out> poll(TimePoint now);
+    /// A reliable frame poll() gave out and the transport refused (its queue full): first again, its bytes
+    /// given back to the budget. Freshest frames are not put back (a newer one will come).
+    void put_back(Out out);
     [[nodiscard]] TimePoint poll_timeout() const;
 
-    [[nodiscard]] const FrameForwarderStats& stats() const { return stats_; }
+    [[nodiscard]] FrameForwarderStats stats() const;
     [[nodiscard]] double budget_bytes_per_s() const { return budget_; }
     [[nodiscard]] const FrameForwarderConfig& config() const { return config_; }
 

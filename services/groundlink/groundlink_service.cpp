@@ -17,6 +17,8 @@
 namespace airseg::groundlink {
 
 namespace {
+/// How soon a reliable forwarded frame the transport's full queue refused is tried again.
+constexpr auto kForwardRetry = std::chrono::milliseconds(100);
 
 constexpr const char* kNoKeyRefusal =
     "this vehicle has no ground-link key (groundlink.key_file) and groundlink.insecure is not set, so every "
@@ -331,31 +333,55 @@ void GroundlinkService::on_ground_station_frames(protocol::MavlinkFrames frames)
 }
 
 void GroundlinkService::on_forwarded(const autopilot::ForwardedFrame& frame) {
-    if (!driver_ || !driver_->link_up()) {
+    const bool up = driver_ && driver_->link_up();
+    if (!up && frame.delivery != autopilot::ForwardedFrame::Delivery::Reliable) {
         return;  // as with telemetry: nobody listens, and a frame kept now would be stale
     }
-    forwarder_.offer(frame, SteadyClock::now());
-    pump_forward();
+    // Reliable frames (a parameter download's values, command and mission answers) wait through an outage:
+    // a ground station asked for them once and will not ask again for most.
+    const auto dropped_before = forwarder_.stats().dropped;
+    const auto now = SteadyClock::now();
+    forwarder_.offer(frame, now);
+    if (forwarder_.stats().dropped != dropped_before) {
+        log_.log("groundlink: forwarded frames overflow", now, spdlog::level::warn,
+                 "groundlink: a reliable MAVLink frame (message {}) dropped: {} bytes already wait for the "
+                 "ground (groundlink.mavlink_forward.dropped)",
+                 frame.id, forwarder_.config().reliable_queue_bytes);
+    }
+    if (up) {
+        pump_forward();
+    }
 }
 
-// Everything the forwarder lets go now, then its timer for the next.
+// Everything the forwarder lets go now, then its timer for the next. Nothing while the link is down: the
+// reliable frames wait in the forwarder (bounded), not in the transport.
 void GroundlinkService::pump_forward() {
     const TimePoint now = SteadyClock::now();
-    if (driver_) {
-        driver_->batch([&] {
-            while (auto out = forwarder_.poll(now)) {
-                const auto bytes = protocol::encode(protocol::MavlinkFrames{std::move(out->bytes)});
-                const auto r = out->delivery == autopilot::ForwardedFrame::Delivery::Reliable
-                                   ? driver_->send_safe(protocol::kPriorityBulk, bytes)
-                                   : driver_->send_fast(protocol::kPriorityBulk,
-                                                        protocol::mavlink_topic(out->id), bytes);
-                if (r == SendResult::QueueFull || r == SendResult::TooLarge || r == SendResult::BadPriority) {
-                    ++forward_refused_;
-                }
-            }
-        });
+    if (!driver_ || !driver_->link_up()) {
+        forward_timer_.cancel();
+        return;
     }
-    forward_timer_.arm(forwarder_.poll_timeout(), [this] { pump_forward(); });
+    bool transport_full = false;
+    driver_->batch([&] {
+        while (auto out = forwarder_.poll(now)) {
+            const bool reliable = out->delivery == autopilot::ForwardedFrame::Delivery::Reliable;
+            const auto bytes = protocol::encode(protocol::MavlinkFrames{out->bytes});
+            const auto r = reliable ? driver_->send_safe(protocol::kPriorityBulk, bytes)
+                                    : driver_->send_fast(protocol::kPriorityBulk,
+                                                         protocol::mavlink_topic(out->id), bytes);
+            if (r == SendResult::QueueFull && reliable) {
+                // The transport's own queue is full: the frame waits here, first, and is tried again shortly.
+                forwarder_.put_back(std::move(*out));
+                transport_full = true;
+                break;
+            }
+            if (r == SendResult::QueueFull || r == SendResult::TooLarge || r == SendResult::BadPriority) {
+                ++forward_refused_;
+            }
+        }
+    });
+    const auto next = transport_full ? now + kForwardRetry : forwarder_.poll_timeout();
+    forward_timer_.arm(next, [this] { pump_forward(); });
 }
 
 void GroundlinkService::on_event(const TransportEvent& event) {
@@ -367,11 +393,12 @@ void GroundlinkService::on_event(const TransportEvent& event) {
                      : !control_key_                  ? "unauthenticated: groundlink.insecure"
                      : ground_role() == Role::Control ? "control key"
                                                       : "monitor key");
+            pump_forward();  // what waited through the outage
             break;
         case TransportEvent::Kind::LinkDown:
             log_.log("groundlink: link down", SteadyClock::now(), spdlog::level::warn,
                      "groundlink: link down");
-            forwarder_.clear();
+            forwarder_.link_down();
             break;
         case TransportEvent::Kind::PeerRestarted:
             log_.log("groundlink: the ground end restarted", SteadyClock::now(), spdlog::level::info,
@@ -616,6 +643,10 @@ void GroundlinkService::publish_status() {
                                     {"replaced", fwd.replaced},
                                     {"filtered", fwd.filtered},
                                     {"dropped", fwd.dropped + fwd_counters[0]},
+                                    {"overflow", fwd.dropped},
+                                    {"stale", fwd.stale},
+                                    {"reliable_queued", fwd.reliable_queued},
+                                    {"reliable_queued_bytes", fwd.reliable_queued_bytes},
                                     {"from_ground", fwd_counters[1]},
                                     {"from_ground_refused", fwd_counters[2]}};
             g["tx"] = {{"safe", class_json(s.tx_safe)}, {"fast", class_json(s.tx_fast)}};

@@ -42,6 +42,10 @@
   let wpMarkers = [];       // their numbered markers (those drawn)
   let nextIndex = null;     // the plan's next waypoint (0-based index), from the telemetry
   let progressText = '';
+  let planArea = null;      // the box around the plan's elements (the no-fly zones left out), when drawn
+  // ?state=track: the page's state also lists the track's points (for a test; up to 10,000 of them, not
+  // worth writing out at every sample otherwise).
+  const stateTrack = new URLSearchParams(location.search).get('state') === 'track';
   let positionAt = null;    // when the last position was new, by this page's clock (ms)
   let positionAge = null;   // seconds, once older than kStaleSeconds
   const kStaleSeconds = 3;
@@ -65,6 +69,8 @@
       no_fly: counts.no_fly,
       track_points: trackLine.getLatLngs().length,
       track_m: Math.round(trackLength()),
+      track: stateTrack ? trackLine.getLatLngs().map(p => [p.lat, p.lng]) : undefined,
+      plan_area: planArea,
       vehicle: lastPosition ? { lat: lastPosition.lat, lon: lastPosition.lon, heading: lastPosition.heading } : null,
       link: linkState,
       events: eventCount,
@@ -137,6 +143,7 @@
     route = planRoute(plan);
     document.getElementById('plan-name').textContent = planName ? planName : 'no plan';
     const bounds = L.latLngBounds([]);
+    const area = L.latLngBounds([]);
     const mainRoute = [];
     ((plan && plan.elements) || []).forEach((e, i) => {
       const pts = latlngs(e.points);
@@ -144,7 +151,8 @@
       const route = String(e.path || '').startsWith('plan.blocks') ? [] : mainRoute;
       const title = (e.name ? e.name + ' — ' : '') + e.kind + ' ' + e.path;
       counts.elements += 1;
-      pts.forEach(p => bounds.extend(p));
+      pts.forEach(p => { bounds.extend(p); area.extend(p); });
+      latlngs(e.lines).forEach(p => area.extend(p));
       if (e.closed && pts.length >= 3) {
         L.polygon(pts, { className: 'airseg-plan-area airseg-plan-el-' + i, color: '#1f6feb', weight: 1,
                          fillOpacity: 0.08 }).bindTooltip(title).addTo(planLayer);
@@ -188,6 +196,7 @@
         pts.forEach(p => bounds.extend(p));
       }
     });
+    planArea = area.isValid() ? [[area.getSouth(), area.getWest()], [area.getNorth(), area.getEast()]] : null;
     if (plan && plan.truncated) {
       addEvent({ text: 'the plan is drawn in part: it has more points than a map answer carries' });
     }

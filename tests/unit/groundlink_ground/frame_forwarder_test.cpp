@@ -191,6 +191,79 @@ TEST(FrameForwarder, RateZeroFiltersAndAFullReliableQueueDrops) {
     EXPECT_FALSE(fwd.poll(now + seconds(10)));
 }
 
+// An outage in the middle of a parameter download: the values not yet sent stay queued and all go once the
+// link is back; the telemetry that waited is dropped as stale.
+TEST(FrameForwarder, AParameterDownloadSurvivesAnOutageWhole) {
+    FrameForwarderConfig c;
+    c.budget_bytes_per_s = 1728;  // 30 % of 57600 baud
+    TimePoint now = TimePoint{} + seconds(100);
+    FrameForwarder fwd(c, 5760, now);
+    constexpr int kParams = 280;
+    for (int i = 0; i < kParams; ++i) {
+        fwd.offer(frame(22, Delivery::Reliable, 37, static_cast<std::uint8_t>(i)), now);
+    }
+    fwd.offer(frame(30, Delivery::Freshest, 40, 1), now);
+    std::vector<std::uint8_t> tags;
+    // One second of link, then 8 s down (nothing polled), then up again.
+    for (TimePoint end = now + seconds(1); now < end; now += milliseconds(10)) {
+        while (auto out = fwd.poll(now)) {
+            if (out->id == 22) {
+                tags.push_back(out->bytes.front());
+            }
+        }
+    }
+    const auto before_outage = tags.size();
+    EXPECT_GT(before_outage, 10u);
+    EXPECT_LT(before_outage, static_cast<std::size_t>(kParams));
+    fwd.offer(frame(30, Delivery::Freshest, 40, 2), now);
+    fwd.link_down();
+    EXPECT_EQ(fwd.stats().stale, 1u);
+    EXPECT_EQ(fwd.stats().reliable_queued, kParams - before_outage);
+    now += seconds(8);
+    for (TimePoint end = now + seconds(20); now < end; now += milliseconds(10)) {
+        while (auto out = fwd.poll(now)) {
+            EXPECT_EQ(out->id, 22u) << "telemetry from before the outage went out after it";
+            tags.push_back(out->bytes.front());
+        }
+    }
+    ASSERT_EQ(tags.size(), static_cast<std::size_t>(kParams));
+    for (int i = 0; i < kParams; ++i) {
+        EXPECT_EQ(tags[static_cast<std::size_t>(i)], static_cast<std::uint8_t>(i)) << "out of order at " << i;
+    }
+    EXPECT_EQ(fwd.stats().dropped, 0u);
+    EXPECT_EQ(fwd.stats().reliable_queued, 0u);
+}
+
+// A full parameter download fits the default bound with room; beyond the bound frames are counted.
+TEST(FrameForwarder, TheDefaultBoundHoldsAFullParameterDownloadAndCountsWhatIsBeyond) {
+    FrameForwarderConfig c;
+    TimePoint now{};
+    FrameForwarder fwd(c, 5760, now);
+    const std::size_t fit = c.reliable_queue_bytes / 37;
+    EXPECT_GE(fit, 2u * 280u);
+    for (std::size_t i = 0; i < fit + 5; ++i) {
+        fwd.offer(frame(22, Delivery::Reliable, 37, 1), now);
+    }
+    EXPECT_EQ(fwd.stats().dropped, 5u);
+    EXPECT_EQ(fwd.stats().reliable_queued, fit);
+}
+
+// A reliable frame the transport refused goes first again, and costs the budget nothing.
+TEST(FrameForwarder, AFramePutBackGoesFirst) {
+    FrameForwarderConfig c;
+    TimePoint now{};
+    FrameForwarder fwd(c, 5760, now);
+    fwd.offer(frame(22, Delivery::Reliable, 30, 1), now);
+    fwd.offer(frame(22, Delivery::Reliable, 30, 2), now);
+    auto first = fwd.poll(now);
+    ASSERT_TRUE(first);
+    fwd.put_back(std::move(*first));
+    EXPECT_EQ(fwd.stats().forwarded, 0u);
+    auto again = fwd.poll(now);
+    ASSERT_TRUE(again);
+    EXPECT_EQ(again->bytes.front(), 1);
+}
+
 TEST(FrameForwarderConfig, RefusesBadRates) {
     FrameForwarderConfig c;
     EXPECT_TRUE(c.validate().empty());
