@@ -202,8 +202,8 @@ constexpr Entry kRover[] = {
     {"EKF_ABIAS_PNOISE", Real32, 2e-4F},
     {"EKF_MAGE_PNOISE", Real32, 3e-4F},
     {"EKF_MAGB_PNOISE", Real32, 3e-4F},
-    {"EKF_VEL_DELAY", Int8, 220},
-    {"EKF_POS_DELAY", Int8, 220},
+    {"EKF_VEL_DELAY", Int16, 220},  // AP_Int16 in NavEKF: 220 ms does not fit an Int8
+    {"EKF_POS_DELAY", Int16, 220},
     {"EKF_GLITCH_ACCEL", Real32, 150},
     {"EKF_GLITCH_RAD", Int8, 15},
     {"EKF_GND_GRADIENT", Int8, 2},

@@ -125,6 +125,7 @@ void RoverSim::reboot(TimePoint now) {
     out_.drop_held();
     server_.reset();
     legacy_server_.reset();
+    ftp_.reset();
     streams_.clear();
     if (parsing_) {
         reboot_during_parse_ = true;  // the parser is mid-push: replaced when the push returns
@@ -363,6 +364,15 @@ void RoverSim::dispatch(const mv::Frame& f, TimePoint now) {
             return;
         case mv::CommandLong::kId:
             on_command_long(f, now);
+            return;
+        case mv::CommandInt::kId:
+            on_command_int(f, now);
+            return;
+        case mv::Timesync::kId:
+            on_timesync(f, now);
+            return;
+        case mv::FileTransferProtocol::kId:
+            on_ftp(f);
             return;
         case mv::SetMode::kId:
             on_set_mode(f, now);

@@ -16,8 +16,10 @@
 // What it does: boot sequence (silent, then "Initialising APM..." and heartbeats in CALIBRATING, then
 // STANDBY and "Ready to drive."), 1 Hz heartbeats with Rover custom modes, telemetry streams, parameters,
 // the mission protocol (mission_server.hpp), modes and a kinematic vehicle that drives missions, RTL,
-// guided targets and RC overrides, and the fault injection of Faults. Every mode change is recorded with
-// its cause in mode_history(), every change of the speed the rover drives at in speed_log().
+// guided targets (MISSION_ITEM in GUIDED, COMMAND_INT MAV_CMD_DO_REPOSITION) and RC overrides, TIMESYNC,
+// MAVLink FTP of the packed parameter file (ftp_server.hpp), and the fault injection of Faults. Every mode
+// change is recorded with its cause in mode_history(), every change of the speed the rover drives at in
+// speed_log().
 //
 // The firmware it behaves as is RoverSimConfig::firmware (firmware_profile.hpp): modern ArduPilot Rover, or
 // APMrover2 2.4x (rover2), whose receiver, mission protocol, command processor and telemetry are modelled
@@ -36,6 +38,7 @@
 #include "services/autopilot/mavlink/frame.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
 #include "tools/apmsim/firmware_profile.hpp"
+#include "tools/apmsim/ftp_server.hpp"
 #include "tools/apmsim/legacy_mission_server.hpp"
 #include "tools/apmsim/legacy_parser.hpp"
 #include "tools/apmsim/mission_change_detector.hpp"
@@ -233,6 +236,7 @@ class RoverSim {
     const ParamTable& params() const { return params_; }
     ParamTable& params() { return params_; }
     const MissionStore& mission() const { return store_; }
+    const FtpServerStats& ftp_stats() const { return ftp_.stats(); }
     const MissionServerStats& mission_stats() const {
         return rover2_mission() ? legacy_server_.stats() : server_.stats();
     }
@@ -279,6 +283,12 @@ class RoverSim {
     void send_param(std::size_t index, std::optional<std::uint16_t> reported_index = std::nullopt);
     void apply_param_side_effects(const std::string& name, const std::string& cause, TimePoint now);
     void on_command_long(const mavlink::Frame& f, TimePoint now);
+    void on_command(const mavlink::CommandLong& c, const mavlink::Frame& f, TimePoint now);
+    // rover_sim_gcs_services.cpp: COMMAND_INT, TIMESYNC and MAVLink FTP (modern firmware)
+    void on_command_int(const mavlink::Frame& f, TimePoint now);
+    std::uint8_t do_reposition(const mavlink::CommandInt& c, TimePoint now);
+    void on_timesync(const mavlink::Frame& f, TimePoint now);
+    void on_ftp(const mavlink::Frame& f);
     void on_set_mode(const mavlink::Frame& f, TimePoint now);
     void on_request_data_stream(const mavlink::Frame& f, TimePoint now);
     void on_rc_override(const mavlink::Frame& f, TimePoint now);
@@ -336,6 +346,7 @@ class RoverSim {
     Faults faults_;
     SimCounters counters_;
     ParamTable params_;
+    FtpServer ftp_{params_};
     MissionStore store_;
     Outbox out_;
     MissionServer server_;

@@ -149,7 +149,12 @@ void RoverSim::on_command_long(const mv::Frame& f, TimePoint now) {
         r2_on_command_long(f, now);
         return;
     }
-    const auto c = mv::decode_payload<mv::CommandLong>(f.payload_view());
+    on_command(mv::decode_payload<mv::CommandLong>(f.payload_view()), f, now);
+}
+
+// The commands both COMMAND_LONG and COMMAND_INT carry (ArduPilot turns one into the other and handles them
+// in one place).
+void RoverSim::on_command(const mv::CommandLong& c, const mv::Frame& f, TimePoint now) {
     if (!addressed(c.target_system)) {
         return;
     }
