@@ -1,36 +1,12 @@
 #include "ground/map/http.hpp"
 
-#include <algorithm>
 #include <array>
-#include <charconv>
-#include <cstdint>
+
+#include "ground/map/beast.hpp"
 
 namespace airseg::ground::http {
 
 namespace {
-
-bool is_token_char(char c) {
-    static constexpr std::string_view kSpecials = "!#$%&'*+-.^_`|~";
-    return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
-           kSpecials.find(c) != std::string_view::npos;
-}
-
-std::string lower(std::string_view s) {
-    std::string out(s);
-    std::transform(out.begin(), out.end(), out.begin(),
-                   [](char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; });
-    return out;
-}
-
-std::string_view trim(std::string_view s) {
-    while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) {
-        s.remove_prefix(1);
-    }
-    while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) {
-        s.remove_suffix(1);
-    }
-    return s;
-}
 
 int hex_value(char c) {
     if (c >= '0' && c <= '9') {
@@ -78,133 +54,6 @@ std::optional<std::string> percent_decode(std::string_view s) {
     return out;
 }
 
-RequestParser::State RequestParser::fail(int status, std::string why) {
-    state_ = State::Failed;
-    error_status_ = status;
-    error_ = std::move(why);
-    return state_;
-}
-
-RequestParser::State RequestParser::feed(std::string_view bytes) {
-    if (state_ != State::Incomplete) {
-        return state_;
-    }
-    buffer_.append(bytes);
-    if (!head_done_) {
-        const auto end = buffer_.find("\r\n\r\n");
-        if (end == std::string::npos) {
-            if (buffer_.size() > limits_.head_bytes) {
-                return fail(431, "request head larger than " + std::to_string(limits_.head_bytes) + " bytes");
-            }
-            return state_;
-        }
-        if (end + 4 > limits_.head_bytes) {
-            return fail(431, "request head larger than " + std::to_string(limits_.head_bytes) + " bytes");
-        }
-        if (parse_head(std::string_view(buffer_).substr(0, end + 2)) == State::Failed) {
-            return state_;
-        }
-        head_done_ = true;
-        buffer_.erase(0, end + 4);
-    }
-    if (buffer_.size() >= body_length_) {
-        request_.body = buffer_.substr(0, body_length_);
-        buffer_.clear();
-        state_ = State::Done;
-    }
-    return state_;
-}
-
-RequestParser::State RequestParser::parse_head(std::string_view head) {
-    // Request line: METHOD SP target SP HTTP/1.x
-    const auto line_end = head.find("\r\n");
-    const std::string_view line = head.substr(0, line_end);
-    const auto sp1 = line.find(' ');
-    const auto sp2 = sp1 == std::string_view::npos ? sp1 : line.find(' ', sp1 + 1);
-    if (sp1 == std::string_view::npos || sp2 == std::string_view::npos ||
-        line.find(' ', sp2 + 1) != std::string_view::npos) {
-        return fail(400, "the request line is not \"METHOD /path HTTP/1.1\"");
-    }
-    const auto method = line.substr(0, sp1);
-    const auto target = line.substr(sp1 + 1, sp2 - sp1 - 1);
-    const auto version = line.substr(sp2 + 1);
-    if (method.empty() || !std::all_of(method.begin(), method.end(), is_token_char)) {
-        return fail(400, "bad method");
-    }
-    if (version != "HTTP/1.1" && version != "HTTP/1.0") {
-        return fail(version.starts_with("HTTP/") ? 505 : 400, "only HTTP/1.0 and HTTP/1.1 are spoken here");
-    }
-    if (target.empty() || target.front() != '/') {
-        return fail(400, "the target must be a path starting with /");
-    }
-    if (target.size() > 2048) {
-        return fail(414, "target longer than 2048 bytes");
-    }
-    for (char c : target) {
-        if (static_cast<unsigned char>(c) <= 0x20 || static_cast<unsigned char>(c) >= 0x7f) {
-            return fail(400, "control or non-ASCII character in the target");
-        }
-    }
-    const auto q = target.find('?');
-    auto path = percent_decode(target.substr(0, q));
-    if (!path) {
-        return fail(400, "bad percent escape in the path");
-    }
-    request_.method = std::string(method);
-    request_.path = std::move(*path);
-    request_.query = q == std::string_view::npos ? std::string() : std::string(target.substr(q + 1));
-
-    std::string_view rest =
-        line_end == std::string_view::npos ? std::string_view() : head.substr(line_end + 2);
-    while (!rest.empty()) {
-        const auto eol = rest.find("\r\n");
-        const std::string_view h = rest.substr(0, eol);
-        rest = eol == std::string_view::npos ? std::string_view() : rest.substr(eol + 2);
-        if (h.find('\n') != std::string_view::npos || h.find('\r') != std::string_view::npos) {
-            return fail(400, "bare CR or LF in a header");
-        }
-        if (h.front() == ' ' || h.front() == '\t') {
-            return fail(400, "folded header lines are not accepted");
-        }
-        const auto colon = h.find(':');
-        if (colon == std::string_view::npos || colon == 0 ||
-            !std::all_of(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(colon), is_token_char)) {
-            return fail(400, "malformed header line");
-        }
-        if (request_.headers.size() >= limits_.headers) {
-            return fail(431, "more than " + std::to_string(limits_.headers) + " headers");
-        }
-        request_.headers.emplace_back(lower(h.substr(0, colon)), std::string(trim(h.substr(colon + 1))));
-    }
-    if (version == "HTTP/1.1" && !request_.header("host")) {
-        return fail(400, "an HTTP/1.1 request needs a Host header");
-    }
-    if (request_.header("transfer-encoding")) {
-        return fail(501, "only bodies with a Content-Length are accepted, not Transfer-Encoding");
-    }
-    int lengths = 0;
-    for (const auto& [n, v] : request_.headers) {
-        if (n != "content-length") {
-            continue;
-        }
-        if (++lengths > 1) {
-            return fail(400, "more than one Content-Length");
-        }
-        // 64 bits whatever size_t is: a length beyond a 32-bit board's size_t is too large, not malformed.
-        std::uint64_t value = 0;
-        const auto [ptr, ec] = std::from_chars(v.data(), v.data() + v.size(), value);
-        const bool digits_only = !v.empty() && ptr == v.data() + v.size();
-        if (!digits_only || (ec != std::errc() && ec != std::errc::result_out_of_range)) {
-            return fail(400, "Content-Length is not a number");
-        }
-        if (ec == std::errc::result_out_of_range || value > limits_.body_bytes) {
-            return fail(413, "body larger than " + std::to_string(limits_.body_bytes) + " bytes");
-        }
-        body_length_ = static_cast<std::size_t>(value);  // at most body_bytes
-    }
-    return state_;
-}
-
 const char* reason(int status) {
     switch (status) {
         case 200:
@@ -242,21 +91,63 @@ const char* reason(int status) {
     }
 }
 
-std::string response(int status, std::string_view content_type, std::string_view body,
-                     const std::vector<std::string>& extra, bool head_only) {
-    std::string out = "HTTP/1.1 " + std::to_string(status) + " " + reason(status) + "\r\n";
-    out += "Content-Type: ";
-    out += content_type;
-    out += "\r\nContent-Length: " + std::to_string(body.size()) + "\r\n";
-    out += "Cache-Control: no-cache\r\nX-Content-Type-Options: nosniff\r\nConnection: close\r\n";
-    for (const auto& h : extra) {
-        out += h + "\r\n";
-    }
-    out += "\r\n";
-    if (!head_only) {
-        out += body;
+namespace {
+
+/// Beast's serializer, its buffers gathered into one string.
+template <typename Body>
+std::string serialize(beast_http::message<false, Body>& message) {
+    beast_http::serializer<false, Body> serializer(message);
+    std::string out;
+    beast::error_code ec;
+    while (!ec && !serializer.is_done()) {
+        serializer.next(ec, [&](beast::error_code&, const auto& buffers) {
+            for (const auto buffer : beast::buffers_range_ref(buffers)) {
+                out.append(static_cast<const char*>(buffer.data()), buffer.size());
+            }
+            serializer.consume(beast::buffer_bytes(buffers));
+        });
     }
     return out;
+}
+
+template <typename Body>
+void common_fields(beast_http::message<false, Body>& message, int status, Framing framing) {
+    message.version(framing.version == 10 ? 10 : 11);
+    message.result(static_cast<unsigned>(status));
+    message.reason(reason(status));
+    message.set(beast_http::field::cache_control, "no-cache");
+    message.set("X-Content-Type-Options", "nosniff");
+}
+
+}  // namespace
+
+std::string render(const Reply& reply, Framing framing) {
+    beast_http::response<beast_http::string_body> message;
+    common_fields(message, reply.status, framing);
+    message.set(beast_http::field::content_type, reply.content_type);
+    for (const auto& [name, value] : reply.headers) {
+        message.set(name, value);
+    }
+    message.keep_alive(framing.keep_alive);
+    message.content_length(reply.body.size());
+    if (!framing.head) {
+        message.body() = reply.body;
+    }
+    return serialize(message);
+}
+
+std::string render_stream_head(Framing framing) {
+    beast_http::response<beast_http::empty_body> message;
+    common_fields(message, 200, framing);
+    message.set(beast_http::field::content_type, "text/event-stream");
+    message.keep_alive(false);
+    return serialize(message);
+}
+
+Reply error_reply(int status, const std::string& why,
+                  std::vector<std::pair<std::string, std::string>> headers) {
+    return Reply{status, "text/plain; charset=utf-8",
+                 std::to_string(status) + " " + reason(status) + ": " + why + "\n", std::move(headers)};
 }
 
 std::string_view content_type_for(std::string_view file_name) {

@@ -15,6 +15,7 @@
 #include "ground/map/http.hpp"
 #include "ground/map/plan_export.hpp"
 #include "ground/map/request_guard.hpp"
+#include "ground/map/request_reader.hpp"
 #include "groundside/watch_view.hpp"
 #include "services/common/limited_log.hpp"
 
@@ -25,8 +26,16 @@ using asio::ip::tcp;
 
 namespace {
 
+// A request must arrive within this of the connection or of the previous answer.
 constexpr auto kRequestDeadline = std::chrono::seconds(15);
+// An answer must be taken by the client within this (a client that stops reading gives up its connection).
+constexpr auto kAnswerDeadline = std::chrono::seconds(30);
+// The event streams' comment line, which keeps proxies and the browser's stream open.
 constexpr auto kKeepAlive = std::chrono::seconds(15);
+constexpr auto kAcceptRetry = std::chrono::milliseconds(100);
+constexpr std::size_t kMaxHeadBytes = 16 * 1024;
+constexpr std::size_t kMaxHeaders = 64;
+constexpr std::size_t kMaxTargetBytes = 2048;
 constexpr std::size_t kEventsKept = 200;
 constexpr std::size_t kMaxFileBytes = 8u << 20;
 // A browser that stops reading (a sleeping laptop) is dropped rather than buffered for without end.
@@ -76,15 +85,6 @@ std::optional<std::string> read_file(const std::filesystem::path& path) {
         return std::nullopt;
     }
     return std::move(file.text);
-}
-
-std::string error_response(int status, const std::string& why, const std::vector<std::string>& extra = {}) {
-    return http::response(status, "text/plain; charset=utf-8",
-                          std::to_string(status) + " " + http::reason(status) + ": " + why + "\n", extra);
-}
-
-std::string json_response(int status, const Json& body) {
-    return http::response(status, "application/json", dump(body));
 }
 
 /// The command a map button may send, checked and reduced to the fields it may carry; or why not.
@@ -190,10 +190,11 @@ struct MapServer::Impl : std::enable_shared_from_this<MapServer::Impl> {
           web_dir(map_web_dir(config.web_dir)),
           sink(std::move(s)),
           acceptor(strand),
+          accept_retry(strand),
           keepalive(strand) {}
 
     void accept();
-    /// Closes the oldest connection still waiting for its request, if any.
+    /// Closes the connection that has waited longest for a request, if any.
     void make_room();
     void tick();
     void broadcast(const std::string& event, const Json& data);
@@ -205,6 +206,7 @@ struct MapServer::Impl : std::enable_shared_from_this<MapServer::Impl> {
     std::string web_dir;
     CommandSink sink;
     tcp::acceptor acceptor;
+    asio::steady_timer accept_retry;
     std::uint64_t accepted = 0;
     MapServer::Counts counts;
     asio::steady_timer keepalive;
@@ -227,48 +229,45 @@ struct MapServer::Impl : std::enable_shared_from_this<MapServer::Impl> {
     void push_event(Json e);
 };
 
+/// One browser connection: requests read with Beast (http::RequestReader) and answered one at a time, in
+/// order, on a kept-alive connection; or, after GET /events, an event stream until either side goes.
 class Session : public std::enable_shared_from_this<Session> {
   public:
     Session(std::shared_ptr<MapServer::Impl> server, tcp::socket socket)
         : server_(std::move(server)),
           socket_(std::move(socket)),
-          deadline_(server_->strand),
-          parser_(http::Limits{16 * 1024, 64, kMaxBodyBytes}) {}
+          timer_(server_->strand),
+          reader_(http::Limits{kMaxHeadBytes, kMaxHeaders, kMaxTargetBytes, kMaxBodyBytes}) {}
 
-    void start() {
-        deadline_.expires_after(kRequestDeadline);
-        deadline_.async_wait([self = shared_from_this()](boost::system::error_code ec) {
-            if (!ec && !self->answered_) {
-                self->send(error_response(408, "the request did not arrive in time"), true);
-            }
-        });
-        read();
+    void start() { wait_for_request(); }
+
+    void refuse_busy() {
+        phase_ = Phase::Answering;
+        send(http::render(http::error_reply(503, "too many connections to the map"), {}), true);
     }
 
-    void refuse_busy() { send(error_response(503, "too many connections to the map"), true); }
-
-    /// Connected, and its request not complete yet: what a newcomer may take the place of.
-    bool waiting_for_request() const { return !answered_ && !closed_; }
-    TimePoint connected_at() const { return connected_at_; }
+    /// Connected, and no request being answered: what a newcomer may take the place of.
+    bool waiting_for_request() const { return phase_ == Phase::Reading && !closed_; }
+    /// Since when it waits: connected, or its last answer sent.
+    TimePoint waiting_since() const { return waiting_since_; }
 
     /// One server-sent event, if this is an event stream.
     void event(const std::string& text) {
-        if (streaming_) {
+        if (phase_ == Phase::Streaming) {
             send(text, false);
         }
     }
-
-    bool streaming() const { return streaming_; }
 
     void close() {
         if (closed_) {
             return;
         }
         closed_ = true;
-        if (streaming_) {
+        if (phase_ == Phase::Streaming) {
             --server_->counts.streams;
         }
-        deadline_.cancel();
+        ++timer_generation_;
+        timer_.cancel();
         boost::system::error_code ignored;
         socket_.shutdown(tcp::socket::shutdown_both, ignored);
         socket_.close(ignored);
@@ -276,32 +275,95 @@ class Session : public std::enable_shared_from_this<Session> {
     }
 
   private:
-    void read() {
-        socket_.async_read_some(
-            asio::buffer(buf_), [self = shared_from_this()](boost::system::error_code ec, std::size_t n) {
-                if (ec || self->closed_) {
-                    self->close();
-                    return;
-                }
-                if (self->answered_) {
-                    // An event stream or a sent answer: the browser has nothing more to say; reading on only
-                    // notices when it goes.
-                    self->read();
-                    return;
-                }
-                switch (self->parser_.feed(std::string_view(self->buf_.data(), n))) {
-                    case http::RequestParser::State::Incomplete:
-                        self->read();
-                        break;
-                    case http::RequestParser::State::Failed:
-                        self->send(error_response(self->parser_.error_status(), self->parser_.error()), true);
-                        break;
-                    case http::RequestParser::State::Done:
-                        self->handle(self->parser_.request());
-                        self->read();
-                        break;
-                }
-            });
+    enum class Phase { Reading, Answering, Streaming };
+
+    /// One timer per connection, for whichever deadline its phase has; a newer arming disowns older waits.
+    template <typename F>
+    void arm(std::chrono::steady_clock::duration after, F on_expiry) {
+        const auto generation = ++timer_generation_;
+        timer_.expires_after(after);
+        timer_.async_wait([self = shared_from_this(), generation, on_expiry](boost::system::error_code ec) {
+            if (!ec && !self->closed_ && generation == self->timer_generation_) {
+                on_expiry(*self);
+            }
+        });
+    }
+
+    void wait_for_request() {
+        phase_ = Phase::Reading;
+        waiting_since_ = SteadyClock::now();
+        arm(kRequestDeadline, [](Session& self) { self.on_request_deadline(); });
+        on_reader(reader_.feed({}));  // a request pipelined behind the last one may be here already
+    }
+
+    void on_request_deadline() {
+        if (phase_ != Phase::Reading) {
+            return;
+        }
+        if (requests_ > 0 && !reader_.started()) {
+            close();  // a kept-alive connection with nothing more to ask: closed without a word
+            return;
+        }
+        answer({}, http::error_reply(408, "the request did not arrive in time"), true);
+    }
+
+    void do_read() {
+        socket_.async_read_some(asio::buffer(buf_),
+                                [self = shared_from_this()](boost::system::error_code ec, std::size_t n) {
+                                    self->on_read(ec, n);
+                                });
+    }
+
+    void on_read(boost::system::error_code ec, std::size_t n) {
+        if (ec || closed_) {
+            close();
+            return;
+        }
+        if (phase_ == Phase::Streaming) {
+            // The browser has nothing more to say; reading on only notices when it goes.
+            do_read();
+            return;
+        }
+        if (phase_ == Phase::Reading) {
+            on_reader(reader_.feed(std::string_view(buf_.data(), n)));
+        }
+        // Answering (a 408 on its way): the answer's end closes the connection.
+    }
+
+    void on_reader(http::RequestReader::State state) {
+        switch (state) {
+            case http::RequestReader::State::Incomplete:
+                do_read();
+                break;
+            case http::RequestReader::State::Failed:
+                // The request's end is unknown: nothing after it can be read.
+                answer({}, http::error_reply(reader_.error_status(), reader_.error()), true);
+                break;
+            case http::RequestReader::State::Done:
+                ++requests_;
+                phase_ = Phase::Answering;
+                ++timer_generation_;  // no request deadline while the vehicle answers a command
+                timer_.cancel();
+                handle(reader_.take());
+                break;
+        }
+    }
+
+    /// How an answer to `req` is framed; kept alive when the client asked and `close` does not say otherwise.
+    http::Framing framing_of(const http::Request& req, bool close) const {
+        return {req.version, req.method == "HEAD", req.keep_alive && !close && server_->running};
+    }
+
+    void answer(http::Framing framing, const http::Reply& reply, bool close = false) {
+        framing.keep_alive = framing.keep_alive && !close;
+        send(http::render(reply, framing), !framing.keep_alive);
+    }
+
+    void reply(const http::Request& req, const http::Reply& reply) { answer(framing_of(req, false), reply); }
+    void refuse(const http::Request& req, const http::Reply& reply) { answer(framing_of(req, true), reply); }
+
+    void reply_json(const http::Request& req, int status, const Json& body) {
+        reply(req, {status, "application/json", dump(body), {}});
     }
 
     /// "/events?for=S" ends the stream after S seconds: a snapshot of the live map (a headless browser only
@@ -316,22 +378,17 @@ class Session : public std::enable_shared_from_this<Session> {
         if (ec != std::errc() || end != text.data() + text.size() || seconds < 1 || seconds > 3600) {
             return;
         }
-        deadline_.expires_after(std::chrono::seconds(seconds));
-        deadline_.async_wait([self = shared_from_this()](boost::system::error_code e) {
-            if (!e) {
-                self->send(": end of the snapshot\n\n", true);
-            }
-        });
+        arm(std::chrono::seconds(seconds),
+            [](Session& self) { self.send(": end of the snapshot\n\n", true); });
     }
 
     void send(std::string bytes, bool close_after) {
         if (closed_) {
             return;
         }
-        answered_ = true;
         close_after_ = close_after_ || close_after;
         queued_ += bytes.size();
-        if (streaming_ && queued_ > kMaxQueuedBytes) {
+        if (phase_ == Phase::Streaming && queued_ > kMaxQueuedBytes) {
             close();
             return;
         }
@@ -342,63 +399,77 @@ class Session : public std::enable_shared_from_this<Session> {
     }
 
     void write() {
-        asio::async_write(socket_, asio::buffer(out_.front()),
-                          [self = shared_from_this()](boost::system::error_code ec, std::size_t) {
-                              if (ec || self->closed_) {
-                                  self->close();
-                                  return;
-                              }
-                              self->queued_ -= self->out_.front().size();
-                              self->out_.pop_front();
-                              if (!self->out_.empty()) {
-                                  self->write();
-                              } else if (self->close_after_) {
-                                  self->close();
-                              }
-                          });
+        if (phase_ != Phase::Streaming) {
+            // A client that does not read its answers gives up its connection.
+            arm(kAnswerDeadline, [](Session& self) { self.close(); });
+        }
+        asio::async_write(
+            socket_, asio::buffer(out_.front()),
+            [self = shared_from_this()](boost::system::error_code ec, std::size_t) { self->on_written(ec); });
+    }
+
+    void on_written(boost::system::error_code ec) {
+        if (ec || closed_) {
+            close();
+            return;
+        }
+        queued_ -= out_.front().size();
+        out_.pop_front();
+        if (!out_.empty()) {
+            write();
+        } else if (close_after_) {
+            close();
+        } else if (phase_ == Phase::Answering) {
+            wait_for_request();
+        }
     }
 
     void handle(const http::Request& req);
+    void stream(const http::Request& req);
     void serve_file(const http::Request& req, const std::string& dir, std::string_view rest);
     void command(const http::Request& req);
 
     std::shared_ptr<MapServer::Impl> server_;
     tcp::socket socket_;
-    asio::steady_timer deadline_;
-    http::RequestParser parser_;
+    asio::steady_timer timer_;
+    std::uint64_t timer_generation_ = 0;
+    http::RequestReader reader_;
     std::array<char, 8192> buf_{};
     std::deque<std::string> out_;
     std::size_t queued_ = 0;
-    bool answered_ = false;  // the request has its answer (or is an event stream)
+    Phase phase_ = Phase::Reading;
+    std::uint64_t requests_ = 0;
     bool close_after_ = false;
-    bool streaming_ = false;
     bool closed_ = false;
-    TimePoint connected_at_ = SteadyClock::now();
+    TimePoint waiting_since_ = SteadyClock::now();
 };
 
 void Session::handle(const http::Request& req) {
-    deadline_.cancel();
     const std::string& path = req.path;
     const bool head = req.method == "HEAD";
     auto& s = *server_;
     if (const auto why = s.guard.host_refusal(req)) {
         s.log.log("map: refused a request for another host", SteadyClock::now(), spdlog::level::warn,
                   "map: refused {} {}: {}", req.method, req.path.substr(0, 100), *why);
-        send(error_response(403, *why), true);
+        refuse(req, http::error_reply(403, *why));
         return;
     }
     if (path == "/api/command") {
         if (req.method != "POST") {
-            send(error_response(405, "use POST", {"Allow: POST"}), true);
+            reply(req, http::error_reply(405, "use POST", {{"Allow", "POST"}}));
             return;
         }
         command(req);
         return;
     }
     if (req.method != "GET" && !head) {
-        send(error_response(405, "only GET and HEAD here", {"Allow: GET, HEAD"}), true);
+        reply(req, http::error_reply(405, "only GET and HEAD here", {{"Allow", "GET, HEAD"}}));
         return;
     }
+    const auto attachment = [](const char* name) {
+        return std::vector<std::pair<std::string, std::string>>{
+            {"Content-Disposition", std::string("attachment; filename=\"") + name + "\""}};
+    };
     if (path == "/" || path == "/index.html") {
         serve_file(req, s.web_dir, "index.html");
     } else if (path.starts_with("/static/")) {
@@ -406,94 +477,93 @@ void Session::handle(const http::Request& req) {
     } else if (path.starts_with("/leaflet/")) {
         serve_file(req, s.config.leaflet_dir, std::string_view(path).substr(9));
     } else if (path == "/events") {
-        if (s.counts.streams >= MapServer::kMaxStreams) {
-            ++s.counts.refused_streams;
-            s.log.log("map: refused an event stream", SteadyClock::now(), spdlog::level::warn,
-                      "map: refused an event stream: {} are open (close a map tab)", MapServer::kMaxStreams);
-            send(error_response(503, "too many live maps open (" + std::to_string(MapServer::kMaxStreams) +
-                                         "); close a map tab"),
-                 true);
-            return;
-        }
-        answered_ = true;
-        streaming_ = true;
-        ++s.counts.streams;
-        send(
-            "HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-cache\r\n"
-            "X-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n",
-            false);
-        if (!head) {
-            send("retry: 2000\nevent: state\ndata: " + dump(s.state()) + "\n\n", false);
-            end_stream_after(req.query);
-        } else {
-            close_after_ = true;
-        }
+        stream(req);
     } else if (path == "/plan.geojson") {
-        send(http::response(200, "application/geo+json", dump(plan_geojson(s.plan)), {}, head), true);
+        reply(req, {200, "application/geo+json", dump(plan_geojson(s.plan)), {}});
     } else if (path == "/track.geojson") {
-        send(http::response(200, "application/geo+json", dump(track_geojson(s.track)), {}, head), true);
+        reply(req, {200, "application/geo+json", dump(track_geojson(s.track)), {}});
     } else if (path == "/plan.kml") {
-        send(http::response(200, "application/vnd.google-earth.kml+xml", plan_kml(s.plan),
-                            {"Content-Disposition: attachment; filename=\"plan.kml\""}, head),
-             true);
+        reply(req, {200, "application/vnd.google-earth.kml+xml", plan_kml(s.plan), attachment("plan.kml")});
     } else if (path == "/track.kml") {
-        send(http::response(200, "application/vnd.google-earth.kml+xml", track_kml(s.track),
-                            {"Content-Disposition: attachment; filename=\"track.kml\""}, head),
-             true);
+        reply(req,
+              {200, "application/vnd.google-earth.kml+xml", track_kml(s.track), attachment("track.kml")});
     } else {
-        send(error_response(404, "no such page: " + path), true);
+        reply(req, http::error_reply(404, "no such page: " + path));
     }
+}
+
+void Session::stream(const http::Request& req) {
+    auto& s = *server_;
+    const auto framing = framing_of(req, true);
+    if (framing.head) {
+        send(http::render_stream_head(framing), true);
+        return;
+    }
+    if (s.counts.streams >= MapServer::kMaxStreams) {
+        ++s.counts.refused_streams;
+        s.log.log("map: refused an event stream", SteadyClock::now(), spdlog::level::warn,
+                  "map: refused an event stream: {} are open (close a map tab)", MapServer::kMaxStreams);
+        refuse(req,
+               http::error_reply(503, "too many live maps open (" + std::to_string(MapServer::kMaxStreams) +
+                                          "); close a map tab"));
+        return;
+    }
+    phase_ = Phase::Streaming;
+    ++s.counts.streams;
+    send(http::render_stream_head(framing), false);
+    send("retry: 2000\nevent: state\ndata: " + dump(s.state()) + "\n\n", false);
+    end_stream_after(req.query);
+    do_read();
 }
 
 void Session::serve_file(const http::Request& req, const std::string& dir, std::string_view rest) {
     if (!safe_relative_path(rest)) {
-        send(error_response(404, "no such file"), true);
+        reply(req, http::error_reply(404, "no such file"));
         return;
     }
-    const auto content = read_file(std::filesystem::path(dir) / std::string(rest));
+    auto content = read_file(std::filesystem::path(dir) / std::string(rest));
     if (!content) {
-        send(error_response(404, "no such file: " + std::string(rest)), true);
+        reply(req, http::error_reply(404, "no such file: " + std::string(rest)));
         return;
     }
-    send(http::response(200, http::content_type_for(rest), *content, {}, req.method == "HEAD"), true);
+    reply(req, {200, std::string(http::content_type_for(rest)), std::move(*content), {}});
 }
 
 void Session::command(const http::Request& req) {
     auto& s = *server_;
     if (!s.config.control) {
-        send(json_response(
-                 403, {{"ok", false},
-                       {"error", "this map only watches: it was started without control of the vehicle"}}),
-             true);
+        reply_json(req, 403,
+                   {{"ok", false},
+                    {"error", "this map only watches: it was started without control of the vehicle"}});
         return;
     }
     if (const auto why = s.guard.command_refusal(req)) {
         s.log.log("map: refused a command", SteadyClock::now(), spdlog::level::warn,
                   "map: refused a command: {}", *why);
-        send(json_response(403, {{"ok", false}, {"error", *why}}), true);
+        reply_json(req, 403, {{"ok", false}, {"error", *why}});
         return;
     }
     auto checked = map_command(req.body);
     if (auto* why = std::get_if<std::string>(&checked)) {
-        send(json_response(400, {{"ok", false}, {"error", *why}}), true);
+        reply_json(req, 400, {{"ok", false}, {"error", *why}});
         return;
     }
     if (!s.sink) {
-        send(json_response(503, {{"ok", false}, {"error", "no vehicle link to send the command on"}}), true);
+        reply_json(req, 503, {{"ok", false}, {"error", "no vehicle link to send the command on"}});
         return;
     }
     const auto& request = std::get<Json>(checked);
     s.log.log("map: command", SteadyClock::now(), spdlog::level::info, "map: command {} from the page of {}",
               request.value("cmd", std::string()),
               req.header("origin").value_or(req.header("host").value_or("")));
-    answered_ = true;
     auto once = std::make_shared<bool>(false);
-    s.sink(std::move(std::get<Json>(checked)), [self = shared_from_this(), once](Json answer) {
-        if (std::exchange(*once, true)) {
-            return;
-        }
-        self->send(json_response(200, answer), true);
-    });
+    s.sink(std::move(std::get<Json>(checked)),
+           [self = shared_from_this(), framing = framing_of(req, false), once](Json answer) {
+               if (std::exchange(*once, true)) {
+                   return;
+               }
+               self->answer(framing, {200, "application/json", dump(answer), {}});
+           });
 }
 
 void MapServer::Impl::accept() {
@@ -501,20 +571,35 @@ void MapServer::Impl::accept() {
         if (!self->running) {
             return;
         }
-        if (!ec) {
-            ++self->accepted;
-            ++self->counts.accepted;
-            auto session = std::make_shared<Session>(self, std::move(socket));
-            if (self->sessions.size() - self->counts.streams >= kMaxConnections) {
-                self->make_room();
-            }
-            if (self->sessions.size() - self->counts.streams >= kMaxConnections) {
-                ++self->counts.refused_busy;
-                session->refuse_busy();  // kept alive by its write until the answer is out
-            } else {
-                self->sessions.insert(session);
-                session->start();
-            }
+        if (ec) {
+            // Out of descriptors (EMFILE) or the like: free one if an idle connection holds it, and try again
+            // shortly rather than spinning on the error.
+            ++self->counts.accept_errors;
+            self->log.log("map: accept failed", SteadyClock::now(), spdlog::level::warn,
+                          "map: cannot accept a connection: {}", ec.message());
+            self->make_room();
+            self->accept_retry.expires_after(kAcceptRetry);
+            self->accept_retry.async_wait([self](boost::system::error_code e) {
+                if (!e && self->running) {
+                    self->accept();
+                }
+            });
+            return;
+        }
+        ++self->accepted;
+        ++self->counts.accepted;
+        auto session = std::make_shared<Session>(self, std::move(socket));
+        if (self->sessions.size() - self->counts.streams >= kMaxConnections) {
+            self->make_room();
+        }
+        if (self->sessions.size() - self->counts.streams >= kMaxConnections) {
+            ++self->counts.refused_busy;
+            self->log.log("map: refused a connection", SteadyClock::now(), spdlog::level::warn,
+                          "map: refused a connection: all {} are being answered", kMaxConnections);
+            session->refuse_busy();  // kept alive by its write until the answer is out
+        } else {
+            self->sessions.insert(session);
+            session->start();
         }
         self->accept();
     });
@@ -523,7 +608,8 @@ void MapServer::Impl::accept() {
 void MapServer::Impl::make_room() {
     std::shared_ptr<Session> oldest;
     for (const auto& session : sessions) {
-        if (session->waiting_for_request() && (!oldest || session->connected_at() < oldest->connected_at())) {
+        if (session->waiting_for_request() &&
+            (!oldest || session->waiting_since() < oldest->waiting_since())) {
             oldest = session;
         }
     }
@@ -644,6 +730,7 @@ void MapServer::stop() {
     s.running = false;
     boost::system::error_code ignored;
     s.acceptor.close(ignored);
+    s.accept_retry.cancel();
     s.keepalive.cancel();
     for (const auto& session : std::vector(s.sessions.begin(), s.sessions.end())) {
         session->close();

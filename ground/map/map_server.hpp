@@ -1,5 +1,6 @@
 #pragma once
-// The live map of airseg-ground: a small local web server (HTTP/1.1 on asio) serving the map page, the
+// The live map of airseg-ground: a small local web server (HTTP/1.1 on Boost.Beast: kept-alive connections,
+// pipelined requests answered in order) serving the map page, the
 // plan and the vehicle's track as they change (server-sent events), exports as GeoJSON and KML, and, when
 // allowed, the plan commands (load, pause, resume, skip) passed to the vehicle through the hub.
 //
@@ -38,9 +39,9 @@ class MapServer {
 
     /// Points of the track kept (the oldest go first).
     static constexpr std::size_t kTrackPoints = 10000;
-    /// Requests served at once (pages, files, exports, commands). When all are taken, the oldest one that
-    /// has not yet sent its request is closed for a newcomer (idle or slow clients cannot lock out the page);
-    /// only when every one is being answered is a newcomer answered 503.
+    /// Connections for requests (pages, files, exports, commands), kept alive between requests. When all are
+    /// taken, the one that has waited longest for its next request is closed for a newcomer (idle or slow
+    /// clients cannot lock out the page); only when every one is being answered is a newcomer answered 503.
     static constexpr std::size_t kMaxConnections = 64;
     /// Event streams (/events, one per open map tab), apart from the requests above: the 33rd is answered
     /// 503, and however many there are, pages and exports are still served.
@@ -51,6 +52,7 @@ class MapServer {
         std::uint64_t evicted_idle = 0;     // closed before their request for a newcomer
         std::uint64_t refused_busy = 0;     // answered 503: every request slot was being answered
         std::uint64_t refused_streams = 0;  // /events answered 503: kMaxStreams open
+        std::uint64_t accept_errors = 0;    // accepting failed (out of descriptors): retried shortly
         std::size_t streams = 0;            // event streams open now
     };
 
