@@ -161,7 +161,16 @@ int main(int argc, char** argv) {
     bool end_armed = false;
     long samples = 0;
     airseg::groundlink::protocol::Telemetry held;  // the last sample sent, sent again while holding
-    std::function<void()> drive = [&] {
+    std::function<void()> drive;
+    const auto drive_again = [&] {  // the next sample in 100 ms
+        step.expires_after(std::chrono::milliseconds(100));
+        step.async_wait([&](boost::system::error_code ec) {
+            if (!ec) {
+                drive();
+            }
+        });
+    };
+    drive = [&] {
         if (!end_armed && map.connections_accepted() > 0) {
             // The run is counted from the browser's first request: a browser slow to start (a loaded
             // machine) finds the page served all the same.
@@ -195,24 +204,14 @@ int main(int argc, char** argv) {
         const long n = samples++;
         if (hold_after > 0 && n >= hold_after) {
             map.add_position(held, std::chrono::system_clock::now());
-            step.expires_after(std::chrono::milliseconds(100));
-            step.async_wait([&](boost::system::error_code ec) {
-                if (!ec) {
-                    drive();
-                }
-            });
+            drive_again();
             return;
         }
         if (outage_after >= 0 && n >= outage_after) {
             if (n == outage_after) {
                 map.set_link({{"link", "down"}, {"rtt_ms", 84}, {"loss", 0.0}});
             }
-            step.expires_after(std::chrono::milliseconds(100));
-            step.async_wait([&](boost::system::error_code ec) {
-                if (!ec) {
-                    drive();
-                }
-            });
+            drive_again();
             return;
         }
         if (n < fixless_first || (lose_fix_after >= 0 && n >= lose_fix_after)) {
@@ -241,12 +240,7 @@ int main(int argc, char** argv) {
                 map.add_event(Event{Event::Severity::Info, text});
             }
         }
-        step.expires_after(std::chrono::milliseconds(100));
-        step.async_wait([&](boost::system::error_code ec) {
-            if (!ec) {
-                drive();
-            }
-        });
+        drive_again();
     };
     airseg::asio::post(strand, drive);
     signals.async_wait([&](boost::system::error_code, int) {
