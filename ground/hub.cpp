@@ -51,6 +51,9 @@ Hub::Hub(Strand strand, HubConfig config)
                                                    log_.log("ground hub: link down", now, spdlog::level::warn,
                                                             "ground hub: link to the vehicle down");
                                                }
+                                               for (const auto& listener : link_listeners_) {
+                                                   listener(e);
+                                               }
                                            }}),
       tick_timer_(strand_),
       accept_retry_(strand_) {}
@@ -468,6 +471,9 @@ Json Hub::link_stats() const {
         stats["control_client"] = it->second.name;
     } else {
         stats["control_client"] = nullptr;
+    }
+    for (const auto& source : stats_sources_) {
+        source(stats);
     }
     return stats;
 }

@@ -41,6 +41,10 @@ class Hub {
     using Listener = std::function<void(const groundlink::protocol::Message&)>;
     /// The name of each relayed command ("plan.load") and the vehicle's answer to it.
     using ResultListener = std::function<void(const std::string& cmd, const nlohmann::json& answer)>;
+    /// The link's events (up, down, the vehicle's end restarted).
+    using LinkListener = std::function<void(const groundlink::TransportEvent& event)>;
+    /// Adds counters of the hub's parts to its link statistics.
+    using StatsSource = std::function<void(nlohmann::json& stats)>;
 
     Hub(Strand strand, HubConfig config);
     ~Hub();
@@ -56,6 +60,8 @@ class Hub {
     void command(nlohmann::json request, Done done);
     void add_listener(Listener listener) { listeners_.push_back(std::move(listener)); }
     void add_result_listener(ResultListener listener) { result_listeners_.push_back(std::move(listener)); }
+    void add_link_listener(LinkListener listener) { link_listeners_.push_back(std::move(listener)); }
+    void add_stats_source(StatsSource source) { stats_sources_.push_back(std::move(source)); }
     /// Sends a message to the vehicle reliably (MAVLink from ground stations).
     groundlink::SendResult send_to_vehicle(const groundlink::protocol::Message& message);
     nlohmann::json link_stats() const;
@@ -107,6 +113,8 @@ class Hub {
     std::map<std::uint32_t, Pending> pending_;
     std::vector<Listener> listeners_;
     std::vector<ResultListener> result_listeners_;
+    std::vector<LinkListener> link_listeners_;
+    std::vector<StatsSource> stats_sources_;
     std::uint32_t next_client_ = 1;
     std::uint32_t next_request_ = 1;
     std::uint32_t control_holder_ = 0;
