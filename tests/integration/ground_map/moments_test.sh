@@ -39,11 +39,12 @@ cleanup() {
 }
 trap cleanup EXIT
 
-# Starts the fixture for $1 seconds (the rest: its options); sets $url.
+# Starts the fixture for $1 seconds (the rest: its options); sets $url and $fixture_pid.
 start_fixture() {
   local out=$work/fixture.$RANDOM
   "$fixture" --web-dir "$web_dir" --seconds "$@" >"$out" 2>&1 &
-  pids+=($!)
+  fixture_pid=$!
+  pids+=($fixture_pid)
   for _ in $(seq 100); do
     url=$(sed -n 's/^listening on \(http:[^ ]*\)$/\1/p' "$out")
     [ -n "$url" ] && return 0
@@ -81,6 +82,7 @@ moment() {
     fail=1
     return
   fi
+  kill "$fixture_pid" 2>/dev/null || true
   python3 - "$name" "$dom" "$next" "$element" <<'PY' || fail=1
 import html, json, re, sys
 name, dom_path, next_wp, element = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
@@ -148,6 +150,7 @@ PY
   start_fixture 120 --moment "$name"
   local png=$work/map-$name.png
   run_browser --screenshot="$png" "${url}?for=$seconds" >/dev/null || true
+  kill "$fixture_pid" 2>/dev/null || true
   if [ ! -s "$png" ]; then
     echo "FAIL: $name: no screenshot written" >&2
     tail -20 "$work/browser.log" >&2
