@@ -28,7 +28,7 @@ const char* to_string(ArmingPolicy p) {
 }
 
 std::optional<std::uint32_t> message_id(std::string_view name) {
-    if (const auto* info = mavlink::find_message(name)) {
+    if (const auto* info = mavlink::find_dialect_message(name)) {
         return info->id;
     }
     return std::nullopt;

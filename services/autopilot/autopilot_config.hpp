@@ -41,8 +41,9 @@ struct ParamSetting {
     double value = 0.0;
 };
 
-/// The id of the MAVLink message called `name` ("ATTITUDE"), for autopilot.message_rates; nullopt when this
-/// build does not know it. Keeps message names in the autopilot layer.
+/// The id of the MAVLink message called `name` ("ATTITUDE", any message of ArduPilot's dialect), for
+/// autopilot.message_rates and the forwarding rates; nullopt when it is not in the dialect. Keeps message
+/// names in the autopilot layer.
 std::optional<std::uint32_t> message_id(std::string_view name);
 
 struct RcOverrideConfig {
