@@ -41,16 +41,16 @@ RequestReader::State RequestReader::fail(int status, std::string why) {
 }
 
 RequestReader::State RequestReader::fail(const beast::error_code& ec) {
-    using error = beast_http::error;
+    using Error = beast_http::error;
     const std::string beast_says = " (" + ec.message() + ")";
-    if (ec == error::header_limit || ec == error::buffer_overflow) {
+    if (ec == Error::header_limit || ec == Error::buffer_overflow) {
         return fail(431, "request head larger than " + std::to_string(limits_.head_bytes) + " bytes");
     }
-    if (ec == error::body_limit) {
+    if (ec == Error::body_limit) {
         return fail(413, "body larger than " + std::to_string(limits_.body_bytes) + " bytes");
     }
-    if (ec == error::bad_version || ec == error::bad_value || ec == error::bad_field ||
-        ec == error::bad_line_ending) {
+    if (ec == Error::bad_version || ec == Error::bad_value || ec == Error::bad_field ||
+        ec == Error::bad_line_ending) {
         // Beast stops where a line ends in a bare LF: at the version, or inside a header's name or value.
         const std::string_view seen(static_cast<const char*>(buffer_.data().data()), buffer_.size());
         for (auto lf = seen.find('\n'); lf != std::string_view::npos; lf = seen.find('\n', lf + 1)) {
@@ -58,7 +58,7 @@ RequestReader::State RequestReader::fail(const beast::error_code& ec) {
                 return fail(400, "a line ends in a bare LF: HTTP/1.1 lines end in CRLF");
             }
         }
-        if (ec == error::bad_version) {
+        if (ec == Error::bad_version) {
             const auto line = seen.substr(0, seen.find_first_of("\r\n"));
             const auto space = line.rfind(' ');
             const auto version = line.substr(space == std::string_view::npos ? 0 : space + 1);
@@ -68,19 +68,19 @@ RequestReader::State RequestReader::fail(const beast::error_code& ec) {
             return fail(400, std::string(kRequestLine) + beast_says);
         }
     }
-    if (ec == error::bad_method || ec == error::bad_target) {
+    if (ec == Error::bad_method || ec == Error::bad_target) {
         return fail(400, std::string(kRequestLine) + beast_says);
     }
-    if (ec == error::bad_line_ending) {
+    if (ec == Error::bad_line_ending) {
         return fail(400, "a bare CR or LF: HTTP/1.1 lines end in CRLF");
     }
-    if (ec == error::bad_field || ec == error::bad_value) {
+    if (ec == Error::bad_field || ec == Error::bad_value) {
         return fail(400, "malformed header line" + beast_says);
     }
-    if (ec == error::bad_content_length) {
+    if (ec == Error::bad_content_length) {
         return fail(400, "Content-Length is not a number, or more than one and different, or too large");
     }
-    if (ec == error::bad_transfer_encoding) {
+    if (ec == Error::bad_transfer_encoding) {
         return fail(501, "only bodies with a Content-Length are accepted, not Transfer-Encoding");
     }
     return fail(400, "malformed request" + beast_says);
