@@ -2,7 +2,9 @@
 // airseg-ground ⇄ several airsegctl at once. Watchers and one operator share the one radio session; the
 // operator's plan reaches every watcher; a monitor's command is refused by the vehicle; control is held by
 // one client at a time.
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/socket.h>
@@ -12,11 +14,15 @@
 
 #include <cstring>
 #include <iostream>
+#include <map>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
 #include "client/hub_client.hpp"
 #include "groundside/hub_wire.hpp"
+#include "services/autopilot/mavlink/encoder.hpp"
+#include "services/autopilot/mavlink/parser.hpp"
 #include "tests/support/control_client.hpp"
 #include "tests/support/ground_chain.hpp"
 #include "tests/support/json_lines.hpp"
@@ -299,6 +305,231 @@ TEST_F(GroundHubE2e, AGroundStationGetsTheAutopilotsMavlinkThroughTheHub) {
     const auto forward = Json::parse(status.out, nullptr, false)["groundlink"]["mavlink_forward"];
     EXPECT_GT(forward.value("forwarded", 0), 0) << forward.dump();
     EXPECT_GT(forward.value("from_ground", 0), 0) << forward.dump();
+}
+
+/// A ground station of the test's own on the hub's MAVLink endpoint (UDP or TCP, real sockets), as
+/// QGroundControl identifies itself: heartbeats as (255, `compid`). Counts what it receives.
+class TestStation {
+  public:
+    TestStation(bool tcp, const std::string& address, std::uint8_t compid) : encoder_(255, compid) {
+        const auto colon = address.rfind(':');
+        sockaddr_in to{};
+        to.sin_family = AF_INET;
+        to.sin_port = htons(static_cast<std::uint16_t>(std::stoi(address.substr(colon + 1))));
+        to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+        fd_ = ::socket(AF_INET, (tcp ? SOCK_STREAM : SOCK_DGRAM) | SOCK_CLOEXEC, 0);
+        connected_ = ::connect(fd_, reinterpret_cast<sockaddr*>(&to), sizeof to) == 0;
+    }
+    ~TestStation() { ::close(fd_); }
+    TestStation(const TestStation&) = delete;
+    TestStation& operator=(const TestStation&) = delete;
+    bool connected() const { return connected_; }
+
+    template <class M>
+    void send(const M& m) {
+        const auto bytes = encoder_.encode(m);
+        ::send(fd_, bytes.data(), bytes.size(), MSG_NOSIGNAL);
+    }
+    void heartbeat() {
+        mavlink::Heartbeat hb;
+        hb.type = 6;       // MAV_TYPE_GCS
+        hb.autopilot = 8;  // MAV_AUTOPILOT_INVALID
+        send(hb);
+    }
+    /// Reads what has arrived (at most `wait`), a heartbeat once a second meanwhile.
+    void poll(std::chrono::milliseconds wait) {
+        const auto now = std::chrono::steady_clock::now();
+        if (now - last_heartbeat_ >= 1s) {
+            last_heartbeat_ = now;
+            heartbeat();
+        }
+        pollfd p{fd_, POLLIN, 0};
+        if (::poll(&p, 1, static_cast<int>(wait.count())) <= 0) {
+            return;
+        }
+        std::uint8_t buf[65536];
+        const auto n = ::recv(fd_, buf, sizeof buf, MSG_DONTWAIT);
+        if (n <= 0) {
+            return;
+        }
+        parser_.push(std::span(buf, static_cast<std::size_t>(n)),
+                     [&](const mavlink::Frame& f) { on_frame(f); });
+    }
+
+    std::map<int, float> params;  // index -> value
+    int param_count = 0;
+    int param_frames = 0;
+    std::map<std::uint32_t, int> mission_items;  // seq -> count
+    int mission_count = -1;
+    int to_others = 0;   // frames addressed to another component of system 255 than this station's
+    int to_airsegd = 0;  // frames addressed to airsegd (255/191)
+    int addressed_to_me = 0;
+
+  private:
+    void on_frame(const mavlink::Frame& f) {
+        if (const auto t = addressee(f)) {
+            if (t->first == 255 && t->second == 191) {
+                ++to_airsegd;
+            } else if (t->first == 255 && t->second != 0 && t->second != encoder_.compid()) {
+                ++to_others;
+            } else if (t->first == 255 && t->second == encoder_.compid()) {
+                ++addressed_to_me;
+            }
+        }
+        if (auto v = mavlink::decode<mavlink::ParamValue>(f)) {
+            ++param_frames;
+            param_count = v->param_count;
+            params[v->param_index] = v->param_value;
+        } else if (auto c = mavlink::decode<mavlink::MissionCount>(f)) {
+            if (c->target_component == encoder_.compid()) {
+                mission_count = c->count;
+            }
+        } else if (auto item = mavlink::decode<mavlink::MissionItemInt>(f)) {
+            if (item->target_component == encoder_.compid()) {
+                ++mission_items[item->seq];
+            }
+        }
+    }
+    /// (target_system, target_component) of the messages the test watches.
+    static std::optional<std::pair<int, int>> addressee(const mavlink::Frame& f) {
+        const auto* info = mavlink::find_message(f.msgid);
+        const auto* sys = info != nullptr ? info->find_field("target_system") : nullptr;
+        const auto* comp = info != nullptr ? info->find_field("target_component") : nullptr;
+        if (sys == nullptr || comp == nullptr) {
+            return std::nullopt;
+        }
+        return std::pair<int, int>{f.payload[sys->offset], f.payload[comp->offset]};
+    }
+
+    int fd_ = -1;
+    bool connected_ = false;
+    mavlink::Encoder encoder_;
+    mavlink::Parser parser_;
+    std::chrono::steady_clock::time_point last_heartbeat_{};
+};
+
+// Two ground stations at once through the hub, one on UDP (component 190) and one on TCP (component 200):
+// the first downloads every parameter across an 8 s radio outage (no value lost, none asked again), then
+// again from the hub's cache; the second downloads the mission while airsegd writes the plan's window.
+// Neither ever sees what is addressed to the other or to airsegd.
+TEST_F(GroundHubE2e, TwoGroundStationsRoutedAndParametersThroughAnOutageThenFromTheHub) {
+    start_chain();
+    std::string udp;
+    std::string tcp;
+    ASSERT_TRUE(wait_until(
+        [&] {
+            udp = logged_after("MAVLink for ground stations on udp ");
+            tcp = logged_after(", tcp ");
+            return !udp.empty() && !tcp.empty();
+        },
+        kGenerous))
+        << hub->err();
+    TestStation a(false, udp, 190);
+    TestStation b(true, tcp, 200);
+    ASSERT_TRUE(a.connected() && b.connected());
+    const auto poll_both = [&] {
+        a.poll(20ms);
+        b.poll(0ms);
+    };
+    // Heard by the hub before anything is asked (each sends a heartbeat at once, then once a second).
+    for (int i = 0; i < 100; ++i) {
+        poll_both();
+    }
+    // airsegd writes a plan's window meanwhile: its own mission traffic with the autopilot (255/191).
+    auto loaded = ctl({"plan", "load", plan_file(), "--paused"}, true);
+    ASSERT_EQ(loaded.exit_code, 0) << loaded.out << loaded.err;
+
+    mavlink::ParamRequestList list;
+    list.target_system = 1;
+    list.target_component = 0;
+    a.send(list);
+    ASSERT_TRUE(wait_until(
+        [&] {
+            poll_both();
+            return a.param_count > 0 && static_cast<int>(a.params.size()) >= a.param_count / 3;
+        },
+        120s))
+        << "params " << a.params.size() << " of " << a.param_count << "\nhub:\n"
+        << hub->err();
+    const auto before_outage = a.params.size();
+    ASSERT_LT(static_cast<int>(before_outage), a.param_count) << "the download ended before the outage";
+    // An 8 s radio outage: the radios stop carrying anything.
+    chain->linksim->signal(SIGSTOP);
+    const auto outage_end = std::chrono::steady_clock::now() + 8s;
+    while (std::chrono::steady_clock::now() < outage_end) {
+        poll_both();
+    }
+    chain->linksim->signal(SIGCONT);
+    const bool whole = wait_until(
+        [&] {
+            poll_both();
+            return static_cast<int>(a.params.size()) == a.param_count;
+        },
+        180s);
+    EXPECT_TRUE(whole) << "params " << a.params.size() << " of " << a.param_count << " (" << before_outage
+                       << " before the outage)\nhub:\n"
+                       << hub->err();
+    std::cerr << "first download: " << a.params.size() << " of " << a.param_count << ", " << before_outage
+              << " before the 8 s outage\n";
+
+    // Again, now from the hub.
+    const auto values_first = a.params;
+    a.params.clear();
+    const auto asked = std::chrono::steady_clock::now();
+    a.send(list);
+    ASSERT_TRUE(wait_until(
+        [&] {
+            a.poll(5ms);
+            return static_cast<int>(a.params.size()) == a.param_count;
+        },
+        60s))
+        << "params " << a.params.size() << " of " << a.param_count;
+    const auto took = std::chrono::duration<double>(std::chrono::steady_clock::now() - asked).count();
+    std::cerr << "second download (from the hub): " << a.param_count << " values in " << took * 1000
+              << " ms\n";
+    EXPECT_LT(took, 1.0);
+    EXPECT_EQ(a.params, values_first);
+
+    // B downloads the mission (the plan's window): MISSION_COUNT and MISSION_ITEM_INTs addressed to B.
+    mavlink::MissionRequestList ask;
+    ask.target_system = 1;
+    ask.target_component = 1;
+    b.send(ask);
+    ASSERT_TRUE(wait_until(
+        [&] {
+            poll_both();
+            return b.mission_count >= 0;
+        },
+        60s))
+        << hub->err();
+    for (int seq = 0; seq < b.mission_count; ++seq) {
+        mavlink::MissionRequestInt item;
+        item.target_system = 1;
+        item.target_component = 1;
+        item.seq = static_cast<std::uint16_t>(seq);
+        b.send(item);
+        ASSERT_TRUE(wait_until(
+            [&] {
+                poll_both();
+                return b.mission_items.contains(static_cast<std::uint32_t>(seq));
+            },
+            60s))
+            << "item " << seq << " of " << b.mission_count;
+    }
+    mavlink::MissionAck done;
+    done.target_system = 1;
+    done.target_component = 1;
+    b.send(done);
+    for (int i = 0; i < 100; ++i) {
+        poll_both();
+    }
+    EXPECT_GE(b.mission_count, 1);
+    EXPECT_GT(b.addressed_to_me, b.mission_count);
+    EXPECT_EQ(a.to_others, 0) << "frames addressed to the other station reached A";
+    EXPECT_EQ(b.to_others, 0) << "frames addressed to the other station reached B";
+    EXPECT_EQ(a.to_airsegd, 0) << "frames addressed to airsegd reached A";
+    EXPECT_EQ(b.to_airsegd, 0) << "frames addressed to airsegd reached B";
+    EXPECT_EQ(b.mission_items.size(), static_cast<std::size_t>(b.mission_count));
 }
 
 /// A raw client of the hub's Unix socket that reads frames (and says nothing unless asked).
