@@ -460,6 +460,9 @@ TEST_F(GroundHubE2e, TwoGroundStationsRoutedAndParametersThroughAnOutageThenFrom
         poll_both();
     }
     chain->linksim->signal(SIGCONT);
+    EXPECT_NE(hub->err().find("link to the vehicle down"), std::string::npos)
+        << "the outage did not take the link down:\n"
+        << hub->err();
     const bool whole = wait_until(
         [&] {
             poll_both();
