@@ -8,7 +8,7 @@ namespace mav = airseg::mavlink;
 
 TargetOffsets target_offsets(std::uint32_t msgid) {
     TargetOffsets out;
-    const auto* info = mav::find_message(msgid);
+    const auto* info = mav::find_dialect_message(msgid);
     if (info == nullptr) {
         return out;
     }

@@ -4,8 +4,8 @@
 // (broadcast). MAVLink 2 drops trailing zero bytes of a payload; the parser zero-extends it again, so a
 // truncated target byte reads as 0, as the specification means it.
 //
-// The offsets come from the typed message table (messages.def), so only its messages are known; a frame of
-// any other message counts as broadcast. They belong with a table of the whole dialect once there is one.
+// The offsets come from the table of ArduPilot's whole dialect (dialect.def); a frame of a message outside it
+// counts as broadcast.
 #include <cstdint>
 #include <optional>
 

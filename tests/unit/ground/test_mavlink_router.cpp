@@ -4,6 +4,7 @@
 
 #include "ground/mavlink_target.hpp"
 #include "services/autopilot/mavlink/encoder.hpp"
+#include "services/autopilot/mavlink/message_table.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
 
 namespace airseg::ground {
@@ -56,6 +57,17 @@ TEST(MavlinkTarget, ATruncatedTargetByteIsZeroAndAMessageWithoutOneIsABroadcast)
     value.param_count = 1;
     EXPECT_FALSE(frame_target(parsed(value)));
     EXPECT_FALSE(target_offsets(0xFFFFFF).system);  // unknown message: broadcast
+}
+
+// A message airseg does not type (LOG_REQUEST_LIST: start, end as uint16_t, then the targets) is still
+// addressed: the offsets come from the whole dialect.
+TEST(MavlinkTarget, AMessageOfTheDialectThatIsNotTypedHasItsAddressee) {
+    ASSERT_EQ(mav::find_message(117), nullptr) << "LOG_REQUEST_LIST became typed: pick another message";
+    const auto offsets = target_offsets(117);
+    ASSERT_TRUE(offsets.system);
+    ASSERT_TRUE(offsets.component);
+    EXPECT_EQ(*offsets.system, 4);
+    EXPECT_EQ(*offsets.component, 5);
 }
 
 TEST(MavlinkRouter, AFrameGoesOnlyWhereItsAddresseeWasHeard) {
