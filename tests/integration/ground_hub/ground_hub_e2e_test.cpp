@@ -22,6 +22,7 @@
 #include "client/hub_client.hpp"
 #include "groundside/hub_wire.hpp"
 #include "services/autopilot/mavlink/encoder.hpp"
+#include "services/autopilot/mavlink/message_table.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
 #include "tests/support/control_client.hpp"
 #include "tests/support/ground_chain.hpp"
@@ -364,6 +365,8 @@ class TestStation {
     int to_others = 0;   // frames addressed to another component of system 255 than this station's
     int to_airsegd = 0;  // frames addressed to airsegd (255/191)
     int addressed_to_me = 0;
+    std::vector<std::uint16_t> mission_requests;  // seqs asked of this station (its mission upload)
+    std::optional<int> mission_ack;               // the MISSION_ACK type that ended this station's upload
 
   private:
     void on_frame(const mavlink::Frame& f) {
@@ -388,11 +391,23 @@ class TestStation {
             if (item->target_component == encoder_.compid()) {
                 ++mission_items[item->seq];
             }
+        } else if (auto r = mavlink::decode<mavlink::MissionRequestInt>(f)) {
+            if (r->target_component == encoder_.compid()) {
+                mission_requests.push_back(r->seq);
+            }
+        } else if (auto r1 = mavlink::decode<mavlink::MissionRequest>(f)) {
+            if (r1->target_component == encoder_.compid()) {
+                mission_requests.push_back(r1->seq);
+            }
+        } else if (auto ack = mavlink::decode<mavlink::MissionAck>(f)) {
+            if (ack->target_component == encoder_.compid()) {
+                mission_ack = ack->type;
+            }
         }
     }
     /// (target_system, target_component) of the messages the test watches.
     static std::optional<std::pair<int, int>> addressee(const mavlink::Frame& f) {
-        const auto* info = mavlink::find_message(f.msgid);
+        const auto* info = mavlink::find_dialect_message(f.msgid);
         const auto* sys = info != nullptr ? info->find_field("target_system") : nullptr;
         const auto* comp = info != nullptr ? info->find_field("target_component") : nullptr;
         if (sys == nullptr || comp == nullptr) {
@@ -410,8 +425,8 @@ class TestStation {
 
 // Two ground stations at once through the hub, one on UDP (component 190) and one on TCP (component 200):
 // the first downloads every parameter across an 8 s radio outage (no value lost, none asked again), then
-// again from the hub's cache; the second downloads the mission while airsegd writes the plan's window.
-// Neither ever sees what is addressed to the other or to airsegd.
+// again from the hub's cache; the second downloads the mission while airsegd writes the plan's window, and
+// the first uploads one. Neither ever sees what is addressed to the other or to airsegd.
 TEST_F(GroundHubE2e, TwoGroundStationsRoutedAndParametersThroughAnOutageThenFromTheHub) {
     start_chain();
     std::string udp;
@@ -523,10 +538,48 @@ TEST_F(GroundHubE2e, TwoGroundStationsRoutedAndParametersThroughAnOutageThenFrom
     done.target_system = 1;
     done.target_component = 1;
     b.send(done);
+    // A uploads a mission: the MISSION_REQUESTs and the MISSION_ACK answering it go to A alone, whether the
+    // flight plan manager takes the mission as the plan or refuses it.
+    std::vector<mavlink::MissionItemInt> upload(3);
+    for (std::size_t i = 0; i < upload.size(); ++i) {
+        auto& it = upload[i];
+        it.target_system = 1;
+        it.target_component = 1;
+        it.seq = static_cast<std::uint16_t>(i);
+        it.frame = i == 0 ? 0 : 6;  // home in MAV_FRAME_GLOBAL, then MAV_FRAME_GLOBAL_RELATIVE_ALT_INT
+        it.command = 16;            // MAV_CMD_NAV_WAYPOINT
+        it.autocontinue = 1;
+        it.x = 413900000 + static_cast<std::int32_t>(i) * 900;
+        it.y = 21100000 + static_cast<std::int32_t>(i) * 900;
+    }
+    mavlink::MissionCount count;
+    count.target_system = 1;
+    count.target_component = 1;
+    count.count = static_cast<std::uint16_t>(upload.size());
+    a.send(count);
+    std::size_t answered = 0;
+    ASSERT_TRUE(wait_until(
+        [&] {
+            poll_both();
+            for (; answered < a.mission_requests.size(); ++answered) {
+                const auto seq = a.mission_requests[answered];
+                if (seq < upload.size()) {
+                    a.send(upload[seq]);
+                }
+            }
+            return a.mission_ack.has_value();
+        },
+        60s))
+        << "no MISSION_ACK for A's upload after " << a.mission_requests.size() << " requests\nhub:\n"
+        << hub->err();
+    std::cerr << "A's upload: " << a.mission_requests.size() << " requests, MISSION_ACK type "
+              << *a.mission_ack << "\n";
     for (int i = 0; i < 100; ++i) {
         poll_both();
     }
     EXPECT_GE(b.mission_count, 1);
+    EXPECT_TRUE(b.mission_requests.empty()) << "B was asked for A's items";
+    EXPECT_FALSE(b.mission_ack.has_value()) << "B got the answer to A's upload";
     EXPECT_GT(b.addressed_to_me, b.mission_count);
     EXPECT_EQ(a.to_others, 0) << "frames addressed to the other station reached A";
     EXPECT_EQ(b.to_others, 0) << "frames addressed to the other station reached B";
