@@ -125,28 +125,28 @@ class UdpStation {
 class GcsPassageE2e : public ::testing::Test {
   protected:
     static void SetUpTestSuite() {
-        dir_ = new TempDir;
-        port_ = free_udp_port();
+        shared_dir = new TempDir;
+        shared_port = free_udp_port();
         // Ports of the test's own (or none): the defaults may be taken by a demo or another suite.
-        chain_ = new GroundChain(dir_->path(),
-                                 {"--map", "off", "--mavlink-udp", "127.0.0.1:" + std::to_string(port_),
-                                  "--mavlink-udp-listen", "127.0.0.1:0", "--mavlink-tcp", "off"});
-        error_ = chain_->start();
+        shared_chain = new GroundChain(
+            shared_dir->path(), {"--map", "off", "--mavlink-udp", "127.0.0.1:" + std::to_string(shared_port),
+                                 "--mavlink-udp-listen", "127.0.0.1:0", "--mavlink-tcp", "off"});
+        setup_error = shared_chain->start();
     }
     static void TearDownTestSuite() {
-        delete chain_;
-        delete dir_;
-        chain_ = nullptr;
-        dir_ = nullptr;
+        delete shared_chain;
+        delete shared_dir;
+        shared_chain = nullptr;
+        shared_dir = nullptr;
     }
     void SetUp() override {
-        ASSERT_EQ(error_, "");
-        station_ = std::make_unique<UdpStation>(port_);
+        ASSERT_EQ(setup_error, "");
+        station_ = std::make_unique<UdpStation>(shared_port);
         ASSERT_TRUE(station_->bound());
         ASSERT_TRUE(station_->wait_for_peer(kGenerous)) << "the hub sends the vehicle's MAVLink";
     }
     std::string logs() const {
-        return "\nhub:\n" + chain_->hub->err() + "\ndaemon:\n" + chain_->daemon->err();
+        return "\nhub:\n" + shared_chain->hub->err() + "\ndaemon:\n" + shared_chain->daemon->err();
     }
 
     /// One MAVFTP request, sent again (same sequence number) until an answer to it comes.
@@ -197,10 +197,10 @@ class GcsPassageE2e : public ::testing::Test {
         return std::nullopt;
     }
 
-    static inline TempDir* dir_ = nullptr;
-    static inline GroundChain* chain_ = nullptr;
-    static inline std::string error_;
-    static inline int port_ = 0;
+    static inline TempDir* shared_dir = nullptr;
+    static inline GroundChain* shared_chain = nullptr;
+    static inline std::string setup_error;
+    static inline int shared_port = 0;
     std::unique_ptr<UdpStation> station_;
     std::uint16_t ftp_seq_ = 100;
 };
@@ -337,7 +337,7 @@ TEST_F(GcsPassageE2e, AMavftpWriteOfTheMissionIsRefusedByTheGate) {
         kGenerous);
     EXPECT_TRUE(said.has_value()) << logs();
     // The autopilot never saw it: its own answer to an open for writing would be UnknownCommand.
-    EXPECT_NE(chain_->daemon->err().find("refused a mission write"), std::string::npos) << logs();
+    EXPECT_NE(shared_chain->daemon->err().find("refused a mission write"), std::string::npos) << logs();
 }
 
 }  // namespace
