@@ -60,48 +60,50 @@ constexpr std::uint32_t kTypedIds[] = {
 #include "services/autopilot/mavlink/messages.def"
 };
 
-constexpr std::size_t kFieldCount = field_count(kDecls);
-
-// The laid-out fields of all messages, message after message in kHeads order, with the declaration order of
-// each message's fields and the summaries.
-struct Laid {
-    std::array<FieldInfo, kFieldCount> wire{};
-    std::array<std::uint8_t, kFieldCount> wire_index_by_decl{};
-    std::array<LayoutSummary, kMessageCount> summary{};
-    std::array<std::size_t, kMessageCount> first_field{};
-};
-
-constexpr Laid lay_out_all() {
-    Laid laid{};
+// Where each message's declarations start in kDecls.
+constexpr std::array<std::size_t, kMessageCount> kFirstDecl = [] {
+    std::array<std::size_t, kMessageCount> first{};
     std::size_t decl = 0;
-    std::size_t field = 0;
     for (std::size_t m = 0; m < kMessageCount; ++m) {
-        const std::span<const FieldDecl> decls = std::span(kDecls).subspan(decl, kHeads[m].decl_count);
-        const std::size_t n = field_count(decls);
-        laid.first_field[m] = field;
-        laid.summary[m] = lay_out(kHeads[m].name, decls, std::span(laid.wire).subspan(field, n),
-                                  std::span(laid.wire_index_by_decl).subspan(field, n));
-        decl += decls.size();
-        field += n;
+        first[m] = decl;
+        decl += kHeads[m].decl_count;
     }
-    if (decl != std::size(kDecls) || field != kFieldCount) {
+    if (decl != std::size(kDecls)) {
         throw "dialect.def is not read whole";
     }
-    return laid;
-}
-constexpr Laid kLaid = lay_out_all();
+    return first;
+}();
 
-constexpr std::size_t field_count_of(std::size_t m) {
-    return (m + 1 < kMessageCount ? kLaid.first_field[m + 1] : kFieldCount) - kLaid.first_field[m];
+template <std::size_t M>
+constexpr std::span<const FieldDecl> decls_of() {
+    return std::span(kDecls).subspan(kFirstDecl[M], kHeads[M].decl_count);
+}
+
+template <std::size_t N>
+struct LaidMessage {
+    std::array<FieldInfo, N> wire{};
+    std::array<std::uint8_t, N> wire_index_by_decl{};
+    LayoutSummary summary{};
+};
+
+// One variable per message, so that each is its own constant evaluation: laying out the whole dialect in one
+// would exceed the evaluation budget of a compiler (clang's 1,048,576 steps) long before it exceeds GCC's.
+template <std::size_t M>
+constexpr auto kLaid = [] {
+    LaidMessage<field_count(decls_of<M>())> laid{};
+    laid.summary = lay_out(kHeads[M].name, decls_of<M>(), laid.wire, laid.wire_index_by_decl);
+    return laid;
+}();
+
+constexpr bool is_typed(std::uint32_t id) {
+    return std::find(std::begin(kTypedIds), std::end(kTypedIds), id) != std::end(kTypedIds);
 }
 
 template <std::size_t... M>
 constexpr std::array<MessageInfo, kMessageCount> make_infos(std::index_sequence<M...>) {
-    return {MessageInfo{
-        kHeads[M].id, kHeads[M].name, kLaid.summary[M].crc_extra, kLaid.summary[M].base_length,
-        kLaid.summary[M].length, std::span(kLaid.wire).subspan(kLaid.first_field[M], field_count_of(M)),
-        std::span(kLaid.wire_index_by_decl).subspan(kLaid.first_field[M], field_count_of(M)),
-        std::find(std::begin(kTypedIds), std::end(kTypedIds), kHeads[M].id) != std::end(kTypedIds)}...};
+    return {MessageInfo{kHeads[M].id, kHeads[M].name, kLaid<M>.summary.crc_extra, kLaid<M>.summary.base_length,
+                        kLaid<M>.summary.length, std::span(kLaid<M>.wire), std::span(kLaid<M>.wire_index_by_decl),
+                        is_typed(kHeads[M].id)}...};
 }
 constexpr auto kDialect = make_infos(std::make_index_sequence<kMessageCount>{});
 
