@@ -64,17 +64,36 @@ bool command_writes_mission(std::uint16_t command) {
 }
 
 /// A path of ArduPilot's @MISSION file system whose writing replaces the mission. Its fence.dat and
-/// rally.dat pass, as fence and rally uploads by message do. A leading '/' is ignored, as ArduPilot's FTP
-/// server ignores it.
+/// rally.dat pass, as fence and rally uploads by message do. The path is judged as resolved: empty and "."
+/// segments dropped, ".." taking the one before it (none above the top), so no spelling of it reaches
+/// @MISSION unseen ("/@MISSION//mission.dat", "@PARAM/../@MISSION/mission.dat").
 bool is_mission_file(std::string_view path) {
-    while (!path.empty() && path.front() == '/') {
-        path.remove_prefix(1);
+    constexpr std::size_t kMaxSegments = 16;  // a 239-byte path that needs more is refused, not resolved
+    std::array<std::string_view, kMaxSegments> segments{};
+    std::size_t depth = 0;
+    while (!path.empty()) {
+        const std::size_t slash = path.find('/');
+        const std::string_view segment = path.substr(0, slash);
+        path.remove_prefix(slash == std::string_view::npos ? path.size() : slash + 1);
+        if (segment.empty() || segment == ".") {
+            continue;
+        }
+        if (segment == "..") {
+            depth -= depth > 0 ? 1 : 0;
+            continue;
+        }
+        if (depth == kMaxSegments) {
+            return true;
+        }
+        segments[depth++] = segment;
     }
     constexpr std::string_view kRoot = "@MISSION";
-    if (path.substr(0, kRoot.size()) != kRoot) {
+    if (depth == 0 || segments[0].substr(0, kRoot.size()) != kRoot) {
         return false;
     }
-    return path != "@MISSION/fence.dat" && path != "@MISSION/rally.dat";
+    const bool fence_or_rally =
+        depth == 2 && segments[0] == kRoot && (segments[1] == "fence.dat" || segments[1] == "rally.dat");
+    return !fence_or_rally;
 }
 
 /// A MAVFTP request that would create, change or remove a mission file.

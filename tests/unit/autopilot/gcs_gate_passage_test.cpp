@@ -98,6 +98,8 @@ TEST(GcsGatePassage, MavftpReadsPassAndWritesToTheMissionAreRefusedWithANak) {
          {ftp_request(Op::OpenFileRO, "@PARAM/param.pck"), ftp_request(Op::ListDirectory, "@PARAM"),
           ftp_request(Op::OpenFileRO, "@MISSION/mission.dat"),
           ftp_request(Op::CreateFile, "@MISSION/fence.dat"),
+          ftp_request(Op::OpenFileWO, "/@MISSION/./rally.dat"),
+          ftp_request(Op::OpenFileWO, "@MISSION/../APM/mission.dat"),
           ftp_request(Op::OpenFileWO, "/APM/scripts/a.lua"), ftp_request(Op::ResetSessions, ""),
           ftp_request(Op::OpenFileWO, "@MISSION/mission.dat", 9)}) {
         const auto out = rig.gate.from_ground(rig.gcs.encode(m));
@@ -109,6 +111,10 @@ TEST(GcsGatePassage, MavftpReadsPassAndWritesToTheMissionAreRefusedWithANak) {
          {ftp_request(Op::OpenFileWO, "@MISSION/mission.dat"),
           ftp_request(Op::CreateFile, "@MISSION/mission.dat"),
           ftp_request(Op::CreateFile, "/@MISSION/mission.dat"),
+          ftp_request(Op::CreateFile, "//@MISSION//mission.dat"),
+          ftp_request(Op::OpenFileWO, "@PARAM/../@MISSION/mission.dat"),
+          ftp_request(Op::OpenFileWO, "../../@MISSION/./mission.dat"),
+          ftp_request(Op::OpenFileWO, "@MISSION/fence.dat/../mission.dat"),
           ftp_request(Op::TruncateFile, "@MISSION/mission.dat"),
           ftp_request(Op::RemoveFile, "@MISSION/mission.dat"), ftp_request(Op::CreateDirectory, "@MISSION/x"),
           ftp_request(Op::Rename, std::string_view("a.dat\0@MISSION/mission.dat", 26)),
