@@ -4,6 +4,9 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
+#include <string_view>
+#include <utility>
 
 #include "services/autopilot/mavlink/layout.hpp"
 #include "services/autopilot/mavlink/message_table.hpp"
@@ -12,15 +15,6 @@ namespace airseg::mavlink {
 // Named apart from message_table.cpp's internals: a unity build compiles both in one translation unit.
 namespace dialect_table {
 namespace {
-
-using std::int16_t;
-using std::int32_t;
-using std::int64_t;
-using std::int8_t;
-using std::uint16_t;
-using std::uint32_t;
-using std::uint64_t;
-using std::uint8_t;
 
 // Every declaration of the dialect, message after message, each in XML order with its extensions marker.
 constexpr FieldDecl kDecls[] = {
@@ -101,9 +95,9 @@ constexpr bool is_typed(std::uint32_t id) {
 
 template <std::size_t... M>
 constexpr std::array<MessageInfo, kMessageCount> make_infos(std::index_sequence<M...>) {
-    return {MessageInfo{kHeads[M].id, kHeads[M].name, kLaid<M>.summary.crc_extra, kLaid<M>.summary.base_length,
-                        kLaid<M>.summary.length, std::span(kLaid<M>.wire), std::span(kLaid<M>.wire_index_by_decl),
-                        is_typed(kHeads[M].id)}...};
+    return {MessageInfo{kHeads[M].id, kHeads[M].name, kLaid<M>.summary.crc_extra,
+                        kLaid<M>.summary.base_length, kLaid<M>.summary.length, std::span(kLaid<M>.wire),
+                        std::span(kLaid<M>.wire_index_by_decl), is_typed(kHeads[M].id)}...};
 }
 constexpr auto kDialect = make_infos(std::make_index_sequence<kMessageCount>{});
 

@@ -75,6 +75,17 @@ constexpr std::string_view type_name(FieldType t) {
     return "";
 }
 
+// The definition files (messages.def, dialect.def) name the field types as the XML does: uint8_t, not
+// std::uint8_t.
+using std::int16_t;
+using std::int32_t;
+using std::int64_t;
+using std::int8_t;
+using std::uint16_t;
+using std::uint32_t;
+using std::uint64_t;
+using std::uint8_t;
+
 /// FieldTypeOf<T>::value: the wire type of C++ type T (or of an array's elements).
 template <class T>
 struct FieldTypeOf;

@@ -23,15 +23,6 @@
 
 namespace airseg::mavlink {
 
-using std::int16_t;
-using std::int32_t;
-using std::int64_t;
-using std::int8_t;
-using std::uint16_t;
-using std::uint32_t;
-using std::uint64_t;
-using std::uint8_t;
-
 /// Value of the HEARTBEAT mavlink_version field this implementation sends (the common.xml dialect version).
 inline constexpr std::uint8_t kMavlinkDialectVersion = 3;
 
