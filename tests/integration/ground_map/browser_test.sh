@@ -8,46 +8,17 @@
 #   browser_test.sh PATH/TO/airseg-map-fixture
 set -euo pipefail
 fixture=${1:?airseg-map-fixture}
-browser=${CHROMIUM:-$(command -v chromium || command -v chromium-browser || true)}
-if [ -z "$browser" ]; then
-  echo "FAIL: chromium is not installed; install it with: sudo apt-get install chromium libjs-leaflet" >&2
-  exit 1
-fi
-if [ ! -f /usr/share/javascript/leaflet/leaflet.js ]; then
-  echo "FAIL: Leaflet is not installed; install it with: sudo apt-get install libjs-leaflet" >&2
-  exit 1
-fi
+. "$(dirname "$0")/headless_map.sh"
 
-work=$(mktemp -d)
-pids=()
-cleanup() {
-  for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  rm -rf "$work"
-}
-trap cleanup EXIT
-
-# Starts the fixture for $1 seconds (the rest: its options); sets $url and $out (its output).
+# Starts the fixture for $1 seconds (the rest: its options).
 start_fixture() {
-  out=$work/fixture.$RANDOM
-  "$fixture" --seconds "$@" >"$out" 2>&1 &
-  pids+=($!)
-  for _ in $(seq 100); do
-    url=$(sed -n 's/^listening on \(http:[^ ]*\)$/\1/p' "$out")
-    [ -n "$url" ] && return 0
-    sleep 0.1
-  done
-  echo "FAIL: airseg-map-fixture did not start:" >&2
-  cat "$out" >&2
-  exit 1
+  launch_fixture --seconds "$@"
 }
 
 # The page's event stream holds the browser's virtual time until the fixture ends it, so the fixture
 # runs a few seconds (the vehicle moves 10 times a second) and the browser then dumps what it drew.
 run_browser() {
-  timeout 120 "$browser" --headless --no-sandbox --disable-gpu --disable-dev-shm-usage --no-first-run \
-    --user-data-dir="$work/profile.$RANDOM" --window-size=1200,800 --virtual-time-budget=15000 "$@" \
-    2>>"$work/browser.log"
+  headless_browser --window-size=1200,800 --virtual-time-budget=15000 "$@"
 }
 
 # The vehicle's first samples come before a GPS fix (0,0, flagged as no position), as on every bench.
@@ -208,7 +179,6 @@ check "the vehicle marker greyed" "$(grep -q 'airseg-no-fix' "$work/dom-nofix.ht
 # The attack: a page on another origin, opened in the operator's browser, POSTs a command to a map started
 # with control ("no-cors": it cannot read the answer, and needs none). The map must refuse it and say so.
 start_fixture 4 --control
-fixture_out=$out
 attacker=$work/attacker
 mkdir -p "$attacker"
 cat >"$attacker/index.html" <<HTML

@@ -13,15 +13,7 @@
 set -euo pipefail
 fixture=${1:?airseg-map-fixture}
 web_dir=$(cd "$(dirname "$0")/../../../ground/map/web" && pwd)
-browser=${CHROMIUM:-$(command -v chromium || command -v chromium-browser || true)}
-if [ -z "$browser" ]; then
-  echo "FAIL: chromium is not installed; install it with: sudo apt-get install chromium libjs-leaflet" >&2
-  exit 1
-fi
-if [ ! -f /usr/share/javascript/leaflet/leaflet.js ]; then
-  echo "FAIL: Leaflet is not installed; install it with: sudo apt-get install libjs-leaflet" >&2
-  exit 1
-fi
+. "$(dirname "$0")/headless_map.sh"
 keep=${AIRSEG_MAP_SCREENSHOTS:-}
 if [ -n "$keep" ] && [ ! -d "$keep" ]; then
   echo "FAIL: AIRSEG_MAP_SCREENSHOTS=$keep is not a directory" >&2
@@ -30,29 +22,9 @@ fi
 width=1000
 height=700
 
-work=$(mktemp -d)
-pids=()
-cleanup() {
-  for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  rm -rf "$work"
-}
-trap cleanup EXIT
-
-# Starts the fixture for $1 seconds (the rest: its options); sets $url and $fixture_pid.
+# Starts the fixture for $1 seconds (the rest: its options).
 start_fixture() {
-  local out=$work/fixture.$RANDOM
-  "$fixture" --web-dir "$web_dir" --seconds "$@" >"$out" 2>&1 &
-  fixture_pid=$!
-  pids+=($fixture_pid)
-  for _ in $(seq 100); do
-    url=$(sed -n 's/^listening on \(http:[^ ]*\)$/\1/p' "$out")
-    [ -n "$url" ] && return 0
-    sleep 0.1
-  done
-  echo "FAIL: airseg-map-fixture did not start:" >&2
-  cat "$out" >&2
-  exit 1
+  launch_fixture --web-dir "$web_dir" --seconds "$@"
 }
 
 # The page's event stream holds the browser's virtual time until it ends (the page's ?for=S: a snapshot,
@@ -60,9 +32,7 @@ start_fixture() {
 # and the browser dumps (or pictures) what it drew. A held moment gets little (its position stays fresh, the
 # page greys a position 3 s old), the outage enough for its position's age.
 run_browser() {
-  timeout 120 "$browser" --headless --no-sandbox --disable-gpu --disable-dev-shm-usage --no-first-run \
-    --hide-scrollbars --user-data-dir="$work/profile.$RANDOM" --window-size=$width,$height \
-    --virtual-time-budget="$budget" "$@" 2>>"$work/browser.log"
+  headless_browser --hide-scrollbars --window-size=$width,$height --virtual-time-budget="$budget" "$@"
 }
 
 fail=0
