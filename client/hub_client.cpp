@@ -214,7 +214,8 @@ void HubClient::take_json(const nlohmann::json& j) {
     }
 }
 
-LocalAnswer HubClient::request(const nlohmann::json& request, std::chrono::milliseconds timeout) {
+LocalAnswer HubClient::request(const nlohmann::json& request, std::chrono::milliseconds timeout,
+                               const MessageHandler& on_message) {
     LocalAnswer out;
     const std::uint32_t id = next_id_++;
     if (fd_ < 0 ||
@@ -233,6 +234,9 @@ LocalAnswer HubClient::request(const nlohmann::json& request, std::chrono::milli
                 result && result->request_id == id) {
                 out.answer = result->answer;
                 return true;
+            }
+            if (on_message) {
+                on_message(*decoded.message);  // pushed while it waits, as run_for sees it
             }
         }
         return false;

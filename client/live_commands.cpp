@@ -49,22 +49,36 @@ bool drives(std::uint8_t plan_state) {
 }
 
 /// What the vehicle says of its plan (plan.show; with `route`, plan.geometry for the distance left): the
-/// plan's count and element names, so progress and events read "waypoint 4 of 12" as on the map. Blocking:
-/// the link's pushes in the meantime are not seen, so only watch asks it whenever a plan starts.
-groundside::PlanFacts ask_plan(VehicleLink& radio, const LiveOptions& o, bool route) {
-    const auto show = radio.request({{"cmd", "plan.show"}}, o.timeout);
+/// plan's count and element names, so progress and events read "waypoint 4 of 12" as on the map. What the
+/// vehicle pushes while it asks goes to `on_message`, as the live views see it.
+groundside::PlanFacts ask_plan(VehicleLink& radio, const LiveOptions& o, bool route,
+                               const VehicleLink::MessageHandler& on_message) {
+    const auto show = radio.request({{"cmd", "plan.show"}}, o.timeout, on_message);
     if (!show.answer || !show.answer->value("ok", false)) {
         return {};
     }
     nlohmann::json geometry;
     if (route) {
         // Few points: the answer crosses the radio; a longer plan is drawn in part and has no distance left.
-        auto shape = radio.request({{"cmd", "plan.geometry"}, {"max_points", kRoutePoints}}, o.timeout);
+        auto shape =
+            radio.request({{"cmd", "plan.geometry"}, {"max_points", kRoutePoints}}, o.timeout, on_message);
         if (shape.answer && shape.answer->value("ok", false)) {
             geometry = std::move((*shape.answer)["result"]);
         }
     }
     return groundside::plan_facts((*show.answer)["result"], geometry);
+}
+
+/// A message after which the plan's facts are to be asked again: a plan started to drive (`last_state`, the
+/// plan state seen before, none at first), or the vehicle announced another plan over the one that drove.
+bool tells_of_a_new_plan(const proto::Message& m, std::optional<std::uint8_t>& last_state) {
+    if (const auto* t = std::get_if<proto::Telemetry>(&m)) {
+        const bool started = drives(t->plan_state) && !(last_state && drives(*last_state));
+        last_state = t->plan_state;
+        return started;
+    }
+    const auto* e = std::get_if<proto::Event>(&m);
+    return e != nullptr && groundside::announces_plan(e->text);
 }
 
 }  // namespace
@@ -89,17 +103,15 @@ bool stop_requested() {
 int run_radio_watch(VehicleLink& radio, const LiveOptions& o) {
     groundside::WatchState state;
     state.set_debug(o.debug);
-    // The plan's facts are asked again whenever a plan starts to drive (a new one, or the first seen).
-    std::optional<std::uint8_t> asked_for;
+    // The plan's facts are asked again whenever a plan starts to drive (a new one, or the first seen) or
+    // another takes over; the view keeps taking what the vehicle pushes while it asks.
+    std::optional<std::uint8_t> plan_state;
     bool ask = false;
     auto take = [&](const proto::Message& m) {
         state.take(m, Clock::now());
-        if (const auto* t = std::get_if<proto::Telemetry>(&m)) {
-            if (drives(t->plan_state) && !(asked_for && drives(*asked_for))) {
-                state.set_plan({});  // the last plan's facts are not this one's
-                ask = true;
-            }
-            asked_for = t->plan_state;
+        if (tells_of_a_new_plan(m, plan_state)) {
+            state.set_plan({});  // the last plan's facts are not this one's
+            ask = true;
         }
     };
     if (!wait_for_link(radio, o, take)) {
@@ -114,9 +126,12 @@ int run_radio_watch(VehicleLink& radio, const LiveOptions& o) {
     while (g_stop == 0 && !expired(o, started)) {
         const auto next = Clock::now() + o.refresh;
         radio.run_for(o.refresh, take);
-        if (ask) {
-            ask = false;
-            state.set_plan(ask_plan(radio, o, true));
+        while (ask && g_stop == 0) {
+            ask = false;  // set again if another plan is announced while this one is asked for
+            auto facts = ask_plan(radio, o, true, take);
+            if (!ask) {
+                state.set_plan(std::move(facts));
+            }
         }
         // The view is redrawn at its interval only, even over a link that returns early (nothing to wait on).
         std::this_thread::sleep_until(next);
@@ -148,13 +163,12 @@ int run_log(VehicleLink& radio, const LiveOptions& o) {
     // Worded as watch and the map word them: in plan terms, each happening once.
     groundside::EventWording wording;
     std::optional<std::uint8_t> plan_state;  // none before the first sample
-    auto print = [&o, &wording, &plan_state](const proto::Message& m) {
-        if (const auto* t = std::get_if<proto::Telemetry>(&m)) {
-            if (plan_state && !drives(*plan_state) && drives(t->plan_state)) {
-                // A plan started: its count is not known, and no count is better than a wrong one.
-                wording.set_waypoints(std::nullopt);
-            }
-            plan_state = t->plan_state;
+    bool ask = true;                         // the running plan's count: "waypoint 8 of 12 reached"
+    auto print = [&o, &wording, &plan_state, &ask](const proto::Message& m) {
+        if (tells_of_a_new_plan(m, plan_state)) {
+            // No count is better than a wrong one until the new plan's is known.
+            wording.set_waypoints(std::nullopt);
+            ask = true;
         }
         const auto e = wording.take(m, Clock::now());
         if (!e || (e->debug && !o.debug)) {
@@ -174,14 +188,16 @@ int run_log(VehicleLink& radio, const LiveOptions& o) {
     if (!wait_for_link(radio, o, print)) {
         return kNoLink;
     }
-    // The running plan's count, asked once as the log starts ("waypoint 8 of 12 reached"); asking again
-    // later would lose the events pushed meanwhile, so a plan started after it is numbered without "of N".
-    const auto plan = ask_plan(radio, o, false);
-    if (plan.waypoints) {
-        wording.set_waypoints(plan.waypoints);
-    }
     const auto started = Clock::now();
     while (g_stop == 0 && !expired(o, started)) {
+        // Asked while the events go on printing (they are numbered without "of N" until it is known).
+        while (ask && g_stop == 0) {
+            ask = false;
+            const auto plan = ask_plan(radio, o, false, print);
+            if (!ask && plan.waypoints) {
+                wording.set_waypoints(plan.waypoints);
+            }
+        }
         radio.run_for(std::chrono::milliseconds(100), print);
     }
     return kDone;
@@ -191,7 +207,7 @@ int run_joystick(VehicleLink& radio, const LiveOptions& o, const JoystickOptions
     std::string error;
     // The first input is a command: the vehicle acknowledges that this station may drive (a monitor key is
     // refused here, before any stick input is streamed).
-    auto first = radio.request({{"cmd", "joystick"}, {"steering", 0.0}, {"throttle", 0.0}}, o.timeout);
+    auto first = radio.request({{"cmd", "joystick"}, {"steering", 0.0}, {"throttle", 0.0}}, o.timeout, {});
     if (!first.answer) {
         std::cerr << "airsegctl: " << first.error << "\n";
         return kNoLink;

@@ -314,7 +314,7 @@ struct Requester {
     airseg::client::VehicleLink* radio;
     std::chrono::milliseconds timeout;
     airseg::client::LocalAnswer request(const nlohmann::json& r) {
-        return radio ? radio->request(r, timeout) : local.request(r);
+        return radio ? radio->request(r, timeout, {}) : local.request(r);
     }
 };
 

@@ -167,7 +167,15 @@ void MqttClient::on_message(const std::string& topic, const std::string& payload
     }
 }
 
-LocalAnswer MqttClient::request(const Json& request, std::chrono::milliseconds timeout) {
+LocalAnswer MqttClient::request(const Json& request, std::chrono::milliseconds timeout,
+                                const MessageHandler& on_message) {
+    on_message_ = on_message;  // the pushes while it waits, as run_for sees them
+    LocalAnswer out = exchange(request, timeout);
+    on_message_ = nullptr;
+    return out;
+}
+
+LocalAnswer MqttClient::exchange(const Json& request, std::chrono::milliseconds timeout) {
     LocalAnswer out;
     std::random_device rd;
     awaiting_ = fmt::format("{:08x}{:08x}", rd(), rd());

@@ -27,7 +27,8 @@ class MqttClient final : public VehicleLink {
     /// Connects to the broker and subscribes; an error for people (refused: "not authorised") or empty.
     std::string open(std::chrono::milliseconds timeout);
 
-    LocalAnswer request(const nlohmann::json& request, std::chrono::milliseconds timeout) override;
+    LocalAnswer request(const nlohmann::json& request, std::chrono::milliseconds timeout,
+                        const MessageHandler& on_message) override;
     void run_for(std::chrono::milliseconds duration,
                  const std::function<void(const groundlink::protocol::Message&)>& on_message) override;
     nlohmann::json link_stats() const override { return link_; }
@@ -36,6 +37,7 @@ class MqttClient final : public VehicleLink {
     void send_joystick(double, double) override {}
 
   private:
+    LocalAnswer exchange(const nlohmann::json& request, std::chrono::milliseconds timeout);
     void on_message(const std::string& topic, const std::string& payload);
 
     asio::io_context io_;

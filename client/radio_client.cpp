@@ -23,7 +23,15 @@ class RadioClient::Impl {
 
     std::string open() { return end_.open(); }
 
-    LocalAnswer request(const nlohmann::json& req, std::chrono::milliseconds timeout) {
+    LocalAnswer request(const nlohmann::json& req, std::chrono::milliseconds timeout,
+                        const VehicleLink::MessageHandler& on_message) {
+        on_message_ = on_message;  // the pushes while it waits, as run_for sees them
+        LocalAnswer out = exchange(req, timeout);
+        on_message_ = nullptr;
+        return out;
+    }
+
+    LocalAnswer exchange(const nlohmann::json& req, std::chrono::milliseconds timeout) {
         LocalAnswer out;
         const std::uint32_t id = next_id_++;
         std::optional<nlohmann::json> answer;
@@ -119,8 +127,9 @@ RadioClient::~RadioClient() = default;
 std::string RadioClient::open() {
     return impl_->open();
 }
-LocalAnswer RadioClient::request(const nlohmann::json& r, std::chrono::milliseconds t) {
-    return impl_->request(r, t);
+LocalAnswer RadioClient::request(const nlohmann::json& r, std::chrono::milliseconds t,
+                                 const MessageHandler& f) {
+    return impl_->request(r, t, f);
 }
 void RadioClient::run_for(std::chrono::milliseconds d, const std::function<void(const proto::Message&)>& f) {
     impl_->run_for(d, f);

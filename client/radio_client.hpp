@@ -23,7 +23,8 @@ class RadioClient final : public VehicleLink {
     std::string open();
 
     /// Sends one command and waits for its result (the session is set up first if needed).
-    LocalAnswer request(const nlohmann::json& request, std::chrono::milliseconds timeout) override;
+    LocalAnswer request(const nlohmann::json& request, std::chrono::milliseconds timeout,
+                        const MessageHandler& on_message) override;
 
     void run_for(std::chrono::milliseconds duration,
                  const std::function<void(const groundlink::protocol::Message&)>& on_message) override;

@@ -15,12 +15,15 @@ class VehicleLink {
   public:
     virtual ~VehicleLink() = default;
 
-    /// Sends one command and waits for the vehicle's result.
-    virtual LocalAnswer request(const nlohmann::json& request, std::chrono::milliseconds timeout) = 0;
+    using MessageHandler = std::function<void(const groundlink::protocol::Message&)>;
+
+    /// Sends one command and waits for the vehicle's result. What the vehicle pushes meanwhile goes to
+    /// `on_message` as in run_for (a live view that asks keeps its picture whole); nothing is given none.
+    virtual LocalAnswer request(const nlohmann::json& request, std::chrono::milliseconds timeout,
+                                const MessageHandler& on_message) = 0;
 
     /// Runs the link for `duration`, calling `on_message` for each ground-protocol message from the vehicle.
-    virtual void run_for(std::chrono::milliseconds duration,
-                         const std::function<void(const groundlink::protocol::Message&)>& on_message) = 0;
+    virtual void run_for(std::chrono::milliseconds duration, const MessageHandler& on_message) = 0;
 
     /// Link statistics seen from the ground end of the radio link, in the status document's groundlink form.
     virtual nlohmann::json link_stats() const = 0;

@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include "groundside/event_wording.hpp"
+
 namespace airseg::ground {
 
 namespace proto = groundlink::protocol;
@@ -75,6 +77,9 @@ void MapFeed::on_vehicle(const proto::Message& message) {
         }
     } else if (const auto* e = std::get_if<proto::Event>(&message)) {
         map_.add_event(*e);
+        if (groundside::announces_plan(e->text)) {
+            refresh_plan();  // another plan took over the running one: the state alone does not change
+        }
     }
 }
 

@@ -215,6 +215,10 @@ std::string progress_words(const proto::Telemetry& t, const PlanFacts& plan) {
     return out;
 }
 
+bool announces_plan(std::string_view text) {
+    return text.starts_with("plan '") && (text.ends_with("' started") || text.ends_with("' loaded, paused"));
+}
+
 std::string waypoint_words(std::uint64_t index, std::optional<std::uint64_t> waypoints) {
     if (waypoints && index < *waypoints) {
         return fmt::format("waypoint {} of {}", index + 1, *waypoints);
@@ -261,7 +265,10 @@ WordedEvent EventWording::word(const proto::Event& e, Clock::time_point now) {
     if (out.debug) {
         return out;
     }
-    if (const auto index = plan_reached(e.text)) {
+    if (announces_plan(e.text)) {
+        waypoints_.reset();  // another plan: its waypoints are new happenings, its count not yet known
+        last_reached_.reset();
+    } else if (const auto index = plan_reached(e.text)) {
         if (last_reached_ == *index) {
             out.debug = true;  // said already (a redelivery, a second path to the same vehicle)
             return out;

@@ -42,6 +42,10 @@ struct WordedEvent {
 WordedEvent word_event(const groundlink::protocol::Event& e, std::uint8_t plan_state,
                        std::optional<std::uint64_t> waypoints);
 
+/// The vehicle's announcement that another plan drives it ("plan 'north field' started", "plan 'x' loaded,
+/// paused"; groundlink/event_text.hpp): what the ground knew of the last plan is no longer true.
+bool announces_plan(std::string_view text);
+
 /// "waypoint 8 of 12" (index 7, 12 waypoints), "waypoint 8" without a count: the plan's numbering.
 std::string waypoint_words(std::uint64_t index, std::optional<std::uint64_t> waypoints);
 
@@ -82,7 +86,8 @@ class EventWording {
     void set_plan_state(std::uint8_t plan_state);
     /// The plan's waypoint count when known (a new plan: nothing until it is known again).
     void set_waypoints(std::optional<std::uint64_t> waypoints) { waypoints_ = waypoints; }
-    /// Takes the plan state from a telemetry message; events are worded; anything else is ignored.
+    /// Takes the plan state from a telemetry message; events are worded (a plan's announcement forgets the
+    /// count, set_waypoints tells the new one); anything else is ignored.
     std::optional<WordedEvent> take(const groundlink::protocol::Message& m, Clock::time_point now);
     WordedEvent word(const groundlink::protocol::Event& e, Clock::time_point now);
 

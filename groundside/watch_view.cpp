@@ -104,6 +104,9 @@ void WatchState::set_plan(PlanFacts plan) {
 
 void WatchState::take(const proto::Message& message, Clock::time_point now) {
     if (auto worded = wording_.take(message, now)) {
+        if (announces_plan(worded->raw)) {
+            plan_ = {};  // the last plan's facts are not this one's; set_plan tells the new ones
+        }
         if (!worded->debug || debug_) {
             events_.push_back(event_line(*worded, debug_));
             while (events_.size() > kRecentEvents) {

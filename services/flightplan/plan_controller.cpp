@@ -823,9 +823,9 @@ const std::string& PlanController::shown_interruption(const FeederProgress& p) {
 
 void PlanController::publish_status(bool force) {
     const auto p = feeder_.progress();
-    StatusUpdate u{
-        PlanProgress{p.state, top_element_index(p.element), p.next_waypoint.value_or(0), p.waypoints_reached},
-        std::nullopt};
+    StatusUpdate u{PlanProgress{p.state, top_element_index(p.element), p.next_waypoint.value_or(0),
+                                p.waypoints_reached, p.generation, p.plan_name},
+                   std::nullopt};
     auto key = status_key(p);
     if (force || key != last_status_) {
         last_status_ = std::move(key);

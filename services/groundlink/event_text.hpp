@@ -75,6 +75,19 @@ inline std::optional<std::string> plan_reached_text(const flightplan::PlanProgre
     return fmt::format("plan waypoints reached: {} more, next {}", more, after.next_waypoint);
 }
 
+/// "plan 'north field' started" (or "plan 'north field' loaded, paused") when a plan other than the one last
+/// announced drives the vehicle: loaded, or resumed after a restart, even over a plan still running. The
+/// ground's views ask for the new plan's facts on it (groundside::announces_plan); `announced` is the
+/// generation of the plan last announced, none before the first.
+inline std::optional<std::string> plan_started_text(std::optional<std::uint32_t> announced,
+                                                    const flightplan::PlanProgress& now) {
+    if (!plan_drives_mission(now.state) || announced == now.generation) {
+        return std::nullopt;
+    }
+    return fmt::format("plan '{}' {}", now.name,
+                       now.state == flightplan::PlanState::Paused ? "loaded, paused" : "started");
+}
+
 /// The severity of an autopilot status text. MAV_SEVERITY 0..3 (emergency..error) is an error, except the
 /// boot notices ArduPilot sends at CRITICAL or ALERT on every power-up (the sensor calibration, "Initialising
 /// APM..."): routine, so info; a calibration that failed stays an error.

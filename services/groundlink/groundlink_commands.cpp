@@ -130,6 +130,12 @@ void GroundlinkService::subscribe_bus() {
                     send_event(Sev::Info, *text);
                 }
             }
+            if (auto text = plan_started_text(announced_plan_, p)) {
+                send_event(Sev::Info, *text);
+            }
+            if (plan_drives_mission(p.state)) {
+                announced_plan_ = p.generation;
+            }
             plan_progress_ = p;
             plan_ = PlanProgressSample{
                 static_cast<std::uint8_t>(p.state),

@@ -114,6 +114,7 @@ class GroundlinkService : public Service {
     std::optional<autopilot::Telemetry> vehicle_;
     PlanProgressSample plan_;
     std::optional<flightplan::PlanProgress> plan_progress_;  // the last, for the plan's own events
+    std::optional<std::uint32_t> announced_plan_;            // the generation of the plan last announced
     std::uint64_t events_folded_ = 0;  // slot events and window texts not sent while a plan drives
     std::vector<Subscription> subscriptions_;
     bool commands_registered_ = false;

@@ -12,10 +12,12 @@
 #include <unistd.h>
 #include <map>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -297,6 +299,69 @@ TEST_F(GroundControlE2e, APlanLoadedOverTheRadioIsDrivenPausedResumedAndSkipped)
     }
     const auto folded = status_doc()["groundlink"].value("events_folded", 0);
     EXPECT_GT(folded, 0) << "the board's slot events and texts are counted";
+}
+
+// Another plan loaded over the running one (here on the board's own socket) leaves the plan "running": the
+// vehicle announces it, and `log` over the radio says so, asks for the new plan's count while the events go
+// on, and numbers the new plan's waypoints "of" its own count, never the last plan's.
+TEST_F(GroundControlE2e, AnotherPlanOverTheRunningOneIsAnnouncedAndLogCountsItsWaypoints) {
+    start_link();
+    start_sim({"--speedup", "4"});
+    start_daemon();
+    ASSERT_TRUE(
+        wait_until([&] { return status_doc().value("autopilot", Json::object()).value("ready", false); },
+                   kGenerous, 500ms))
+        << daemon->err();
+    const auto zigzag = [&](const std::string& name, int legs, double lat_offset) {
+        const std::string path = dir.file(name + ".yaml");
+        std::string elements;
+        for (int i = 1; i <= legs; ++i) {
+            elements += "    - waypoint: {lat: " + std::to_string(kHomeLat + lat_offset + 0.00008 * (i % 2)) +
+                        ", lon: " + std::to_string(kHomeLon + 0.0001 * i) + "}\n";
+        }
+        write_file(path, "plan:\n  name: " + name + "\n  vehicle: {type: rover}\n  elements:\n" + elements);
+        return path;
+    };
+    auto first = ctl({"plan", "load", zigzag("long-one", 24, 0)});
+    ASSERT_EQ(first.exit_code, 0) << first.out << first.err << "\ndaemon:\n" << daemon->err();
+
+    Subprocess log({binary("client/airsegctl"), "--link", ground(), "--json", "log", "--duration", "120000"},
+                   {}, dir.path());
+    const auto texts = [&] {
+        std::vector<std::string> out;
+        for (const auto& e : json_lines(log.out())) {
+            out.push_back(e.value("text", ""));
+        }
+        return out;
+    };
+    const auto has = [&](const std::function<bool(const std::string&)>& pred) {
+        const auto t = texts();
+        return std::find_if(t.begin(), t.end(), pred) != t.end();
+    };
+    ASSERT_TRUE(wait_until([&] { return has([](const auto& t) { return t.ends_with(" of 24 reached"); }); },
+                           kGenerous, 500ms))
+        << "the running plan's count, asked as the log starts:\n"
+        << log.out() << log.err();
+
+    const auto second = run({binary("client/airsegctl"), "--local", "--socket", dir.file("status.sock"),
+                             "--json", "plan", "load", zigzag("short-one", 10, 0.00004)});
+    ASSERT_EQ(second.exit_code, 0) << second.out << second.err;
+    EXPECT_TRUE(wait_until([&] { return has([](const auto& t) { return t.ends_with(" of 10 reached"); }); },
+                           kGenerous, 500ms))
+        << "the new plan's count, asked when it was announced:\n"
+        << log.out() << log.err();
+    log.signal(SIGTERM);
+    ASSERT_TRUE(log.wait_exit(kGenerous));
+
+    const auto all = texts();
+    const auto announced = std::find(all.begin(), all.end(), "plan 'short-one' started");
+    ASSERT_NE(announced, all.end()) << log.out();
+    EXPECT_EQ(std::count(all.begin(), all.end(), "plan 'short-one' started"), 1) << log.out();
+    for (auto it = announced; it != all.end(); ++it) {
+        EXPECT_FALSE(it->ends_with(" of 24 reached"))
+            << "the last plan's count after the new one began: " << *it << "\n"
+            << log.out();
+    }
 }
 
 TEST_F(GroundControlE2e, AMonitorKeyWatchesButItsCommandsAreRefused) {

@@ -77,5 +77,27 @@ TEST(EventText, WhileAPlanDrivesWaypointsAreNamedInPlanTermsOnce) {
     EXPECT_FALSE(plan_reached_text(before, {PlanState::Running, 0, 0, 0})) << "a new plan starts again";
 }
 
+// A plan that takes over (loaded, over a running one too, or resumed after a restart) is announced once; the
+// same plan paused and resumed, or one that ended, is not.
+TEST(EventText, APlanThatTakesOverIsAnnouncedOnce) {
+    using flightplan::PlanProgress;
+    using flightplan::PlanState;
+    const PlanProgress first{PlanState::Running, 0, 0, 0, 3, "north field"};
+    EXPECT_EQ(plan_started_text(std::nullopt, first), "plan 'north field' started");
+    EXPECT_FALSE(plan_started_text(3, first)) << "announced already";
+    auto paused = first;
+    paused.state = PlanState::Paused;
+    EXPECT_FALSE(plan_started_text(3, paused)) << "the same plan paused";
+    const PlanProgress second{PlanState::Running, 0, 0, 0, 4, "south"};
+    EXPECT_EQ(plan_started_text(3, second), "plan 'south' started") << "over the running one";
+    const PlanProgress waiting{PlanState::Paused, 0, 0, 0, 5, "later"};
+    EXPECT_EQ(plan_started_text(4, waiting), "plan 'later' loaded, paused");
+    const PlanProgress cleared{PlanState::None, 0, 0, 0, 6, ""};
+    EXPECT_FALSE(plan_started_text(5, cleared)) << "no plan drives";
+    auto done = second;
+    done.state = PlanState::Done;
+    EXPECT_FALSE(plan_started_text(3, done));
+}
+
 }  // namespace
 }  // namespace airseg::groundlink

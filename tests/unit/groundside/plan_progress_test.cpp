@@ -172,5 +172,32 @@ TEST(WatchView, SaysThePlansProgressAndItsEventsOfN) {
     EXPECT_FALSE(w.to_json(t0)["vehicle"].contains("plan"));
 }
 
+// Another plan over the running one leaves the state "running": only the vehicle's announcement says the
+// facts held are the last plan's.
+TEST(WatchView, AnotherPlansAnnouncementForgetsTheLastPlansFacts) {
+    EXPECT_TRUE(announces_plan("plan 'north field' started"));
+    EXPECT_TRUE(announces_plan("plan 'x' loaded, paused"));
+    EXPECT_FALSE(announces_plan("plan waypoint 4 reached"));
+    EXPECT_FALSE(announces_plan("plan 'x' done"));
+    EXPECT_FALSE(announces_plan("autopilot: plan 'x' started by a text"));
+
+    WatchState w;
+    const auto t0 = WatchState::Clock::now();
+    w.take(mid_scan(), t0);
+    w.set_plan(plan_facts(show_answer(), geometry_answer()));
+    w.take(proto::Event{proto::Event::Severity::Info, "plan waypoint 5 reached"}, t0);
+    ASSERT_EQ(w.plan().waypoints, 14u);
+    w.take(proto::Event{proto::Event::Severity::Info, "plan 'second' started"}, t0);
+    EXPECT_FALSE(w.plan().waypoints) << "the count was the last plan's";
+    EXPECT_TRUE(w.plan().top.empty());
+    w.take(proto::Event{proto::Event::Severity::Info, "plan waypoint 5 reached"}, t0);
+    const auto screen = w.render(t0);
+    EXPECT_NE(screen.find("info: plan 'second' started\n"), std::string::npos) << screen;
+    EXPECT_NE(screen.find("progress    running — waypoint 6\n"), std::string::npos) << "no count: " << screen;
+    EXPECT_NE(screen.rfind("info: waypoint 6 reached\n"), std::string::npos)
+        << "the same index in the new plan is a new happening, without the old count\n"
+        << screen;
+}
+
 }  // namespace
 }  // namespace airseg::groundside
