@@ -1,412 +1,65 @@
 #include "ground/station_endpoint.hpp"
 
-#include <spdlog/spdlog.h>
-
-#include <algorithm>
-#include <array>
-#include <deque>
 #include <map>
-
-#include "hal/udp_socket.hpp"
-#include "services/autopilot/mavlink/encoder.hpp"
-#include "services/autopilot/mavlink/parser.hpp"
-#include "services/common/limited_log.hpp"
 
 namespace airseg::ground {
 
-namespace mav = airseg::mavlink;
-using Tcp = asio::ip::tcp;
-
-namespace {
-
-constexpr auto kAcceptRetry = std::chrono::milliseconds(100);
-
-/// "ADDRESS:PORT" split (the configuration is validated before: GcsEndpointConfig::validate()).
-std::pair<std::string, std::uint16_t> split(const std::string& text) {
-    const auto colon = text.rfind(':');
-    return {text.substr(0, colon), static_cast<std::uint16_t>(std::stoul(text.substr(colon + 1)))};
-}
-
-/// The size of the frame starting at `bytes[at]` (our own re-encoded frames: unsigned), or 0.
-std::size_t frame_size(std::span<const std::uint8_t> bytes, std::size_t at) {
-    if (at + 2 > bytes.size()) {
-        return 0;
-    }
-    const std::size_t payload = bytes[at + 1];
-    const std::size_t size = bytes[at] == mav::kMagicV2
-                                 ? mav::kHeaderLengthV2 + payload + mav::kChecksumLength +
-                                       ((bytes.size() > at + 2 && (bytes[at + 2] & mav::kIncompatSigned) != 0)
-                                            ? mav::kSignatureLength
-                                            : 0)
-                                 : mav::kHeaderLengthV1 + payload + mav::kChecksumLength;
-    return std::min(size, bytes.size() - at);
-}
-
-}  // namespace
-
-class StationEndpoint::Impl : public std::enable_shared_from_this<Impl> {
-  public:
-    Impl(asio::any_io_executor strand, autopilot::GcsEndpointConfig config, FromStation from_station)
-        : strand_(strand),
-          config_(std::move(config)),
-          from_station_(std::move(from_station)),
-          udp_(strand),
-          acceptor_(strand),
-          retry_(strand) {}
-
-    std::string start() {
-        if (auto problems = config_.validate(); !problems.empty()) {
-            return "ground stations: " + problems.front();
-        }
-        running_ = true;
-        if (!config_.udp.empty()) {
-            const auto [host, port] = split(config_.udp);
-            hal::UdpConfig u;
-            u.bind_address = host;
-            u.bind_port = port;
-            if (auto r = udp_.open(u); !r.ok()) {
-                stop();
-                return "ground stations: " + r.message;
-            }
-            if (!config_.udp_remote.empty()) {
-                const auto [rhost, rport] = split(config_.udp_remote);
-                const hal::UdpSocket::Endpoint remote(asio::ip::make_address(rhost), rport);
-                Peer& fixed = peers_[remote];
-                fixed.id = next_station_++;
-                fixed.fixed = true;
-            }
-            udp_.start_receiving(
-                [weak = weak_from_this()](std::span<const std::uint8_t> d,
-                                          const hal::UdpSocket::Endpoint& from) {
-                    if (auto self = weak.lock()) {
-                        self->on_datagram(d, from);
-                    }
-                },
-                [](std::error_code, const std::string& what) { spdlog::warn("ground stations: {}", what); });
-        }
-        if (!config_.tcp.empty()) {
-            const auto [host, port] = split(config_.tcp);
-            const Tcp::endpoint at(asio::ip::make_address(host), port);
-            boost::system::error_code ec;
-            acceptor_.open(at.protocol(), ec);
-            if (!ec) {
-                acceptor_.set_option(Tcp::acceptor::reuse_address(true), ec);
-                acceptor_.bind(at, ec);
-            }
-            if (!ec) {
-                acceptor_.listen(asio::socket_base::max_listen_connections, ec);
-            }
-            if (ec) {
-                stop();
-                return "ground stations: cannot listen on tcp " + config_.tcp + ": " + ec.message();
-            }
-            accept();
-        }
-        return {};
-    }
-
-    void stop() {
-        running_ = false;
-        udp_.close();
-        boost::system::error_code ignored;
-        acceptor_.close(ignored);
-        retry_.cancel();
-        for (auto& [id, client] : clients_) {
-            client->socket.close(ignored);
-        }
-        clients_.clear();
-        peers_.clear();
-    }
-
-    void from_vehicle(const std::vector<VehicleFrame>& frames) {
-        if (!running_ || frames.empty()) {
-            return;
-        }
-        expire_peers();
-        std::vector<StationId> stations;
-        for (const auto& [at, peer] : peers_) {
-            stations.push_back(peer.id);
-        }
-        for (const auto& [id, client] : clients_) {
-            stations.push_back(id);
-        }
-        std::map<StationId, std::vector<std::uint8_t>> out;
-        for (const auto& f : frames) {
-            for (const auto station : router_.destinations(f.target, stations)) {
-                auto& bytes = out[station];
-                bytes.insert(bytes.end(), f.bytes.begin(), f.bytes.end());
-            }
-        }
-        for (const auto& [station, bytes] : out) {
-            to_station(station, bytes);
-        }
-    }
-
-    void to_station(StationId station, std::span<const std::uint8_t> frames) {
-        if (!running_ || frames.empty()) {
-            return;
-        }
-        if (auto client = clients_.find(station); client != clients_.end()) {
-            send_tcp(client->second, frames);
-            return;
-        }
-        for (const auto& [at, peer] : peers_) {
-            if (peer.id == station) {
-                send_udp(frames, at);
-                return;
-            }
-        }
-    }
-
-    std::uint16_t udp_port() const { return udp_.is_open() ? udp_.local_endpoint().port() : 0; }
-    std::uint16_t tcp_port() const {
-        boost::system::error_code ec;
-        return acceptor_.is_open() ? acceptor_.local_endpoint(ec).port() : 0;
-    }
-    StationEndpointStats stats() const {
-        StationEndpointStats s{io_, router_.stats()};
-        s.io.udp_peers = peers_.size();
-        s.io.tcp_clients = clients_.size();
-        return s;
-    }
-
-  private:
-    struct Peer {
-        StationId id = 0;
-        mav::Parser parser;
-        TimePoint last_heard{};
-        bool fixed = false;  // the configured destination: never forgotten
-    };
-    struct Client {
-        explicit Client(asio::any_io_executor ex) : socket(ex) {}
-        Tcp::socket socket;
-        mav::Parser parser;
-        std::array<std::uint8_t, 2048> buffer{};
-        std::deque<std::vector<std::uint8_t>> queue;
-        std::size_t backlog = 0;
-        bool writing = false;
-    };
-
-    void expire_peers() {
-        const auto now = SteadyClock::now();
-        for (auto it = peers_.begin(); it != peers_.end();) {
-            if (!it->second.fixed && now - it->second.last_heard > kPeerTimeout) {
-                router_.forget(it->second.id);
-                it = peers_.erase(it);
-            } else {
-                ++it;
-            }
-        }
-    }
-
-    /// Whole frames in datagrams of at most kMaxDatagram bytes (one longer frame alone).
-    void send_udp(std::span<const std::uint8_t> frames, const hal::UdpSocket::Endpoint& to) {
-        std::size_t begin = 0;
-        while (begin < frames.size()) {
-            std::size_t end = begin;
-            while (end < frames.size()) {
-                const auto size = frame_size(frames, end);
-                if (size == 0 || (end > begin && end + size - begin > kMaxDatagram)) {
-                    break;
-                }
-                end += size;
-            }
-            if (end == begin) {
-                end = frames.size();  // not a frame we can measure: as it is
-            }
-            if (udp_.send_to({frames.begin() + static_cast<std::ptrdiff_t>(begin),
-                              frames.begin() + static_cast<std::ptrdiff_t>(end)},
-                             to) == hal::WriteResult::Queued) {
-                io_.bytes_out += end - begin;
-            } else {
-                ++io_.dropped_out;
-            }
-            begin = end;
-        }
-    }
-
-    void send_tcp(const std::shared_ptr<Client>& client, std::span<const std::uint8_t> frames) {
-        if (client->backlog + frames.size() > kMaxTcpBacklog) {
-            ++io_.dropped_out;
-            return;
-        }
-        client->queue.emplace_back(frames.begin(), frames.end());
-        client->backlog += frames.size();
-        io_.bytes_out += frames.size();
-        if (!client->writing) {
-            write(client);
-        }
-    }
-
-    /// The valid frames of `bytes` from `station`, each learnt by the router; counts the rest.
-    std::vector<StationFrame> valid_frames(StationId station, mav::Parser& parser,
-                                           std::span<const std::uint8_t> bytes) {
-        std::vector<StationFrame> out;
-        const auto damaged_before = parser.stats().bad_checksum + parser.stats().truncated;
-        parser.push(bytes, [&](const mav::Frame& f) {
-            auto frame = f.checksum_verified ? mav::reencode(f) : std::vector<std::uint8_t>{};
-            if (frame.empty()) {
-                ++io_.invalid_in;
-                return;
-            }
-            ++io_.frames_in;
-            router_.heard(station, f.sysid, f.compid);
-            out.push_back(StationFrame{f, std::move(frame)});
-        });
-        io_.invalid_in += parser.stats().bad_checksum + parser.stats().truncated - damaged_before;
-        return out;
-    }
-
-    void on_datagram(std::span<const std::uint8_t> datagram, const hal::UdpSocket::Endpoint& from) {
-        if (!running_) {
-            return;
-        }
-        auto it = peers_.find(from);
-        if (it == peers_.end()) {
-            if (peers_.size() >= kMaxUdpPeers) {
-                auto stalest = peers_.end();
-                for (auto p = peers_.begin(); p != peers_.end(); ++p) {
-                    if (!p->second.fixed &&
-                        (stalest == peers_.end() || p->second.last_heard < stalest->second.last_heard)) {
-                        stalest = p;
-                    }
-                }
-                if (stalest != peers_.end()) {
-                    router_.forget(stalest->second.id);
-                    peers_.erase(stalest);
-                    ++io_.udp_peers_evicted;
-                }
-            }
-            it = peers_.try_emplace(from).first;
-            it->second.id = next_station_++;
-        }
-        Peer& peer = it->second;
-        peer.last_heard = SteadyClock::now();
-        pass_on(peer.id, valid_frames(peer.id, peer.parser, datagram));
-    }
-
-    void pass_on(StationId station, std::vector<StationFrame> frames) {
-        if (!frames.empty() && from_station_) {
-            from_station_(station, std::move(frames));
-        }
-    }
-
-    void accept() {
-        auto client = std::make_shared<Client>(strand_);
-        acceptor_.async_accept(
-            client->socket, [self = shared_from_this(), client](boost::system::error_code ec) {
-                if (ec || !self->running_) {
-                    if (ec != asio::error::operation_aborted && self->running_) {
-                        self->log_.log("ground stations: accept", SteadyClock::now(), spdlog::level::warn,
-                                       "ground stations: accept: {}", ec.message());
-                        self->retry_.expires_after(kAcceptRetry);
-                        self->retry_.async_wait([self](boost::system::error_code e) {
-                            if (!e && self->running_) {
-                                self->accept();
-                            }
-                        });
-                    }
-                    return;
-                }
-                if (self->clients_.size() >= kMaxTcpClients) {
-                    ++self->io_.tcp_refused;
-                    self->log_.log(
-                        "ground stations: refused a tcp client", SteadyClock::now(), spdlog::level::warn,
-                        "ground stations: refused a tcp client: {} already connected", kMaxTcpClients);
-                    boost::system::error_code ignored;
-                    client->socket.close(ignored);
-                    self->accept();
-                    return;
-                }
-                boost::system::error_code ignored;
-                client->socket.set_option(Tcp::no_delay(true), ignored);
-                const auto id = self->next_station_++;
-                self->clients_.emplace(id, client);
-                self->read(id, client);
-                self->accept();
-            });
-    }
-
-    void read(StationId id, const std::shared_ptr<Client>& client) {
-        client->socket.async_read_some(
-            asio::buffer(client->buffer),
-            [self = shared_from_this(), id, client](boost::system::error_code ec, std::size_t n) {
-                if (ec || !self->running_) {
-                    self->drop(id);
-                    return;
-                }
-                self->pass_on(id, self->valid_frames(id, client->parser, std::span(client->buffer).first(n)));
-                self->read(id, client);
-            });
-    }
-
-    void write(const std::shared_ptr<Client>& client) {
-        client->writing = true;
-        asio::async_write(client->socket, asio::buffer(client->queue.front()),
-                          [self = shared_from_this(), client](boost::system::error_code ec, std::size_t) {
-                              client->writing = false;
-                              if (ec) {
-                                  return;  // the read side notices and drops the client
-                              }
-                              client->backlog -= client->queue.front().size();
-                              client->queue.pop_front();
-                              if (!client->queue.empty()) {
-                                  self->write(client);
-                              }
-                          });
-    }
-
-    void drop(StationId id) {
-        if (auto it = clients_.find(id); it != clients_.end()) {
-            boost::system::error_code ignored;
-            it->second->socket.close(ignored);
-            clients_.erase(it);
-        }
-        router_.forget(id);
-    }
-
-    asio::any_io_executor strand_;
-    autopilot::GcsEndpointConfig config_;
-    FromStation from_station_;
-    hal::UdpSocket udp_;
-    Tcp::acceptor acceptor_;
-    asio::steady_timer retry_;
-    LimitedLog log_;
-    std::map<hal::UdpSocket::Endpoint, Peer> peers_;
-    std::map<StationId, std::shared_ptr<Client>> clients_;
-    StationId next_station_ = 1;
-    MavlinkRouter router_;
-    autopilot::GcsEndpointStats io_;
-    bool running_ = false;
-};
-
 StationEndpoint::StationEndpoint(asio::any_io_executor strand, autopilot::GcsEndpointConfig config,
                                  FromStation from_station)
-    : impl_(std::make_shared<Impl>(std::move(strand), std::move(config), std::move(from_station))) {}
+    : from_station_(std::move(from_station)),
+      sockets_(std::move(strand), std::move(config), "ground stations", kMaxTcpBacklog,
+               {[this](StationId station, std::vector<StationFrame> frames) {
+                    for (const auto& f : frames) {
+                        router_.heard(station, f.frame.sysid, f.frame.compid);
+                    }
+                    if (from_station_) {
+                        from_station_(station, std::move(frames));
+                    }
+                },
+                [this](StationId station) { router_.forget(station); }}) {}
 
+// The sockets call nothing once stopped, so the handlers' `this` never outlives the endpoint.
 StationEndpoint::~StationEndpoint() {
-    impl_->stop();
+    sockets_.stop();
 }
+
 std::string StationEndpoint::start() {
-    return impl_->start();
+    return sockets_.start();
 }
+
 void StationEndpoint::stop() {
-    impl_->stop();
+    sockets_.stop();
 }
+
 void StationEndpoint::from_vehicle(const std::vector<VehicleFrame>& frames) {
-    impl_->from_vehicle(frames);
+    if (frames.empty()) {
+        return;
+    }
+    const auto stations = sockets_.stations();
+    std::map<StationId, std::vector<std::uint8_t>> out;
+    for (const auto& f : frames) {
+        for (const auto station : router_.destinations(f.target, stations)) {
+            auto& bytes = out[station];
+            bytes.insert(bytes.end(), f.bytes.begin(), f.bytes.end());
+        }
+    }
+    for (const auto& [station, bytes] : out) {
+        sockets_.send(station, bytes);
+    }
 }
+
 void StationEndpoint::to_station(StationId station, std::span<const std::uint8_t> frames) {
-    impl_->to_station(station, frames);
+    sockets_.send(station, frames);
 }
+
 std::uint16_t StationEndpoint::udp_port() const {
-    return impl_->udp_port();
+    return sockets_.udp_port();
 }
 std::uint16_t StationEndpoint::tcp_port() const {
-    return impl_->tcp_port();
+    return sockets_.tcp_port();
 }
 StationEndpointStats StationEndpoint::stats() const {
-    return impl_->stats();
+    return StationEndpointStats{sockets_.stats(), router_.stats()};
 }
 
 }  // namespace airseg::ground

@@ -1,13 +1,12 @@
 #pragma once
 // StationEndpoint: the hub's MAVLink endpoint for standard ground stations (QGroundControl, Mission Planner,
-// MAVProxy) on UDP (every peer heard, plus an optional fixed destination) and TCP (any number of clients),
-// with routing as mavlink-router does it (MavlinkRouter): each station is learnt from the frames it sends,
-// and a frame from the vehicle addressed to a system and component goes only to the stations that sent as
-// it. Bytes from a station go through the project's MAVLink parser (one per station), so only whole valid
-// frames of known messages are passed on, each datagram's or read's frames in one call.
+// MAVProxy) on the sockets the daemon's endpoint stands on too (autopilot::StationSockets: UDP peers and a
+// fixed destination, TCP clients, each station's valid frames in one call), with routing as mavlink-router
+// does it (MavlinkRouter): each station is learnt from the frames it sends, and a frame from the vehicle
+// addressed to a system and component goes only to the stations that sent as it.
 //
 // Threading: build it with a strand and call every member from that strand; the callback runs there too.
-// The sockets' handlers keep what they need alive, so it may be destroyed after stop() at any time.
+// It may be destroyed after stop() at any time.
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -17,17 +16,13 @@
 #include <vector>
 
 #include "ground/mavlink_router.hpp"
-#include "services/autopilot/gcs_endpoint.hpp"
-#include "services/autopilot/mavlink/frame.hpp"
+#include "services/autopilot/gcs_endpoint_config.hpp"
+#include "services/autopilot/station_sockets.hpp"
 #include "services/common/asio.hpp"
 
 namespace airseg::ground {
 
-/// A valid frame from a ground station: as parsed, and its bytes (re-encoded, unsigned).
-struct StationFrame {
-    mavlink::Frame frame;
-    std::vector<std::uint8_t> bytes;
-};
+using autopilot::StationFrame;
 
 /// A frame from the vehicle, for routing: its addressee and its bytes.
 struct VehicleFrame {
@@ -43,12 +38,11 @@ struct StationEndpointStats {
 class StationEndpoint {
   public:
     using FromStation = std::function<void(StationId station, std::vector<StationFrame> frames)>;
-    static constexpr auto kPeerTimeout = autopilot::GcsEndpoint::kPeerTimeout;
+    static constexpr auto kPeerTimeout = autopilot::StationSockets::kPeerTimeout;
     static constexpr std::size_t kMaxTcpBacklog = 256 * 1024;  // a parameter list from the cache fits
-    static constexpr std::size_t kMaxUdpPeers = autopilot::GcsEndpoint::kMaxUdpPeers;
-    static constexpr std::size_t kMaxTcpClients = autopilot::GcsEndpoint::kMaxTcpClients;
-    /// A UDP datagram carries whole frames up to this many bytes (one longer frame alone).
-    static constexpr std::size_t kMaxDatagram = 1400;
+    static constexpr std::size_t kMaxUdpPeers = autopilot::StationSockets::kMaxUdpPeers;
+    static constexpr std::size_t kMaxTcpClients = autopilot::StationSockets::kMaxTcpClients;
+    static constexpr std::size_t kMaxDatagram = autopilot::StationSockets::kMaxDatagram;
 
     StationEndpoint(asio::any_io_executor strand, autopilot::GcsEndpointConfig config,
                     FromStation from_station);
@@ -66,10 +60,10 @@ class StationEndpoint {
     std::uint16_t tcp_port() const;
     StationEndpointStats stats() const;
 
-    class Impl;
-
   private:
-    std::shared_ptr<Impl> impl_;
+    FromStation from_station_;
+    MavlinkRouter router_;
+    autopilot::StationSockets sockets_;  // last: its handlers use the router
 };
 
 }  // namespace airseg::ground
