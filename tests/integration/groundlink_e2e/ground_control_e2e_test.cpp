@@ -113,6 +113,17 @@ class GroundControlE2e : public ::testing::Test {
         daemon = std::make_unique<Subprocess>(args, std::map<std::string, std::string>{}, dir.path());
     }
 
+    /// The link, the simulated rover at speedup 4 and the daemon, until the daemon says the autopilot is ready.
+    void start_ready_vehicle() {
+        start_link();
+        start_sim({"--speedup", "4"});
+        start_daemon();
+        ASSERT_TRUE(
+            wait_until([&] { return status_doc().value("autopilot", Json::object()).value("ready", false); },
+                       kGenerous, 500ms))
+            << daemon->err();
+    }
+
     /// airsegctl over the radio; `key` empty = unkeyed link.
     RunResult ctl(std::vector<std::string> args, const std::string& key = {}, long timeout_ms = 30'000) {
         std::vector<std::string> argv{binary("client/airsegctl"), "--link", ground(), "--timeout",
@@ -202,13 +213,10 @@ TEST_F(GroundControlE2e, StatusAndPushedTelemetryOverTheRadio) {
 // 25 s at speedup 4, where a 12-point plan could end before a slow client's watch did (its last sample then
 // said "done", next_waypoint 0).
 TEST_F(GroundControlE2e, APlanLoadedOverTheRadioIsDrivenPausedResumedAndSkipped) {
-    start_link();
-    start_sim({"--speedup", "4"});
-    start_daemon();
-    ASSERT_TRUE(
-        wait_until([&] { return status_doc().value("autopilot", Json::object()).value("ready", false); },
-                   kGenerous, 500ms))
-        << daemon->err();
+    start_ready_vehicle();
+    if (HasFatalFailure()) {
+        return;
+    }
     const std::string plan = dir.file("square.yaml");
     std::string elements;
     for (int i = 1; i <= 24; ++i) {
@@ -305,13 +313,10 @@ TEST_F(GroundControlE2e, APlanLoadedOverTheRadioIsDrivenPausedResumedAndSkipped)
 // vehicle announces it, and `log` over the radio says so, asks for the new plan's count while the events go
 // on, and numbers the new plan's waypoints "of" its own count, never the last plan's.
 TEST_F(GroundControlE2e, AnotherPlanOverTheRunningOneIsAnnouncedAndLogCountsItsWaypoints) {
-    start_link();
-    start_sim({"--speedup", "4"});
-    start_daemon();
-    ASSERT_TRUE(
-        wait_until([&] { return status_doc().value("autopilot", Json::object()).value("ready", false); },
-                   kGenerous, 500ms))
-        << daemon->err();
+    start_ready_vehicle();
+    if (HasFatalFailure()) {
+        return;
+    }
     const auto zigzag = [&](const std::string& name, int legs, double lat_offset) {
         const std::string path = dir.file(name + ".yaml");
         std::string elements;
