@@ -58,7 +58,8 @@ nlohmann::json autopilot_status_json(const autopilot::AutopilotStatus& s) {
         {"last", s.refused_value.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.refused_value)}};
     j["params"] = {
         {"cached", s.params_cached}, {"announced", s.params_announced}, {"dropped", s.params_dropped}};
-    auto& stations = j["ground_stations"] = {{"missions_too_large", s.gcs_missions_too_large}};
+    auto& stations = j["ground_stations"] = {{"missions_too_large", s.gcs_missions_too_large},
+                                             {"to_airsegd_kept", s.gcs_to_airsegd_kept}};
     if (s.gcs_endpoint) {
         stations["udp_peers"] = s.gcs_udp_peers;
         stations["tcp_clients"] = s.gcs_tcp_clients;

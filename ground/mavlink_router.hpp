@@ -13,10 +13,13 @@
 #include <span>
 #include <vector>
 
-#include "ground/mavlink_target.hpp"
+#include "services/autopilot/mavlink/target.hpp"
 
 namespace airseg::ground {
 
+using mavlink::frame_target;
+using mavlink::FrameTarget;
+using mavlink::target_offsets;
 using StationId = std::uint64_t;
 
 struct MavlinkRouterStats {

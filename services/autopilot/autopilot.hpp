@@ -268,6 +268,9 @@ struct AutopilotStatus {
     // autopilot.ground_stations (filled by the service): mission uploads refused for their size, and with the
     // MAVLink endpoint on, its UDP peers and TCP clients now, peers forgotten to make room, clients refused
     std::uint64_t gcs_missions_too_large = 0;
+    // The autopilot's frames addressed to airsegd itself (its mission and command traffic): kept from every
+    // ground station, the endpoint's and the radio's, as mavlink-router keeps them.
+    std::uint64_t gcs_to_airsegd_kept = 0;
     bool gcs_endpoint = false;
     std::size_t gcs_udp_peers = 0;
     std::size_t gcs_tcp_clients = 0;

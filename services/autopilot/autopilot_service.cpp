@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "hal/gpio_pulse.hpp"
+#include "services/autopilot/mavlink/target.hpp"
 
 namespace airseg::autopilot {
 
@@ -59,6 +60,10 @@ AutopilotService::AutopilotService(ServiceContext& ctx, AutopilotServiceConfig c
                 tlog_.record(frame, std::chrono::system_clock::now(), SteadyClock::now());
             }
             if (!outgoing && running_) {
+                if (addressed_to_airsegd(frame)) {
+                    ++to_airsegd_kept_;  // the autopilot's answer to airsegd is no station's business
+                    return;
+                }
                 to_ground_stations(forwarded(frame));
             }
         });
@@ -140,6 +145,12 @@ void AutopilotService::from_ground_station(std::span<const std::uint8_t> frames)
         }
         keeper_.write(std::move(frame));
     }
+}
+
+bool AutopilotService::addressed_to_airsegd(std::span<const std::uint8_t> frame) const {
+    const auto target = mavlink::frame_target(frame);
+    return target && target->system == config_.autopilot.own_sysid &&
+           target->component == config_.autopilot.own_compid;
 }
 
 // The endpoint's ground stations are on the board's network: they get every frame, unthrottled.
@@ -337,6 +348,7 @@ void AutopilotService::publish_status() {
     s.tlog_dropped_frames = tlog_.stats().dropped_frames;
     s.tlog_error = tlog_.stats().last_error;
     s.gcs_missions_too_large = uploads_.refused_too_large();
+    s.gcs_to_airsegd_kept = to_airsegd_kept_;
     if (endpoint_) {
         const auto e = endpoint_->stats();
         s.gcs_endpoint = true;

@@ -75,6 +75,8 @@ class AutopilotService : public Service {
     void update_health();
     void from_ground_station(std::span<const std::uint8_t> frames);
     void to_ground_stations(const ForwardedFrame& frame);
+    /// A frame of the autopilot's addressed to airsegd itself (its own sysid and compid).
+    bool addressed_to_airsegd(std::span<const std::uint8_t> frame) const;
     /// Sends the receiver's answers and hands a complete upload to the flight plan manager.
     void drain_uploads();
 
@@ -90,6 +92,7 @@ class AutopilotService : public Service {
     std::unique_ptr<GcsEndpoint> endpoint_;
     DeadlineTimer timer_;
     TimePoint status_published_at_{};
+    std::uint64_t to_airsegd_kept_ = 0;  // the autopilot's frames to airsegd, kept from ground stations
     std::map<std::uint32_t, Reply<RequestDone>> requesters_;  // driver id -> who waits for the result
     std::vector<Subscription> subscriptions_;
     bool running_ = false;

@@ -15,6 +15,7 @@
 #include "services/autopilot/mavlink/encoder.hpp"
 #include "services/autopilot/mavlink/enums.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
+#include "services/autopilot/mavlink/target.hpp"
 #include "tests/unit/autopilot/fake_rover.hpp"
 #include "tools/mavdump/tlog_reader.hpp"
 
@@ -268,6 +269,18 @@ TEST(AutopilotService, GroundStationsGetTheAutopilotsFramesAndMissionUploadsAreR
     const auto run_until = [&](const std::function<bool()>& cond) { return rig.run_until(cond); };
     ASSERT_TRUE(run_until([&] { return rig.ready(); }));
     ASSERT_NE(service->gcs_endpoint(), nullptr);
+    // The autopilot's answers to airsegd's own reads (the mission download's MISSION_COUNT and items, to
+    // 255/191) are kept from every station, and counted.
+    const auto to_airsegd = [](const std::vector<std::uint8_t>& bytes) {
+        const auto t = mavlink::frame_target(bytes);
+        return t && t->system == 255 && t->component == 191;
+    };
+    ASSERT_TRUE(run_until([&] {
+        const auto s = bus.latest<AutopilotStatus>();
+        return s && s->gcs_to_airsegd_kept > 0;
+    }));
+    EXPECT_TRUE(std::none_of(forwarded.begin(), forwarded.end(),
+                             [&](const ForwardedFrame& f) { return to_airsegd(f.bytes); }));
     const auto port = service->gcs_endpoint()->udp_port();
     ASSERT_NE(port, 0);
 

@@ -2,10 +2,10 @@
 
 #include <gtest/gtest.h>
 
-#include "ground/mavlink_target.hpp"
 #include "services/autopilot/mavlink/encoder.hpp"
 #include "services/autopilot/mavlink/message_table.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
+#include "services/autopilot/mavlink/target.hpp"
 
 namespace airseg::ground {
 namespace {
@@ -57,6 +57,38 @@ TEST(MavlinkTarget, ATruncatedTargetByteIsZeroAndAMessageWithoutOneIsABroadcast)
     value.param_count = 1;
     EXPECT_FALSE(frame_target(parsed(value)));
     EXPECT_FALSE(target_offsets(0xFFFFFF).system);  // unknown message: broadcast
+}
+
+// The vehicle reads a frame's addressee from its bytes as they came from the autopilot (to keep what is
+// addressed to airsegd off the radio): the same answer as from the parsed frame.
+TEST(MavlinkTarget, AWholeFramesBytesGiveTheAddresseeOfItsParsedForm) {
+    mav::Encoder encoder(1, 1);
+    mav::CommandAck ack;
+    ack.target_system = 255;
+    ack.target_component = 191;
+    const auto a = mav::frame_target(std::span<const std::uint8_t>(encoder.encode(ack)));
+    ASSERT_TRUE(a);
+    EXPECT_EQ(a->system, 255);
+    EXPECT_EQ(a->component, 191);
+
+    mav::MissionRequestInt request;  // the targets 0: cut from the wire, read as 0
+    request.seq = 7;
+    const auto r = mav::frame_target(std::span<const std::uint8_t>(encoder.encode(request)));
+    ASSERT_TRUE(r);
+    EXPECT_EQ(r->system, 0);
+    EXPECT_EQ(r->component, 0);
+
+    // MAVLink 1 MISSION_REQUEST (40): seq u16, target_system, target_component (the checksum is not read).
+    const std::vector<std::uint8_t> v1{0xFE, 4, 0, 1, 1, 40, 7, 0, 9, 8, 0, 0};
+    const auto one = mav::frame_target(std::span<const std::uint8_t>(v1));
+    ASSERT_TRUE(one);
+    EXPECT_EQ(one->system, 9);
+    EXPECT_EQ(one->component, 8);
+
+    mav::ParamValue value;
+    EXPECT_FALSE(mav::frame_target(std::span<const std::uint8_t>(encoder.encode(value))));
+    const std::vector<std::uint8_t> stub{0xFD, 9, 0};
+    EXPECT_FALSE(mav::frame_target(std::span<const std::uint8_t>(stub)));
 }
 
 // A message airseg does not type (LOG_REQUEST_LIST: start, end as uint16_t, then the targets) is still

@@ -8,10 +8,11 @@
 // counts as broadcast.
 #include <cstdint>
 #include <optional>
+#include <span>
 
 #include "services/autopilot/mavlink/frame.hpp"
 
-namespace airseg::ground {
+namespace airseg::mavlink {
 
 struct TargetOffsets {
     std::optional<std::uint8_t> system;     // payload offset of target_system, if the message has one
@@ -28,6 +29,10 @@ struct FrameTarget {
 
 /// The addressee of `frame` (as the parser delivers it: payload zero-extended), or nothing when its message
 /// has no target_system (a broadcast).
-std::optional<FrameTarget> frame_target(const mavlink::Frame& frame);
+std::optional<FrameTarget> frame_target(const Frame& frame);
 
-}  // namespace airseg::ground
+/// The same from a whole frame's bytes as they came (MAVLink 1 or 2, unparsed; a payload cut short reads as
+/// zero-extended); nothing for a frame too short to have a header.
+std::optional<FrameTarget> frame_target(std::span<const std::uint8_t> frame);
+
+}  // namespace airseg::mavlink
