@@ -19,6 +19,9 @@ std::string validate(const RadioOptions& o) {
         if (!o.ports.empty()) {
             return "--udp and --link exclude each other";
         }
+        if (o.profile_given) {
+            return "--radio describes serial radios; it does not apply to --udp";
+        }
         const auto colon = o.udp.rfind(':');
         if (colon == std::string::npos || colon == 0 || colon + 1 == o.udp.size()) {
             return "--udp needs HOST:PORT";

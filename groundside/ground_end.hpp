@@ -31,6 +31,7 @@ struct RadioOptions {
     std::string key_file;         // must match the vehicle's groundlink.key_file
     // --radio: the same as the vehicle's groundlink.radio; serial links only
     groundlink::RadioProfile profile;
+    bool profile_given = false;  // --radio was given (refused with --udp: there is no radio to describe)
 };
 
 /// Checks option combinations; returns a message for people, empty when fine.

@@ -45,6 +45,7 @@ void add_radio_options(cli::OptionTable& table, RadioOptions& radio, std::functi
                    if (auto error = groundlink::parse_radio_profile(v, radio.profile); !error.empty()) {
                        throw UsageError(error);
                    }
+                   radio.profile_given = true;
                });
 }
 

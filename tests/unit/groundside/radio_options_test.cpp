@@ -76,6 +76,14 @@ TEST(RadioOptions, BadRadioValuesNameTheOptionAndTheKey) {
     }
 }
 
+// A UDP link has no radio to describe: --radio with it is a mistake said at once, not ignored.
+TEST(RadioOptions, RadioWithUdpIsRefused) {
+    EXPECT_EQ(validate(parsed({"--udp", "127.0.0.1:14660"})), "");
+    EXPECT_EQ(validate(parsed({"--udp", "127.0.0.1:14660", "--radio", "air_speed=64"})),
+              "--radio describes serial radios; it does not apply to --udp");
+    EXPECT_EQ(validate(parsed({"--link", "/dev/ttyUSB0", "--radio", "air_speed=64"})), "");
+}
+
 TEST(RadioOptions, HelpListsRadio) {
     RadioOptions radio;
     cli::OptionTable table;
