@@ -371,6 +371,9 @@ void RoverSim::dispatch(const mv::Frame& f, TimePoint now) {
         case mv::Timesync::kId:
             on_timesync(f, now);
             return;
+        case mv::SetPositionTargetGlobalInt::kId:
+            on_set_position_target(f);
+            return;
         case mv::FileTransferProtocol::kId:
             on_ftp(f);
             return;

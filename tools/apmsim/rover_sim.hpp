@@ -288,6 +288,7 @@ class RoverSim {
     void on_command_int(const mavlink::Frame& f, TimePoint now);
     std::uint8_t do_reposition(const mavlink::CommandInt& c, TimePoint now);
     void on_timesync(const mavlink::Frame& f, TimePoint now);
+    void on_set_position_target(const mavlink::Frame& f);
     void on_ftp(const mavlink::Frame& f);
     void on_set_mode(const mavlink::Frame& f, TimePoint now);
     void on_request_data_stream(const mavlink::Frame& f, TimePoint now);

@@ -1,7 +1,8 @@
 // RoverSim: what modern ArduPilot serves a ground station besides parameters, missions and COMMAND_LONG:
 // COMMAND_INT (MAV_CMD_DO_REPOSITION as GCS_MAVLINK_Rover::handle_command_int_do_reposition(), the rest as
-// their COMMAND_LONG form), TIMESYNC (GCS_MAVLINK::handle_timesync()) and MAVLink FTP (ftp_server.hpp).
-// APMrover2 2.4x knows none of them: its board ignores them.
+// their COMMAND_LONG form), SET_POSITION_TARGET_GLOBAL_INT (a position in GUIDED, as ArduPilot's "Rover
+// Commands in Guided Mode" documents it), TIMESYNC (GCS_MAVLINK::handle_timesync()) and MAVLink FTP
+// (ftp_server.hpp). APMrover2 2.4x knows none of them: its board ignores them.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -18,8 +19,9 @@ namespace mv = mavlink;
 namespace {
 
 constexpr std::uint16_t kCmdDoReposition = 192;
-constexpr int kRepositionChangeMode = 1;      // MAV_DO_REPOSITION_FLAGS_CHANGE_MODE, in param2
-constexpr float kLocationAltMaxM = 83000.0F;  // LOCATION_ALT_MAX_M: what a Location's altitude can hold
+constexpr int kRepositionChangeMode = 1;           // MAV_DO_REPOSITION_FLAGS_CHANGE_MODE, in param2
+constexpr float kLocationAltMaxM = 83000.0F;       // LOCATION_ALT_MAX_M: what a Location's altitude can hold
+constexpr std::uint16_t kPositionIgnored = 0b111;  // POSITION_TARGET_TYPEMASK X_IGNORE | Y_IGNORE | Z_IGNORE
 
 /// The frames mavlink_coordinate_frame_to_location_alt_frame() turns into a Location's altitude frame.
 bool global_frame(std::uint8_t frame) {
@@ -100,6 +102,36 @@ std::uint8_t RoverSim::do_reposition(const mv::CommandInt& c, TimePoint now) {
     target.alt = c.z;
     target.frame = c.frame;
     return guided_goto(target) ? mv::kResultAccepted : mv::kResultFailed;
+}
+
+// In GUIDED only, in a global frame, and with a position: the rover drives to it (a position given makes
+// ArduPilot ignore the velocity, yaw and yaw rate). A target alone as velocity or yaw is not simulated, and
+// is ignored as a target outside GUIDED is. No answer either way: a station watches
+// POSITION_TARGET_GLOBAL_INT or the vehicle to see it took effect.
+void RoverSim::on_set_position_target(const mv::Frame& f) {
+    if (rover2_commands()) {
+        ++counters_.frames_ignored;
+        return;
+    }
+    const auto m = mv::decode_payload<mv::SetPositionTargetGlobalInt>(f.payload_view());
+    if (!addressed(m.target_system)) {
+        return;
+    }
+    const bool position = (m.type_mask & kPositionIgnored) != kPositionIgnored;
+    // check_latlng(): the position within the globe's ranges.
+    if (phase_ != BootPhase::Ready || mode_ != RoverMode::Guided || !global_frame(m.coordinate_frame) ||
+        !position || std::abs(m.lat_int) > 900'000'000 || std::abs(m.lon_int) > 1'800'000'000) {
+        ++counters_.frames_ignored;
+        return;
+    }
+    StoredItem target;
+    target.lat_e7 = m.lat_int;
+    target.lon_e7 = m.lon_int;
+    target.alt = m.alt;
+    target.frame = m.coordinate_frame;
+    if (!guided_goto(target)) {
+        ++counters_.frames_ignored;
+    }
 }
 
 void RoverSim::on_timesync(const mv::Frame& f, TimePoint now) {

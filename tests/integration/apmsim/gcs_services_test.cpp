@@ -61,6 +61,48 @@ TEST(ApmsimCommandInt, RepositionSwitchesToGuidedAndDrivesTowardThePoint) {
     ASSERT_TRUE(h.run_until([&] { return distance_m(h.sim.state().position, kPoint) < 5; }, seconds(300)));
 }
 
+mv::SetPositionTargetGlobalInt position_target(std::uint16_t type_mask = 0x0DFC /* position only */) {
+    mv::SetPositionTargetGlobalInt m;
+    m.target_system = 1;
+    m.coordinate_frame = mv::kFrameGlobalRelativeAltInt;
+    m.type_mask = type_mask;
+    m.lat_int = static_cast<std::int32_t>(kPoint.lat * 1e7);
+    m.lon_int = static_cast<std::int32_t>(kPoint.lon * 1e7);
+    return m;
+}
+
+// As ArduPilot's "Rover Commands in Guided Mode": a position target drives the rover in GUIDED; outside it,
+// without a position, or in a frame that is no global position, nothing happens (and nothing is answered).
+TEST(ApmsimSetPositionTarget, APositionInGuidedDrivesTheRoverAndIsIgnoredElsewhere) {
+    SimHarness h;
+    h.boot_armed();
+    ASSERT_EQ(h.sim.state().mode, RoverMode::Manual);
+    const auto ignored_before = h.sim.counters().frames_ignored;
+    h.send(position_target());
+    h.run_for(seconds(1));
+    EXPECT_FALSE(h.sim.state().target.has_value()) << "outside GUIDED";
+    EXPECT_EQ(h.sim.counters().frames_ignored, ignored_before + 1);
+
+    h.set_mode(RoverMode::Guided);
+    ASSERT_TRUE(h.run_until([&] { return h.sim.state().mode == RoverMode::Guided; }, seconds(2)));
+    auto velocity_only = position_target(0x0DE7);
+    h.send(velocity_only);
+    auto local = position_target();
+    local.coordinate_frame = 1;  // MAV_FRAME_LOCAL_NED
+    h.send(local);
+    h.run_for(seconds(1));
+    EXPECT_FALSE(h.sim.state().target.has_value()) << "no position, or no global frame";
+
+    const double before = distance_m(h.sim.state().position, kPoint);
+    const std::size_t from = h.received.size();
+    h.send(position_target());
+    h.run_for(seconds(10));
+    ASSERT_TRUE(h.sim.state().target.has_value());
+    EXPECT_LT(distance_m(*h.sim.state().target, kPoint), 0.05);
+    EXPECT_LT(distance_m(h.sim.state().position, kPoint), before - 5) << "driving toward the point";
+    EXPECT_TRUE(h.all<mv::CommandAck>(from).empty()) << "a target is not answered";
+}
+
 TEST(ApmsimCommandInt, OtherCommandsAreHandledAsTheirCommandLongForm) {
     SimHarness h;
     h.boot();
