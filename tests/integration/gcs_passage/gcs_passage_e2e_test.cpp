@@ -13,6 +13,8 @@
 #include <deque>
 #include <functional>
 #include <iostream>
+#include <limits>
+#include <limits>
 #include <optional>
 
 #include "services/autopilot/mavftp.hpp"
@@ -265,6 +267,36 @@ TEST_F(GcsPassageE2e, CommandIntRepositionDrivesTheRoverTowardThePoint) {
     std::cout << "[ figures ] the rover closed from " << start << " m to " << closest << " m of the point in "
               << seconds_since(began) << " s\n";
     EXPECT_LT(closest, start / 2) << logs();
+
+    // In GUIDED, SET_POSITION_TARGET_GLOBAL_INT (no answer: the position tells) turns it to another point.
+    const apmsim::GeoPoint other{GroundChain::kHomeLat - 0.0006, GroundChain::kHomeLon + 0.0006};
+    mav::SetPositionTargetGlobalInt target;
+    target.target_system = 1;
+    target.target_component = 1;
+    target.coordinate_frame = mav::kFrameGlobalRelativeAltInt;
+    target.type_mask = 0x0DFC;  // a position only
+    target.lat_int = static_cast<std::int32_t>(other.lat * 1e7);
+    target.lon_int = static_cast<std::int32_t>(other.lon * 1e7);
+    double from_other = -1;
+    double nearest_other = std::numeric_limits<double>::max();
+    const auto turned = Clock::now();
+    auto sent = turned;
+    station_->send(target);
+    station_->wait<mav::GlobalPositionInt>(
+        [&](const mav::GlobalPositionInt& p) {
+            const double d = apmsim::distance_m({p.lat / 1e7, p.lon / 1e7}, other);
+            from_other = from_other < 0 ? d : from_other;
+            nearest_other = std::min(nearest_other, d);
+            if (Clock::now() - sent > 10s && nearest_other > from_other - 5) {
+                sent = Clock::now();
+                station_->send(target);  // lost on the way: sent again, as stations stream their targets
+            }
+            return nearest_other < from_other - 20;
+        },
+        kGenerous);
+    std::cout << "[ figures ] toward the position target: from " << from_other << " m to " << nearest_other
+              << " m in " << seconds_since(turned) << " s\n";
+    EXPECT_LT(nearest_other, from_other - 20) << logs();
 }
 
 TEST_F(GcsPassageE2e, MavftpReadsTheParameterFileAndItsParametersAreTheBoards) {
