@@ -26,10 +26,6 @@ using asio::ip::tcp;
 
 namespace {
 
-// A request must arrive within this of the connection or of the previous answer.
-constexpr auto kRequestDeadline = std::chrono::seconds(15);
-// An answer must be taken by the client within this (a client that stops reading gives up its connection).
-constexpr auto kAnswerDeadline = std::chrono::seconds(30);
 // The event streams' comment line, which keeps proxies and the browser's stream open.
 constexpr auto kKeepAlive = std::chrono::seconds(15);
 constexpr auto kAcceptRetry = std::chrono::milliseconds(100);
@@ -292,7 +288,7 @@ class Session : public std::enable_shared_from_this<Session> {
     void wait_for_request() {
         phase_ = Phase::Reading;
         waiting_since_ = SteadyClock::now();
-        arm(kRequestDeadline, [](Session& self) { self.on_request_deadline(); });
+        arm(server_->config.request_deadline, [](Session& self) { self.on_request_deadline(); });
         on_reader(reader_.feed({}));  // a request pipelined behind the last one may be here already
     }
 
@@ -300,6 +296,7 @@ class Session : public std::enable_shared_from_this<Session> {
         if (phase_ != Phase::Reading) {
             return;
         }
+        ++server_->counts.request_timeouts;
         if (requests_ > 0 && !reader_.started()) {
             close();  // a kept-alive connection with nothing more to ask: closed without a word
             return;
@@ -401,7 +398,10 @@ class Session : public std::enable_shared_from_this<Session> {
     void write() {
         if (phase_ != Phase::Streaming) {
             // A client that does not read its answers gives up its connection.
-            arm(kAnswerDeadline, [](Session& self) { self.close(); });
+            arm(server_->config.answer_deadline, [](Session& self) {
+                ++self.server_->counts.answers_cut_off;
+                self.close();
+            });
         }
         asio::async_write(
             socket_, asio::buffer(out_.front()),

@@ -26,6 +26,11 @@ struct MapConfig {
     std::string tile_url;  // empty: offline grid
     bool control = false;  // buttons command the vehicle; otherwise they are shown disabled
     std::vector<std::string> host_names;  // names the map answers to besides addresses and localhost
+    // A request must arrive within request_deadline of the connection or of the previous answer (else 408, or
+    // for a kept-alive connection with nothing more to ask, a close without a word); a client must take an
+    // answer within answer_deadline (else its connection is closed). Shorter only in tests.
+    std::chrono::milliseconds request_deadline{15'000};
+    std::chrono::milliseconds answer_deadline{30'000};
 };
 
 /// The page's files: `configured` when given, else the installed ones, else the source tree's.
@@ -53,6 +58,8 @@ class MapServer {
         std::uint64_t refused_busy = 0;     // answered 503: every request slot was being answered
         std::uint64_t refused_streams = 0;  // /events answered 503: kMaxStreams open
         std::uint64_t accept_errors = 0;    // accepting failed (out of descriptors): retried shortly
+        std::uint64_t request_timeouts = 0;  // no whole request within request_deadline: 408, or closed
+        std::uint64_t answers_cut_off = 0;   // a client took no answer within answer_deadline: closed
         std::size_t streams = 0;            // event streams open now
     };
 

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 
+#include <array>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <future>
@@ -404,6 +406,58 @@ TEST(MapServer, AKeptAliveConnectionServesOneRequestAfterAnother) {
 
 // Requests pipelined in one write are answered one by one, in the order sent (a HEAD's answer has no body,
 // which the next answer must not be mistaken for).
+// A request that never finishes arriving gets 408 and its connection back; a kept-alive connection with
+// nothing more to ask is closed without a word; a client that stops reading an answer loses its connection
+// (deadlines shortened from 15 s and 30 s).
+TEST(MapServer, SlowRequestsIdleConnectionsAndClientsThatStopReadingAreCutOff) {
+    MapConfig config;
+    config.request_deadline = std::chrono::milliseconds(300);
+    config.answer_deadline = std::chrono::milliseconds(300);
+    Rig rig(config);
+
+    Client slow(rig.map->port());
+    const auto started = std::chrono::steady_clock::now();
+    slow.send("GET / HTTP/1.1\r\nHost: loc");  // and no more
+    const auto timeout = slow.response();
+    EXPECT_EQ(status_line(timeout), "HTTP/1.1 408 Request Timeout") << timeout.substr(0, 200);
+    EXPECT_GE(std::chrono::steady_clock::now() - started, std::chrono::milliseconds(250));
+    EXPECT_TRUE(slow.ended_by_server());
+
+    Client idle(rig.map->port());
+    idle.send("GET /leaflet/leaflet.css HTTP/1.1\r\nHost: localhost\r\n\r\n");
+    EXPECT_EQ(status_line(idle.response()), "HTTP/1.1 200 OK");
+    EXPECT_TRUE(idle.ended_by_server()) << "closed after the deadline, without an answer of its own";
+    MapServer::Counts counts;
+    rig.on_strand([&] { counts = rig.map->counts(); });
+    EXPECT_EQ(counts.request_timeouts, 2u) << "the slow request and the idle kept-alive connection";
+
+    // More than the loopback's socket buffers hold: the answer cannot be written while the client reads
+    // nothing, and the connection is closed before it all went.
+    constexpr std::size_t kBig = 7u << 20;
+    std::ofstream(rig.leaflet / "big.js") << std::string(kBig, 'x');
+    Client stalled(rig.map->port());
+    stalled.socket.set_option(asio::socket_base::receive_buffer_size(4096));
+    stalled.send("GET /leaflet/big.js HTTP/1.1\r\nHost: localhost\r\n\r\n");
+    const auto cut_off = [&] {
+        MapServer::Counts counts;
+        rig.on_strand([&] { counts = rig.map->counts(); });
+        return counts.answers_cut_off;
+    };
+    const auto limit = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (cut_off() == 0 && std::chrono::steady_clock::now() < limit) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    ASSERT_EQ(cut_off(), 1u) << "the stalled client's connection was not closed";
+    std::size_t got = 0;
+    std::array<char, 65536> chunk{};
+    boost::system::error_code ec;
+    while (!ec) {
+        got += stalled.socket.read_some(asio::buffer(chunk), ec);
+    }
+    EXPECT_LT(got, kBig) << "the whole answer went to a client that did not read";
+    EXPECT_GT(got, 0u);
+}
+
 TEST(MapServer, PipelinedRequestsAreAnsweredInOrder) {
     Rig rig;
     Client client(rig.map->port());
