@@ -11,6 +11,9 @@ namespace proto = groundlink::protocol;
 namespace mav = airseg::mavlink;
 
 namespace {
+// The vehicle's event when its autopilot rebooted (services/groundlink/groundlink_commands.cpp).
+constexpr std::string_view kAutopilotRebooted = "autopilot rebooted: ";
+
 autopilot::GcsEndpointConfig endpoint_config(const GcsConfig& c) {
     autopilot::GcsEndpointConfig e;
     e.udp = c.udp_listen;
@@ -35,6 +38,9 @@ std::string GcsFeed::start() {
     hub_.add_listener([this](const proto::Message& m) {
         if (const auto* frames = std::get_if<proto::MavlinkFrames>(&m)) {
             from_vehicle(frames->bytes);
+        } else if (const auto* e = std::get_if<proto::Event>(&m);
+                   e != nullptr && e->text.starts_with(kAutopilotRebooted)) {
+            params_.autopilot_rebooted();
         }
     });
     hub_.add_link_listener([this](const groundlink::TransportEvent& e) { on_link(e); });

@@ -57,10 +57,18 @@ void ParamCache::watch_boot_time(const mav::Frame& frame) {
         return;
     }
     if (boot_ms_ && *boot_ms + kRebootBackstepMs < *boot_ms_) {
-        ++stats_.reboots;
-        reset();  // its parameters may have changed with the reboot (a new firmware, a parameter file)
+        autopilot_rebooted();
     }
     boot_ms_ = boot_ms;
+}
+
+void ParamCache::autopilot_rebooted() {
+    if (emptied_for_reboot_) {
+        return;  // the same reboot, told again
+    }
+    ++stats_.reboots;
+    reset();  // its parameters may have changed with the reboot (a new firmware, a parameter file)
+    emptied_for_reboot_ = true;
 }
 
 void ParamCache::from_vehicle(const mav::Frame& frame, std::span<const std::uint8_t> bytes) {
@@ -111,6 +119,7 @@ void ParamCache::store(const std::string& id, std::size_t index, std::span<const
         ++stats_.overflow;
         return;
     }
+    emptied_for_reboot_ = false;
     if (by_index_.size() <= index) {
         by_index_.resize(std::min(count_, kMaxEntries));
     }

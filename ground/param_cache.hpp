@@ -7,7 +7,8 @@
 // changes are outstanding. The cache is reset (emptied) when the vehicle's link session starts anew (its
 // airsegd restarted), after an outage of the link longer than kOutageKept (the hub decides; the vehicle
 // queues parameter values through a shorter one), when the autopilot reboots (its time since boot goes
-// back), and when a PARAM_VALUE announces another param_count. A PARAM_SET a station sends marks its
+// back in the frames forwarded, or the vehicle says so in its event, which comes whatever is forwarded), and
+// when a PARAM_VALUE announces another param_count. A PARAM_SET a station sends marks its
 // parameter outstanding until the autopilot's PARAM_VALUE echo comes back; meanwhile requests go over the
 // radio. Sans-IO: frames in, frames out.
 #include <chrono>
@@ -52,6 +53,9 @@ class ParamCache {
     /// autopilot's PARAM_VALUEs as they came) and true; otherwise false and the frame goes to the vehicle.
     bool answer(const mavlink::Frame& frame, std::vector<std::uint8_t>& out);
     void reset();
+    /// The vehicle said its autopilot rebooted (its "autopilot rebooted: ..." event). One reboot told twice
+    /// (by the time since boot, then by the event) with no value between empties the cache once.
+    void autopilot_rebooted();
 
     [[nodiscard]] bool fresh() const;
     [[nodiscard]] ParamCacheStats stats() const;
@@ -72,6 +76,7 @@ class ParamCache {
     std::set<std::string> outstanding_;  // PARAM_SETs not yet echoed
     std::size_t held_ = 0;
     std::optional<std::uint32_t> boot_ms_;
+    bool emptied_for_reboot_ = false;  // no value came since a reboot emptied the cache
     ParamCacheStats stats_;
 };
 

@@ -149,6 +149,29 @@ TEST_F(ParamCacheTest, AnAutopilotRebootOrAnotherCountEmptiesIt) {
     EXPECT_EQ(cache.stats().entries, 1u);
 }
 
+// The vehicle's event says so whatever frames are forwarded; the same reboot told by both signals empties
+// the cache once, and a reboot after new values empties it again.
+TEST_F(ParamCacheTest, TheVehiclesRebootEventEmptiesItOncePerReboot) {
+    feed_all(10);
+    ASSERT_TRUE(cache.fresh());
+    cache.autopilot_rebooted();
+    EXPECT_FALSE(cache.fresh());
+    EXPECT_EQ(cache.stats().reboots, 1u);
+    EXPECT_EQ(cache.stats().entries, 0u);
+
+    feed_value(0, 10, 1.0f);
+    boot_time(60'000);
+    boot_time(500);  // told by the time since boot first
+    EXPECT_EQ(cache.stats().reboots, 2u);
+    cache.autopilot_rebooted();  // then by the event: the same reboot
+    EXPECT_EQ(cache.stats().reboots, 2u);
+    feed_all(10);
+    EXPECT_TRUE(cache.fresh()) << "what came after the reboot is kept";
+    cache.autopilot_rebooted();
+    EXPECT_EQ(cache.stats().reboots, 3u);
+    EXPECT_FALSE(cache.fresh());
+}
+
 TEST_F(ParamCacheTest, ItIsBoundedAndAnswersOnlyForItsAutopilot) {
     feed_value(0, 60000, 1.0f);
     feed_value(5000, 60000, 1.0f);
