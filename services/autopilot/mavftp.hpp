@@ -111,6 +111,18 @@ inline std::array<std::uint8_t, kPayloadSize> encode(const Packet& pk) {
     return p;
 }
 
+/// A request of `op` naming `path` (cut at kMaxData bytes) from `offset`; without a path, `size` is its data
+/// size (a read's block size).
+inline Packet request(Opcode op, std::string_view path = {}, std::uint32_t offset = 0, std::uint8_t size = 0) {
+    Packet p;
+    p.opcode = op;
+    p.offset = offset;
+    const std::size_t n = std::min(path.size(), kMaxData);
+    std::copy_n(path.begin(), n, p.data.begin());
+    p.size = n > 0 ? static_cast<std::uint8_t>(n) : size;
+    return p;
+}
+
 /// The answer to `request` that a server sends: seq one on, the request's opcode in req_opcode.
 inline Packet reply_to(const Packet& request, Opcode opcode) {
     Packet r;

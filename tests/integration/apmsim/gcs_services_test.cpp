@@ -169,12 +169,7 @@ struct FtpClient {
     }
     static ftp::Packet op(ftp::Opcode o, std::string_view path = {}, std::uint32_t offset = 0,
                           std::uint8_t size = 0) {
-        ftp::Packet p;
-        p.opcode = o;
-        p.offset = offset;
-        std::memcpy(p.data.data(), path.data(), path.size());
-        p.size = path.empty() ? size : static_cast<std::uint8_t>(path.size());
-        return p;
+        return ftp::request(o, path, offset, size);
     }
     static std::uint32_t u32(const ftp::Packet& p) {
         return std::uint32_t{p.data[0]} | std::uint32_t{p.data[1]} << 8 | std::uint32_t{p.data[2]} << 16 |

@@ -175,12 +175,7 @@ class GcsPassageE2e : public ::testing::Test {
         return std::nullopt;
     }
     static ftp::Packet op(ftp::Opcode o, std::string_view path = {}, std::uint32_t offset = 0) {
-        ftp::Packet p;
-        p.opcode = o;
-        p.offset = offset;
-        std::memcpy(p.data.data(), path.data(), path.size());
-        p.size = static_cast<std::uint8_t>(path.size());
-        return p;
+        return ftp::request(o, path, offset);
     }
 
     std::optional<mav::CommandAck> command(mav::CommandLong c) {
