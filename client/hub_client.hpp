@@ -35,7 +35,7 @@ class HubClient final : public VehicleLink {
     const std::string& role_reason() const { return role_reason_; }
 
     LocalAnswer request(const nlohmann::json& request, std::chrono::milliseconds timeout,
-                        const MessageHandler& on_message) override;
+                        const MessageHandler& on_message = {}) override;
     void run_for(std::chrono::milliseconds duration,
                  const std::function<void(const groundlink::protocol::Message&)>& on_message) override;
     nlohmann::json link_stats() const override { return link_; }

@@ -28,7 +28,7 @@ class MqttClient final : public VehicleLink {
     std::string open(std::chrono::milliseconds timeout);
 
     LocalAnswer request(const nlohmann::json& request, std::chrono::milliseconds timeout,
-                        const MessageHandler& on_message) override;
+                        const MessageHandler& on_message = {}) override;
     void run_for(std::chrono::milliseconds duration,
                  const std::function<void(const groundlink::protocol::Message&)>& on_message) override;
     nlohmann::json link_stats() const override { return link_; }

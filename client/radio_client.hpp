@@ -24,7 +24,7 @@ class RadioClient final : public VehicleLink {
 
     /// Sends one command and waits for its result (the session is set up first if needed).
     LocalAnswer request(const nlohmann::json& request, std::chrono::milliseconds timeout,
-                        const MessageHandler& on_message) override;
+                        const MessageHandler& on_message = {}) override;
 
     void run_for(std::chrono::milliseconds duration,
                  const std::function<void(const groundlink::protocol::Message&)>& on_message) override;

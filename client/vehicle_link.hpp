@@ -18,9 +18,9 @@ class VehicleLink {
     using MessageHandler = std::function<void(const groundlink::protocol::Message&)>;
 
     /// Sends one command and waits for the vehicle's result. What the vehicle pushes meanwhile goes to
-    /// `on_message` as in run_for (a live view that asks keeps its picture whole); nothing is given none.
+    /// `on_message` as in run_for (a live view that asks keeps its picture whole); without one they are not seen.
     virtual LocalAnswer request(const nlohmann::json& request, std::chrono::milliseconds timeout,
-                                const MessageHandler& on_message) = 0;
+                                const MessageHandler& on_message = {}) = 0;
 
     /// Runs the link for `duration`, calling `on_message` for each ground-protocol message from the vehicle.
     virtual void run_for(std::chrono::milliseconds duration, const MessageHandler& on_message) = 0;
