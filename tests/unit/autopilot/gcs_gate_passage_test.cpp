@@ -138,8 +138,8 @@ TEST(GcsGatePassage, MavftpReadsPassAndWritesToTheMissionAreRefusedWithANak) {
         ASSERT_EQ(nak.size, 1);
         EXPECT_EQ(nak.data[0], static_cast<std::uint8_t>(mavftp::Error::FileProtected));
     }
-    EXPECT_EQ(rig.gate.stats().ftp_refused, 8u);
-    EXPECT_EQ(rig.gate.stats().missions_refused, 8u);
+    EXPECT_EQ(rig.gate.stats().ftp_refused, 12u);
+    EXPECT_EQ(rig.gate.stats().missions_refused, 12u);
 }
 
 TEST(GcsGatePassage, AMavftpSizeBeyondTheDataIsReadOnlyAsFarAsTheDataGoes) {
