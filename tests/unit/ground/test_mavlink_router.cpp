@@ -87,8 +87,8 @@ TEST(MavlinkTarget, AWholeFramesBytesGiveTheAddresseeOfItsParsedForm) {
 
     mav::ParamValue value;
     EXPECT_FALSE(mav::frame_target(std::span<const std::uint8_t>(encoder.encode(value))));
-    const std::vector<std::uint8_t> stub{0xFD, 9, 0};
-    EXPECT_FALSE(mav::frame_target(std::span<const std::uint8_t>(stub)));
+    const std::vector<std::uint8_t> header_cut_short{0xFD, 9, 0};  // three bytes of a 10-byte header
+    EXPECT_FALSE(mav::frame_target(std::span<const std::uint8_t>(header_cut_short)));
 }
 
 // A message airseg does not type (LOG_REQUEST_LIST: start, end as uint16_t, then the targets) is still
