@@ -3,9 +3,12 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
+#include <set>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -254,11 +257,15 @@ class App::Impl {
         const auto stalled = health_.stalled(SteadyClock::now(), period / 2);
         if (stalled.empty()) {
             notifier_.watchdog();
-            watchdog_complained_ = false;
-        } else if (!watchdog_complained_) {
-            // No ping: systemd will restart the daemon if this lasts for the watchdog period.
+            watchdog_named_.clear();
+        } else if (std::any_of(stalled.begin(), stalled.end(),
+                               [this](const std::string& s) { return !watchdog_named_.contains(s); })) {
+            // No ping: systemd will restart the daemon if this lasts for the watchdog period. With one service
+            // thread every service waits behind the stuck one, and whichever last ticked earliest is the first
+            // past the limit; the complaint is repeated as the list grows, at most once per service, so the
+            // stuck one is always named.
             spdlog::error("watchdog: not pinging systemd: no progress from {}", fmt::join(stalled, ", "));
-            watchdog_complained_ = true;
+            watchdog_named_.insert(stalled.begin(), stalled.end());
         }
         watchdog_timer_.expires_after(period / 4);
         watchdog_timer_.async_wait([this](boost::system::error_code ec) {
@@ -318,7 +325,7 @@ class App::Impl {
     std::unique_ptr<AutopilotCommands> autopilot_commands_;
     Subscription line_sub_;
     bool stopping_ = false;
-    bool watchdog_complained_ = false;
+    std::set<std::string> watchdog_named_;  // services already named in this stall's complaints
 };
 
 App::App(CliOptions options, Config config)

@@ -92,8 +92,9 @@ TEST_F(DaemonProcess, ReadyPingsAnswersAndStopsCleanlyWithoutAnyDevice) {
 }
 
 // groundlink's strand blocks; the pings stop within one watchdog period and airsegd says what stalled. With
-// one service thread (the default) every service waits behind the stuck one, so the stuck one is named among
-// those whose last tick is older than half a period; with two, it is named alone. Either way signals still
+// one service thread (the default) every service waits behind the stuck one and whichever ticked earliest
+// is named first (not always the stuck one); the complaint is repeated as the list grows, so the stuck one is
+// named in one of them. With two threads it is named alone. Either way signals still
 // work: the watchdog and signals have a thread of their own. `named`: the complaint's list of services, or a
 // regex matching it.
 void check_a_stuck_service_stops_the_pings(DaemonProcess& t, int threads, const std::string& named) {
