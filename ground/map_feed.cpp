@@ -78,7 +78,7 @@ void MapFeed::on_vehicle(const proto::Message& message) {
     } else if (const auto* e = std::get_if<proto::Event>(&message)) {
         map_.add_event(*e);
         if (groundside::announces_plan(e->text)) {
-            refresh_plan();  // another plan took over the running one: the state alone does not change
+            refresh_plan();  // another plan took over, or one was appended: the state alone does not change
         }
     }
 }

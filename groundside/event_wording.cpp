@@ -216,7 +216,12 @@ std::string progress_words(const proto::Telemetry& t, const PlanFacts& plan) {
 }
 
 bool announces_plan(std::string_view text) {
-    return text.starts_with("plan '") && (text.ends_with("' started") || text.ends_with("' loaded, paused"));
+    return text.starts_with("plan '") && (text.ends_with("' started") || text.ends_with("' loaded, paused") ||
+                                          extends_plan(text));
+}
+
+bool extends_plan(std::string_view text) {
+    return text.starts_with("plan '") && text.ends_with("' extended");
 }
 
 std::string waypoint_words(std::uint64_t index, std::optional<std::uint64_t> waypoints) {
@@ -266,8 +271,10 @@ WordedEvent EventWording::word(const proto::Event& e, Clock::time_point now) {
         return out;
     }
     if (announces_plan(e.text)) {
-        waypoints_.reset();  // another plan: its waypoints are new happenings, its count not yet known
-        last_reached_.reset();
+        waypoints_.reset();  // its count is not known yet
+        if (!extends_plan(e.text)) {
+            last_reached_.reset();  // another plan: its waypoints are new happenings
+        }
     } else if (const auto index = plan_reached(e.text)) {
         if (last_reached_ == *index) {
             out.debug = true;  // said already (a redelivery, a second path to the same vehicle)

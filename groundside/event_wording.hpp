@@ -43,8 +43,12 @@ WordedEvent word_event(const groundlink::protocol::Event& e, std::uint8_t plan_s
                        std::optional<std::uint64_t> waypoints);
 
 /// The vehicle's announcement that another plan drives it ("plan 'north field' started", "plan 'x' loaded,
-/// paused"; groundlink/event_text.hpp): what the ground knew of the last plan is no longer true.
+/// paused"; groundlink/event_text.hpp), or that a plan was appended to it ("plan 'x' extended"): what the
+/// ground knew of the plan (its count, its elements) is no longer true.
 bool announces_plan(std::string_view text);
+
+/// The announcement of an append ("plan 'x' extended"): the same plan goes on, with more waypoints.
+bool extends_plan(std::string_view text);
 
 /// "waypoint 8 of 12" (index 7, 12 waypoints), "waypoint 8" without a count: the plan's numbering.
 std::string waypoint_words(std::uint64_t index, std::optional<std::uint64_t> waypoints);

@@ -72,6 +72,7 @@ struct FeederProgress {
     std::optional<std::uint64_t> next_waypoint;  // plan.next_waypoint (plan index of the current target)
     std::size_t window = 0;                      // plan.window (plan waypoints on the autopilot, confirmed)
     std::uint32_t generation = 0;
+    std::uint32_t extensions = 0;  // plans appended to this one since it was loaded
     // Where to resume after a restart: the first unreached waypoint (or the hold being held).
     StreamOrigin resume_origin;
     std::optional<std::uint64_t> resume_index;

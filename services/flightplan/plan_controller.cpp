@@ -824,7 +824,7 @@ const std::string& PlanController::shown_interruption(const FeederProgress& p) {
 void PlanController::publish_status(bool force) {
     const auto p = feeder_.progress();
     StatusUpdate u{PlanProgress{p.state, top_element_index(p.element), p.next_waypoint.value_or(0),
-                                p.waypoints_reached, p.generation, p.plan_name},
+                                p.waypoints_reached, p.generation, p.plan_name, p.extensions},
                    std::nullopt};
     auto key = status_key(p);
     if (force || key != last_status_) {

@@ -16,6 +16,7 @@ struct PlanProgress {
     std::uint32_t generation =
         0;  // which plan: each plan loaded or resumed counts on (so does a cleared one)
     std::string name{};
+    std::uint32_t extensions = 0;  // plans appended to this one (plan.append): its count has grown
     bool operator==(const PlanProgress&) const = default;
 };
 

@@ -167,6 +167,7 @@ void WindowFeeder::replace_plan(PlanFeed feed, TimePoint now) {
     stream_ = std::move(feed.stream);
     plan_name_ = std::move(feed.name);
     ++generation_;
+    extensions_ = 0;
     stream_ended_ = false;
     done_ = false;
     reached_ = 0;
@@ -253,6 +254,7 @@ void WindowFeeder::start_fresh(TimePoint now) {
 
 void WindowFeeder::continue_with(PlanFeed feed, TimePoint now) {
     stream_ = std::move(feed.stream);
+    ++extensions_;
     if (!feed.name.empty()) {
         plan_name_ = std::move(feed.name);
     }
@@ -290,6 +292,7 @@ void WindowFeeder::clear_plan() {
     done_ = false;
     cleared_ = true;
     ++generation_;
+    extensions_ = 0;
 }
 
 void WindowFeeder::pause() {
@@ -1042,6 +1045,7 @@ FeederProgress WindowFeeder::progress() const {
     FeederProgress p = counters_;
     p.plan_name = plan_name_;
     p.generation = generation_;
+    p.extensions = extensions_;
     p.waypoints_reached = reached_;
     if (!stream_ && queue_.empty()) {
         p.state = PlanState::None;

@@ -195,6 +195,7 @@ class WindowFeeder {
     std::unique_ptr<WaypointStream> stream_;
     std::string plan_name_;
     std::uint32_t generation_ = 0;
+    std::uint32_t extensions_ = 0;  // continue_with() calls since the plan was loaded
     bool stream_ended_ = false;
     std::deque<Entry> queue_;                    // queue_[0] is the current target
     std::uint16_t fresh_slot_ = kFirstRingSlot;  // slot of the first entry when the queue starts empty

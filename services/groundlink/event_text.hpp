@@ -75,17 +75,31 @@ inline std::optional<std::string> plan_reached_text(const flightplan::PlanProgre
     return fmt::format("plan waypoints reached: {} more, next {}", more, after.next_waypoint);
 }
 
+/// The plan last announced to the ground: which one, and how many plans had been appended to it then.
+struct AnnouncedPlan {
+    std::uint32_t generation = 0;
+    std::uint32_t extensions = 0;
+    bool operator==(const AnnouncedPlan&) const = default;
+};
+
 /// "plan 'north field' started" (or "plan 'north field' loaded, paused") when a plan other than the one last
-/// announced drives the vehicle: loaded, or resumed after a restart, even over a plan still running. The
-/// ground's views ask for the new plan's facts on it (groundside::announces_plan); `announced` is the
-/// generation of the plan last announced, none before the first.
-inline std::optional<std::string> plan_started_text(std::optional<std::uint32_t> announced,
-                                                    const flightplan::PlanProgress& now) {
-    if (!plan_drives_mission(now.state) || announced == now.generation) {
+/// announced drives the vehicle: loaded, or resumed after a restart, even over a plan still running; "plan
+/// 'north field' extended" when another plan was appended to the one announced (its waypoint count grew).
+/// The ground's views ask for the plan's facts again on each (groundside::announces_plan); `announced` is
+/// none before the first.
+inline std::optional<std::string> plan_announcement_text(std::optional<AnnouncedPlan> announced,
+                                                         const flightplan::PlanProgress& now) {
+    if (!plan_drives_mission(now.state)) {
         return std::nullopt;
     }
-    return fmt::format("plan '{}' {}", now.name,
-                       now.state == flightplan::PlanState::Paused ? "loaded, paused" : "started");
+    if (!announced || announced->generation != now.generation) {
+        return fmt::format("plan '{}' {}", now.name,
+                           now.state == flightplan::PlanState::Paused ? "loaded, paused" : "started");
+    }
+    if (now.extensions != announced->extensions) {
+        return fmt::format("plan '{}' extended", now.name);
+    }
+    return std::nullopt;
 }
 
 /// The severity of an autopilot status text. MAV_SEVERITY 0..3 (emergency..error) is an error, except the

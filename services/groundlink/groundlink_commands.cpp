@@ -130,11 +130,11 @@ void GroundlinkService::subscribe_bus() {
                     send_event(Sev::Info, *text);
                 }
             }
-            if (auto text = plan_started_text(announced_plan_, p)) {
+            if (auto text = plan_announcement_text(announced_plan_, p)) {
                 send_event(Sev::Info, *text);
             }
             if (plan_drives_mission(p.state)) {
-                announced_plan_ = p.generation;
+                announced_plan_ = AnnouncedPlan{p.generation, p.extensions};
             }
             plan_progress_ = p;
             plan_ = PlanProgressSample{

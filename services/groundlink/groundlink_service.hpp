@@ -15,6 +15,7 @@
 #include "services/common/slack_timer.hpp"
 #include "services/flightplan/plan_progress.hpp"
 #include "services/groundlink/delivery_meter.hpp"
+#include "services/groundlink/event_text.hpp"
 #include "services/groundlink/frame_forwarder.hpp"
 #include "services/groundlink/link/link_driver.hpp"
 #include "services/groundlink/protocol/ground_protocol.hpp"
@@ -114,7 +115,7 @@ class GroundlinkService : public Service {
     std::optional<autopilot::Telemetry> vehicle_;
     PlanProgressSample plan_;
     std::optional<flightplan::PlanProgress> plan_progress_;  // the last, for the plan's own events
-    std::optional<std::uint32_t> announced_plan_;            // the generation of the plan last announced
+    std::optional<AnnouncedPlan> announced_plan_;            // the plan last announced, and its appends
     std::uint64_t events_folded_ = 0;  // slot events and window texts not sent while a plan drives
     std::vector<Subscription> subscriptions_;
     bool commands_registered_ = false;

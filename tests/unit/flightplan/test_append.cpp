@@ -82,8 +82,12 @@ TEST(FlightplanAppend, FeederContinuesMidRouteAndAfterTheEndWithoutStopping) {
     auto next = std::make_unique<Expander>(plan_ab);
     ASSERT_TRUE(next->restore(running->origin(), running->position()));
     running = next.get();
+    const auto generation = h.feeder.progress().generation;
+    EXPECT_EQ(h.feeder.progress().extensions, 0u);
     h.feeder.continue_with(PlanFeed{std::move(next), "a"}, h.now);
     EXPECT_EQ(h.ap.writes(), writes_before) << "the window on the autopilot was already right";
+    EXPECT_EQ(h.feeder.progress().generation, generation) << "the same plan goes on";
+    EXPECT_EQ(h.feeder.progress().extensions, 1u) << "counted, so that the ground hears of the append";
     ASSERT_LT(h.run_until_done(200), 200);
     for (int i = 0; i < 3; ++i) {
         h.step();
@@ -99,6 +103,7 @@ TEST(FlightplanAppend, FeederContinuesMidRouteAndAfterTheEndWithoutStopping) {
     ASSERT_TRUE(third->restore(running->origin(), running->position()));
     h.feeder.continue_with(PlanFeed{std::move(third), "a"}, h.now);
     EXPECT_EQ(h.feeder.progress().state, PlanState::Running);
+    EXPECT_EQ(h.feeder.progress().extensions, 2u);
     ASSERT_LT(h.run_until_done(200), 200);
     for (int i = 0; i < 3; ++i) {
         h.step();
@@ -110,6 +115,9 @@ TEST(FlightplanAppend, FeederContinuesMidRouteAndAfterTheEndWithoutStopping) {
     EXPECT_EQ(h.feeder.progress().waypoints_reached, 22u);
     EXPECT_EQ(h.ap.end_of_mission_holds(), 0);
     EXPECT_EQ(h.feeder.progress().starvation_holds, 0u);
+
+    h.feeder.replace_plan(PlanFeed{std::make_unique<Expander>(load(a)), "a"}, h.now);
+    EXPECT_EQ(h.feeder.progress().extensions, 0u) << "another plan starts with none";
 }
 
 // The merge as it was before it streamed (the library keeps it for the layouts that need it) is the

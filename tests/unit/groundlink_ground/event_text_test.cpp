@@ -78,25 +78,41 @@ TEST(EventText, WhileAPlanDrivesWaypointsAreNamedInPlanTermsOnce) {
 }
 
 // A plan that takes over (loaded, over a running one too, or resumed after a restart) is announced once; the
-// same plan paused and resumed, or one that ended, is not.
-TEST(EventText, APlanThatTakesOverIsAnnouncedOnce) {
+// same plan paused and resumed, or one that ended, is not. A plan appended to the announced one is announced
+// as an extension, once per append.
+TEST(EventText, APlanThatTakesOverIsAnnouncedOnceAndAnAppendAsAnExtension) {
     using flightplan::PlanProgress;
     using flightplan::PlanState;
     const PlanProgress first{PlanState::Running, 0, 0, 0, 3, "north field"};
-    EXPECT_EQ(plan_started_text(std::nullopt, first), "plan 'north field' started");
-    EXPECT_FALSE(plan_started_text(3, first)) << "announced already";
+    EXPECT_EQ(plan_announcement_text(std::nullopt, first), "plan 'north field' started");
+    EXPECT_FALSE(plan_announcement_text(AnnouncedPlan{3, 0}, first)) << "announced already";
     auto paused = first;
     paused.state = PlanState::Paused;
-    EXPECT_FALSE(plan_started_text(3, paused)) << "the same plan paused";
+    EXPECT_FALSE(plan_announcement_text(AnnouncedPlan{3, 0}, paused)) << "the same plan paused";
     const PlanProgress second{PlanState::Running, 0, 0, 0, 4, "south"};
-    EXPECT_EQ(plan_started_text(3, second), "plan 'south' started") << "over the running one";
+    EXPECT_EQ(plan_announcement_text(AnnouncedPlan{3, 0}, second), "plan 'south' started")
+        << "over the running one";
     const PlanProgress waiting{PlanState::Paused, 0, 0, 0, 5, "later"};
-    EXPECT_EQ(plan_started_text(4, waiting), "plan 'later' loaded, paused");
+    EXPECT_EQ(plan_announcement_text(AnnouncedPlan{4, 0}, waiting), "plan 'later' loaded, paused");
     const PlanProgress cleared{PlanState::None, 0, 0, 0, 6, ""};
-    EXPECT_FALSE(plan_started_text(5, cleared)) << "no plan drives";
+    EXPECT_FALSE(plan_announcement_text(AnnouncedPlan{5, 0}, cleared)) << "no plan drives";
     auto done = second;
     done.state = PlanState::Done;
-    EXPECT_FALSE(plan_started_text(3, done));
+    EXPECT_FALSE(plan_announcement_text(AnnouncedPlan{3, 0}, done));
+
+    auto appended = first;
+    appended.extensions = 1;
+    EXPECT_EQ(plan_announcement_text(AnnouncedPlan{3, 0}, appended), "plan 'north field' extended");
+    EXPECT_FALSE(plan_announcement_text(AnnouncedPlan{3, 1}, appended)) << "that append was announced";
+    appended.extensions = 2;
+    appended.state = PlanState::Paused;
+    EXPECT_EQ(plan_announcement_text(AnnouncedPlan{3, 1}, appended), "plan 'north field' extended")
+        << "an append to the paused plan";
+    auto other = appended;
+    other.generation = 4;
+    other.state = PlanState::Running;
+    EXPECT_EQ(plan_announcement_text(AnnouncedPlan{3, 2}, other), "plan 'north field' started")
+        << "another plan of the same name, loaded after appends";
 }
 
 }  // namespace

@@ -180,6 +180,10 @@ TEST(WatchView, AnotherPlansAnnouncementForgetsTheLastPlansFacts) {
     EXPECT_FALSE(announces_plan("plan waypoint 4 reached"));
     EXPECT_FALSE(announces_plan("plan 'x' done"));
     EXPECT_FALSE(announces_plan("autopilot: plan 'x' started by a text"));
+    EXPECT_TRUE(announces_plan("plan 'north field' extended"));
+    EXPECT_TRUE(extends_plan("plan 'north field' extended"));
+    EXPECT_FALSE(extends_plan("plan 'north field' started"));
+    EXPECT_FALSE(extends_plan("autopilot: plan 'x' extended by a text"));
 
     WatchState w;
     const auto t0 = WatchState::Clock::now();
@@ -197,6 +201,25 @@ TEST(WatchView, AnotherPlansAnnouncementForgetsTheLastPlansFacts) {
     EXPECT_NE(screen.rfind("info: waypoint 6 reached\n"), std::string::npos)
         << "the same index in the new plan is a new happening, without the old count\n"
         << screen;
+}
+
+// A plan appended to the running one: the count grew, so it is forgotten until asked again; the plan goes on,
+// so a waypoint reached before the append and told again is still the same happening.
+TEST(WatchView, AnAppendsAnnouncementForgetsTheCountButNotTheWaypointsReached) {
+    WatchState w;
+    const auto t0 = WatchState::Clock::now();
+    w.take(mid_scan(), t0);
+    w.set_plan(plan_facts(show_answer(), geometry_answer()));
+    w.take(proto::Event{proto::Event::Severity::Info, "plan waypoint 5 reached"}, t0);
+    ASSERT_EQ(w.plan().waypoints, 14u);
+    w.take(proto::Event{proto::Event::Severity::Info, "plan 'field' extended"}, t0);
+    EXPECT_FALSE(w.plan().waypoints) << "the count was the plan's before the append";
+    w.take(proto::Event{proto::Event::Severity::Info, "plan waypoint 5 reached"}, t0);
+    const auto screen = w.render(t0);
+    EXPECT_NE(screen.find("info: plan 'field' extended\n"), std::string::npos) << screen;
+    EXPECT_EQ(screen.find("info: waypoint 6 reached\n"), std::string::npos)
+        << "told again, not a new happening: " << screen;
+    EXPECT_NE(screen.find("progress    running — waypoint 6\n"), std::string::npos) << "no count: " << screen;
 }
 
 }  // namespace
