@@ -113,7 +113,8 @@ class GroundControlE2e : public ::testing::Test {
         daemon = std::make_unique<Subprocess>(args, std::map<std::string, std::string>{}, dir.path());
     }
 
-    /// The link, the simulated rover at speedup 4 and the daemon, until the daemon says the autopilot is ready.
+    /// The link, the simulated rover at speedup 4 and the daemon, until the daemon says the autopilot is
+    /// ready.
     void start_ready_vehicle() {
         start_link();
         start_sim({"--speedup", "4"});
@@ -355,6 +356,14 @@ TEST_F(GroundControlE2e, AnotherPlanOverTheRunningOneIsAnnouncedAndLogCountsItsW
                            kGenerous, 500ms))
         << "the new plan's count, asked when it was announced:\n"
         << log.out() << log.err();
+    // An append grows the count of the plan that drives: announced too, and asked again.
+    const auto appended = run({binary("client/airsegctl"), "--local", "--socket", dir.file("status.sock"),
+                               "--json", "plan", "append", zigzag("more-one", 6, 0.00008)});
+    ASSERT_EQ(appended.exit_code, 0) << appended.out << appended.err;
+    EXPECT_TRUE(wait_until([&] { return has([](const auto& t) { return t.ends_with(" of 16 reached"); }); },
+                           kGenerous, 500ms))
+        << "the count after the append:\n"
+        << log.out() << log.err();
     log.signal(SIGTERM);
     ASSERT_TRUE(log.wait_exit(kGenerous));
 
@@ -365,6 +374,17 @@ TEST_F(GroundControlE2e, AnotherPlanOverTheRunningOneIsAnnouncedAndLogCountsItsW
     for (auto it = announced; it != all.end(); ++it) {
         EXPECT_FALSE(it->ends_with(" of 24 reached"))
             << "the last plan's count after the new one began: " << *it << "\n"
+            << log.out();
+    }
+    const auto extends = [](const std::string& t) {
+        return t.starts_with("plan '") && t.ends_with("' extended");
+    };
+    const auto extended = std::find_if(all.begin(), all.end(), extends);
+    ASSERT_NE(extended, all.end()) << log.out();
+    EXPECT_EQ(std::count_if(all.begin(), all.end(), extends), 1) << log.out();
+    for (auto it = extended; it != all.end(); ++it) {
+        EXPECT_FALSE(it->ends_with(" of 10 reached"))
+            << "the count before the append, after it was announced: " << *it << "\n"
             << log.out();
     }
 }
