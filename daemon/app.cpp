@@ -260,10 +260,10 @@ class App::Impl {
             watchdog_named_.clear();
         } else if (std::any_of(stalled.begin(), stalled.end(),
                                [this](const std::string& s) { return !watchdog_named_.contains(s); })) {
-            // No ping: systemd will restart the daemon if this lasts for the watchdog period. With one service
-            // thread every service waits behind the stuck one, and whichever last ticked earliest is the first
-            // past the limit; the complaint is repeated as the list grows, at most once per service, so the
-            // stuck one is always named.
+            // No ping: systemd will restart the daemon if this lasts for the watchdog period. With one
+            // service thread every service waits behind the stuck one, and whichever last ticked earliest is
+            // the first past the limit; the complaint is repeated as the list grows, at most once per
+            // service, so the stuck one is always named.
             spdlog::error("watchdog: not pinging systemd: no progress from {}", fmt::join(stalled, ", "));
             watchdog_named_.insert(stalled.begin(), stalled.end());
         }

@@ -172,6 +172,15 @@ TEST(WatchView, SaysThePlansProgressAndItsEventsOfN) {
     EXPECT_FALSE(w.to_json(t0)["vehicle"].contains("plan"));
 }
 
+/// A watch of the mid-scan sample with the plan's facts, told that plan waypoint 5 (the sixth) was reached.
+WatchState watching_the_scan_at_its_sixth_waypoint(WatchState::Clock::time_point t0) {
+    WatchState w;
+    w.take(mid_scan(), t0);
+    w.set_plan(plan_facts(show_answer(), geometry_answer()));
+    w.take(proto::Event{proto::Event::Severity::Info, "plan waypoint 5 reached"}, t0);
+    return w;
+}
+
 // Another plan over the running one leaves the state "running": only the vehicle's announcement says the
 // facts held are the last plan's.
 TEST(WatchView, AnotherPlansAnnouncementForgetsTheLastPlansFacts) {
@@ -185,11 +194,8 @@ TEST(WatchView, AnotherPlansAnnouncementForgetsTheLastPlansFacts) {
     EXPECT_FALSE(extends_plan("plan 'north field' started"));
     EXPECT_FALSE(extends_plan("autopilot: plan 'x' extended by a text"));
 
-    WatchState w;
     const auto t0 = WatchState::Clock::now();
-    w.take(mid_scan(), t0);
-    w.set_plan(plan_facts(show_answer(), geometry_answer()));
-    w.take(proto::Event{proto::Event::Severity::Info, "plan waypoint 5 reached"}, t0);
+    WatchState w = watching_the_scan_at_its_sixth_waypoint(t0);
     ASSERT_EQ(w.plan().waypoints, 14u);
     w.take(proto::Event{proto::Event::Severity::Info, "plan 'second' started"}, t0);
     EXPECT_FALSE(w.plan().waypoints) << "the count was the last plan's";
@@ -206,11 +212,8 @@ TEST(WatchView, AnotherPlansAnnouncementForgetsTheLastPlansFacts) {
 // A plan appended to the running one: the count grew, so it is forgotten until asked again; the plan goes on,
 // so a waypoint reached before the append and told again is still the same happening.
 TEST(WatchView, AnAppendsAnnouncementForgetsTheCountButNotTheWaypointsReached) {
-    WatchState w;
     const auto t0 = WatchState::Clock::now();
-    w.take(mid_scan(), t0);
-    w.set_plan(plan_facts(show_answer(), geometry_answer()));
-    w.take(proto::Event{proto::Event::Severity::Info, "plan waypoint 5 reached"}, t0);
+    WatchState w = watching_the_scan_at_its_sixth_waypoint(t0);
     ASSERT_EQ(w.plan().waypoints, 14u);
     w.take(proto::Event{proto::Event::Severity::Info, "plan 'field' extended"}, t0);
     EXPECT_FALSE(w.plan().waypoints) << "the count was the plan's before the append";
