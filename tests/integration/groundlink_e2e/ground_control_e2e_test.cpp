@@ -344,49 +344,49 @@ TEST_F(GroundControlE2e, AnotherPlanOverTheRunningOneIsAnnouncedAndLogCountsItsW
         const auto t = texts();
         return std::find_if(t.begin(), t.end(), pred) != t.end();
     };
-    ASSERT_TRUE(wait_until([&] { return has([](const auto& t) { return t.ends_with(" of 24 reached"); }); },
-                           kGenerous, 500ms))
-        << "the running plan's count, asked as the log starts:\n"
-        << log.out() << log.err();
+    // "waypoint N of COUNT reached": the count `log` knows for the plan that drives.
+    const auto counted = [](int count) {
+        return [suffix = " of " + std::to_string(count) + " reached"](const std::string& t) {
+            return t.ends_with(suffix);
+        };
+    };
+    const auto wait_for_count = [&](int count, const char* why) {
+        return wait_until([&] { return has(counted(count)); }, kGenerous, 500ms)
+                   ? ::testing::AssertionSuccess()
+                   : ::testing::AssertionFailure() << why << ":\n"
+                                                   << log.out() << log.err();
+    };
+    ASSERT_TRUE(wait_for_count(24, "the running plan's count, asked as the log starts"));
 
     const auto second = run({binary("client/airsegctl"), "--local", "--socket", dir.file("status.sock"),
                              "--json", "plan", "load", zigzag("short-one", 10, 0.00004)});
     ASSERT_EQ(second.exit_code, 0) << second.out << second.err;
-    EXPECT_TRUE(wait_until([&] { return has([](const auto& t) { return t.ends_with(" of 10 reached"); }); },
-                           kGenerous, 500ms))
-        << "the new plan's count, asked when it was announced:\n"
-        << log.out() << log.err();
+    EXPECT_TRUE(wait_for_count(10, "the new plan's count, asked when it was announced"));
     // An append grows the count of the plan that drives: announced too, and asked again.
     const auto appended = run({binary("client/airsegctl"), "--local", "--socket", dir.file("status.sock"),
                                "--json", "plan", "append", zigzag("more-one", 6, 0.00008)});
     ASSERT_EQ(appended.exit_code, 0) << appended.out << appended.err;
-    EXPECT_TRUE(wait_until([&] { return has([](const auto& t) { return t.ends_with(" of 16 reached"); }); },
-                           kGenerous, 500ms))
-        << "the count after the append:\n"
-        << log.out() << log.err();
+    EXPECT_TRUE(wait_for_count(16, "the count after the append"));
     log.signal(SIGTERM);
     ASSERT_TRUE(log.wait_exit(kGenerous));
 
+    // Each announcement comes once, and the count from before it is never used after it.
     const auto all = texts();
-    const auto announced = std::find(all.begin(), all.end(), "plan 'short-one' started");
-    ASSERT_NE(announced, all.end()) << log.out();
-    EXPECT_EQ(std::count(all.begin(), all.end(), "plan 'short-one' started"), 1) << log.out();
-    for (auto it = announced; it != all.end(); ++it) {
-        EXPECT_FALSE(it->ends_with(" of 24 reached"))
-            << "the last plan's count after the new one began: " << *it << "\n"
-            << log.out();
-    }
-    const auto extends = [](const std::string& t) {
-        return t.starts_with("plan '") && t.ends_with("' extended");
+    const auto announced_once_then_not_counted_by = [&](const std::function<bool(const std::string&)>& is_it,
+                                                        int old_count) {
+        const auto at = std::find_if(all.begin(), all.end(), is_it);
+        ASSERT_NE(at, all.end()) << log.out();
+        EXPECT_EQ(std::count_if(all.begin(), all.end(), is_it), 1) << log.out();
+        for (auto it = at; it != all.end(); ++it) {
+            EXPECT_FALSE(counted(old_count)(*it))
+                << "the count from before the announcement, after it: " << *it << "\n"
+                << log.out();
+        }
     };
-    const auto extended = std::find_if(all.begin(), all.end(), extends);
-    ASSERT_NE(extended, all.end()) << log.out();
-    EXPECT_EQ(std::count_if(all.begin(), all.end(), extends), 1) << log.out();
-    for (auto it = extended; it != all.end(); ++it) {
-        EXPECT_FALSE(it->ends_with(" of 10 reached"))
-            << "the count before the append, after it was announced: " << *it << "\n"
-            << log.out();
-    }
+    announced_once_then_not_counted_by([](const std::string& t) { return t == "plan 'short-one' started"; },
+                                       24);
+    announced_once_then_not_counted_by(
+        [](const std::string& t) { return t.starts_with("plan '") && t.ends_with("' extended"); }, 10);
 }
 
 TEST_F(GroundControlE2e, AMonitorKeyWatchesButItsCommandsAreRefused) {
