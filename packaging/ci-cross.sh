@@ -20,6 +20,9 @@
 #    priority beside the ARM builds, whose suites leave a core mostly idle (AIRSEG_CROSS_OVERLAP=0: first,
 #    before them); then booted under a real systemd in a virtual machine (packaging/test-vm.sh).
 #    AIRSEG_CI_SKIP_INSTALL_TEST=1 skips both.
+# AIRSEG_CROSS_SUITE_DONE=FILE: CI started this stage at nice 19 beside another suite, which has ended when FILE
+# exists; then the ARM builds get their own priorities (nice 0, 10, 19) and the install and boot tests start.
+# The suites take AIRSEG_TEST_LOCK (default: one of this stage's own), one at a time.
 # With --prepare, only step 1: CI runs it in the background while it compiles the sanitizer build, so
 # the downloads overlap the compiling.
 # The .debs are left in dist/. Each step prints its start time in seconds since the stage began,
@@ -34,7 +37,7 @@ for a in "$@"; do
   case "$a" in
     --prepare) prepare_only=1 ;;
     amd64|armhf|armel|arm64) arches+=("$a") ;;
-    -h|--help) sed -n '2,25p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,28p' "$0"; exit 0 ;;
     *) die "unknown argument '$a' (expected --prepare, amd64, armhf, armel, arm64)" ;;
   esac
 done
@@ -124,6 +127,12 @@ amd64_packages() {
   record_stage "cross: amd64 packages, built and checked" "$((SECONDS - start))" "" cross-amd64
   line="amd64: $((SECONDS - start)) s wall; packages checked; ccache $(ccache_stage_rate cross-amd64)"
   if [ "${AIRSEG_CI_SKIP_INSTALL_TEST:-0}" != 1 ]; then
+    # The virtual machine's boot (a core for minutes, with a time limit) waits for the end of the suite this
+    # stage was started beside.
+    if [ -n "${AIRSEG_CROSS_SUITE_DONE:-}" ] && [ ! -e "$AIRSEG_CROSS_SUITE_DONE" ]; then
+      step "the install test waits for $AIRSEG_CROSS_SUITE_DONE"
+      while [ ! -e "$AIRSEG_CROSS_SUITE_DONE" ]; do sleep 5; done
+    fi
     # The install test's own copy, from the build's own directory (the ARM builds write dist/ meanwhile),
     # before the rebuild below empties that directory.
     rm -rf "$AIRSEG_CI_LOGS/install-debs" && mkdir -p "$AIRSEG_CI_LOGS/install-debs/next"
@@ -158,6 +167,17 @@ amd64_packages() {
   echo "$line; $(($(cpu_seconds) - cpu0)) CPU-s in all" >"$AIRSEG_CI_LOGS/cross-amd64.summary"
 }
 
+# renice_tree PID LEVEL: PID and every process under it at nice LEVEL (those started later inherit it), but for
+# a suite (tools/run-ctest.sh), which runs at nice 0 whatever its build does.
+renice_tree() {
+  local child
+  [ "$(ps -o comm= -p "$1" 2>/dev/null)" != run-ctest.sh ] || return 0
+  renice -n "$2" -p "$1" >/dev/null 2>&1 || true
+  for child in $(ps -o pid= --ppid "$1" 2>/dev/null); do
+    renice_tree "$child" "$2"
+  done
+}
+
 arm_arches=()
 with_amd64=0
 for arch in "${arches[@]}"; do
@@ -175,9 +195,11 @@ if [ "$overlap" = 1 ]; then
   # the CPU and the next compile takes what is left; the suites run one at a time, each at nice 0 again
   # (tools/run-ctest.sh takes AIRSEG_TEST_LOCK and renices itself), so a suite always comes before any
   # compile. The suite's cases then see what they see on a board that does other work too.
-  step "cross-building ${arm_arches[*]} side by side (nice 0, 10, 19), the suites one at a time at nice 0"
-  export AIRSEG_TEST_LOCK="$AIRSEG_CI_LOGS/arm-suite.lock"
+  step "cross-building ${arm_arches[*]} side by side (from nice $(nice), each next one 10 lower), the suites one at a time at nice 0"
+  # The lock CI's other suites take too when it starts this stage beside them (tools/build-and-test.sh).
+  export AIRSEG_TEST_LOCK=${AIRSEG_TEST_LOCK:-$AIRSEG_CI_LOGS/arm-suite.lock}
   arm_pids=() level=$(nice)
+  [ -z "${AIRSEG_CROSS_SUITE_DONE:-}" ] || level=19
   for arch in "${arm_arches[@]}"; do
     (
       t=$SECONDS
@@ -190,6 +212,20 @@ if [ "$overlap" = 1 ]; then
     arm_pids+=($!)
     level=$((level + 10 > 19 ? 19 : level + 10))  # relative to this script's own priority
   done
+  # Started beside another suite (all at nice 19), the builds take their own priorities once it has ended. A
+  # build's suite already running keeps its nice 0.
+  renice_pid=""
+  if [ -n "${AIRSEG_CROSS_SUITE_DONE:-}" ]; then
+    (
+      while [ ! -e "$AIRSEG_CROSS_SUITE_DONE" ]; do sleep 5; done
+      level=0
+      for pid in "${arm_pids[@]}"; do
+        renice_tree "$pid" "$level"
+        level=$((level + 10 > 19 ? 19 : level + 10))
+      done
+    ) &
+    renice_pid=$!
+  fi
   # The amd64 packages at the lowest priority beside them (the ARM suites come first; its compile takes the
   # CPU they leave), then its install test, which mostly downloads.
   amd64_pid=""
@@ -215,6 +251,7 @@ if [ "$overlap" = 1 ]; then
     step "amd64 finished; log:"
     sed "s/^/amd64| /" "$AIRSEG_CI_LOGS/cross-amd64.log"
   fi
+  [ -z "$renice_pid" ] || kill "$renice_pid" 2>/dev/null || true
   [ ${#failed[@]} = 0 ] || die "the package build for ${failed[*]} failed (logs: $AIRSEG_CI_LOGS/cross-ARCH.log)"
 else
   for arch in "${arm_arches[@]}"; do

@@ -21,6 +21,9 @@
 #             cross-built with the whole test suite, which runs under qemu-arm; the arm64 packages are
 #             cross-built and checked (their suite under qemu-aarch64 with AIRSEG_CROSS_TEST_ARM64=1; needs root)
 #   native    GCC build as shipped (build/, the one tools/demo.sh runs) and the whole ctest suite
+# With sanitize, the cross stage starts when the sanitizer build is done and compiles at nice 19 beside the
+# ASan+UBSan suite; every suite (ASan+UBSan, TSan, armhf, armel) takes one lock, so they run one at a time, each
+# at nice 0 (AIRSEG_CROSS_BESIDE_SUITE=0: the cross stage after the others, as without sanitize).
 # Default: "sanitize tidy fuzz tsan cross". The shipped GCC build is tested by the cross stage on the two ARM
 # targets; "native" repeats that on amd64 and is the quickest check while developing.
 # Every compile goes through ccache when it is installed, in the cache this user's ccache uses
@@ -72,7 +75,7 @@ kill_tree() {
 finish() {
   local code=$? pid
   if [ "$code" != 0 ]; then
-    for pid in ${fuzz_pid:-} ${tsan_build_pid:-} ${tidy_pid:-} ${prepare_pid:-}; do
+    for pid in ${fuzz_pid:-} ${tsan_build_pid:-} ${tidy_pid:-} ${prepare_pid:-} ${cross_pid:-}; do
       kill_tree "$pid"
     done
     record_stage "FAILED (exit $code) after the stages above" "-" "" ""
@@ -81,11 +84,11 @@ finish() {
 }
 trap finish EXIT
 
-# The MAVLink interoperability test needs node-mavlink (pinned by its lock file) in each build directory.
+# The MAVLink interoperability test needs node-mavlink (pinned by its lock file) in each build directory, set up
+# (tests/integration/mavlink_interop/setup.sh) before the suite; the ARM suites use build-san's.
 run_ctest() {
   local dir=$1
   shift
-  tests/integration/mavlink_interop/setup.sh "$dir"
   tools/run-ctest.sh "$dir" -j"$test_jobs" --timeout 600 "$@"
 }
 
@@ -119,6 +122,33 @@ if has_stage sanitize || has_stage fuzz; then
     -DAIRSEG_SANITIZE=fuzzer-no-link,address,undefined
   cmake --build build-san -j"$jobs"
   elapsed "sanitize: build (clang, ASan+UBSan)" "$start" "" sanitize-build
+  tests/integration/mavlink_interop/setup.sh build-san
+fi
+
+# Every suite takes a slot of one lock (tools/ci-lib.sh, take_suite_slot): one suite at a time, at nice 0, while
+# the builds that are not testing compile beside it at nice 19.
+export AIRSEG_TEST_LOCK=${AIRSEG_TEST_LOCK:-$AIRSEG_CI_LOGS/suite.lock}
+
+# With the sanitize stage, the cross stage starts as soon as the sanitizer build is done, at nice 19 beside the
+# ASan+UBSan suite: the package compiles take the core that suite leaves idle (one line of simulated-rover
+# cases bounds it, not the CPU), and the ARM suites wait for the lock, after the ASan+UBSan and TSan suites.
+# The amd64 install and boot tests wait for the ASan+UBSan suite's end (AIRSEG_CROSS_SUITE_DONE): the
+# virtual machine's boot has a time limit that a core shared with every background job could break.
+cross_pid=""
+cross_early=0
+if has_stage cross && has_stage sanitize && [ "${AIRSEG_CROSS_BESIDE_SUITE:-1}" = 1 ]; then
+  cross_early=1
+  if [ -n "$prepare_pid" ]; then
+    wait "$prepare_pid" || { cat build-logs/cross-prepare.log; echo "build-and-test: cross preparation failed" >&2; exit 1; }
+    prepare_pid=""
+  fi
+  export AIRSEG_CROSS_SUITE_DONE=$AIRSEG_CI_LOGS/asan-suite.done
+  rm -f "$AIRSEG_CROSS_SUITE_DONE"
+  cross_start=$SECONDS
+  # shellcheck disable=SC2086
+  AIRSEG_INTEROP_MODULES="$PWD/build-san/mavlink_interop/node_modules" \
+    nice -n 19 packaging/ci-cross.sh ${AIRSEG_CROSS:-amd64 armhf armel arm64} >build-logs/cross.log 2>&1 &
+  cross_pid=$!
 fi
 
 # Each libFuzzer target for $seconds from its seeds, $1 at a time; each log ends with libFuzzer's statistics.
@@ -188,6 +218,7 @@ if has_stage sanitize; then
     UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 run_ctest build-san || suite=$?
   elapsed "sanitize: whole suite under ASan+UBSan" "$start" build-san/ctest-summary.txt
   [ "${suite:-0}" = 0 ] || exit 1
+  [ -z "${AIRSEG_CROSS_SUITE_DONE:-}" ] || touch "$AIRSEG_CROSS_SUITE_DONE"
 fi
 
 if [ -n "$tidy_pid" ]; then
@@ -226,6 +257,7 @@ if has_stage tsan; then
     tsan_build
   fi
   elapsed "tsan: build of the concurrency tests (GCC, TSan)${tsan_build_pid:+, at nice 19 beside the suite}" "$start" "" tsan-build
+  take_suite_slot
   start=$SECONDS
   # Each executable runs whole and directly (ctest's label list cannot carry a second label through
   # gtest_discover_tests), all at once: they mostly wait on real time. Each log is printed when it ends.
@@ -235,7 +267,7 @@ if has_stage tsan; then
     exe=$(find build-tsan -type f -name "$t" -perm -u+x | head -n1)
     [ -n "$exe" ] || { echo "build-and-test: $t was not built in build-tsan" >&2; exit 1; }
     TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 timeout 900 "$exe" --gtest_brief=1 \
-      >"build-tsan/logs/$t.log" 2>&1 &
+      >"build-tsan/logs/$t.log" 2>&1 9>&- &
     pids+=($!)
   done
   failed=0 t_passed=0 t_failed=0 t_skipped=0
@@ -258,10 +290,18 @@ if has_stage tsan; then
   done
   echo "passed=$t_passed failed=$t_failed skipped=$t_skipped reruns=" >build-tsan/logs/summary.txt
   elapsed "tsan: the concurrency tests, whole, at once" "$start" build-tsan/logs/summary.txt
+  exec 9>&-  # the suite slot
   [ "$failed" = 0 ] || { echo "build-and-test: a ThreadSanitizer run failed" >&2; exit 1; }
 fi
 
-if has_stage cross; then
+if [ "$cross_early" = 1 ]; then
+  code=0
+  wait "$cross_pid" || code=$?
+  cross_pid=""
+  cat build-logs/cross.log
+  [ "$code" = 0 ] || { echo "build-and-test: the cross stage failed" >&2; exit 1; }
+  elapsed "cross: the whole package stage (rows above), from the sanitizer build's end" "$cross_start"
+elif has_stage cross; then
   start=$SECONDS
   # The ARM test suites run mavlink_interop too, with the node-mavlink set up in the first build directory.
   modules_dir=build-san
@@ -270,7 +310,7 @@ if has_stage cross; then
     wait "$prepare_pid" || { cat build-logs/cross-prepare.log; echo "build-and-test: cross preparation failed" >&2; exit 1; }
     cat build-logs/cross-prepare.log
   fi
-  tests/integration/mavlink_interop/setup.sh "$modules_dir"
+  [ "$modules_dir" = build-san ] || tests/integration/mavlink_interop/setup.sh "$modules_dir"
   # shellcheck disable=SC2086
   AIRSEG_INTEROP_MODULES="$(cd "$modules_dir" && pwd)/mavlink_interop/node_modules" \
     packaging/ci-cross.sh ${AIRSEG_CROSS:-amd64 armhf armel arm64}
@@ -290,6 +330,7 @@ if has_stage native; then
   cmake --build build -j"$jobs"
   elapsed "native: build" "$start" "" native-build
   start=$SECONDS
+  tests/integration/mavlink_interop/setup.sh build
   run_ctest build || suite=$?
   elapsed "native: whole suite" "$start" build/ctest-summary.txt
   [ "${suite:-0}" = 0 ] || exit 1

@@ -25,6 +25,26 @@ airseg_ccache_env() {
   esac
 }
 
+# take_suite_slot: with AIRSEG_TEST_LOCK set, waits for one of its AIRSEG_SUITES_AT_ONCE (default 1) slots and
+# holds it on file descriptor 9 until that is closed or the process ends, then runs the caller at nice 0, so that
+# no compile beside a suite ever comes before its cases. The caller starts its tests with 9>&-: a process a test
+# leaves behind must not hold the lock. CI's suites (ASan+UBSan, TSan, armhf, armel) take it: one runs at a
+# time, whatever compiles meanwhile.
+take_suite_slot() {
+  [ -n "${AIRSEG_TEST_LOCK:-}" ] || return 0
+  local slot
+  echo "suite: waiting for one of ${AIRSEG_SUITES_AT_ONCE:-1} slot(s) of $AIRSEG_TEST_LOCK"
+  while :; do
+    for ((slot = 0; slot < ${AIRSEG_SUITES_AT_ONCE:-1}; slot++)); do
+      exec 9>>"$AIRSEG_TEST_LOCK.$slot"
+      flock -n 9 && break 2
+      exec 9>&-
+    done
+    sleep 2
+  done
+  renice -n 0 -p $$ >/dev/null 2>&1 || echo "suite: cannot run at nice 0 (not root): staying at nice $(nice)"
+}
+
 # ccache_stage_begin NAME: this stage's compiles are counted apart (CCACHE_STATSLOG, one line per result), so
 # other users of the cache (developers building meanwhile) do not blur its hit rate.
 ccache_stage_begin() {

@@ -7,8 +7,8 @@
 #     recorded in docs/reliability.md): such a case runs again, at most twice, and every failure before its pass
 #     is printed as "ctest: RERUN NAME: failed, passed at attempt K". No flight-plan, autopilot or system-suite
 #     case is ever rerun, whatever the file says.
-#   - With AIRSEG_TEST_LOCK set, it waits for that lock first and runs at nice 0 (CI's side-by-side ARM
-#     builds: one suite at a time, or AIRSEG_SUITES_AT_ONCE, never behind a compile).
+#   - With AIRSEG_TEST_LOCK set, it waits for that lock first and runs at nice 0 (CI's suites, which run while
+#     other builds compile: one suite at a time, or AIRSEG_SUITES_AT_ONCE, never behind a compile).
 #   - BUILD_DIR/ctest-summary.txt gets "passed=N failed=N skipped=N reruns=NAME,NAME", and
 #     BUILD_DIR/ctest-failed.txt one line per case that failed: its name, a tab, and why (its first assertion
 #     failure and the lines after it, or the last lines it printed); both are read by the table at the end of
@@ -20,21 +20,10 @@ top=$(cd "$(dirname "$0")/.." && pwd)
 dir=$(cd "${1:?usage: run-ctest.sh BUILD_DIR [CTEST_ARGS...]}" && pwd)
 shift
 
-# AIRSEG_TEST_LOCK (CI's ARM package builds, which compile side by side): one suite at a time, and at nice 0
-# whatever the build around it was started at, so that no compile ever comes before a suite's cases.
-# AIRSEG_SUITES_AT_ONCE (default 1) suites may hold one of its slots at a time.
-if [ -n "${AIRSEG_TEST_LOCK:-}" ]; then
-  echo "ctest: waiting for one of ${AIRSEG_SUITES_AT_ONCE:-1} slot(s) of $AIRSEG_TEST_LOCK"
-  while :; do
-    for ((slot = 0; slot < ${AIRSEG_SUITES_AT_ONCE:-1}; slot++)); do
-      exec 9>>"$AIRSEG_TEST_LOCK.$slot"
-      flock -n 9 && break 2
-      exec 9>&-
-    done
-    sleep 2
-  done
-  renice -n 0 -p $$ >/dev/null 2>&1 || echo "ctest: cannot run at nice 0 (not root): staying at nice $(nice)"
-fi
+# AIRSEG_TEST_LOCK: one suite at a time (tools/ci-lib.sh, take_suite_slot), at nice 0 whatever the build around
+# it was started at.
+. "$top/tools/ci-lib.sh"
+take_suite_slot
 
 # junit_field FILE ATTRIBUTE: an attribute of the <testsuite> element.
 junit_field() { sed -n "s/^[[:space:]]*$2=\"\([0-9]*\)\".*/\1/p" "$1" | head -n1; }
@@ -69,7 +58,7 @@ first="$dir/ctest-attempt-1.xml"
 rm -f "$dir"/ctest-attempt-*.xml "$dir/ctest-summary.txt" "$dir/ctest-failed.txt"
 code=0
 # A suite that finds no test at all is a failure, not a pass.
-ctest --test-dir "$dir" --output-on-failure --no-tests=error --output-junit "$first" "$@" || code=$?
+ctest --test-dir "$dir" --output-on-failure --no-tests=error --output-junit "$first" "$@" 9>&- || code=$?
 if [ ! -f "$first" ]; then
   echo "ctest: no result file (ctest exit $code)" >&2
   echo "passed=0 failed=? skipped=0 reruns=" >"$dir/ctest-summary.txt"
@@ -100,7 +89,7 @@ while [ ${#rerun[@]} -gt 0 ] && [ $attempt -lt 3 ]; do
   pattern="^($(printf '%s\n' "${rerun[@]}" | regex_quote | paste -sd'|' -))\$"
   echo "ctest: attempt $attempt of ${#rerun[@]} case(s) tests/ci-rerun.txt allows to rerun: ${rerun[*]}"
   ctest --test-dir "$dir" --output-on-failure --output-junit "$dir/ctest-attempt-$attempt.xml" "$@" \
-    -R "$pattern" || true
+    -R "$pattern" 9>&- || true
   mapfile -t still < <(junit_failed "$dir/ctest-attempt-$attempt.xml")
   for name in "${rerun[@]}"; do
     if ! printf '%s\n' "${still[@]}" | grep -qxF -- "$name"; then
