@@ -210,11 +210,7 @@ std::optional<ListSplice> find_list_splice(std::string_view text, std::size_t it
             batch.after = mark_at(starts[i + 1].begin + column, starts[i + 1].number, column);
         } else if (followed) {
             batch.after = mark_at(line.begin + line.indent, line.number, line.indent);
-        } else {
-            // yaml-cpp's mark at the end of a text: the line after its last line break, column 0.
-            batch.after =
-                mark_at(text.size(), static_cast<int>(std::count(text.begin(), text.end(), '\n')), 0);
-        }
+        }  // else the batch ends the text, and its own marks are kept
         splice.batches.push_back(batch);
     }
     return splice;

@@ -27,7 +27,8 @@ struct ListSplice {
         std::size_t end = 0;
         int first_line = 0;  // 0-based, as yaml-cpp counts
         /// Where the whole text's next token after the batch is. A mark at the batch's end (a null or a
-        /// collection's end takes the next token's mark) is moved there, as the unsplit text would give it.
+        /// collection's end takes the next token's mark) is moved there, as the unsplit text would give it,
+        /// unless the batch ends the text: its parser meets the same end, with the same indentation open.
         YAML::Mark after;
         bool ends_text = false;  // nothing but comments after it: read to the text's end, as it is
     };

@@ -102,7 +102,8 @@ void PlanEventReader::splice(std::string_view text, const ListSplice& splice) {
 
 YAML::Mark PlanEventReader::place(const YAML::Mark& mark) const {
     if (batch_ != nullptr && !mark.is_null()) {
-        if (static_cast<std::size_t>(mark.pos) >= batch_->end - batch_->begin) {
+        // A batch that ends the text is the text's own end, where its parser's marks are the whole text's.
+        if (!batch_->ends_text && static_cast<std::size_t>(mark.pos) >= batch_->end - batch_->begin) {
             return batch_->after;
         }
         YAML::Mark m = mark;

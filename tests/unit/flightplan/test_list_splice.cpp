@@ -243,5 +243,25 @@ TEST(ListSplice, AnErrorAfterTheListIsReportedAtItsLine) {
     EXPECT_EQ(r.errors[0].line, 13) << to_string(r.errors);
 }
 
+TEST(ListSplice, AListAtTheEndOfATextWithoutALastLineBreakLoadsAsUnsplit) {
+    // Found by fuzz_flightplan_loader: an empty last item, then a comment with no line break after it. The
+    // item's null takes the mark where yaml-cpp closes its mapping, which depends on that last line.
+    const std::string list =
+        "  elements:\n    - waypoint: {lat: 41.27530, lon: 1.98700}\n"
+        "    - waypoint: {lat: 41.27560, lon: 1.98720, speed: ,20 .radius: 3}\n"
+        "    - speed: 1.2\n    - scan:\n";
+    for (const std::string end : {"#", "  # no line break", "   ", "", "#\n"}) {
+        const std::string text = "plan:\n  name: survey\n" + list + end;
+        LoadOptions options;
+        options.splice_batch_items = 0;
+        const auto expected = load_plan_text(text, "end.yaml", options);
+        options.splice_batch_items = 1;
+        const auto got = load_plan_text(text, "end.yaml", options);
+        EXPECT_EQ(got.reading, PlanReading::Spliced) << text;
+        EXPECT_FALSE(got.ok()) << text;
+        EXPECT_EQ(describe(got), describe(expected)) << text;
+    }
+}
+
 }  // namespace
 }  // namespace airseg::flightplan
