@@ -195,7 +195,7 @@ if [ "$overlap" = 1 ]; then
   # the CPU and the next compile takes what is left; the suites run one at a time, each at nice 0 again
   # (tools/run-ctest.sh takes AIRSEG_TEST_LOCK and renices itself), so a suite always comes before any
   # compile. The suite's cases then see what they see on a board that does other work too.
-  step "cross-building ${arm_arches[*]} side by side (from nice $(nice), each next one 10 lower), the suites one at a time at nice 0"
+  step "cross-building ${arm_arches[*]} side by side (from nice $(nice), each next one at 10 more), the suites one at a time at nice 0"
   # The lock CI's other suites take too when it starts this stage beside them (tools/build-and-test.sh).
   export AIRSEG_TEST_LOCK=${AIRSEG_TEST_LOCK:-$AIRSEG_CI_LOGS/arm-suite.lock}
   arm_pids=() level=$(nice)
