@@ -8,7 +8,7 @@
 #             last passed them (tools/clang-tidy-check.sh; build-tidy/ is configured, not built); at nice 19
 #             beside the sanitize stage's suite when both run
 #   fuzz      each libFuzzer target for AIRSEG_FUZZ_SECONDS (default 30) on its seed corpus (tests/fuzz/run.sh,
-#             same build directory), one at a time at nice 19 beside the sanitize stage's suite (one per core
+#             same build directory), one at a time at nice 15 beside the sanitize stage's suite (one per core
 #             without it); a crash or a broken property fails the stage
 #   tsan      GCC build with ThreadSanitizer (build-tsan/) of the test executables listed in
 #             tests/concurrency-tests.txt (the bus and dispatcher, the serial port's threads, the daemon's
@@ -173,13 +173,15 @@ fuzz_targets() {
   echo "fuzz: ${#targets[@]} targets, $seconds s each, $parallel at a time"
 }
 
-# The fuzzers run beside the ASan+UBSan suite, one at a time at the lowest priority: most of the suite waits
-# on real time and leaves a core idle, which the fuzzers take without delaying the suite's simulated peers.
+# The fuzzers run beside the ASan+UBSan suite, one at a time at nice 15: most of the suite waits on real time
+# and leaves a core idle, which the fuzzers take without delaying the suite's simulated peers. Each runs for a
+# fixed time, so its share of that core is its coverage: it comes before the compiles beside it (nice 19; at
+# the same priority as the package compiles the byte-level targets ran a third of their executions).
 fuzz_pid=""
 if has_stage fuzz && has_stage sanitize; then
   fuzz_start=$SECONDS
   mkdir -p build-logs
-  nice -n 19 bash -c "$(declare -f fuzz_targets); fuzz_targets 1" >build-logs/fuzz.log 2>&1 &
+  nice -n 15 bash -c "$(declare -f fuzz_targets); fuzz_targets 1" >build-logs/fuzz.log 2>&1 &
   fuzz_pid=$!
 fi
 
