@@ -171,7 +171,11 @@ amd64_packages() {
 # a suite (tools/run-ctest.sh), which runs at nice 0 whatever its build does.
 renice_tree() {
   local child
-  [ "$(ps -o comm= -p "$1" 2>/dev/null)" != run-ctest.sh ] || return 0
+  local -a args
+  # By its command line: run through env and bash, the script's process is named "bash".
+  read -r -a args <<<"$(ps -o args= -p "$1" 2>/dev/null)"
+  case "${args[0]:-}" in */run-ctest.sh | run-ctest.sh) return 0 ;; esac
+  case "${args[0]##*/} ${args[1]:-}" in "bash "*run-ctest.sh | "sh "*run-ctest.sh) return 0 ;; esac
   renice -n "$2" -p "$1" >/dev/null 2>&1 || true
   for child in $(ps -o pid= --ppid "$1" 2>/dev/null); do
     renice_tree "$child" "$2"
