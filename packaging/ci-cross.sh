@@ -21,7 +21,8 @@
 #    before them); then booted under a real systemd in a virtual machine (packaging/test-vm.sh).
 #    AIRSEG_CI_SKIP_INSTALL_TEST=1 skips both.
 # AIRSEG_CROSS_SUITE_DONE=FILE: CI started this stage at nice 19 beside another suite, which has ended when FILE
-# exists; then the ARM builds get their own priorities (nice 0, 10, 19) and the install and boot tests start.
+# exists; then the ARM builds get priorities of their own, below any suite's (nice 10, 15, 19: a suite is
+# always running from then on), and the install and boot tests start.
 # The suites take AIRSEG_TEST_LOCK (default: one of this stage's own), one at a time.
 # With --prepare, only step 1: CI runs it in the background while it compiles the sanitizer build, so
 # the downloads overlap the compiling.
@@ -37,7 +38,7 @@ for a in "$@"; do
   case "$a" in
     --prepare) prepare_only=1 ;;
     amd64|armhf|armel|arm64) arches+=("$a") ;;
-    -h|--help) sed -n '2,28p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,29p' "$0"; exit 0 ;;
     *) die "unknown argument '$a' (expected --prepare, amd64, armhf, armel, arm64)" ;;
   esac
 done
@@ -216,16 +217,17 @@ if [ "$overlap" = 1 ]; then
     arm_pids+=($!)
     level=$((level + 10 > 19 ? 19 : level + 10))  # relative to this script's own priority
   done
-  # Started beside another suite (all at nice 19), the builds take their own priorities once it has ended. A
-  # build's suite already running keeps its nice 0.
+  # Started beside another suite (all at nice 19), the builds take priorities of their own once it has ended,
+  # each still below the suites (nice 0), one of which runs from then on: armhf 10 (its suite is needed first),
+  # armel 15, arm64 19. A build's suite already running keeps its nice 0.
   renice_pid=""
   if [ -n "${AIRSEG_CROSS_SUITE_DONE:-}" ]; then
     (
       while [ ! -e "$AIRSEG_CROSS_SUITE_DONE" ]; do sleep 5; done
-      level=0
+      level=10
       for pid in "${arm_pids[@]}"; do
         renice_tree "$pid" "$level"
-        level=$((level + 10 > 19 ? 19 : level + 10))
+        level=$((level + 5 > 19 ? 19 : level + 5))
       done
     ) &
     renice_pid=$!
