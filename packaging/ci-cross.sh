@@ -38,7 +38,7 @@ for a in "$@"; do
   case "$a" in
     --prepare) prepare_only=1 ;;
     amd64|armhf|armel|arm64) arches+=("$a") ;;
-    -h|--help) sed -n '2,29p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,31p' "$0"; exit 0 ;;
     *) die "unknown argument '$a' (expected --prepare, amd64, armhf, armel, arm64)" ;;
   esac
 done
