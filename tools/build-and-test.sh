@@ -131,7 +131,8 @@ export AIRSEG_TEST_LOCK=${AIRSEG_TEST_LOCK:-$AIRSEG_CI_LOGS/suite.lock}
 
 # With the sanitize stage, the cross stage starts as soon as the sanitizer build is done, at nice 19 beside the
 # ASan+UBSan suite: the package compiles take the core that suite leaves idle (one line of simulated-rover
-# cases bounds it, not the CPU), and the ARM suites wait for the lock, after the ASan+UBSan and TSan suites.
+# cases bounds it, not the CPU), and the ARM suites wait for the lock: after the ASan+UBSan suite, before or
+# after the TSan run, whichever takes the lock first.
 # The amd64 install and boot tests wait for the ASan+UBSan suite's end (AIRSEG_CROSS_SUITE_DONE): the
 # virtual machine's boot has a time limit that a core shared with every background job could break.
 cross_pid=""
@@ -141,6 +142,7 @@ if has_stage cross && has_stage sanitize && [ "${AIRSEG_CROSS_BESIDE_SUITE:-1}" 
   if [ -n "$prepare_pid" ]; then
     wait "$prepare_pid" || { cat build-logs/cross-prepare.log; echo "build-and-test: cross preparation failed" >&2; exit 1; }
     prepare_pid=""
+    cat build-logs/cross-prepare.log
   fi
   export AIRSEG_CROSS_SUITE_DONE=$AIRSEG_CI_LOGS/asan-suite.done
   rm -f "$AIRSEG_CROSS_SUITE_DONE"
