@@ -20,8 +20,9 @@
 #    priority beside the ARM builds, whose suites leave a core mostly idle (AIRSEG_CROSS_OVERLAP=0: first,
 #    before them); then booted under a real systemd in a virtual machine (packaging/test-vm.sh).
 #    AIRSEG_CI_SKIP_INSTALL_TEST=1 skips both.
-# AIRSEG_CROSS_SUITE_DONE=FILE: CI started this stage at nice 19 beside another suite, which has ended when FILE
-# exists; then the ARM builds get priorities of their own, below any suite's (nice 10, 15, 19: a suite is
+# AIRSEG_CROSS_SUITE_DONE=FILE: CI started this stage beside another suite (at nice 14), which has ended when
+# FILE exists. Meanwhile the ARM builds are 3 apart (armhf at the stage's priority, armel 3 below, arm64 at 19;
+# amd64 at 19 throughout); then they move up, still below any suite's priority (nice 10, 15, 19: a suite is
 # always running from then on), and the install and boot tests start.
 # The suites take AIRSEG_TEST_LOCK (default: one of this stage's own), one at a time.
 # With --prepare, only step 1: CI runs it in the background while it compiles the sanitizer build, so
@@ -38,7 +39,7 @@ for a in "$@"; do
   case "$a" in
     --prepare) prepare_only=1 ;;
     amd64|armhf|armel|arm64) arches+=("$a") ;;
-    -h|--help) sed -n '2,31p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,32p' "$0"; exit 0 ;;
     *) die "unknown argument '$a' (expected --prepare, amd64, armhf, armel, arm64)" ;;
   esac
 done
@@ -200,11 +201,13 @@ if [ "$overlap" = 1 ]; then
   # the CPU and the next compile takes what is left; the suites run one at a time, each at nice 0 again
   # (tools/run-ctest.sh takes AIRSEG_TEST_LOCK and renices itself), so a suite always comes before any
   # compile. The suite's cases then see what they see on a board that does other work too.
-  step "cross-building ${arm_arches[*]} side by side (from nice $(nice), each next one at 10 more), the suites one at a time at nice 0"
+  # Started beside another suite (CI starts this stage at nice 14 beside the ASan+UBSan suite), the builds are
+  # three apart: armhf (whose suite is needed first) at the stage's own priority, armel 3 below, arm64 at 19.
+  arm_pids=() level=$(nice) level_step=10
+  [ -z "${AIRSEG_CROSS_SUITE_DONE:-}" ] || level_step=3
+  step "cross-building ${arm_arches[*]} side by side (from nice $(nice), each next one at $level_step more, at most 19), the suites one at a time at nice 0"
   # The lock CI's other suites take too when it starts this stage beside them (tools/build-and-test.sh).
   export AIRSEG_TEST_LOCK=${AIRSEG_TEST_LOCK:-$AIRSEG_CI_LOGS/arm-suite.lock}
-  arm_pids=() level=$(nice)
-  [ -z "${AIRSEG_CROSS_SUITE_DONE:-}" ] || level=19
   for arch in "${arm_arches[@]}"; do
     (
       t=$SECONDS
@@ -215,11 +218,11 @@ if [ "$overlap" = 1 ]; then
       exit "$code"
     ) &
     arm_pids+=($!)
-    level=$((level + 10 > 19 ? 19 : level + 10))  # relative to this script's own priority
+    level=$((level + level_step > 19 ? 19 : level + level_step))  # relative to this script's own priority
   done
-  # Started beside another suite (all at nice 19), the builds take priorities of their own once it has ended,
-  # each still below the suites (nice 0), one of which runs from then on: armhf 10 (its suite is needed first),
-  # armel 15, arm64 19. A build's suite already running keeps its nice 0.
+  # Started beside another suite, the builds move up once it has ended, each still below the suites (nice 0),
+  # one of which runs from then on: armhf 10, armel 15, arm64 19. A build's suite already running keeps its
+  # nice 0.
   renice_pid=""
   if [ -n "${AIRSEG_CROSS_SUITE_DONE:-}" ]; then
     (

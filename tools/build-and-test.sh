@@ -8,7 +8,7 @@
 #             last passed them (tools/clang-tidy-check.sh; build-tidy/ is configured, not built); at nice 19
 #             beside the sanitize stage's suite when both run
 #   fuzz      each libFuzzer target for AIRSEG_FUZZ_SECONDS (default 30) on its seed corpus (tests/fuzz/run.sh,
-#             same build directory), one at a time at nice 15 beside the sanitize stage's suite (one per core
+#             same build directory), one at a time at nice 10 beside the sanitize stage's suite (one per core
 #             without it); a crash or a broken property fails the stage
 #   tsan      GCC build with ThreadSanitizer (build-tsan/) of the test executables listed in
 #             tests/concurrency-tests.txt (the bus and dispatcher, the serial port's threads, the daemon's
@@ -21,7 +21,7 @@
 #             cross-built with the whole test suite, which runs under qemu-arm; the arm64 packages are
 #             cross-built and checked (their suite under qemu-aarch64 with AIRSEG_CROSS_TEST_ARM64=1; needs root)
 #   native    GCC build as shipped (build/, the one tools/demo.sh runs) and the whole ctest suite
-# With sanitize, the cross stage starts when the sanitizer build is done and compiles at nice 19 beside the
+# With sanitize, the cross stage starts when the sanitizer build is done and compiles at nice 14 to 19 beside the
 # ASan+UBSan suite; every suite (ASan+UBSan, TSan, armhf, armel) takes one lock, so they run one at a time, each
 # at nice 0 (AIRSEG_CROSS_BESIDE_SUITE=0: the cross stage after the others, as without sanitize).
 # Default: "sanitize tidy fuzz tsan cross". The shipped GCC build is tested by the cross stage on the two ARM
@@ -31,7 +31,8 @@
 # run, in this clone or in a fresh one elsewhere on the same machine, compiles almost nothing. Each stage
 # says how many of its compiles the cache served. Test suites run through tools/run-ctest.sh (every case
 # once; no rerun unless tests/ci-rerun.txt names the case with its cause). The log ends with a table of the
-# stages (build-logs/stages.tsv): wall time, tests passed / failed / skipped, ccache hits, reruns.
+# stages (build-logs/stages.tsv): wall time, tests passed / failed / skipped, ccache hits, how busy the machine's
+# CPU was meanwhile (build-logs/cpu.log, sampled every 5 s), reruns.
 # docs/operations.md ("CI") has the figures for each stage.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -40,6 +41,7 @@ export AIRSEG_CI_LOGS=$PWD/build-logs
 mkdir -p "$AIRSEG_CI_LOGS"
 rm -f "$AIRSEG_CI_LOGS/stages.tsv" "$AIRSEG_CI_LOGS/failed.tsv"
 airseg_ccache_env "$PWD"
+cpu_sampler_start
 stages=${AIRSEG_STAGES:-sanitize tidy fuzz tsan cross}
 jobs=$(nproc)
 # Test cases at once: most of them wait on real time (the simulated radios and autopilot run at real speed),
@@ -81,6 +83,7 @@ finish() {
     record_stage "FAILED (exit $code) after the stages above" "-" "" ""
   fi
   print_stage_table "$((SECONDS - total))"
+  kill "$cpu_sampler_pid" 2>/dev/null || true
 }
 trap finish EXIT
 
@@ -126,11 +129,12 @@ if has_stage sanitize || has_stage fuzz; then
 fi
 
 # Every suite takes a slot of one lock (tools/ci-lib.sh, take_suite_slot): one suite at a time, at nice 0, while
-# the builds that are not testing compile beside it at nice 19.
+# the builds that are not testing compile beside it at lower priorities, in the order their suites are needed.
 export AIRSEG_TEST_LOCK=${AIRSEG_TEST_LOCK:-$AIRSEG_CI_LOGS/suite.lock}
 
-# With the sanitize stage, the cross stage starts as soon as the sanitizer build is done, at nice 19 beside the
-# ASan+UBSan suite: the package compiles take the core that suite leaves idle (one line of simulated-rover
+# With the sanitize stage, the cross stage starts as soon as the sanitizer build is done, at nice 14 beside the
+# ASan+UBSan suite (its builds at 14 to 19: armhf, whose suite is needed first, at 14; arm64 and amd64, which
+# nothing waits for, at 19): the package compiles take the core that suite leaves idle (one line of simulated-rover
 # cases bounds it, not the CPU), and the ARM suites wait for the lock: after the ASan+UBSan suite, before or
 # after the TSan run, whichever takes the lock first.
 # The amd64 install and boot tests wait for the ASan+UBSan suite's end (AIRSEG_CROSS_SUITE_DONE): the
@@ -149,7 +153,7 @@ if has_stage cross && has_stage sanitize && [ "${AIRSEG_CROSS_BESIDE_SUITE:-1}" 
   cross_start=$SECONDS
   # shellcheck disable=SC2086
   AIRSEG_INTEROP_MODULES="$PWD/build-san/mavlink_interop/node_modules" \
-    nice -n 19 packaging/ci-cross.sh ${AIRSEG_CROSS:-amd64 armhf armel arm64} >build-logs/cross.log 2>&1 &
+    nice -n 14 packaging/ci-cross.sh ${AIRSEG_CROSS:-amd64 armhf armel arm64} >build-logs/cross.log 2>&1 &
   cross_pid=$!
 fi
 
@@ -175,15 +179,15 @@ fuzz_targets() {
   echo "fuzz: ${#targets[@]} targets, $seconds s each, $parallel at a time"
 }
 
-# The fuzzers run beside the ASan+UBSan suite, one at a time at nice 15: most of the suite waits on real time
+# The fuzzers run beside the ASan+UBSan suite, one at a time at nice 10: most of the suite waits on real time
 # and leaves a core idle, which the fuzzers take without delaying the suite's simulated peers. Each runs for a
-# fixed time, so its share of that core is its coverage: it comes before the compiles beside it (nice 19; at
-# the same priority as the package compiles the byte-level targets ran a third of their executions).
+# fixed time, so its share of that core is its coverage: it comes before the compiles beside it (nice 12 to
+# 19; at the same priority as the package compiles the byte-level targets ran a third of their executions).
 fuzz_pid=""
 if has_stage fuzz && has_stage sanitize; then
   fuzz_start=$SECONDS
   mkdir -p build-logs
-  nice -n 15 bash -c "$(declare -f fuzz_targets); fuzz_targets 1" >build-logs/fuzz.log 2>&1 &
+  nice -n 10 bash -c "$(declare -f fuzz_targets); fuzz_targets 1" >build-logs/fuzz.log 2>&1 &
   fuzz_pid=$!
 fi
 
@@ -197,12 +201,14 @@ tsan_build() {
   cmake --build build-tsan -j"$jobs" --target "${tsan_targets[@]}"
 }
 
-# The TSan build compiles at nice 19 beside the ASan+UBSan suite, which mostly waits on real time: a core is
-# idle there (the fuzzers, also at nice 19, share it). Its log is printed at the tsan stage.
+# The TSan build compiles at nice 12 beside the ASan+UBSan suite, which mostly waits on real time: a core is
+# idle there. It comes after the fuzzers (nice 10) and before the package builds (14 to 19): its run is the
+# first suite that can follow the ASan+UBSan one, and a cold run's lock stood free waiting for it and for
+# armhf's compile. Its log is printed at the tsan stage.
 tsan_build_pid=""
 if has_stage tsan && has_stage sanitize && [ "${AIRSEG_TSAN_BESIDE_SUITE:-1}" = 1 ]; then
   tsan_start=$SECONDS
-  ( renice -n 19 -p "$BASHPID" >/dev/null; tsan_build ) >build-logs/tsan-build.log 2>&1 &
+  ( renice -n 12 -p "$BASHPID" >/dev/null; tsan_build ) >build-logs/tsan-build.log 2>&1 &
   tsan_build_pid=$!
 fi
 
@@ -260,7 +266,7 @@ if has_stage tsan; then
   else
     tsan_build
   fi
-  elapsed "tsan: build of the concurrency tests (GCC, TSan)${tsan_build_pid:+, at nice 19 beside the suite}" "$start" "" tsan-build
+  elapsed "tsan: build of the concurrency tests (GCC, TSan)${tsan_build_pid:+, at nice 12 beside the suite}" "$start" "" tsan-build
   take_suite_slot
   start=$SECONDS
   # Each executable runs whole and directly (ctest's label list cannot carry a second label through

@@ -67,12 +67,47 @@ ccache_stage_rate() {
   fi
 }
 
+# cpu_sampler_start: the machine's CPU time (/proc/stat's first line: user, nice, system, idle, iowait, in clock
+# ticks since boot) written with the time every 5 s to $AIRSEG_CI_LOGS/cpu.log, until the calling shell ends, so
+# that each stage's row says how busy the machine was meanwhile: whether a stage left a core idle, and how much
+# of the CPU went to work at nice above 0 (CI's compiles beside a suite) rather than at nice 0 (the suites).
+cpu_sampler_start() {
+  local parent=$$
+  mkdir -p "$AIRSEG_CI_LOGS"
+  : >"$AIRSEG_CI_LOGS/cpu.log"
+  (
+    exec 9>&-
+    while kill -0 "$parent" 2>/dev/null; do
+      cpu_sample >>"$AIRSEG_CI_LOGS/cpu.log"
+      sleep 5
+    done
+  ) &
+  # shellcheck disable=SC2034  # the caller stops it
+  cpu_sampler_pid=$!
+}
+# cpu_sample: "EPOCH USER NICE SYSTEM IDLE IOWAIT" now.
+cpu_sample() {
+  local _cpu user nice system idle iowait _rest
+  read -r _cpu user nice system idle iowait _rest </proc/stat
+  echo "$(date +%s) $user $nice $system $idle $iowait"
+}
+# cpu_busy_since EPOCH: "B % (N % niced)": the share of the machine's CPU time that was busy from the last sample
+# at or before EPOCH until now, and the share spent at nice above 0; "-" without samples.
+cpu_busy_since() {
+  local log="$AIRSEG_CI_LOGS/cpu.log"
+  [ -s "$log" ] || { echo "-"; return; }
+  { cat "$log"; cpu_sample; } | awk -v from="$1" '
+    $1 <= from || !have { t = $1; u = $2; n = $3; s = $4; i = $5; w = $6; have = 1 }
+    END { du = $2 - u; dn = $3 - n; ds = $4 - s; all = du + dn + ds + ($5 - i) + ($6 - w)
+          if (all <= 0) print "-"; else printf "%d %% (%d %% niced)\n", 100 * (du + dn + ds) / all, 100 * dn / all }'
+}
+
 # record_stage NAME WALL_SECONDS [SUMMARY_FILE] [CCACHE_STAGE]: one row of the closing table. SUMMARY_FILE is
 # a ctest-summary.txt from tools/run-ctest.sh ("passed=N failed=N skipped=N reruns=A,B"); the ctest-failed.txt
 # beside it (a failed case's name, a tab and why, per line) goes to the list of failed cases printed under the
 # table.
 record_stage() {
-  local name=$1 wall=$2 summary=${3:-} cstage=${4:-} passed=- failed=- skipped=- reruns=- rate=-
+  local name=$1 wall=$2 summary=${3:-} cstage=${4:-} passed=- failed=- skipped=- reruns=- rate=- busy=-
   if [ -n "$summary" ] && [ -f "$summary" ]; then
     passed=$(sed -n 's/.*passed=\([0-9?]*\).*/\1/p' "$summary")
     failed=$(sed -n 's/.*failed=\([0-9?]*\).*/\1/p' "$summary")
@@ -83,11 +118,12 @@ record_stage() {
     failed="?"
   fi
   [ -z "$cstage" ] || rate=$(ccache_stage_rate "$cstage")
+  [[ "$wall" =~ ^[0-9]+$ ]] && busy=$(cpu_busy_since "$(($(date +%s) - wall))")
   mkdir -p "$AIRSEG_CI_LOGS"
   if [ -n "$summary" ] && [ -s "$(dirname "$summary")/ctest-failed.txt" ]; then
     sed "s/^/$name\t/" "$(dirname "$summary")/ctest-failed.txt" >>"$AIRSEG_CI_LOGS/failed.tsv"
   fi
-  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "$wall" "$passed" "$failed" "$skipped" "$rate" "$reruns" \
+  printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "$wall" "$passed" "$failed" "$skipped" "$rate" "$busy" "$reruns" \
     >>"$AIRSEG_CI_LOGS/stages.tsv"
 }
 
@@ -97,13 +133,14 @@ print_stage_table() {
   local table="$AIRSEG_CI_LOGS/stages.tsv" p=0 f=0 s=0
   [ -f "$table" ] || return 0
   echo
-  echo "== CI stages (wall seconds; tests passed / failed / skipped; compiles served by ccache; reruns)"
+  echo "== CI stages (wall seconds; tests passed / failed / skipped; compiles served by ccache; the machine's CPU"
+  echo "   busy during the stage, and the part of it at nice above 0; reruns)"
   {
-    printf 'stage\twall s\tpassed\tfailed\tskipped\tccache hits\treruns\n'
+    printf 'stage\twall s\tpassed\tfailed\tskipped\tccache hits\tCPU busy\treruns\n'
     cat "$table"
-    printf 'total\t%s\t\t\t\t\t\n' "$1"
-  } | awk -F'\t' '{ printf "%-44s %7s %7s %7s %8s  %-18s %s\n", $1, $2, $3, $4, $5, $6, $7 }'
-  while IFS=$'\t' read -r _ _ passed failed skipped _ _; do
+    printf 'total\t%s\t\t\t\t\t%s\t\n' "$1" "$(cpu_busy_since "$(($(date +%s) - $1))")"
+  } | awk -F'\t' '{ printf "%-44s %7s %7s %7s %8s  %-18s %-19s %s\n", $1, $2, $3, $4, $5, $6, $7, $8 }'
+  while IFS=$'\t' read -r _ _ passed failed skipped _ _ _; do
     [[ "$passed" =~ ^[0-9]+$ ]] && p=$((p + passed))
     [[ "$failed" =~ ^[0-9]+$ ]] && f=$((f + failed))
     [[ "$failed" == "?" ]] && f=$((f + 1))
