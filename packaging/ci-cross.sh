@@ -172,15 +172,10 @@ amd64_packages() {
 # renice_tree PID LEVEL: PID and every process under it at nice LEVEL (those started later inherit it), but for
 # a suite (tools/run-ctest.sh), which runs at nice 0 whatever its build does.
 renice_tree() {
-  local child
-  local -a args
+  local pid
   # By its command line: run through env and bash, the script's process is named "bash".
-  read -r -a args <<<"$(ps -o args= -p "$1" 2>/dev/null)"
-  case "${args[0]:-}" in */run-ctest.sh | run-ctest.sh) return 0 ;; esac
-  case "${args[0]##*/} ${args[1]:-}" in "bash "*run-ctest.sh | "sh "*run-ctest.sh) return 0 ;; esac
-  renice -n "$2" -p "$1" >/dev/null 2>&1 || true
-  for child in $(ps -o pid= --ppid "$1" 2>/dev/null); do
-    renice_tree "$child" "$2"
+  for pid in $(process_tree "$1" '^([^ ]*/)?((ba)?sh [^ ]*)?run-ctest\.sh( |$)'); do
+    renice -n "$2" -p "$pid" >/dev/null 2>&1 || true
   done
 }
 

@@ -66,11 +66,10 @@ elapsed() {
 }
 # A process started here in the background, with everything it started.
 kill_tree() {
-  local child
-  for child in $(ps -o pid= --ppid "$1" 2>/dev/null); do
-    kill_tree "$child"
+  local pid
+  for pid in $(process_tree "$1"); do
+    kill "$pid" 2>/dev/null || true
   done
-  kill "$1" 2>/dev/null || true
 }
 # The table ends the log however the run ends; a stage that failed is its last row, and what it left running
 # in the background (fuzzers, the TSan build, the cross preparation) is stopped.

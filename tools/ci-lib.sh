@@ -45,6 +45,19 @@ take_suite_slot() {
   renice -n 0 -p $$ >/dev/null 2>&1 || echo "suite: cannot run at nice 0 (not root): staying at nice $(nice)"
 }
 
+# process_tree PID [SKIP]: PID and every process under it, one per line, each after the processes under it (the
+# order to stop them in). SKIP, an extended regular expression, leaves out a process whose command line matches
+# it, with everything under it.
+process_tree() {
+  local child args
+  args=$(ps -o args= -p "$1" 2>/dev/null) || return 0
+  [ -z "${2:-}" ] || ! [[ "$args" =~ $2 ]] || return 0
+  for child in $(ps -o pid= --ppid "$1" 2>/dev/null); do
+    process_tree "$child" "${2:-}"
+  done
+  echo "$1"
+}
+
 # ccache_stage_begin NAME: this stage's compiles are counted apart (CCACHE_STATSLOG, one line per result), so
 # other users of the cache (developers building meanwhile) do not blur its hit rate.
 ccache_stage_begin() {
