@@ -53,6 +53,7 @@ void GcsFeed::stop() {
 }
 
 void GcsFeed::from_vehicle(std::span<const std::uint8_t> bytes) {
+    const auto reboots = params_.stats().reboots;
     std::vector<VehicleFrame> frames;
     vehicle_parser_.push(bytes, [&](const mav::Frame& f) {
         auto encoded = f.checksum_verified ? mav::reencode(f) : std::vector<std::uint8_t>{};
@@ -63,6 +64,11 @@ void GcsFeed::from_vehicle(std::span<const std::uint8_t> bytes) {
         frames.push_back(VehicleFrame{frame_target(f), std::move(encoded)});
     });
     endpoint_.from_vehicle(frames);
+    if (params_.stats().reboots != reboots) {
+        log_.log("ground hub: autopilot rebooted", std::chrono::steady_clock::now(), spdlog::level::info,
+                 "ground hub: the autopilot's time since boot went back (a reboot): its parameters are asked "
+                 "over the radio until a full download refills the hub's copy");
+    }
 }
 
 void GcsFeed::from_station(StationId station, std::vector<StationFrame> frames) {

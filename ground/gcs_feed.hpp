@@ -13,6 +13,7 @@
 #include "ground/param_cache.hpp"
 #include "ground/station_endpoint.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
+#include "services/common/limited_log.hpp"
 
 namespace airseg::ground {
 
@@ -49,6 +50,7 @@ class GcsFeed {
     ParamCache params_;
     std::optional<std::chrono::steady_clock::time_point> down_since_;
     std::uint64_t refused_ = 0;
+    LimitedLog log_;  // lines the vehicle's frames can make the hub write
 };
 
 }  // namespace airseg::ground

@@ -41,7 +41,7 @@ void ParamCache::reset() {
     index_of_.clear();
     outstanding_.clear();
     held_ = 0;
-    boot_ms_.reset();
+    boot_ms_.clear();
 }
 
 void ParamCache::watch_boot_time(const mav::Frame& frame) {
@@ -56,10 +56,16 @@ void ParamCache::watch_boot_time(const mav::Frame& frame) {
     if (!boot_ms) {
         return;
     }
-    if (boot_ms_ && *boot_ms + kRebootBackstepMs < *boot_ms_) {
+    // Per message: the vehicle sends these as Fast messages, each topic's freshest value replacing an unsent
+    // one in its place in the queue, so one message's time may come after a later one of another message's,
+    // seconds later after an outage; a message's own times never go back but by a reboot.
+    // At most three entries: the messages decoded above.
+    const auto [last, first_seen] = boot_ms_.try_emplace(frame.msgid, *boot_ms);
+    if (!first_seen && *boot_ms + kRebootBackstepMs < last->second) {
         autopilot_rebooted();
     }
-    boot_ms_ = boot_ms;
+    // Looked up again: a reboot empties the table.
+    boot_ms_[frame.msgid] = *boot_ms;
 }
 
 void ParamCache::autopilot_rebooted() {

@@ -7,10 +7,11 @@
 // changes are outstanding. The cache is reset (emptied) when the vehicle's link session starts anew (its
 // airsegd restarted), after an outage of the link longer than kOutageKept (the hub decides; the vehicle
 // queues parameter values through a shorter one), when the autopilot reboots (its time since boot goes
-// back in the frames forwarded, or the vehicle says so in its event, which comes whatever is forwarded), and
-// when a PARAM_VALUE announces another param_count. A PARAM_SET a station sends marks its
-// parameter outstanding until the autopilot's PARAM_VALUE echo comes back; meanwhile requests go over the
-// radio. Sans-IO: frames in, frames out.
+// back in the frames forwarded, compared message by message, since the link may deliver one message's older
+// value after another's newer one; or the vehicle says so in its event, which comes whatever is forwarded),
+// and when a PARAM_VALUE announces another param_count. A PARAM_SET a station sends marks its parameter
+// outstanding until the autopilot's PARAM_VALUE echo comes back; meanwhile requests go over the radio.
+// Sans-IO: frames in, frames out.
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -75,8 +76,8 @@ class ParamCache {
     std::map<std::string, std::size_t> index_of_;
     std::set<std::string> outstanding_;  // PARAM_SETs not yet echoed
     std::size_t held_ = 0;
-    std::optional<std::uint32_t> boot_ms_;
-    bool emptied_for_reboot_ = false;  // no value came since a reboot emptied the cache
+    std::map<std::uint32_t, std::uint32_t> boot_ms_;  // the last time since boot, by message id
+    bool emptied_for_reboot_ = false;                 // no value came since a reboot emptied the cache
     ParamCacheStats stats_;
 };
 

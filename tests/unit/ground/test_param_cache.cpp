@@ -59,6 +59,12 @@ class ParamCacheTest : public ::testing::Test {
         const auto p = parsed(autopilot, a);
         cache.from_vehicle(p.frame, p.bytes);
     }
+    void system_time(std::uint32_t ms) {
+        mav::SystemTime t;
+        t.time_boot_ms = ms;
+        const auto p = parsed(autopilot, t);
+        cache.from_vehicle(p.frame, p.bytes);
+    }
     bool request_list(std::vector<std::uint8_t>& out, std::uint8_t component = 0) {
         mav::ParamRequestList r;
         r.target_system = 1;
@@ -147,6 +153,29 @@ TEST_F(ParamCacheTest, AnAutopilotRebootOrAnotherCountEmptiesIt) {
     feed_value(0, 11, 1.0f);  // a new table
     EXPECT_FALSE(cache.fresh());
     EXPECT_EQ(cache.stats().entries, 1u);
+}
+
+// The link carries each message's freshest value, in the place in its queue where an older one waited: after
+// an outage one message's time may come seconds behind another's. Only a message's own time going back is a
+// reboot.
+TEST_F(ParamCacheTest, AMessageOlderThanAnotherMessagesIsNoRebootButItsOwnTimeGoingBackIs) {
+    feed_all(10);
+    boot_time(60'000);
+    system_time(60'100);
+    system_time(69'000);  // after an 8 s outage, SYSTEM_TIME's fresh value first,
+    boot_time(61'000);    // then the ATTITUDE that waited: 8 s behind SYSTEM_TIME, ahead of its own last
+    EXPECT_TRUE(cache.fresh());
+    EXPECT_EQ(cache.stats().reboots, 0u);
+    std::vector<std::uint8_t> out;
+    EXPECT_TRUE(request_list(out));
+
+    system_time(400);  // a reboot: SYSTEM_TIME's own time went back
+    EXPECT_FALSE(cache.fresh());
+    EXPECT_EQ(cache.stats().reboots, 1u);
+    feed_all(10);
+    boot_time(450);  // ATTITUDE's first time after it: the same reboot, the values after it kept
+    EXPECT_TRUE(cache.fresh());
+    EXPECT_EQ(cache.stats().reboots, 1u);
 }
 
 // The vehicle's event says so whatever frames are forwarded; the same reboot told by both signals empties
