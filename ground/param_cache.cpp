@@ -60,11 +60,10 @@ void ParamCache::watch_boot_time(const mav::Frame& frame) {
     // one in its place in the queue, so one message's time may come after a later one of another message's,
     // seconds later after an outage; a message's own times never go back but by a reboot.
     // At most three entries: the messages decoded above.
-    const auto [last, first_seen] = boot_ms_.try_emplace(frame.msgid, *boot_ms);
-    if (!first_seen && *boot_ms + kRebootBackstepMs < last->second) {
-        autopilot_rebooted();
+    if (const auto last = boot_ms_.find(frame.msgid);
+        last != boot_ms_.end() && *boot_ms + kRebootBackstepMs < last->second) {
+        autopilot_rebooted();  // empties the table
     }
-    // Looked up again: a reboot empties the table.
     boot_ms_[frame.msgid] = *boot_ms;
 }
 
