@@ -60,7 +60,8 @@ endfunction()
 # airseg_add_test(NAME SOURCES... [LIBS ...] [LABELS ...] [TIMEOUT seconds] [RESOURCE_LOCK name]
 #                  [ALONE gtest-filter])
 # One GoogleTest executable whose cases ctest discovers one by one. The cases ALONE matches run with nothing
-# else of the suite beside them (RUN_SERIAL): measurements of real-time pace, which a starved process spoils.
+# else of the suite beside them (RUN_SERIAL, and the label "alone"): measurements of real-time pace, which a
+# starved process spoils.
 function(airseg_add_test name)
   cmake_parse_arguments(A "" "TIMEOUT;RESOURCE_LOCK;ALONE" "SOURCES;LIBS;LABELS" ${ARGN})
   if(NOT AIRSEG_BUILD_TESTS)
@@ -73,16 +74,23 @@ function(airseg_add_test name)
   target_link_libraries(${name} PRIVATE airseg_options GTest::gtest GTest::gtest_main GTest::gmock ${A_LIBS})
   airseg_test_code(${name})
   set(_lock)
+  set(_labels ${A_LABELS})
   if(A_RESOURCE_LOCK)
     # Cases that must not run beside each other (they share a scarce resource, e.g. real-time radio links).
+    # The lock's name is also a label: tools/run-ctest.sh runs such cases apart from the rest of the suite.
     set(_lock RESOURCE_LOCK ${A_RESOURCE_LOCK})
+    list(APPEND _labels ${A_RESOURCE_LOCK})
   endif()
-  set(_properties TIMEOUT ${A_TIMEOUT} LABELS "${A_LABELS}" ${_lock})
+  # One label of the names joined by "/" (e.g. integration/simulated_rover_chains): gtest_discover_tests
+  # (CMake 3.25) flattens PROPERTIES, so a list of labels would become property names.
+  list(JOIN _labels "/" _labels)
+  set(_properties TIMEOUT ${A_TIMEOUT} LABELS "${_labels}" ${_lock})
   if(A_ALONE)
     gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60 TEST_FILTER "-${A_ALONE}"
                          PROPERTIES ${_properties})
+    # Labelled ".../alone" too: tools/run-ctest.sh runs them with no other suite's cases beside them either.
     gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60 TEST_FILTER "${A_ALONE}"
-                         PROPERTIES ${_properties} RUN_SERIAL TRUE)
+                         PROPERTIES TIMEOUT ${A_TIMEOUT} LABELS "${_labels}/alone" ${_lock} RUN_SERIAL TRUE)
   else()
     gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60 PROPERTIES ${_properties})
   endif()

@@ -29,20 +29,38 @@ airseg_ccache_env() {
 # holds it on file descriptor 9 until that is closed or the process ends, then runs the caller at nice 0, so that
 # no compile beside a suite ever comes before its cases. The caller starts its tests with 9>&-: a process a test
 # leaves behind must not hold the lock. CI's suites (ASan+UBSan, TSan, armhf, armel) take it: one runs at a
-# time, whatever compiles meanwhile.
+# time, whatever compiles meanwhile (tools/run-ctest.sh runs a suite's chains of the simulated rover beside it).
+# With "now": takes a free slot or returns 1 at once.
 take_suite_slot() {
   [ -n "${AIRSEG_TEST_LOCK:-}" ] || return 0
   local slot
-  echo "suite: waiting for one of ${AIRSEG_SUITES_AT_ONCE:-1} slot(s) of $AIRSEG_TEST_LOCK"
+  [ "${1:-}" = now ] || echo "suite: waiting for one of ${AIRSEG_SUITES_AT_ONCE:-1} slot(s) of $AIRSEG_TEST_LOCK"
   while :; do
     for ((slot = 0; slot < ${AIRSEG_SUITES_AT_ONCE:-1}; slot++)); do
       exec 9>>"$AIRSEG_TEST_LOCK.$slot"
       flock -n 9 && break 2
       exec 9>&-
     done
+    [ "${1:-}" != now ] || return 1
     sleep 2
   done
-  renice -n 0 -p $$ >/dev/null 2>&1 || echo "suite: cannot run at nice 0 (not root): staying at nice $(nice)"
+  suite_priority
+}
+
+# suite_priority: this shell, and what it starts from then on, at nice 0.
+suite_priority() {
+  renice -n 0 -p "$BASHPID" >/dev/null 2>&1 || echo "suite: cannot run at nice 0 (not root): staying at nice $(nice)"
+}
+
+# take_chains_lock shared|exclusive [now]: AIRSEG_TEST_LOCK's chains lock on file descriptor 8. The suites'
+# chains of the simulated rover hold it shared (any number of suites' chains at once); a suite's pace
+# measurements hold it exclusive, with a suite slot: nothing of any suite beside them. With "now": takes it or
+# returns 1 at once.
+take_chains_lock() {
+  exec 8>>"$AIRSEG_TEST_LOCK.chains"
+  if flock ${2:+-n} "$([ "$1" = shared ] && echo -s || echo -x)" 8; then return 0; fi
+  exec 8>&-
+  return 1
 }
 
 # process_tree PID [SKIP]: PID and every process under it, one per line, each after the processes under it (the

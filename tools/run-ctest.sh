@@ -7,8 +7,18 @@
 #     recorded in docs/reliability.md): such a case runs again, at most twice, and every failure before its pass
 #     is printed as "ctest: RERUN NAME: failed, passed at attempt K". No flight-plan, autopilot or system-suite
 #     case is ever rerun, whatever the file says.
-#   - With AIRSEG_TEST_LOCK set, it waits for that lock first and runs at nice 0 (CI's suites, which run while
-#     other builds compile: one suite at a time, or AIRSEG_SUITES_AT_ONCE, never behind a compile).
+#   - With AIRSEG_TEST_LOCK set (CI's suites, which run while other builds compile), it runs at nice 0, never
+#     behind a compile, and shares the machine with other suites by three locks (tools/ci-lib.sh):
+#       - the suite's cases of a resource lock (the label simulated_rover_chains: the simulated rover's
+#         chains, one at a time, mostly waiting on real time; "chains" in the log) start at once, beside those
+#         of other suites, under a shared lock;
+#       - the other cases ("rest": most of the suite's CPU) wait for one of AIRSEG_SUITES_AT_ONCE (default 1)
+#         suite slots; they run beside the chains of their own suite, as in one ctest run, and of others;
+#       - the cases labelled "alone" (pace measurements) have a suite slot and the chains' lock to themselves:
+#         nothing of any suite beside them. They come first when nothing else runs (CI's first suite), else
+#         after the suite's chains.
+#     AIRSEG_CHAINS_APART=0, or AIRSEG_SUITES_AT_ONCE above 1, runs the whole suite as one ctest run in a suite
+#     slot instead.
 #   - BUILD_DIR/ctest-summary.txt gets "passed=N failed=N skipped=N reruns=NAME,NAME", and
 #     BUILD_DIR/ctest-failed.txt one line per case that failed: its name, a tab, and why (its first assertion
 #     failure and the lines after it, or the last lines it printed); both are read by the table at the end of
@@ -19,11 +29,7 @@ set -euo pipefail
 top=$(cd "$(dirname "$0")/.." && pwd)
 dir=$(cd "${1:?usage: run-ctest.sh BUILD_DIR [CTEST_ARGS...]}" && pwd)
 shift
-
-# AIRSEG_TEST_LOCK: one suite at a time (tools/ci-lib.sh, take_suite_slot), at nice 0 whatever the build around
-# it was started at.
 . "$top/tools/ci-lib.sh"
-take_suite_slot
 
 # junit_field FILE ATTRIBUTE: an attribute of the <testsuite> element.
 junit_field() { sed -n "s/^[[:space:]]*$2=\"\([0-9]*\)\".*/\1/p" "$1" | head -n1; }
@@ -54,71 +60,155 @@ junit_why() {
     }' "$1" | sed 's/&lt;/</g; s/&gt;/>/g; s/&quot;/"/g; s/&apos;/'"'"'/g; s/&amp;/\&/g' | tr -d '\r' | cut -c1-600
 }
 
-first="$dir/ctest-attempt-1.xml"
-rm -f "$dir"/ctest-attempt-*.xml "$dir/ctest-summary.txt" "$dir/ctest-failed.txt"
-code=0
-# A suite that finds no test at all is a failure, not a pass.
-ctest --test-dir "$dir" --output-on-failure --no-tests=error --output-junit "$first" "$@" 9>&- || code=$?
-if [ ! -f "$first" ]; then
-  echo "ctest: no result file (ctest exit $code)" >&2
-  echo "passed=0 failed=? skipped=0 reruns=" >"$dir/ctest-summary.txt"
-  echo "(no result file: ctest exit $code)" >"$dir/ctest-failed.txt"
-  exit 1
-fi
-total=$(junit_field "$first" tests)
-skipped=$(($(junit_field "$first" skipped) + $(junit_field "$first" disabled)))
-mapfile -t failed < <(junit_failed "$first")
-
-# Cases tests/ci-rerun.txt allows a rerun ("REGEX: cause" per line), never one of the three suites whose
-# failures must show at their first run.
-allowed=$(sed -n 's/^\([^#][^:]*\):.*/\1/p' "$top/tests/ci-rerun.txt" 2>/dev/null | paste -sd'|' -)
-never='Flightplan|Autopilot|GcsEndpoint|System'
-rerun=() final_failed=()
-for name in "${failed[@]}"; do
-  if [ -n "$allowed" ] && [[ "$name" =~ $allowed ]] && ! [[ "$name" =~ $never ]]; then
-    rerun+=("$name")
-  else
-    final_failed+=("$name")
+# run_cases PART [CTEST_ARGS...]: one ctest run of the cases CTEST_ARGS select, then the reruns
+# tests/ci-rerun.txt allows. Leaves BUILD_DIR/ctest-PART.result ("TOTAL SKIPPED"), ctest-PART.failed (a case
+# per line: name, a tab, why) and ctest-PART.reruns (the cases that passed only on a rerun). Lock file
+# descriptors (8, 9) are closed for ctest: a process a test leaves behind must not hold a lock.
+run_cases() {
+  local part=$1 code=0 total skipped attempt=1 name k why xml pattern allowed never
+  local -a failed rerun final_failed reruns still
+  shift
+  rm -f "$dir/ctest-$part"-attempt-*.xml "$dir/ctest-$part.result" "$dir/ctest-$part.failed" \
+    "$dir/ctest-$part.reruns"
+  local first="$dir/ctest-$part-attempt-1.xml"
+  ctest --test-dir "$dir" --output-on-failure --output-junit "$first" "$@" 8>&- 9>&- || code=$?
+  if [ ! -f "$first" ]; then
+    echo "ctest: no result file (ctest exit $code)" >&2
+    echo "0 0" >"$dir/ctest-$part.result"
+    printf '%s\t\n' "(no result file: ctest exit $code)" >"$dir/ctest-$part.failed"
+    return 1
   fi
-done
+  total=$(junit_field "$first" tests)
+  skipped=$(($(junit_field "$first" skipped) + $(junit_field "$first" disabled)))
+  mapfile -t failed < <(junit_failed "$first")
 
-reruns=()
-attempt=1
-while [ ${#rerun[@]} -gt 0 ] && [ $attempt -lt 3 ]; do
-  attempt=$((attempt + 1))
-  pattern="^($(printf '%s\n' "${rerun[@]}" | regex_quote | paste -sd'|' -))\$"
-  echo "ctest: attempt $attempt of ${#rerun[@]} case(s) tests/ci-rerun.txt allows to rerun: ${rerun[*]}"
-  ctest --test-dir "$dir" --output-on-failure --output-junit "$dir/ctest-attempt-$attempt.xml" "$@" \
-    -R "$pattern" 9>&- || true
-  mapfile -t still < <(junit_failed "$dir/ctest-attempt-$attempt.xml")
-  for name in "${rerun[@]}"; do
-    if ! printf '%s\n' "${still[@]}" | grep -qxF -- "$name"; then
-      echo "ctest: RERUN $name: failed, passed at attempt $attempt"
-      reruns+=("$name")
+  # Cases tests/ci-rerun.txt allows a rerun ("REGEX: cause" per line), never one of the three suites whose
+  # failures must show at their first run.
+  allowed=$(sed -n 's/^\([^#][^:]*\):.*/\1/p' "$top/tests/ci-rerun.txt" 2>/dev/null | paste -sd'|' -)
+  never='Flightplan|Autopilot|GcsEndpoint|System'
+  rerun=() final_failed=() reruns=()
+  for name in "${failed[@]}"; do
+    if [ -n "$allowed" ] && [[ "$name" =~ $allowed ]] && ! [[ "$name" =~ $never ]]; then
+      rerun+=("$name")
+    else
+      final_failed+=("$name")
     fi
   done
-  rerun=("${still[@]}")
-done
-final_failed+=("${rerun[@]}")
-# ctest failed without a failing case: no test found, or a case that could not run.
-[ "$code" = 0 ] || [ ${#failed[@]} -gt 0 ] || final_failed+=("(ctest exit $code: no test found, or a case not run)")
+  while [ ${#rerun[@]} -gt 0 ] && [ $attempt -lt 3 ]; do
+    attempt=$((attempt + 1))
+    pattern="^($(printf '%s\n' "${rerun[@]}" | regex_quote | paste -sd'|' -))\$"
+    echo "ctest: attempt $attempt of ${#rerun[@]} case(s) tests/ci-rerun.txt allows to rerun: ${rerun[*]}"
+    ctest --test-dir "$dir" --output-on-failure --output-junit "$dir/ctest-$part-attempt-$attempt.xml" "$@" \
+      -R "$pattern" 8>&- 9>&- || true
+    mapfile -t still < <(junit_failed "$dir/ctest-$part-attempt-$attempt.xml")
+    for name in "${rerun[@]}"; do
+      if ! printf '%s\n' "${still[@]}" | grep -qxF -- "$name"; then
+        echo "ctest: RERUN $name: failed, passed at attempt $attempt"
+        reruns+=("$name")
+      fi
+    done
+    rerun=("${still[@]}")
+  done
+  final_failed+=("${rerun[@]}")
+  # ctest failed without a failing case: a case that could not run.
+  [ "$code" = 0 ] || [ ${#failed[@]} -gt 0 ] || final_failed+=("(ctest exit $code: a case not run)")
 
-n_failed=${#final_failed[@]}
-passed=$((total - skipped - n_failed))
-[ "$passed" -ge 0 ] || passed=0
-echo "passed=$passed failed=$n_failed skipped=$skipped reruns=$(IFS=,; echo "${reruns[*]}")" >"$dir/ctest-summary.txt"
-if [ "$n_failed" != 0 ]; then
+  echo "${total:-0} ${skipped:-0}" >"$dir/ctest-$part.result"
+  printf '%s\n' "${reruns[@]}" | sed '/^$/d' >"$dir/ctest-$part.reruns"
   for name in "${final_failed[@]}"; do
     # The last attempt in which the case ran holds its latest failure.
     why=
     for ((k = attempt; k >= 1; k--)); do
-      xml="$dir/ctest-attempt-$k.xml"
+      xml="$dir/ctest-$part-attempt-$k.xml"
       [ -f "$xml" ] && grep -qF "<testcase name=\"$name\"" "$xml" && { why=$(junit_why "$xml" "$name"); break; }
     done
     printf '%s\t%s\n' "$name" "$why"
-  done >"$dir/ctest-failed.txt"
+  done >"$dir/ctest-$part.failed"
+  [ ${#final_failed[@]} = 0 ]
+}
+
+# The parts of the suite, and how they are run: one ctest run, or the chains apart (see the top).
+rm -f "$dir"/ctest-*.xml "$dir"/ctest-*.result "$dir"/ctest-*.failed "$dir"/ctest-*.reruns \
+  "$dir/ctest-summary.txt" "$dir/ctest-failed.txt"
+chains='simulated_rover_chains'
+apart=0
+if [ -n "${AIRSEG_TEST_LOCK:-}" ] && [ "${AIRSEG_CHAINS_APART:-1}" != 0 ] && [ "${AIRSEG_SUITES_AT_ONCE:-1}" = 1 ]; then
+  # The cases are listed once first: gtest_discover_tests lists an executable's cases when ctest first reads
+  # them, and two ctest runs at once must not both write those lists.
+  suite_priority
+  if ctest --test-dir "$dir" -N -L "(^|/)$chains(/|\$)" "$@" 8>&- 9>&- | grep -q '^Total Tests: [1-9]'; then
+    apart=1
+  fi
 fi
-echo "ctest: $passed passed, $n_failed failed, $skipped skipped"
+# run_alone: the cases labelled alone, with the machine to themselves (the caller holds the locks).
+run_alone() {
+  local t=$SECONDS
+  run_cases alone "$@" -L '(^|/)alone$' 2>&1 | sed -u 's/^/alone| /' || true
+  echo "ctest: the alone cases took $((SECONDS - t)) s"
+}
+start=$SECONDS
+if [ "$apart" = 0 ]; then
+  parts=(all)
+  take_suite_slot
+  run_cases all "$@" || true
+else
+  parts=(rest chains alone)
+  echo "ctest: the chains (label $chains) beside other suites' cases, the rest in a suite slot, the alone cases" \
+    "first if nothing else runs, else last"
+  # The alone cases first when no other suite runs anything (CI's first suite): they then never wait for
+  # chains that started later. Otherwise after this suite's chains.
+  alone_first=0
+  if take_suite_slot now; then
+    if take_chains_lock exclusive now; then
+      alone_first=1
+      run_alone "$@"
+    fi
+    exec 8>&- 9>&-
+  fi
+  (
+    t=$SECONDS
+    take_chains_lock shared
+    run_cases chains "$@" -L "(^|/)$chains(/|\$)" -LE '(^|/)alone$' 2>&1 | sed -u 's/^/chains| /' || true
+    echo "ctest: the chains took $((SECONDS - t)) s"
+    exec 8>&-
+    if [ "$alone_first" = 0 ]; then
+      t=$SECONDS
+      take_suite_slot
+      take_chains_lock exclusive
+      echo "ctest: the alone cases waited $((SECONDS - t)) s for the machine"
+      run_alone "$@"
+    fi
+  ) &
+  chains_pid=$!
+  take_suite_slot
+  t=$SECONDS
+  run_cases rest "$@" -LE "(^|/)($chains|alone)(/|\$)" || true
+  echo "ctest: the rest took $((SECONDS - t)) s"
+  exec 9>&-
+  wait "$chains_pid" || true
+fi
+
+# The parts' results, as one suite's.
+total=0 skipped=0
+final_failed=() reruns=()
+for part in "${parts[@]}"; do
+  read -r t s 2>/dev/null <"$dir/ctest-$part.result" || { t=0 s=0; printf '%s\t\n' "($part: no result)" >>"$dir/ctest-$part.failed"; }
+  total=$((total + t)) skipped=$((skipped + s))
+  mapfile -t -O ${#final_failed[@]} final_failed < <(cut -f1 "$dir/ctest-$part.failed" 2>/dev/null)
+  mapfile -t -O ${#reruns[@]} reruns < <(cat "$dir/ctest-$part.reruns" 2>/dev/null)
+  cat "$dir/ctest-$part.failed" >>"$dir/ctest-failed.txt" 2>/dev/null || true
+done
+# A suite that finds no test at all is a failure, not a pass.
+if [ "$total" = 0 ]; then
+  final_failed+=("(no test found)")
+  printf '%s\t\n' "(no test found)" >>"$dir/ctest-failed.txt"
+fi
+[ -s "$dir/ctest-failed.txt" ] || rm -f "$dir/ctest-failed.txt"
+n_failed=${#final_failed[@]}
+passed=$((total - skipped - n_failed))
+[ "$passed" -ge 0 ] || passed=0
+echo "passed=$passed failed=$n_failed skipped=$skipped reruns=$(IFS=,; echo "${reruns[*]}")" >"$dir/ctest-summary.txt"
+echo "ctest: $passed passed, $n_failed failed, $skipped skipped in $((SECONDS - start)) s"
 [ ${#reruns[@]} = 0 ] || echo "ctest: ${#reruns[@]} of them passed only on a rerun: ${reruns[*]}"
 for name in "${final_failed[@]}"; do
   echo "ctest: FAILED $name"
