@@ -21,10 +21,12 @@
 #    before them); then booted under a real systemd in a virtual machine (packaging/test-vm.sh).
 #    AIRSEG_CI_SKIP_INSTALL_TEST=1 skips both.
 # AIRSEG_CROSS_SUITE_DONE=FILE: CI started this stage beside another suite (at nice 14), which has ended when
-# FILE exists. Meanwhile the ARM builds are 3 apart (armhf at the stage's priority, armel 3 below, arm64 at 19;
+# FILE exists. Meanwhile the ARM builds are 3 apart (armel at the stage's priority, armhf 3 below, arm64 at 19;
 # amd64 at 19 throughout); then they move up, still below any suite's priority (nice 10, 15, 19: a suite is
 # always running from then on), and the install and boot tests start.
-# The suites take AIRSEG_TEST_LOCK (default: one of this stage's own), one at a time.
+# The ARM builds start in the order of their suites' length, longest first: armel, armhf, arm64.
+# The suites take AIRSEG_TEST_LOCK (default: one of this stage's own): one suite's CPU-bound part at a time,
+# their simulated-rover chains side by side (tools/run-ctest.sh).
 # With --prepare, only step 1: CI runs it in the background while it compiles the sanitizer build, so
 # the downloads overlap the compiling.
 # The .debs are left in dist/. Each step prints its start time in seconds since the stage began,
@@ -184,6 +186,14 @@ with_amd64=0
 for arch in "${arches[@]}"; do
   if [ "$arch" = amd64 ]; then with_amd64=1; else arm_arches+=("$arch"); fi
 done
+# The build whose suite is longest first, whatever the order asked: armel's (under qemu-arm without a hardware
+# FPU, about 990 s warm against armhf's 720), then armhf, then arm64 (no suite). The suites' chains of the
+# simulated rover run side by side (tools/run-ctest.sh), so the stage ends with the suite that starts last.
+ordered=()
+for arch in armel armhf arm64; do
+  [[ " ${arm_arches[*]} " != *" $arch "* ]] || ordered+=("$arch")
+done
+arm_arches=("${ordered[@]}")
 overlap=${AIRSEG_CROSS_OVERLAP:-1}
 [ ${#arm_arches[@]} -gt 0 ] || overlap=0
 if [ "$with_amd64" = 1 ] && [ "$overlap" = 0 ]; then
@@ -197,10 +207,10 @@ if [ "$overlap" = 1 ]; then
   # (tools/run-ctest.sh takes AIRSEG_TEST_LOCK and renices itself), so a suite always comes before any
   # compile. The suite's cases then see what they see on a board that does other work too.
   # Started beside another suite (CI starts this stage at nice 14 beside the ASan+UBSan suite), the builds are
-  # three apart: armhf (whose suite is needed first) at the stage's own priority, armel 3 below, arm64 at 19.
+  # three apart: armel (whose suite is longest) at the stage's own priority, armhf 3 below, arm64 at 19.
   arm_pids=() level=$(nice) level_step=10
   [ -z "${AIRSEG_CROSS_SUITE_DONE:-}" ] || level_step=3
-  step "cross-building ${arm_arches[*]} side by side (from nice $(nice), each next one at $level_step more, at most 19), the suites one at a time at nice 0"
+  step "cross-building ${arm_arches[*]} side by side (from nice $(nice), each next one at $level_step more, at most 19), the suites at nice 0 (their rover chains side by side)"
   # The lock CI's other suites take too when it starts this stage beside them (tools/build-and-test.sh).
   export AIRSEG_TEST_LOCK=${AIRSEG_TEST_LOCK:-$AIRSEG_CI_LOGS/arm-suite.lock}
   for arch in "${arm_arches[@]}"; do
@@ -216,7 +226,7 @@ if [ "$overlap" = 1 ]; then
     level=$((level + level_step > 19 ? 19 : level + level_step))  # relative to this script's own priority
   done
   # Started beside another suite, the builds move up once it has ended, each still below the suites (nice 0),
-  # one of which runs from then on: armhf 10, armel 15, arm64 19. A build's suite already running keeps its
+  # one of which runs from then on: armel 10, armhf 15, arm64 19. A build's suite already running keeps its
   # nice 0.
   renice_pid=""
   if [ -n "${AIRSEG_CROSS_SUITE_DONE:-}" ]; then
