@@ -22,8 +22,9 @@
 #             cross-built and checked (their suite under qemu-aarch64 with AIRSEG_CROSS_TEST_ARM64=1; needs root)
 #   native    GCC build as shipped (build/, the one tools/demo.sh runs) and the whole ctest suite
 # With sanitize, the cross stage starts when the sanitizer build is done and compiles at nice 14 to 19 beside the
-# ASan+UBSan suite; every suite (ASan+UBSan, TSan, armhf, armel) takes one lock, so they run one at a time, each
-# at nice 0 (AIRSEG_CROSS_BESIDE_SUITE=0: the cross stage after the others, as without sanitize).
+# ASan+UBSan suite; every suite (ASan+UBSan, TSan, armhf, armel) takes one lock, so that their CPU-bound parts run
+# one at a time (their simulated-rover chains side by side: tools/run-ctest.sh), each at nice 0
+# (AIRSEG_CROSS_BESIDE_SUITE=0: the cross stage after the others, as without sanitize).
 # Default: "sanitize tidy fuzz tsan cross". The shipped GCC build is tested by the cross stage on the two ARM
 # targets; "native" repeats that on amd64 and is the quickest check while developing.
 # Every compile goes through ccache when it is installed, in the cache this user's ccache uses
@@ -127,8 +128,9 @@ if has_stage sanitize || has_stage fuzz; then
   tests/integration/mavlink_interop/setup.sh build-san
 fi
 
-# Every suite takes a slot of one lock (tools/ci-lib.sh, take_suite_slot): one suite at a time, at nice 0, while
-# the builds that are not testing compile beside it at lower priorities, in the order their suites are needed.
+# Every suite takes a slot of one lock (tools/ci-lib.sh, take_suite_slot): one suite's CPU-bound part at a time,
+# at nice 0, with the simulated-rover chains of every suite beside it (tools/run-ctest.sh), while the builds that
+# are not testing compile beside them at lower priorities, in the order their suites are needed.
 export AIRSEG_TEST_LOCK=${AIRSEG_TEST_LOCK:-$AIRSEG_CI_LOGS/suite.lock}
 
 # With the sanitize stage, the cross stage starts as soon as the sanitizer build is done, at nice 14 beside the

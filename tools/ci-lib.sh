@@ -31,6 +31,7 @@ airseg_ccache_env() {
 # leaves behind must not hold the lock. CI's suites (ASan+UBSan, TSan, armhf, armel) take it: one runs at a
 # time, whatever compiles meanwhile (tools/run-ctest.sh runs a suite's chains of the simulated rover beside it).
 # With "now": takes a free slot or returns 1 at once.
+# shellcheck disable=SC2120 # the argument is optional
 take_suite_slot() {
   [ -n "${AIRSEG_TEST_LOCK:-}" ] || return 0
   local slot
