@@ -205,7 +205,8 @@ if [ "$overlap" = 1 ]; then
   # build runs at a lower priority than the one before it (nice 0, 10, 19), so the first one's compile has
   # the CPU and the next compile takes what is left; the suites' CPU-bound parts run one at a time, their
   # simulated-rover chains side by side, each at nice 0 again (tools/run-ctest.sh takes AIRSEG_TEST_LOCK and
-  # renices itself), so a suite always comes before any compile. The suite's cases then see what they see on a board that does other work too.
+  # renices itself), so a suite always comes before any compile. The suite's cases then see what they see on a
+  # board that does other work too.
   # Started beside another suite (CI starts this stage at nice 14 beside the ASan+UBSan suite), the builds are
   # three apart: armel (whose suite is longest) at the stage's own priority, armhf 3 below, arm64 at 19.
   arm_pids=() level=$(nice) level_step=10

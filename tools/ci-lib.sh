@@ -58,8 +58,10 @@ suite_priority() {
 # measurements hold it exclusive, with a suite slot: nothing of any suite beside them. With "now": takes it or
 # returns 1 at once.
 take_chains_lock() {
+  local mode=-x
+  [ "$1" != shared ] || mode=-s
   exec 8>>"$AIRSEG_TEST_LOCK.chains"
-  if flock ${2:+-n} "$([ "$1" = shared ] && echo -s || echo -x)" 8; then return 0; fi
+  flock ${2:+-n} "$mode" 8 && return 0
   exec 8>&-
   return 1
 }

@@ -192,7 +192,10 @@ fi
 total=0 skipped=0
 final_failed=() reruns=()
 for part in "${parts[@]}"; do
-  read -r t s 2>/dev/null <"$dir/ctest-$part.result" || { t=0 s=0; printf '%s\t\n' "($part: no result)" >>"$dir/ctest-$part.failed"; }
+  if ! read -r t s 2>/dev/null <"$dir/ctest-$part.result"; then
+    t=0 s=0
+    printf '%s\t\n' "($part: no result)" >>"$dir/ctest-$part.failed"
+  fi
   total=$((total + t)) skipped=$((skipped + s))
   mapfile -t -O ${#final_failed[@]} final_failed < <(cut -f1 "$dir/ctest-$part.failed" 2>/dev/null)
   mapfile -t -O ${#reruns[@]} reruns < <(cat "$dir/ctest-$part.reruns" 2>/dev/null)
