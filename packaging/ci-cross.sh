@@ -25,6 +25,9 @@
 # amd64 at 19 throughout); then they move up, still below any suite's priority (nice 10, 15, 19: a suite is
 # always running from then on), and the install and boot tests start.
 # The ARM builds start in the order of their suites' length, longest first: armel, armhf, arm64.
+# The builds no suite waits for (the arm64 packages, the amd64 packages and their rebuild) compile at SCHED_IDLE
+# (AIRSEG_CROSS_IDLE=0: at nice 19 only): they take only the CPU that nothing else wants, which is the end of the
+# run, where the last suite's simulated-rover chains leave most of the machine idle.
 # The suites take AIRSEG_TEST_LOCK (default: one of this stage's own): one suite's CPU-bound part at a time,
 # their simulated-rover chains side by side (tools/run-ctest.sh).
 # With --prepare, only step 1: CI runs it in the background while it compiles the sanitizer build, so
@@ -89,6 +92,10 @@ mkdir -p "$AIRSEG_CI_LOGS"
 rm -f "$AIRSEG_CI_LOGS/cross-amd64.summary"
 # The ARM builds that run a suite under qemu, and those that are only built and checked.
 arm_with_suite() { [ "$1" != arm64 ] || [ "${AIRSEG_CROSS_TEST_ARM64:-0}" = 1 ]; }
+# at_idle_priority CMD...: CMD at SCHED_IDLE (AIRSEG_CROSS_IDLE=1, the default), for work no suite waits for.
+at_idle_priority() {
+  if [ "${AIRSEG_CROSS_IDLE:-1}" = 1 ]; then chrt --idle 0 "$@"; else "$@"; fi
+}
 # build_arm ARCH: one ARM package build (with its suite where arm_with_suite), its compiles counted apart.
 build_arm() {
   local arch=$1
@@ -103,7 +110,7 @@ build_arm() {
     AIRSEG_EXTRA_CMAKE_ARGS="-DAIRSEG_TEST_HANG_INJECTION=ON -DAIRSEG_TEST_OPTIMIZATION=-O1${bench:+ $bench}" \
       "$AIRSEG_ROOT/packaging/build-debs.sh" --no-debug-info "$arch"
   else
-    "$AIRSEG_ROOT/packaging/build-debs.sh" --no-check --no-debug-info "$arch"
+    at_idle_priority "$AIRSEG_ROOT/packaging/build-debs.sh" --no-check --no-debug-info "$arch"
   fi
 }
 # record_arm ARCH WALL: the ARCH row of the closing table and of this stage's summary.
@@ -127,7 +134,7 @@ amd64_packages() {
   cpu0=$(cpu_seconds)
   step "building amd64 (its tests run in the sanitize stage)"
   ccache_stage_begin cross-amd64
-  "$AIRSEG_ROOT/packaging/build-debs.sh" --no-check --no-debug-info amd64
+  at_idle_priority "$AIRSEG_ROOT/packaging/build-debs.sh" --no-check --no-debug-info amd64
   record_stage "cross: amd64 packages, built and checked" "$((SECONDS - start))" "" cross-amd64
   line="amd64: $((SECONDS - start)) s wall; packages checked; ccache $(ccache_stage_rate cross-amd64)"
   if [ "${AIRSEG_CI_SKIP_INSTALL_TEST:-0}" != 1 ]; then
@@ -144,7 +151,7 @@ amd64_packages() {
       "$AIRSEG_CI_LOGS/install-debs/"
     start=$SECONDS
     step "the amd64 packages rebuilt as the next version, for the upgrade"
-    "$AIRSEG_ROOT/packaging/build-debs.sh" --no-check --no-debug-info --upgrade-build amd64
+    at_idle_priority "$AIRSEG_ROOT/packaging/build-debs.sh" --no-check --no-debug-info --upgrade-build amd64
     record_stage "cross: amd64 rebuilt as the next version" "$((SECONDS - start))" "" ""
     line="$line; rebuilt as the next version in $((SECONDS - start)) s"
     cp "$AIRSEG_ROOT"/dist/upgrade-test/*.deb "$AIRSEG_CI_LOGS/install-debs/next/"
