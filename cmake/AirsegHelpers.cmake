@@ -50,48 +50,6 @@ function(airseg_test_code target)
   target_link_libraries(${target} PRIVATE airseg_test_flags)
 endfunction()
 
-# In the fuzzing build (CI's ASan+UBSan one), the code no fuzz target exercises directly may be compiled at
-# another level, e.g. -O0: clang with ASan+UBSan compiles a shipped batch at -O0 in half the time of -O1
-# (airseg_daemon_core's first: 50.1 -> 26.2 CPU-s), and most of the shipped code is there only to run the
-# suite. The libraries a fuzz target names (airseg_add_fuzzer's LIBS) keep the build's level, so that the
-# fuzzers' executions per second do not drop; the shipped builds (packages, TSan) are not affected.
-set(AIRSEG_UNFUZZED_OPTIMIZATION "" CACHE STRING
-    "With AIRSEG_BUILD_FUZZ: optimisation flag for code no fuzz target links directly, e.g. -O0 (empty: the build's)")
-
-# airseg_targets_under(DIR OUT): every target defined in DIR and the directories below it.
-function(airseg_targets_under dir out)
-  get_property(_targets DIRECTORY ${dir} PROPERTY BUILDSYSTEM_TARGETS)
-  get_property(_subdirs DIRECTORY ${dir} PROPERTY SUBDIRECTORIES)
-  foreach(_sub ${_subdirs})
-    airseg_targets_under(${_sub} _below)
-    list(APPEND _targets ${_below})
-  endforeach()
-  set(${out} ${_targets} PARENT_SCOPE)
-endfunction()
-
-# airseg_apply_unfuzzed_optimization(): called once every target exists (the top CMakeLists.txt's end).
-function(airseg_apply_unfuzzed_optimization)
-  if(NOT AIRSEG_UNFUZZED_OPTIMIZATION OR NOT AIRSEG_BUILD_FUZZ)
-    return()
-  endif()
-  get_property(_fuzzed GLOBAL PROPERTY AIRSEG_FUZZED_TARGETS)
-  airseg_targets_under(${PROJECT_SOURCE_DIR} _all)
-  set(_lowered 0)
-  foreach(_t ${_all})
-    get_target_property(_type ${_t} TYPE)
-    if(_t IN_LIST _fuzzed OR NOT _type MATCHES "^(STATIC_LIBRARY|EXECUTABLE|OBJECT_LIBRARY)$")
-      continue()
-    endif()
-    # After the build type's flags on the command line, so it wins.
-    set_property(TARGET ${_t} APPEND PROPERTY COMPILE_OPTIONS ${AIRSEG_UNFUZZED_OPTIMIZATION})
-    math(EXPR _lowered "${_lowered} + 1")
-  endforeach()
-  list(REMOVE_DUPLICATES _fuzzed)
-  list(JOIN _fuzzed ", " _kept)
-  message(STATUS "airseg: ${_lowered} targets at ${AIRSEG_UNFUZZED_OPTIMIZATION}; fuzz targets and the libraries they "
-                 "name at the build's level: ${_kept}")
-endfunction()
-
 # airseg_add_library(NAME SOURCES... [LIBS ...])
 function(airseg_add_library name)
   cmake_parse_arguments(A "" "" "SOURCES;LIBS" ${ARGN})

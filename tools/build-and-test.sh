@@ -117,13 +117,11 @@ if has_stage sanitize || has_stage fuzz; then
   ccache_stage_begin sanitize-build
   # The same configuration tests/fuzz/run.sh makes, so the fuzz stage reuses this build. The test-only code (the
   # test executables' sources and tests/support) at -O0: clang with ASan+UBSan compiles it in about half the time
-  # of -O1 (six test batches: 98 -> 52 CPU-s), about 420 CPU-s of a cold build. So is the shipped code that no
-  # fuzz target names (AIRSEG_UNFUZZED_OPTIMIZATION; about 750 of the build's 1,000 CPU-s of shipped code at
-  # -O1): the fuzz targets and the libraries they fuzz keep -O1, so the fuzzers run as many inputs as before.
+  # of -O1 (six test batches: 98 -> 52 CPU-s), about 420 CPU-s of a cold build; the libraries, programs and fuzz
+  # targets under test keep -O1.
   CC=clang CXX=clang++ cmake -S . -B build-san -G Ninja "${launcher[@]}" \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" \
     -DAIRSEG_BUILD_FUZZ=ON -DAIRSEG_BUILD_TESTS=ON -DAIRSEG_BUILD_BENCH=ON -DAIRSEG_TEST_OPTIMIZATION=-O0 \
-    -DAIRSEG_UNFUZZED_OPTIMIZATION=-O0 \
     -DAIRSEG_SANITIZE=fuzzer-no-link,address,undefined
   cmake --build build-san -j"$jobs"
   elapsed "sanitize: build (clang, ASan+UBSan)" "$start" "" sanitize-build

@@ -35,6 +35,8 @@ shift
 junit_field() { sed -n "s/^[[:space:]]*$2=\"\([0-9]*\)\".*/\1/p" "$1" | head -n1; }
 # junit_failed FILE: the names of the cases that failed, one per line.
 junit_failed() { sed -n 's/^[[:space:]]*<testcase name="\([^"]*\)".* status="fail".*/\1/p' "$1"; }
+# xml_text: XML's escapes undone (a case's name as ctest knows it: GetParam() = "modern").
+xml_text() { sed 's/&lt;/</g; s/&gt;/>/g; s/&quot;/"/g; s/&apos;/'"'"'/g; s/&amp;/\&/g'; }
 regex_quote() { sed 's/[][\.*^$+?(){}|]/\\&/g'; }
 # junit_why FILE NAME: why case NAME failed, on one line of at most 600 characters: from its output, the first
 # gtest failure and the four lines after it, or (a timeout, a crash) its run time and the last four lines it
@@ -57,7 +59,7 @@ junit_why() {
       line = i <= n ? "" : "no assertion failed (a timeout or a crash?) after " took " s; it printed last:"
       for (i = from; i <= n && i < from + 5; i++) line = line (line == "" ? "" : " | ") out[i]
       print line
-    }' "$1" | sed 's/&lt;/</g; s/&gt;/>/g; s/&quot;/"/g; s/&apos;/'"'"'/g; s/&amp;/\&/g' | tr -d '\r' | cut -c1-600
+    }' "$1" | xml_text | tr -d '\r' | cut -c1-600
 }
 
 # run_cases PART [CTEST_ARGS...]: one ctest run of the cases CTEST_ARGS select, then the reruns
@@ -96,14 +98,14 @@ run_cases() {
   done
   while [ ${#rerun[@]} -gt 0 ] && [ $attempt -lt 3 ]; do
     attempt=$((attempt + 1))
-    pattern="^($(printf '%s\n' "${rerun[@]}" | regex_quote | paste -sd'|' -))\$"
+    pattern="^($(printf '%s\n' "${rerun[@]}" | xml_text | regex_quote | paste -sd'|' -))\$"
     echo "ctest: attempt $attempt of ${#rerun[@]} case(s) tests/ci-rerun.txt allows to rerun: ${rerun[*]}"
     ctest --test-dir "$dir" --output-on-failure --output-junit "$dir/ctest-$part-attempt-$attempt.xml" "$@" \
       -R "$pattern" 8>&- 9>&- || true
     mapfile -t still < <(junit_failed "$dir/ctest-$part-attempt-$attempt.xml")
     for name in "${rerun[@]}"; do
       if ! printf '%s\n' "${still[@]}" | grep -qxF -- "$name"; then
-        echo "ctest: RERUN $name: failed, passed at attempt $attempt"
+        echo "ctest: RERUN $(xml_text <<<"$name"): failed, passed at attempt $attempt"
         reruns+=("$name")
       fi
     done
@@ -114,7 +116,7 @@ run_cases() {
   [ "$code" = 0 ] || [ ${#failed[@]} -gt 0 ] || final_failed+=("(ctest exit $code: a case not run)")
 
   echo "${total:-0} ${skipped:-0}" >"$dir/ctest-$part.result"
-  printf '%s\n' "${reruns[@]}" | sed '/^$/d' >"$dir/ctest-$part.reruns"
+  printf '%s\n' "${reruns[@]}" | sed '/^$/d' | xml_text >"$dir/ctest-$part.reruns"
   for name in "${final_failed[@]}"; do
     # The last attempt in which the case ran holds its latest failure.
     why=
@@ -122,7 +124,7 @@ run_cases() {
       xml="$dir/ctest-$part-attempt-$k.xml"
       [ -f "$xml" ] && grep -qF "<testcase name=\"$name\"" "$xml" && { why=$(junit_why "$xml" "$name"); break; }
     done
-    printf '%s\t%s\n' "$name" "$why"
+    printf '%s\t%s\n' "$(xml_text <<<"$name")" "$why"
   done >"$dir/ctest-$part.failed"
   [ ${#final_failed[@]} = 0 ]
 }
