@@ -99,7 +99,7 @@ run_cases() {
   while [ ${#rerun[@]} -gt 0 ] && [ $attempt -lt 3 ]; do
     attempt=$((attempt + 1))
     pattern="^($(printf '%s\n' "${rerun[@]}" | xml_text | regex_quote | paste -sd'|' -))\$"
-    echo "ctest: attempt $attempt of ${#rerun[@]} case(s) tests/ci-rerun.txt allows to rerun: ${rerun[*]}"
+    echo "ctest: attempt $attempt of ${#rerun[@]} case(s) tests/ci-rerun.txt allows to rerun: $(printf '%s\n' "${rerun[@]}" | xml_text | paste -sd' ' -)"
     ctest --test-dir "$dir" --output-on-failure --output-junit "$dir/ctest-$part-attempt-$attempt.xml" "$@" \
       -R "$pattern" 8>&- 9>&- || true
     mapfile -t still < <(junit_failed "$dir/ctest-$part-attempt-$attempt.xml")
