@@ -44,6 +44,7 @@ nlohmann::json autopilot_status_json(const autopilot::AutopilotStatus& s) {
     j["mission_current"] = s.mission_current;
     j["reboots"] = s.reboots;
     j["link_losses"] = s.link_losses;
+    j["link_verdicts_deferred"] = s.link_verdicts_deferred;
     j["syncs"] = s.syncs;
     j["reconnects"] = s.reconnects;
     j["reset_pulses"] = s.reset_pulses;

@@ -117,6 +117,14 @@ class SerialPort::Impl : public std::enable_shared_from_this<Impl> {
 
     std::size_t queued_bytes() const { return writes_.bytes(); }
 
+    std::size_t bytes_waiting() {
+        int n = 0;
+        if (!is_open() || ::ioctl(stream_.native_handle(), FIONREAD, &n) != 0 || n < 0) {
+            return 0;
+        }
+        return static_cast<std::size_t>(n);
+    }
+
     std::error_code set_line(int bit, bool on) {
         if (!is_open()) {
             return std::make_error_code(std::errc::bad_file_descriptor);
@@ -241,6 +249,9 @@ WriteResult SerialPort::write(std::vector<std::uint8_t> bytes) {
 }
 std::size_t SerialPort::queued_bytes() const {
     return impl_->queued_bytes();
+}
+std::size_t SerialPort::bytes_waiting() const {
+    return impl_->bytes_waiting();
 }
 std::error_code SerialPort::set_dtr(bool on) {
     return impl_->set_line(TIOCM_DTR, on);

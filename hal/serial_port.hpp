@@ -53,6 +53,10 @@ class SerialPort {
     WriteResult write(std::vector<std::uint8_t> bytes);
     /// Bytes accepted by write() and not yet handed to the kernel; the basis for pacing.
     std::size_t queued_bytes() const;
+    /// Bytes received by the kernel and not read yet (FIONREAD); 0 when closed or when the driver cannot
+    /// tell. A consumer judging the peer's silence asks this first: a starved reader's backlog is not
+    /// silence.
+    std::size_t bytes_waiting() const;
 
     /// Drives the DTR / RTS lines now (APM boards reset on a DTR edge). Ptys refuse these: the error says so.
     std::error_code set_dtr(bool on);

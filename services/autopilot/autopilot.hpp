@@ -249,13 +249,14 @@ struct AutopilotStatus {
     std::uint16_t mission_current = 0;           // autopilot.mission_current
     unsigned reboots = 0;                        // autopilot.reboots
     unsigned link_losses = 0;                    // autopilot.link_losses: heartbeats overdue, link down
-    unsigned syncs = 0;                          // autopilot.syncs: parameter + mission downloads started
-    unsigned reconnects = 0;            // autopilot.reconnects (filled by the service from its port keeper)
-    unsigned reset_pulses = 0;          // autopilot.reset_pulses
-    std::optional<bool> armed;          // autopilot.armed: the heartbeat's SAFETY_ARMED; empty before one
-    unsigned arm_refusals = 0;          // autopilot.arm_refusals: arming attempts the board refused
-    std::optional<double> speed;        // autopilot.speed: the leg speed the board last confirmed, m/s
-    std::string mission_items = "int";  // autopilot.mission_items: "int" (MISSION_ITEM_INT) or "float"
+    unsigned link_verdicts_deferred = 0;  // autopilot.link_verdicts_deferred: overdue, the port not read out
+    unsigned syncs = 0;                   // autopilot.syncs: parameter + mission downloads started
+    unsigned reconnects = 0;              // autopilot.reconnects (filled by the service from its port keeper)
+    unsigned reset_pulses = 0;            // autopilot.reset_pulses
+    std::optional<bool> armed;            // autopilot.armed: the heartbeat's SAFETY_ARMED; empty before one
+    unsigned arm_refusals = 0;            // autopilot.arm_refusals: arming attempts the board refused
+    std::optional<double> speed;          // autopilot.speed: the leg speed the board last confirmed, m/s
+    std::string mission_items = "int";    // autopilot.mission_items: "int" (MISSION_ITEM_INT) or "float"
     unsigned auto_restarts_corrected = 0;  // autopilot.auto_restarts_corrected: slots set back after AUTO
     unsigned baud = 0;  // autopilot.baud: the rate the port runs at (the one kept when probing)
     // autopilot.refused_values: values from the autopilot not taken (NaN, out of range), and the last one

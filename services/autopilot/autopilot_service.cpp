@@ -332,7 +332,9 @@ void AutopilotService::on_timer() {
         return;
     }
     const TimePoint now = SteadyClock::now();
-    driver_.handle_timeout(now);
+    // A starved daemon reads a backlog of seconds slower than the link's read grace: the heartbeat it is
+    // about to judge missing may be in it.
+    driver_.handle_timeout(now, keeper_.port().bytes_waiting() > 0);
     tlog_.handle_timeout(now);
     uploads_.handle_timeout(now);
     drain_uploads();

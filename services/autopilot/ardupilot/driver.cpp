@@ -151,12 +151,12 @@ void Driver::send_gcs_heartbeat_if_due(TimePoint now) {
     next_gcs_heartbeat_ = next_on_grid(now, seconds(1));
 }
 
-void Driver::handle_timeout(TimePoint now) {
+void Driver::handle_timeout(TimePoint now, bool input_waiting) {
     missions_.handle_timeout(now);
     params_.handle_timeout(now);
     drain_clients(now);
 
-    const LinkWatch::Due due = link_.handle_timeout(now);
+    const LinkWatch::Due due = link_.handle_timeout(now, input_waiting);
     if (due.lost) {
         link_lost(*due.lost, now);
     }
@@ -813,6 +813,7 @@ AutopilotStatus Driver::status() const {
     s.mission_current = telemetry_.mission_current;
     s.reboots = reboots_;
     s.link_losses = link_.link_losses();
+    s.link_verdicts_deferred = link_.verdicts_deferred();
     s.syncs = syncs_;
     s.reset_pulses = link_.reset_pulses();
     s.armed = armed();

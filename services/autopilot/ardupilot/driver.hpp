@@ -92,7 +92,8 @@ class Driver {
 
     // --- sans-IO plumbing ---
     void handle_bytes(std::span<const std::uint8_t> bytes, TimePoint now);
-    void handle_timeout(TimePoint now);
+    /// `input_waiting`: the port holds bytes not read yet; an overdue heartbeat is not judged on them.
+    void handle_timeout(TimePoint now, bool input_waiting = false);
     TimePoint poll_timeout() const;
     std::optional<std::vector<std::uint8_t>> poll_transmit();
     std::optional<Event> poll_event();

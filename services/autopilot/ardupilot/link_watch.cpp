@@ -127,15 +127,20 @@ std::optional<std::string> LinkWatch::declare(std::string evidence, TimePoint no
     return evidence;
 }
 
-LinkWatch::Due LinkWatch::handle_timeout(TimePoint now) {
+LinkWatch::Due LinkWatch::handle_timeout(TimePoint now, bool input_waiting) {
     Due due;
     if (up_ && now >= heartbeat_due_) {
+        const bool woke_late = now - heartbeat_due_ > kLateWake;  // not awake long enough to tell
         if (!overdue_since_) {
             // Overdue: the heartbeats may be in the port, unread, if the daemon itself was not running.
             overdue_since_ = now;
             heartbeat_due_ = now + kReadGrace;
-        } else if (now - heartbeat_due_ > kLateWake && now - *overdue_since_ < config_.heartbeat_timeout) {
-            heartbeat_due_ = now + kReadGrace;  // even the grace ended late: not awake long enough to tell
+        } else if ((woke_late || input_waiting) && now - *overdue_since_ < config_.heartbeat_timeout) {
+            // Even the grace ended late, or the backlog is still being read: judged once it is.
+            if (!woke_late) {
+                ++verdicts_deferred_;
+            }
+            heartbeat_due_ = now + kReadGrace;
         } else {
             up_ = false;
             ++link_losses_;

@@ -4,11 +4,11 @@
 // Link up on the first heartbeat, down when a heartbeat is overdue by heartbeat_timeout; the verdict waits
 // kReadGrace more, so that a daemon that was itself stopped or starved (its timer and its port ready at
 // once, the frames of the pause still in the port) reads what came before it judges (longer while even that
-// wake comes late, at most heartbeat_timeout more). Baud probing (more than one configured rate): when no
-// frame from the autopilot's system id arrives within baud_probe of the open, the next rate is due, in turn;
-// the first that yields such a frame is kept. An autopilot silent (link down) for unresponsive_timeout while
-// its port is open is due a reset pulse, at most max_reset_pulses until the budget is refilled (the driver
-// does so on READY).
+// wake comes late, or while the port still holds bytes not read: at most heartbeat_timeout more). Baud
+// probing (more than one configured rate): when no frame from the autopilot's system id arrives within
+// baud_probe of the open, the next rate is due, in turn; the first that yields such a frame is kept. An
+// autopilot silent (link down) for unresponsive_timeout while its port is open is due a reset pulse, at most
+// max_reset_pulses until the budget is refilled (the driver does so on READY).
 //
 // Reboot evidence, and only this: the autopilot's time_boot_ms went back by more than kClockBackSlack and
 // ran on from the new value for kClockConfirm (the old clock not seen again meanwhile), or a heartbeat gap of
@@ -88,7 +88,10 @@ class LinkWatch {
     /// The clock of the boot being waited for starts again; evidence held back is dropped.
     void forget_boot_clock();
 
-    Due handle_timeout(TimePoint now);
+    /// `input_waiting`: the port holds bytes not read yet (the I/O side asks the kernel). An overdue
+    /// heartbeat's verdict then waits another kReadGrace, within heartbeat_timeout: a reader starved for
+    /// CPU drains a backlog of seconds slower than one grace, and the heartbeat may be in it.
+    Due handle_timeout(TimePoint now, bool input_waiting = false);
     TimePoint poll_timeout() const;
 
     /// Takes one reset pulse from the budget: its number, or nothing when the budget is spent.
@@ -102,6 +105,8 @@ class LinkWatch {
     unsigned reset_pulses() const { return reset_pulses_; }
     /// Times the link went down for want of heartbeats, ever.
     unsigned link_losses() const { return link_losses_; }
+    /// Verdicts on an overdue heartbeat put off because the port still held unread bytes, ever.
+    unsigned verdicts_deferred() const { return verdicts_deferred_; }
     /// Reboot evidence that came within kRebootSpacing of a declared reboot, ever.
     unsigned reboots_held() const { return reboots_held_; }
 
@@ -125,6 +130,7 @@ class LinkWatch {
     unsigned pulses_ = 0;
     unsigned reset_pulses_ = 0;
     unsigned link_losses_ = 0;
+    unsigned verdicts_deferred_ = 0;
     // Reboot evidence.
     std::optional<ClockSample> clock_;          // the autopilot's clock as trusted
     std::optional<ClockSample> restart_first_;  // where it went back to, while that is being confirmed

@@ -231,6 +231,51 @@ TEST(LinkWatch, ADeadAutopilotIsLostEvenWhenEveryWakeComesLate) {
     EXPECT_FALSE(w.up());
 }
 
+// A daemon short of CPU drains a backlog of seconds in reads slower than one grace: while the port still
+// holds bytes, the verdict waits for them (the heartbeat may be among them), within heartbeat_timeout.
+TEST(LinkWatch, TheVerdictWaitsWhileThePortStillHoldsUnreadBytes) {
+    LinkWatch w(quiet_open());
+    w.on_port_open(kOpen);
+    beat(w, kOpen);
+    const TimePoint overdue = kOpen + seconds(3);
+    EXPECT_FALSE(w.handle_timeout(overdue).lost);  // the grace
+    // Each look comes on time, and each finds the backlog still being read.
+    for (int i = 1; i <= 3; ++i) {
+        EXPECT_FALSE(w.handle_timeout(w.poll_timeout(), true).lost) << "look " << i;
+    }
+    EXPECT_EQ(w.verdicts_deferred(), 3u);
+    EXPECT_FALSE(beat(w, w.poll_timeout() - milliseconds(10))) << "the link never went down";
+    EXPECT_EQ(w.link_losses(), 0u);
+
+    // Without bytes waiting, a grace that ends on time is judged at once: the same look, the other answer.
+    LinkWatch idle(quiet_open());
+    idle.on_port_open(kOpen);
+    beat(idle, kOpen);
+    EXPECT_FALSE(idle.handle_timeout(overdue).lost);
+    EXPECT_TRUE(idle.handle_timeout(idle.poll_timeout(), false).lost);
+    EXPECT_EQ(idle.verdicts_deferred(), 0u);
+}
+
+// Bytes that keep coming without a heartbeat among them (a board that streams but stopped beating, line
+// noise) put the verdict off for at most heartbeat_timeout.
+TEST(LinkWatch, UnreadBytesPutTheVerdictOffForAtMostTheHeartbeatTimeout) {
+    LinkWatch w(quiet_open());
+    w.on_port_open(kOpen);
+    beat(w, kOpen);
+    std::optional<TimePoint> lost_at;
+    for (int i = 0; i < 100 && !lost_at; ++i) {
+        const TimePoint now = w.poll_timeout();
+        if (w.handle_timeout(now, true).lost) {
+            lost_at = now;
+        }
+    }
+    ASSERT_TRUE(lost_at);
+    EXPECT_GE(*lost_at - kOpen, seconds(3) + seconds(3));
+    EXPECT_LE(*lost_at - kOpen, seconds(3) + seconds(3) + LinkWatch::kReadGrace);
+    EXPECT_FALSE(w.up());
+    EXPECT_EQ(w.link_losses(), 1u);
+}
+
 // --- reboot evidence ------------------------------------------------------------------------------------
 
 /// Feeds time_boot_ms samples every `step` from `from` for `span`: the board's clock `clock(t)` at each.

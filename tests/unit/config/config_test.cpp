@@ -460,6 +460,7 @@ TEST(AutopilotStatus, SectionCarriesTheDocumentedKeys) {
     s.mission_current = 3;
     s.reboots = 1;
     s.link_losses = 4;
+    s.link_verdicts_deferred = 5;
     s.syncs = 2;
     s.reconnects = 2;
     const auto j = autopilot_status_json(s);
@@ -473,6 +474,7 @@ TEST(AutopilotStatus, SectionCarriesTheDocumentedKeys) {
     EXPECT_EQ(j["mission_current"], 3);
     EXPECT_EQ(j["reboots"], 1);
     EXPECT_EQ(j["link_losses"], 4);
+    EXPECT_EQ(j["link_verdicts_deferred"], 5);
     EXPECT_EQ(j["syncs"], 2);
     EXPECT_EQ(j["reconnects"], 2);
     const auto down = autopilot_status_json(autopilot::AutopilotStatus{});

@@ -174,6 +174,30 @@ TEST_P(HalSerialPortBaudTest, BytesFlowBothWays) {
 
 INSTANTIATE_TEST_SUITE_P(HalStandardRates, HalSerialPortBaudTest, ::testing::Values(57600u, 115200u));
 
+// What a reader judging the peer's silence asks first: how much the kernel holds that it has not read.
+TEST_F(HalSerialPortTest, BytesWaitingCountsWhatTheKernelHoldsUnread) {
+    SerialPort port(io_.get_executor());
+    EXPECT_EQ(port.bytes_waiting(), 0u) << "closed";
+    auto result = port.open(config_for(pty_));
+    ASSERT_TRUE(result.ok()) << result.message;
+    EXPECT_EQ(port.bytes_waiting(), 0u);
+    const auto down = pattern_bytes(300, 3);
+    ASSERT_TRUE(test::write_all(pty_.master(), down));
+    // The pty hands written bytes to the slave's line discipline asynchronously.
+    ASSERT_TRUE(run_until(io_, [&] { return port.bytes_waiting() == down.size(); })) << port.bytes_waiting();
+
+    port.start_reading(
+        [this](std::span<const std::uint8_t> b) {
+            received_.bytes.insert(received_.bytes.end(), b.begin(), b.end());
+        },
+        [this](std::error_code ec, const std::string& what) { received_.errors.emplace_back(ec, what); });
+    ASSERT_TRUE(run_until(io_, [&] { return received_.bytes.size() >= down.size(); }));
+    EXPECT_EQ(received_.bytes, down);
+    EXPECT_EQ(port.bytes_waiting(), 0u) << "read out";
+    port.close();
+    EXPECT_EQ(port.bytes_waiting(), 0u);
+}
+
 TEST_F(HalSerialPortTest, LargeWritesArriveInOrder) {
     SerialPort port(io_.get_executor());
     open_and_read(port, config_for(pty_));
