@@ -82,6 +82,8 @@ struct FeederProgress {
     std::uint64_t interruptions = 0;
     std::uint64_t starvation_holds = 0;
     bool held_at_frontier = false;      // plan.held_at_frontier: waiting at the barrier for a write now
+    std::string held;                   // plan.held: path of the element being held now, "" if none
+    bool held_until_released = false;   // plan.held_until_released: that hold waits for plan resume
     std::uint64_t frontier_stops = 0;   // plan.frontier_stops: times the vehicle waited at the barrier
     Duration frontier_wait{};           // plan.frontier_wait_s: time spent waiting there (ended waits)
     std::uint64_t ignored_reached = 0;  // duplicate or late reached reports

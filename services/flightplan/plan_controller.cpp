@@ -786,6 +786,8 @@ Json PlanController::progress_json() const {
     j["interruption"] = shown_interruption(p).empty() ? Json(nullptr) : Json(shown_interruption(p));
     j["error"] = problem_.empty() ? Json(nullptr) : Json(problem_);
     j["held_at_frontier"] = p.held_at_frontier;
+    j["held"] = p.held.empty() ? Json(nullptr) : Json(p.held);
+    j["held_until_released"] = p.held_until_released;
     j["frontier_stops"] = p.frontier_stops;
     j["frontier_wait_s"] = std::round(std::chrono::duration<double>(p.frontier_wait).count() * 10.0) / 10.0;
     return j;
@@ -809,9 +811,13 @@ TimePoint PlanController::poll_timeout() const {
 }
 
 PlanController::StatusKey PlanController::status_key(const FeederProgress& p) const {
-    return {p.state,         p.plan_name,        p.element,        p.waypoints_reached,
-            p.next_waypoint, p.window,           last_reaction_,   shown_interruption(p),
-            problem_,        p.held_at_frontier, p.frontier_stops, p.frontier_wait};
+    return {p.state,          p.plan_name,
+            p.element,        p.waypoints_reached,
+            p.next_waypoint,  p.window,
+            last_reaction_,   shown_interruption(p),
+            problem_,         p.held_at_frontier,
+            p.frontier_stops, p.frontier_wait,
+            p.held,           p.held_until_released};
 }
 
 // The last interruption is news while its plan runs (and kept after the plan continued); a plan that has

@@ -158,9 +158,9 @@ class PlanController {
     Json progress_json() const;
     // What progress_json() shows, as plain values: compared at every status check, where building the JSON
     // to compare would cost about 10,000 instructions.
-    using StatusKey =
-        std::tuple<PlanState, std::string, std::string, std::uint64_t, std::optional<std::uint64_t>,
-                   std::size_t, std::string, std::string, std::string, bool, std::uint64_t, Duration>;
+    using StatusKey = std::tuple<PlanState, std::string, std::string, std::uint64_t,
+                                 std::optional<std::uint64_t>, std::size_t, std::string, std::string,
+                                 std::string, bool, std::uint64_t, Duration, std::string, bool>;
     StatusKey status_key(const FeederProgress& p) const;
     /// plan.interruption: the feeder's last interruption, none once the plan is done.
     static const std::string& shown_interruption(const FeederProgress& p);

@@ -165,6 +165,7 @@ void WindowFeeder::emit(FeederEvent::Kind kind, const Waypoint* wp, std::uint32_
 
 void WindowFeeder::replace_plan(PlanFeed feed, TimePoint now) {
     stream_ = std::move(feed.stream);
+    held_back_.reset();
     plan_name_ = std::move(feed.name);
     ++generation_;
     extensions_ = 0;
@@ -212,6 +213,7 @@ bool WindowFeeder::jump_to(std::string_view element_name, TimePoint now) {
 }
 
 void WindowFeeder::restart(TimePoint now) {
+    held_back_.reset();    // the stream was moved on
     interrupted_.reset();  // the operator chose where to go on: taken by hand no more
     interrupted_by_hand_ = false;
     holds_.clear();
@@ -283,6 +285,7 @@ void WindowFeeder::continue_with(PlanFeed feed, TimePoint now) {
 
 void WindowFeeder::clear_plan() {
     stream_.reset();
+    held_back_.reset();
     queue_.clear();
     holds_.clear();
     holding_ = false;
@@ -321,7 +324,10 @@ void WindowFeeder::release_hold(TimePoint now) {
 
 void WindowFeeder::refill(TimePoint now) {
     while (stream_ && !stream_ended_ && queue_.size() < capacity()) {
-        auto w = stream_->next();
+        if (held_back_ && !queue_.empty() && queue_.back().holds_vehicle()) {
+            break;
+        }
+        auto w = held_back_ ? std::exchange(held_back_, std::nullopt) : stream_->next();
         const std::uint16_t slot = queue_.empty() ? fresh_slot_ : ring_next(queue_.back().slot);
         if (!w) {
             stream_ended_ = true;
@@ -349,6 +355,11 @@ void WindowFeeder::refill(TimePoint now) {
             }
             continue;
         }
+        if (!queue_.empty() && queue_.back().holds_vehicle()) {
+            // The hold's barrier stays until the vehicle is there: a starved daemon cannot let it drive on.
+            held_back_ = std::move(w);
+            break;
+        }
         Entry e;
         e.wp = *w;
         e.slot = slot;
@@ -362,6 +373,10 @@ void WindowFeeder::complete_through(std::size_t position, TimePoint now) {
     for (std::size_t i = 0; i <= position && !queue_.empty(); ++i) {
         Entry e = std::move(queue_.front());
         queue_.pop_front();
+        if (queue_.empty()) {
+            // A hold's waypoint was the window's last: what follows goes where its barrier is.
+            fresh_slot_ = ring_next(e.slot);
+        }
         emit(FeederEvent::Kind::WaypointReached, &e.wp, e.generation, e.element_path);
         if (e.generation == generation_) {
             ++reached_;
@@ -456,9 +471,16 @@ void WindowFeeder::end_hold(TimePoint now) {
     }
     if (!holds_.empty()) {
         begin_hold(now);
-    } else {
-        announce_head();
+        return;
     }
+    if (frontier_since_ && frontier_is_hold_ && !queue_.empty()) {
+        // Held at the hold's barrier, and the next waypoint is not on board yet: from now on the vehicle
+        // waits for it.
+        frontier_since_ = now;
+        frontier_is_hold_ = false;
+        count_frontier_stop();
+    }
+    announce_head();
 }
 
 void WindowFeeder::check_done() {
@@ -492,20 +514,30 @@ void WindowFeeder::at_frontier(TimePoint now) {
         return;
     }
     frontier_since_ = now;
-    ++counters_.frontier_stops;
     // Once the head is written the board is pointed at it again: a vehicle parked on a Stop does not leave it
     // because its slot changed (ArduPilot restarts only a waypoint leg when its mission changes).
     need_set_current_ = true;
     repoint_only_ = true;
     ap_target_ = queue_[0].slot;
+    frontier_is_hold_ = holding_;
+    if (!frontier_is_hold_) {
+        count_frontier_stop();
+    }
+}
+
+void WindowFeeder::count_frontier_stop() {
+    ++counters_.frontier_stops;
     emit(FeederEvent::Kind::HeldAtFrontier, &queue_[0].wp, queue_[0].generation, queue_[0].element_path,
          "the next waypoint was not on the autopilot in time: the vehicle waits at the last one written");
 }
 
 void WindowFeeder::left_frontier(TimePoint now) {
     if (frontier_since_) {
-        counters_.frontier_wait += now - *frontier_since_;
+        if (!frontier_is_hold_) {
+            counters_.frontier_wait += now - *frontier_since_;
+        }
         frontier_since_.reset();
+        frontier_is_hold_ = false;
     }
 }
 
@@ -733,6 +765,15 @@ void WindowFeeder::on_mode(VehicleState state, autopilot::ModeChangeCause cause,
     if (frontier_since_ && mode_ == Mode::Hold) {
         // A board whose Stop ends its mission (APM:Rover 2.x) holds at the barrier by itself: the head's
         // write, a set-current and AUTO take it on, as for a vehicle parked there in AUTO.
+        return;
+    }
+    if (mode_ == Mode::Hold && queue_.size() == 1 && !queue_[0].stop && queue_[0].slot == kFirstRingSlot &&
+        confirmed(queue_[0]) && holds_stop(ring_next(kFirstRingSlot))) {
+        // The head is the window's last (a hold's point ends it) and the ring's jump lands on it: a 2.x board
+        // runs the barrier after it as it takes the jump and holds short of it (on_current, slot 2). Its
+        // target report may come after this: it is pointed at slot 2 before AUTO, or AUTO ends its mission
+        // again at once.
+        at_frontier(now);
         return;
     }
     // The board's own HOLD: a failsafe, a mode switch, a DO_JUMP taken its own way, or the end of its
@@ -1061,7 +1102,11 @@ FeederProgress WindowFeeder::progress() const {
     }
     // The last interruption stays in view while the plan goes on; a finished plan has none left.
     p.interruption = done_ ? std::string{} : last_interruption_;
-    p.held_at_frontier = frontier_since_.has_value();
+    p.held_at_frontier = frontier_since_.has_value() && !frontier_is_hold_;
+    if (holding_ && hold_wp_) {
+        p.held = stream_path(*hold_wp_);
+        p.held_until_released = hold_wp_->action == WaypointAction::HoldUntilReleased;
+    }
     if (p.held_at_frontier) {
         p.interruption = "waiting at the last waypoint written to the autopilot for the next one";
     }

@@ -14,7 +14,10 @@
 // window holds up to K-1 entries from the head in ring order, and the slot after the last holds its
 // barrier; a slot is written with an entry only once the slot after it holds that entry's barrier, so a
 // vehicle whose feeder fell behind stops at the frontier and waits (HeldAtFrontier) instead of driving a
-// slot left from an earlier round. The writes after a reached waypoint land three or more waypoints ahead
+// slot left from an earlier round. A hold's waypoint (a timed hold, one until released, or the point a hold
+// without a position is held at) is the last entry of the window until the vehicle has reached it: its
+// barrier stops the vehicle there even when this daemon does not run, and what follows is written once the
+// hold has begun. The writes after a reached waypoint land three or more waypoints ahead
 // of the vehicle's target, outside the look-ahead of ArduPilot's mission change detector (the current
 // navigation command and the next two), so they never restart the leg being driven.
 //
@@ -116,6 +119,9 @@ class WindowFeeder {
         std::uint32_t generation = 0;
         std::string element_path;
         bool announced = false;  // ElementStarted considered (once, when it became the head)
+        /// The plan holds the vehicle at this entry's point: nothing after it is written before it is
+        /// reached.
+        bool holds_vehicle() const { return wp.action != WaypointAction::Go || !holds_after.empty(); }
         autopilot::MissionItem item() const;
         /// The Stop that ends the drivable part of the ring after this entry: at its point.
         autopilot::MissionItem barrier() const;
@@ -177,6 +183,8 @@ class WindowFeeder {
     void check_starvation();
     /// The vehicle stands at a barrier: the head's slot holds a Stop, and the board reports being there.
     void at_frontier(TimePoint now);
+    /// Counts and reports a stop at the frontier (not one at a hold's barrier, where the plan stops anyway).
+    void count_frontier_stop();
     void left_frontier(TimePoint now);
     bool plan_active() const;
     void interrupt(std::string why, bool wait_for_operator);
@@ -197,7 +205,8 @@ class WindowFeeder {
     std::uint32_t generation_ = 0;
     std::uint32_t extensions_ = 0;  // continue_with() calls since the plan was loaded
     bool stream_ended_ = false;
-    std::deque<Entry> queue_;                    // queue_[0] is the current target
+    std::deque<Entry> queue_;            // queue_[0] is the current target
+    std::optional<Waypoint> held_back_;  // taken from the stream, kept out while the last entry is a hold's
     std::uint16_t fresh_slot_ = kFirstRingSlot;  // slot of the first entry when the queue starts empty
     bool done_ = false;
     bool cleared_ = false;
@@ -223,6 +232,7 @@ class WindowFeeder {
     std::optional<std::string> failed_;  // why the autopilot refused the plan
     bool starving_ = false;
     std::optional<TimePoint> frontier_since_;  // the vehicle waits at a barrier for the next write
+    bool frontier_is_hold_ = false;            // ... where the plan holds it anyway: no frontier stop
     bool fault_ = false;
     TimePoint retry_not_before_ = TimePoint::min();
     std::uint32_t consecutive_failures_ = 0;

@@ -862,12 +862,15 @@ TEST_P(FlightplanSurveyE2e,
     }
     // Under a sanitizer or an emulator beside other suites the daemon may fall behind a board at speedup 100:
     // the vehicle then waits at the frontier (a HOLD on 2.x), and every such wait must be one it counted.
+    // A 2.x board also stops short of a hold's point that the ring's jump lands on: a hold's point ends the
+    // window, and 2.x runs the barrier after the place a jump lands on at once (docs/flight-plan.md); it is
+    // then a counted frontier stop, one per hold at most.
     const auto counted = show().value("frontier_stops", 0);
-    if (kSlowed) {
+    if (kSlowed || GetParam() == "rover2") {
         EXPECT_GE(holds, 2) << modes.dump();
         EXPECT_LE(holds, 2 + counted) << modes.dump();
     } else {
-        EXPECT_EQ(holds, 2) << modes.dump();
+        EXPECT_EQ(holds, 2) << modes.dump() << daemon_->err();
     }
     // Ideal: each leg at its speed (the first leg from wherever the vehicle started is not counted).
     double ideal = 0;
@@ -883,7 +886,7 @@ TEST_P(FlightplanSurveyE2e,
               << plan.value("frontier_stops", 0u) << " stops at the frontier ("
               << plan.value("frontier_wait_s", 0.0) << " s)\n";
     if (!kSlowed) {
-        EXPECT_EQ(plan.value("frontier_stops", 0u), 0u) << plan.dump();
+        EXPECT_LE(plan.value("frontier_stops", 0u), GetParam() == "rover2" ? 2u : 0u) << plan.dump();
     }
     if (GetParam() == "rover2") {
         EXPECT_NEAR(actual, ideal, 0.05 * ideal);
@@ -1168,17 +1171,25 @@ TEST_P(FlightplanStarvedSurveyE2e, AStarvedDaemonDrivesTheExampleSurveyInOrderAn
         auto load = ctl({"plan", "load", file});
         ASSERT_EQ(load.exit_code, 0) << load.json.dump() << load.err;
         Starver starver(daemon_->pid(), seed);
-        // The element shown is null between plans (the previous run's end, this one's start).
-        const auto at_operator_check = [&] {
-            const auto element = show()["element"];
-            return element.is_string() && element.get<std::string>().find("elements[7]") != std::string::npos;
+        // Held at the operator's check: the plan says so (the board's HOLD alone may be its own, at a
+        // barrier on the way, and a resume sent then would release nothing).
+        const auto held_at_operator_check = [&] {
+            const auto plan = show();
+            return plan.is_object() && plan.value("held", Json()) == "plan.elements[7]" &&
+                   plan.value("held_until_released", false);
         };
         // The waits add up to less than the case's 240-s limit (a run takes about 40 s under ASan+UBSan or
         // qemu-arm), so a run that stalls fails with the plan's state printed instead of being killed mute.
-        ASSERT_TRUE(wait_until(at_operator_check, 100s, kPoll))
+        ASSERT_TRUE(wait_until(held_at_operator_check, 100s, kPoll))
             << "seed " << seed << " " << show().dump() << daemon_->err();
         ASSERT_TRUE(wait_until([&] { return control_->json("state")["mode"] == "HOLD"; }, 30s, kPoll))
             << "seed " << seed << " " << show().dump() << " board: " << control_->json("state").dump();
+        // The vehicle stopped at the check point, whatever the starver did to the daemon on the way: the
+        // plan's last waypoint (back home) waits for the release.
+        const auto before_release = plan_waypoints_of(reached_log(*control_, first));
+        ASSERT_EQ(before_release.size(), expected.size() - 1)
+            << "seed " << seed << ": the vehicle went on past the operator's check\n"
+            << describe_reached_around(before_release, expected, expected.size() - 1) << daemon_->err();
         auto released = ctl({"plan", "resume"});
         ASSERT_EQ(released.exit_code, 0) << released.json.dump() << released.err;
         ASSERT_TRUE(wait_until([&] { return show().value("state", "") == "done"; }, 100s, kPoll))

@@ -477,7 +477,12 @@ TEST(FlightplanFeeder, HoldWaypointsHoldForTheirTimeOrUntilReleased) {
     }
     EXPECT_EQ(h.reached.size(), 21u);  // held until released
     EXPECT_FALSE(h.ap.in_auto());
+    EXPECT_EQ(h.feeder.progress().held, "plan.elements[0]");
+    EXPECT_TRUE(h.feeder.progress().held_until_released);
+    EXPECT_FALSE(h.feeder.progress().held_at_frontier) << "a hold's barrier is no frontier stop";
     h.feeder.release_hold(h.now);
+    EXPECT_EQ(h.feeder.progress().held, "");
+    EXPECT_FALSE(h.feeder.progress().held_until_released);
     ASSERT_LT(h.run_until_done(500), 500);
     EXPECT_EQ(h.reached, iota(0, 40));
     EXPECT_EQ(h.count(FeederEvent::Kind::HoldStarted), 3u);
@@ -485,6 +490,63 @@ TEST(FlightplanFeeder, HoldWaypointsHoldForTheirTimeOrUntilReleased) {
     // Positioned items only went to the autopilot (39 of 40).
     EXPECT_EQ(h.ap.visited().size(), 39u);
     EXPECT_EQ(h.feeder.progress().starvation_holds, 0u);
+    EXPECT_EQ(h.feeder.progress().frontier_stops, 0u) << "the vehicle stood only where the plan holds";
+}
+
+// A hold is where the vehicle stops whether the daemon runs or not. A starved feeder (the vehicle drives a
+// waypoint a step while it is stalled) never lets it drive past a hold's point before the hold began, nor
+// past a hold until released before the release: the hold's point ends the drivable part of the mission (its
+// barrier) until the vehicle is held there.
+TEST(FlightplanFeeder, AStarvedFeederNeverLetsTheVehicleDrivePastAHold) {
+    Waypoint timed;
+    timed.action = WaypointAction::HoldFor;
+    timed.hold_seconds = 5.0;
+    Waypoint until;
+    until.action = WaypointAction::HoldUntilReleased;
+    Waypoint here;  // a hold without a position: held where waypoint 39 ends
+    here.action = WaypointAction::HoldFor;
+    here.hold_seconds = 5.0;
+    here.has_position = false;
+    // Waypoints driven (positions visited) when each hold begins: through 10, 25 and 39.
+    const std::vector<std::size_t> driven_at_hold{11, 26, 40};
+    for (const bool legacy : {false, true}) {
+        for (unsigned seed = 1; seed <= 20; ++seed) {
+            const std::string run =
+                std::string(legacy ? "legacy" : "current") + " seed " + std::to_string(seed);
+            Impairments imp;
+            imp.stall = 0.15;
+            imp.stall_steps = 8;
+            Harness h({}, imp, seed);
+            h.ap.legacy = legacy;
+            h.feeder.replace_plan(test::synthetic(60, 41.0, {{10, timed}, {25, until}, {40, here}}), h.now);
+            int steps = 0;
+            bool released = false;
+            std::optional<int> until_started_at;
+            while (h.feeder.progress().state != PlanState::Done && steps++ < 3000) {
+                h.step();
+                const std::size_t begun = h.count(FeederEvent::Kind::HoldStarted);
+                const std::size_t limit = begun < driven_at_hold.size() ? driven_at_hold[begun] : 59;
+                // A hold begun and ended is behind the vehicle; the next one bounds how far it may have gone.
+                ASSERT_LE(h.ap.visited().size(), limit)
+                    << run << ", step " << steps << ", holds begun " << begun;
+                if (begun == 2 && !released) {
+                    ASSERT_LE(h.ap.visited().size(), driven_at_hold[1]) << run << ": held until released";
+                    until_started_at = until_started_at.value_or(steps);
+                    if (steps - *until_started_at >= 30) {
+                        h.feeder.release_hold(h.now);
+                        released = true;
+                    }
+                }
+            }
+            ASSERT_EQ(h.feeder.progress().state, PlanState::Done) << run;
+            EXPECT_TRUE(released) << run;
+            EXPECT_EQ(h.reached, iota(0, 60)) << run;
+            EXPECT_EQ(h.ap.visited().size(), 59u) << run;
+            EXPECT_EQ(h.count(FeederEvent::Kind::HoldStarted), 3u) << run;
+            EXPECT_EQ(h.feeder.progress().starvation_holds, 0u) << run;
+            EXPECT_GT(h.stalls, 4) << run;
+        }
+    }
 }
 
 TEST(FlightplanFeeder, ShortPlanEndsOnStopItem) {
