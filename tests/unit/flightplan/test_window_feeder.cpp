@@ -2,6 +2,7 @@
 // pause and holds, all in simulated time.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -446,18 +447,26 @@ TEST(FlightplanFeeder, AReplacementWhoseFirstWriteLandsJustAfterTheTargetIsReach
     }
 }
 
-TEST(FlightplanFeeder, HoldWaypointsHoldForTheirTimeOrUntilReleased) {
+/// The three kinds of hold, at plan indices `at`: a timed hold at a waypoint, one until released, and a timed
+/// hold without a position (held where the waypoint before it ends).
+std::map<std::uint64_t, Waypoint> three_holds(std::array<std::uint64_t, 3> at, double timed_s,
+                                              double here_s) {
     Waypoint timed;
     timed.action = WaypointAction::HoldFor;
-    timed.hold_seconds = 30.0;
+    timed.hold_seconds = timed_s;
     Waypoint until;
     until.action = WaypointAction::HoldUntilReleased;
-    Waypoint here;  // a hold without a position: held where waypoint 29 ends
+    Waypoint here;
     here.action = WaypointAction::HoldFor;
-    here.hold_seconds = 10.0;
+    here.hold_seconds = here_s;
     here.has_position = false;
+    return {{at[0], timed}, {at[1], until}, {at[2], here}};
+}
+
+TEST(FlightplanFeeder, HoldWaypointsHoldForTheirTimeOrUntilReleased) {
     Harness h;
-    h.feeder.replace_plan(test::synthetic(40, 41.0, {{10, timed}, {20, until}, {30, here}}), h.now);
+    // The hold without a position is held where waypoint 29 ends.
+    h.feeder.replace_plan(test::synthetic(40, 41.0, three_holds({10, 20, 30}, 30.0, 10.0)), h.now);
     int steps = 0;
     while (h.reached.size() < 11 && steps++ < 100) {
         h.step();
@@ -498,15 +507,6 @@ TEST(FlightplanFeeder, HoldWaypointsHoldForTheirTimeOrUntilReleased) {
 // past a hold until released before the release: the hold's point ends the drivable part of the mission (its
 // barrier) until the vehicle is held there.
 TEST(FlightplanFeeder, AStarvedFeederNeverLetsTheVehicleDrivePastAHold) {
-    Waypoint timed;
-    timed.action = WaypointAction::HoldFor;
-    timed.hold_seconds = 5.0;
-    Waypoint until;
-    until.action = WaypointAction::HoldUntilReleased;
-    Waypoint here;  // a hold without a position: held where waypoint 39 ends
-    here.action = WaypointAction::HoldFor;
-    here.hold_seconds = 5.0;
-    here.has_position = false;
     // Waypoints driven (positions visited) when each hold begins: through 10, 25 and 39.
     const std::vector<std::size_t> driven_at_hold{11, 26, 40};
     for (const bool legacy : {false, true}) {
@@ -518,7 +518,7 @@ TEST(FlightplanFeeder, AStarvedFeederNeverLetsTheVehicleDrivePastAHold) {
             imp.stall_steps = 8;
             Harness h({}, imp, seed);
             h.ap.legacy = legacy;
-            h.feeder.replace_plan(test::synthetic(60, 41.0, {{10, timed}, {25, until}, {40, here}}), h.now);
+            h.feeder.replace_plan(test::synthetic(60, 41.0, three_holds({10, 25, 40}, 5.0, 5.0)), h.now);
             int steps = 0;
             bool released = false;
             std::optional<int> until_started_at;
