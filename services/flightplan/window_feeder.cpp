@@ -619,6 +619,17 @@ void WindowFeeder::on_current(std::uint16_t slot, TimePoint now) {
         }
         return;
     }
+    if (!starving_ && !queue_[0].stop && slot == ring_next(queue_[0].slot) && drives_to(queue_[0]) &&
+        holds(slot, queue_[0].barrier()) && (queue_.size() == 1 || queue_[1].slot != slot)) {
+        // Heading for the head's own barrier: the head is behind the vehicle, whatever became of its reached
+        // report. With the head the window's last (a hold's point) no later entry's report would tell.
+        ap_target_ = slot;
+        current_mismatches_ = 0;
+        need_set_current_ = false;
+        repoint_only_ = false;
+        complete_through(0, now);
+        return;
+    }
     const std::size_t limit = std::min<std::size_t>(queue_.size(), config_.lost_reached_tolerance + 2);
     if (!starving_) {
         for (std::size_t p = 1; p < limit; ++p) {

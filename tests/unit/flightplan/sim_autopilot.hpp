@@ -331,6 +331,7 @@ struct Impairments {
     bool refuse_missions = false;    // every upload and write is refused (a board that takes none of them)
     int requests_per_step = 2;       // link budget
     bool report_current = true;      // MISSION_CURRENT every step
+    bool current_on_change = false;  // ... only when it changed, as the driver tells it (MissionCurrentChanged)
     // The feeder's own stalls (a starved daemon): at each step a stall starts with this probability and lasts
     // 1..stall_steps steps, during which the vehicle drives on and its reports wait in the port.
     double stall = 0.0;
@@ -409,7 +410,8 @@ class Harness {
             feeder.on_reached(s, now);
             drain();
         }
-        if (imp_.report_current) {
+        if (imp_.report_current && (!imp_.current_on_change || ap.current() != last_current_)) {
+            last_current_ = ap.current();
             feeder.on_current(ap.current(), now);
             drain();
         }
@@ -473,6 +475,7 @@ class Harness {
     std::deque<std::uint16_t> late_;
     std::deque<std::uint16_t> waiting_;
     int stall_left_ = 0;
+    std::uint16_t last_current_ = 0xffff;  // what the feeder was last told the target is
 };
 
 inline PlanFeed synthetic(std::uint64_t n, double base_lat = 41.0,

@@ -549,6 +549,34 @@ TEST(FlightplanFeeder, AStarvedFeederNeverLetsTheVehicleDrivePastAHold) {
     }
 }
 
+// A hold's point is the window's last entry until it is reached, so no later entry's report tells that the
+// vehicle passed it: a lost reached report of it is made good by the board heading for its barrier.
+TEST(FlightplanFeeder, ALostReachedReportOfAHoldsPointIsMadeGoodByTheBarrierAfterIt) {
+    for (const bool legacy : {false, true}) {
+        for (unsigned seed = 1; seed <= 20; ++seed) {
+            const std::string run =
+                std::string(legacy ? "legacy" : "current") + " seed " + std::to_string(seed);
+            Impairments imp;
+            imp.drop_reached = 0.4;
+            imp.current_on_change = true;
+            Harness h({}, imp, seed);
+            h.ap.legacy = legacy;
+            h.feeder.replace_plan(test::synthetic(60, 41.0, three_holds({10, 25, 40}, 5.0, 5.0)), h.now);
+            int steps = 0;
+            while (h.feeder.progress().state != PlanState::Done && steps++ < 2000) {
+                h.step();
+                if (h.feeder.progress().held_until_released) {
+                    h.feeder.release_hold(h.now);
+                }
+            }
+            ASSERT_EQ(h.feeder.progress().state, PlanState::Done)
+                << run << ": " << h.reached.size() << " reached";
+            EXPECT_EQ(h.reached, iota(0, 60)) << run;
+            EXPECT_EQ(h.count(FeederEvent::Kind::HoldStarted), 3u) << run;
+        }
+    }
+}
+
 TEST(FlightplanFeeder, ShortPlanEndsOnStopItem) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(2), h.now);
