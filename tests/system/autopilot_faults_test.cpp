@@ -211,6 +211,9 @@ TEST(SystemAutopilotLink, DaemonStoppedForSecondsKeepsItsLinkAndItsSync) {
     ASSERT_TRUE(bench.wait_ready()) << bench.logs();
     const auto before = section(bench.status(), "autopilot");
     EXPECT_EQ(before.value("syncs", 0u), 1u) << before.dump();
+    // What the stalls below do is judged from here: a loss while the board was still booting (a simulator
+    // starved on a loaded machine goes silent too) is not the daemon's stall.
+    const unsigned losses_at_ready = before.value("link_losses", 99u);
     const auto board_t = [&] { return bench.sim().json("state").value("t", 0.0); };
     const std::vector<double> stalls{2.0, 3.5, 5.0, 2.5};
     for (const double stall : stalls) {
@@ -224,17 +227,19 @@ TEST(SystemAutopilotLink, DaemonStoppedForSecondsKeepsItsLinkAndItsSync) {
     }
     const auto after = section(bench.status(), "autopilot");
     const std::string log = bench.daemon_err();
-    EXPECT_EQ(after.value("link_losses", 99u), 0u) << after.dump() << log;
+    EXPECT_EQ(after.value("link_losses", 99u), losses_at_ready) << after.dump() << log;
     EXPECT_EQ(after.value("reboots", 99u), 0u) << after.dump() << log;
     EXPECT_EQ(after.value("reconnects", 99u), 0u) << after.dump();
     EXPECT_EQ(after.value("syncs", 99u), 1u) << "no re-download of the parameters and the mission";
     EXPECT_EQ(after.value("ready", false), true);
-    EXPECT_EQ(log.find("link down"), std::string::npos) << log;
+    EXPECT_EQ(log.find("link down", log.find(" ready ")), std::string::npos) << log;
     EXPECT_EQ(log.find("rebooted"), std::string::npos) << log;
     expect_daemon_alive(bench);
     std::cout << "[ figures ] daemon stopped " << stalls.size() << " times (2-5 s): link_losses "
               << after.value("link_losses", 99u) << ", reboots " << after.value("reboots", 99u) << ", syncs "
-              << after.value("syncs", 99u) << ", reconnects " << after.value("reconnects", 99u) << "\n";
+              << after.value("syncs", 99u) << ", reconnects " << after.value("reconnects", 99u)
+              << ", link losses before ready " << losses_at_ready << ", verdicts put off "
+              << after.value("link_verdicts_deferred", 99u) << "\n";
 }
 
 TEST_F(SystemPlan, DaemonKilledMidPlanResumesAtTheFirstUnreachedWaypoint) {
