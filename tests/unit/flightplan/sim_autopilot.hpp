@@ -331,7 +331,8 @@ struct Impairments {
     bool refuse_missions = false;    // every upload and write is refused (a board that takes none of them)
     int requests_per_step = 2;       // link budget
     bool report_current = true;      // MISSION_CURRENT every step
-    bool current_on_change = false;  // ... only when it changed, as the driver tells it (MissionCurrentChanged)
+    bool current_on_change =
+        false;  // ... only when it changed, as the driver tells it (MissionCurrentChanged)
     // The feeder's own stalls (a starved daemon): at each step a stall starts with this probability and lasts
     // 1..stall_steps steps, during which the vehicle drives on and its reports wait in the port.
     double stall = 0.0;
