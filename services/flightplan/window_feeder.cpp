@@ -324,9 +324,6 @@ void WindowFeeder::release_hold(TimePoint now) {
 
 void WindowFeeder::refill(TimePoint now) {
     while (stream_ && !stream_ended_ && queue_.size() < capacity()) {
-        if (held_back_ && !queue_.empty() && queue_.back().holds_vehicle()) {
-            break;
-        }
         auto w = held_back_ ? std::exchange(held_back_, std::nullopt) : stream_->next();
         const std::uint16_t slot = queue_.empty() ? fresh_slot_ : ring_next(queue_.back().slot);
         if (!w) {
