@@ -46,8 +46,17 @@ endif()
 if(AIRSEG_SANITIZE MATCHES "fuzzer-no-link" AND CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
   target_compile_options(airseg_test_flags INTERFACE -fno-sanitize=fuzzer-no-link)
 endif()
+# AIRSEG_TEST_UNITY_BATCH_SIZE: the unity batch size of test-only targets, e.g. 0 (each target one translation
+# unit) in CI, where a test executable of 9 to 16 sources otherwise parses GoogleTest, Boost.Asio and fmt and
+# instantiates their templates twice. Only test code: at -O2 one large translation unit of shipped code costs
+# GCC more than the repeated headers save (docs/operations.md). Empty: the build's (8); a developer editing one
+# test file recompiles a batch, not the whole executable.
+set(AIRSEG_TEST_UNITY_BATCH_SIZE "" CACHE STRING "Unity batch size of test-only targets (0: one per target; empty: 8)")
 function(airseg_test_code target)
   target_link_libraries(${target} PRIVATE airseg_test_flags)
+  if(NOT AIRSEG_TEST_UNITY_BATCH_SIZE STREQUAL "")
+    set_target_properties(${target} PROPERTIES UNITY_BUILD_BATCH_SIZE ${AIRSEG_TEST_UNITY_BATCH_SIZE})
+  endif()
 endfunction()
 
 # airseg_add_library(NAME SOURCES... [LIBS ...])

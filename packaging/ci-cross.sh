@@ -105,9 +105,10 @@ build_arm() {
   local bench=""
   [ "$arch" = armhf ] || bench="-DAIRSEG_BUILD_BENCH=OFF"
   # The test sources at -O1 (AIRSEG_TEST_OPTIMIZATION): 20-40 % less compile time for two thirds of the
-  # build; the libraries and programs they test stay as packaged (-O2).
+  # build; the libraries and programs they test stay as packaged (-O2). Each test executable one translation
+  # unit (AIRSEG_TEST_UNITY_BATCH_SIZE=0): its headers parsed and templates instantiated once.
   if arm_with_suite "$arch"; then
-    AIRSEG_EXTRA_CMAKE_ARGS="-DAIRSEG_TEST_HANG_INJECTION=ON -DAIRSEG_TEST_OPTIMIZATION=-O1${bench:+ $bench}" \
+    AIRSEG_EXTRA_CMAKE_ARGS="-DAIRSEG_TEST_HANG_INJECTION=ON -DAIRSEG_TEST_OPTIMIZATION=-O1 -DAIRSEG_TEST_UNITY_BATCH_SIZE=0${bench:+ $bench}" \
       "$AIRSEG_ROOT/packaging/build-debs.sh" --no-debug-info "$arch"
   else
     at_idle_priority "$AIRSEG_ROOT/packaging/build-debs.sh" --no-check --no-debug-info "$arch"

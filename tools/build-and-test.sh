@@ -122,6 +122,7 @@ if has_stage sanitize || has_stage fuzz; then
   CC=clang CXX=clang++ cmake -S . -B build-san -G Ninja "${launcher[@]}" \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" \
     -DAIRSEG_BUILD_FUZZ=ON -DAIRSEG_BUILD_TESTS=ON -DAIRSEG_BUILD_BENCH=ON -DAIRSEG_TEST_OPTIMIZATION=-O0 \
+    -DAIRSEG_TEST_UNITY_BATCH_SIZE=0 \
     -DAIRSEG_SANITIZE=fuzzer-no-link,address,undefined
   cmake --build build-san -j"$jobs"
   elapsed "sanitize: build (clang, ASan+UBSan)" "$start" "" sanitize-build

@@ -10,24 +10,15 @@
 #include "services/autopilot/mavlink/enums.hpp"
 #include "services/autopilot/mavlink/messages.hpp"
 #include "services/autopilot/mavlink/parser.hpp"
+#include "tests/unit/autopilot/gcs_gate_rig.hpp"
 
 namespace airseg::autopilot {
 namespace {
 
 namespace mav = airseg::mavlink;
 
-std::vector<mav::Frame> parse(std::span<const std::uint8_t> bytes) {
-    std::vector<mav::Frame> out;
-    mav::Parser p;
-    p.push(bytes, [&](const mav::Frame& f) { out.push_back(f); });
-    p.finish([&](const mav::Frame& f) { out.push_back(f); });
-    return out;
-}
-
-struct Rig {
-    GcsGate gate{1, 1};
-    mav::Encoder gcs{254, 190};
-};
+using gate_test::parse;
+using gate_test::Rig;
 
 mav::FileTransferProtocol ftp_request(mavftp::Opcode op, std::string_view path, std::uint8_t target = 1) {
     mavftp::Packet p;

@@ -21,7 +21,7 @@ namespace {
 
 namespace mav = airseg::mavlink;
 
-const TimePoint kStart = TimePoint{} + std::chrono::hours(3);
+const TimePoint kInputStart = TimePoint{} + std::chrono::hours(3);
 
 /// Frames from the autopilot (system 1, component 1) straight into a sans-IO core.
 struct Board {
@@ -49,7 +49,7 @@ struct ParamRig {
     ParamClient client{out, 1, 1, ParamClientConfig{}};
     Board board;
     void feed(const mav::ParamValue& v) {
-        board.send(v, [&](const mav::Frame& f) { client.handle_frame(f, kStart); });
+        board.send(v, [&](const mav::Frame& f) { client.handle_frame(f, kInputStart); });
     }
 };
 
@@ -110,7 +110,7 @@ TEST(ParamCacheBound, AGetOfANameTheFullCacheCannotHoldStillCompletes) {
     for (std::uint16_t i = 0; i < 3; ++i) {
         rig.feed(param("P" + std::to_string(i), 3, i));
     }
-    const auto id = rig.client.get("EXTRA", kStart);
+    const auto id = rig.client.get("EXTRA", kInputStart);
     rig.feed(param("EXTRA", 3, 65535, 7.0f));
     const auto done = rig.client.poll_completion();
     ASSERT_TRUE(done);
@@ -125,11 +125,11 @@ struct DriverRig {
     Driver driver{AutopilotConfig::defaults_for(autopilot::Board::Apm2)};
     Board board;
     std::vector<Event> events;
-    DriverRig() { driver.on_port_open(kStart); }
+    DriverRig() { driver.on_port_open(kInputStart); }
     template <class M>
     void feed(const M& m) {
         const auto bytes = board.encoder.encode(m);
-        driver.handle_bytes(bytes, kStart);
+        driver.handle_bytes(bytes, kInputStart);
         while (auto e = driver.poll_event()) {
             events.push_back(std::move(*e));
         }
