@@ -194,12 +194,14 @@ if has_stage fuzz && has_stage sanitize; then
 fi
 
 # The ThreadSanitizer build of the concurrency tests: in batches like every other build (the tidy stage
-# parses each changed source on its own, which is where a missing #include that a batch-mate provides shows).
+# parses each changed source on its own, which is where a missing #include that a batch-mate provides shows),
+# each test executable one batch as in the sanitizer build (core_tests had two).
 mapfile -t tsan_targets < <(grep '^[a-z]' tests/concurrency-tests.txt)
 tsan_build() {
   ccache_stage_begin tsan-build
   cmake -S . -B build-tsan -G Ninja "${launcher[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" -DAIRSEG_BUILD_BENCH=OFF -DAIRSEG_SANITIZE=thread
+    "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" -DAIRSEG_BUILD_BENCH=OFF -DAIRSEG_SANITIZE=thread \
+    -DAIRSEG_TEST_UNITY_BATCH_SIZE=0
   cmake --build build-tsan -j"$jobs" --target "${tsan_targets[@]}"
 }
 
