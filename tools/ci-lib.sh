@@ -14,7 +14,8 @@
 #                   unity batches are the same bytes in every clone, cmake/AirsegUnity.cmake), and a miss is
 #                   stored with the include list the compiler writes anyway (-MD), never running the
 #                   preprocessor a second time: about 0.7 CPU-s a batch, on every miss and every hit that the
-#                   preprocessor's output would otherwise have had to find;
+#                   preprocessor's output would otherwise have had to find (CCACHE_NODEPEND=1 turns it off;
+#                   ccache refuses CCACHE_DEPEND=0);
 #   CCACHE_MAXSIZE  at least 10 GB: one CI run stores about 1.5 GB (5 build configurations), and developers'
 #                   builds share the cache.
 airseg_ccache_env() {
@@ -23,7 +24,7 @@ airseg_ccache_env() {
   CCACHE_DIR=${CCACHE_DIR:-$(ccache -k cache_dir)}
   export CCACHE_DIR
   export CCACHE_BASEDIR=$1
-  export CCACHE_DEPEND=${CCACHE_DEPEND:-1}
+  [ -n "${CCACHE_DEPEND:-}${CCACHE_NODEPEND:-}" ] || export CCACHE_DEPEND=1
   size=$(ccache -k max_size)
   case "$size" in
     *G) [ "${size%%[.G]*}" -ge 10 ] || export CCACHE_MAXSIZE=10G ;;
