@@ -131,30 +131,35 @@ class FlightplanE2e : public ::testing::TestWithParam<std::string> {
     virtual int speedup() const { return kSpeedup; }
 
     void SetUp() override {
-        sim_ = std::make_unique<Subprocess>(
-            std::vector<std::string>{binary("tools/apmsim/airseg-apmsim"),
-                                     "--link",
-                                     dir_.file("ttyACM0"),
-                                     "--control",
-                                     dir_.file("ctl"),
-                                     "--home",
-                                     std::to_string(kHomeLat) + "," + std::to_string(kHomeLon),
-                                     "--speedup",
-                                     std::to_string(speedup()),
-                                     "--boot-delay",
-                                     "2",
-                                     "--calib-time",
-                                     "3",
-                                     "--mission-capacity",
-                                     "150",
-                                     "--param",
-                                     "CRUISE_SPEED=4",
-                                     "--param",
-                                     "WP_RADIUS=1.5",
-                                     "--firmware",
-                                     GetParam(),
-                                     "--quiet"},
-            std::map<std::string, std::string>{}, dir_.path());
+        std::vector<std::string> argv{binary("tools/apmsim/airseg-apmsim"),
+                                      "--link",
+                                      dir_.file("ttyACM0"),
+                                      "--control",
+                                      dir_.file("ctl"),
+                                      "--home",
+                                      std::to_string(kHomeLat) + "," + std::to_string(kHomeLon),
+                                      "--speedup",
+                                      std::to_string(speedup()),
+                                      "--boot-delay",
+                                      "2",
+                                      "--calib-time",
+                                      "3",
+                                      "--mission-capacity",
+                                      "150",
+                                      "--param",
+                                      "CRUISE_SPEED=4",
+                                      "--param",
+                                      "WP_RADIUS=1.5",
+                                      "--firmware",
+                                      GetParam(),
+                                      "--quiet"};
+        if (GetParam() == "modern") {
+            // Current Rover drives AUTO at WP_SPEED (2 m/s unless set), APM:Rover 2.x at CRUISE_SPEED: both
+            // at 4 m/s, so that a route takes the same simulated time on both, at the pace the compressions
+            // above were chosen for (at 2 m/s the current-firmware cases took twice the 2.x ones' wall time).
+            argv.insert(argv.end(), {"--param", "WP_SPEED=4"});
+        }
+        sim_ = std::make_unique<Subprocess>(argv, std::map<std::string, std::string>{}, dir_.path());
         ASSERT_TRUE(wait_until([&] { return exists(dir_.file("ttyACM0")) && exists(dir_.file("ctl")); },
                                kGenerous, kPoll))
             << sim_->err();
@@ -237,6 +242,22 @@ class FlightplanE2e : public ::testing::TestWithParam<std::string> {
         const auto path = dir_.file(name);
         write_file(path, text);
         return path;
+    }
+    /// The example survey (config/plans/rover-survey.yaml) with its photo stop cut to `photo_stop_s`: the
+    /// daemon times a hold in real time, so at the simulator's compression the plan's 20 s would hold the
+    /// vehicle for 20 s of wall time (1,000 simulated at speedup 50) and only lengthen the run. The route is
+    /// the example's.
+    std::string example_survey(double photo_stop_s) {
+        std::string text = read_file(source_path("config/plans/rover-survey.yaml"));
+        const std::string photo = "hold: {name: photo-stop, seconds: 20}";
+        const auto at = text.find(photo);
+        EXPECT_NE(at, std::string::npos) << "the example survey's photo stop moved";
+        if (at != std::string::npos) {
+            std::ostringstream cut;
+            cut << "hold: {name: photo-stop, seconds: " << photo_stop_s << "}";
+            text.replace(at, photo.size(), cut.str());
+        }
+        return write_plan("survey.yaml", text);
     }
     /// HOLD entries in the simulator's mode history from simulated time `after` on.
     Json holds_after(double after) {
@@ -349,9 +370,10 @@ TEST_P(FlightplanE2e, ReplacingThePlanMidRouteHeadsForTheNewFirstWaypointWithout
     // The new plan goes in while the vehicle is held still just after it reached a waypoint: however long a
     // loaded machine takes to write B's first item, the vehicle has not yet reached the kept target (had it,
     // the feeder would rightly hold rather than let it drive to a stale slot). A's legs are 50 s simulated.
+    // B starts beside A's ninth and tenth waypoints, where the vehicle is when B comes: a short drive to it.
     const auto a_file = write_plan("a.yaml", line_plan("route-a", kHomeLat, kHomeLon + 0.0001, 0, 20, 200));
-    const auto b_file =
-        write_plan("b.yaml", line_plan("route-b", kHomeLat + 0.0005, kHomeLon + 0.0010, 90, 20, 8));
+    const auto b_file = write_plan(
+        "b.yaml", line_plan("route-b", kHomeLat + 1700.0 / 111320.0, kHomeLon + 0.0010, 90, 20, 8));
     const auto a = expected_positions(a_file);
     const auto b = expected_positions(b_file);
     start_daemon(10);
@@ -686,8 +708,9 @@ TEST_P(FlightplanE2e, ALawnmowerIsDrivenInOrderWithoutAHoldAtThePlansSpeedWithin
     }
     // Current Rover corners and stops as its S-curves make it: the yardstick is the same mission uploaded
     // plainly to the same board.
-    const auto plain = drive_plainly(file, apmsim::Firmware::Modern,
-                                     {{"CRUISE_SPEED", 4}, {"WP_RADIUS", 1.5}}, {kHomeLat, kHomeLon});
+    const auto plain =
+        drive_plainly(file, apmsim::Firmware::Modern,
+                      {{"CRUISE_SPEED", 4}, {"WP_SPEED", 4}, {"WP_RADIUS", 1.5}}, {kHomeLat, kHomeLon});
     std::cout << "[ figures ] modern: the same mission uploaded plainly " << plain.driving_s << " s ("
               << 100.0 * (plain.driving_s - ideal) / ideal << " % over ideal); through airsegd "
               << 100.0 * (actual - plain.driving_s) / plain.driving_s << " % over plain\n";
@@ -807,8 +830,8 @@ std::vector<Leg> legs_of(const std::string& plan_file) {
     return out;
 }
 
-// The survey's photo stop is timed by the daemon, in real time: 20 s of it whatever the speedup. Each half of
-// the survey takes about 40 s of real time at speedup 25 (armel under qemu), half that elsewhere.
+// The survey's photo stop is its plan's 20 s of simulated time (example_survey). Each half of the survey
+// takes about 40 s of real time at speedup 25 (armel under qemu), half that elsewhere.
 constexpr auto kSurveyWait = kSlowed ? 150s : 90s;
 class FlightplanSurveyE2e : public FlightplanE2e {
   protected:
@@ -817,7 +840,7 @@ class FlightplanSurveyE2e : public FlightplanE2e {
 
 TEST_P(FlightplanSurveyE2e,
        TheExampleSurveyIsDrivenInOrderHoldingOnlyWhereThePlanHoldsWithinFivePercentOfTheIdealTime) {
-    const auto file = source_path("config/plans/rover-survey.yaml");
+    const auto file = example_survey(20.0 / speedup());
     const auto legs = legs_of(file);
     ASSERT_GT(legs.size(), 30u);
     start_daemon(20);
@@ -892,8 +915,9 @@ TEST_P(FlightplanSurveyE2e,
         EXPECT_NEAR(actual, ideal, 0.05 * ideal);
         return;
     }
-    const auto plain = drive_plainly(file, apmsim::Firmware::Modern,
-                                     {{"CRUISE_SPEED", 4}, {"WP_RADIUS", 1.5}}, {kHomeLat, kHomeLon});
+    const auto plain =
+        drive_plainly(file, apmsim::Firmware::Modern,
+                      {{"CRUISE_SPEED", 4}, {"WP_SPEED", 4}, {"WP_RADIUS", 1.5}}, {kHomeLat, kHomeLon});
     std::cout << "[ figures ] modern: the survey uploaded plainly " << plain.driving_s << " s driving ("
               << 100.0 * (plain.driving_s - ideal) / ideal << " % over ideal); through airsegd "
               << 100.0 * (actual - plain.driving_s) / plain.driving_s << " % over plain\n";
@@ -946,7 +970,7 @@ TEST_P(FlightplanArmingE2e,
 // Each leg long enough to reach speed is driven at its planned speed, before and after a HOLD the board
 // forced: current Rover comes back in AUTO at its WP_SPEED, so the daemon sets the plan's speed again.
 TEST_P(FlightplanE2e, EveryLegIsDrivenAtItsPlannedSpeedBeforeAndAfterAHoldTheBoardForced) {
-    constexpr double kSpeed = 3.0;  // neither the board's WP_SPEED (2) nor its CRUISE_SPEED (4)
+    constexpr double kSpeed = 3.0;  // neither the board's WP_SPEED nor its CRUISE_SPEED (both 4)
     const auto file = write_plan("legs.yaml", lawnmower_plan("legs", 1, 14, 40, 12, kSpeed));
     start_daemon(10);
     const auto first = reached_total(*control_);
@@ -1134,8 +1158,8 @@ TEST_P(FlightplanStarvedE2e, AStarvedDaemonStopsTheVehicleAtTheFrontierAndNeverL
 }
 
 // The example survey under the same starvation: its timed photo stop, orbit, patrol loop and the operator's
-// hold (released here) between the writes the starved feeder makes. The photo stop is cut from 20 s to 2 s
-// (it is timed by the daemon in real time and only lengthens each run); the route is the example's.
+// hold (released here) between the writes the starved feeder makes. The photo stop is cut from 20 s to 2 s of
+// real time (example_survey); the route is the example's.
 class FlightplanStarvedSurveyE2e : public FlightplanStarvedE2e {
   protected:
     int speedup() const override { return kSurveySpeedup; }
@@ -1144,12 +1168,8 @@ class FlightplanStarvedSurveyE2e : public FlightplanStarvedE2e {
 TEST_P(FlightplanStarvedSurveyE2e, AStarvedDaemonDrivesTheExampleSurveyInOrderAndNothingElse) {
     const int runs = starve_runs();
     const unsigned first_seed = starve_first_seed();
-    std::string text = read_file(source_path("config/plans/rover-survey.yaml"));
-    const std::string photo = "hold: {name: photo-stop, seconds: 20}";
-    const auto at = text.find(photo);
-    ASSERT_NE(at, std::string::npos) << "the example survey's photo stop moved";
-    text.replace(at, photo.size(), "hold: {name: photo-stop, seconds: 2}");
-    const auto file = write_plan("survey.yaml", text);
+    const auto file = example_survey(2);
+    ASSERT_FALSE(HasFailure());
     const auto legs = legs_of(file);
     ASSERT_GT(legs.size(), 30u);
     std::vector<E7> expected;
