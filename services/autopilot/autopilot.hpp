@@ -157,6 +157,9 @@ struct RequestDone {
     std::optional<double> param_value;                   // GetParam / SetParam (the value read back)
     std::vector<std::pair<std::string, double>> params;  // ListParams: the cached table, by name
     std::optional<bool> armed;  // SetState: the board's heartbeat showed it armed at the end (when known)
+    /// UploadMission, WriteItems: the board runs a Stop as the end of its mission and holds there in HOLD (an
+    /// APM:Rover 2.x has no NAV_LOITER_UNLIM: its Stops are jumps past the end); false: it stays in AUTO.
+    std::optional<bool> stop_ends_mission;
 };
 
 using Event = std::variant<WaypointReached, MissionCurrentChanged, ModeChanged, LinkUp, LinkDown,

@@ -322,6 +322,9 @@ void PlanController::on_request_done(std::uint32_t id, const autopilot::RequestD
                         autopilot::to_string(done.result) +
                         (done.detail.empty() ? "" : " (" + done.detail + ")");
     }
+    if (done.stop_ends_mission) {
+        feeder_.set_stop_ends_mission(*done.stop_ends_mission);
+    }
     feeder_.on_request_result(feeder_id, done.result, now, last_failure_);
     pump(now);
 }

@@ -765,24 +765,28 @@ void WindowFeeder::on_mode(VehicleState state, autopilot::ModeChangeCause cause,
         interrupt("the RC pilot took the vehicle (MANUAL); plan resume continues", true);
         return;
     }
-    if (mode_ == Mode::Hold && old_target_ && need_set_current_ && !repoint_only_) {
-        // After a skip or a new plan, a board whose Stop ends its mission holds by itself at the barrier
-        // after its old target: the set-current and AUTO that follow take it to the new head.
-        return;
-    }
-    if (frontier_since_ && mode_ == Mode::Hold) {
-        // A board whose Stop ends its mission (APM:Rover 2.x) holds at the barrier by itself: the head's
-        // write, a set-current and AUTO take it on, as for a vehicle parked there in AUTO.
-        return;
-    }
-    if (mode_ == Mode::Hold && queue_.size() == 1 && !queue_[0].stop && queue_[0].slot == kFirstRingSlot &&
-        confirmed(queue_[0]) && holds_stop(ring_next(kFirstRingSlot))) {
-        // The head is the window's last (a hold's point ends it) and the ring's jump lands on it: a 2.x board
-        // runs the barrier after it as it takes the jump and holds short of it (on_current, slot 2). Its
-        // target report may come after this: it is pointed at slot 2 before AUTO, or AUTO ends its mission
-        // again at once.
-        at_frontier(now);
-        return;
+    // The HOLDs a board whose Stop ends its mission (APM:Rover 2.x) makes by itself. On a board that stays in
+    // AUTO on a Stop, a HOLD at these moments is a failsafe or a mode switch, said and undone below.
+    if (stop_ends_mission_ && mode_ == Mode::Hold) {
+        if (old_target_ && need_set_current_ && !repoint_only_) {
+            // After a skip or a new plan it holds at the barrier after its old target: the set-current and
+            // AUTO that follow take it to the new head.
+            return;
+        }
+        if (frontier_since_) {
+            // It holds at the barrier: the head's write, a set-current and AUTO take it on, as for a vehicle
+            // parked there in AUTO.
+            return;
+        }
+        if (queue_.size() == 1 && !queue_[0].stop && queue_[0].slot == kFirstRingSlot &&
+            confirmed(queue_[0]) && holds_stop(ring_next(kFirstRingSlot))) {
+            // The head is the window's last (a hold's point ends it) and the ring's jump lands on it: the
+            // board runs the barrier after it as it takes the jump and holds short of it (on_current, slot
+            // 2). Its target report may come after this: it is pointed at slot 2 before AUTO, or AUTO ends
+            // its mission again at once.
+            at_frontier(now);
+            return;
+        }
     }
     // The board's own HOLD: a failsafe, a mode switch, a DO_JUMP taken its own way, or the end of its
     // mission. Every slot still holds what it held. If the board's target is the head (or the one after it,

@@ -25,7 +25,7 @@
 //   inputs   replace_plan(), skip_to(), jump_to(), pause(), resume(), release_hold(),
 //            on_reached(slot), on_current(slot), on_item_stored(slot, item), on_mode(state, cause),
 //            on_request_result(id, result),
-//            on_autopilot_rebooted(),
+//            on_autopilot_rebooted(), set_stop_ends_mission(ends) (with a write's result),
 //            handle_timeout(now) when poll_timeout() is due;
 //   outputs  poll_request(now) after every input, until it returns nothing: at most one request is
 //            outstanding; each ends with exactly one on_request_result() (or a timeout);
@@ -102,6 +102,10 @@ class WindowFeeder {
     void on_request_result(std::uint32_t id, autopilot::RequestResult result, TimePoint now,
                            std::string_view detail = {});
     void on_autopilot_rebooted(TimePoint now);
+    /// How the board runs a Stop, as its last mission write said: as the end of its mission, holding there
+    /// in HOLD (APM:Rover 2.x), or staying in AUTO (current Rover). Until told, a HOLD where a 2.x board
+    /// would hold by itself is taken for that board's.
+    void set_stop_ends_mission(bool ends) { stop_ends_mission_ = ends; }
     void handle_timeout(TimePoint now);
 
     std::optional<FeederRequest> poll_request(TimePoint now);
@@ -239,6 +243,7 @@ class WindowFeeder {
     bool fault_hold_pending_ = false;
     std::deque<Waypoint> holds_;  // holds to run, front first (the one being held while holding_)
     bool holding_ = false;
+    bool stop_ends_mission_ = true;        // set_stop_ends_mission()
     std::optional<TimePoint> hold_until_;  // empty while holding: until released
     std::optional<Waypoint> hold_wp_;
 

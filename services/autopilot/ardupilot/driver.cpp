@@ -35,6 +35,11 @@ RequestResult from_mission(MissionResult r) {
     }
     return RequestResult::Refused;
 }
+
+bool has_stop(const std::vector<MissionItem>& items) {
+    return std::any_of(items.begin(), items.end(),
+                       [](const MissionItem& m) { return m.kind == MissionItem::Kind::Stop; });
+}
 }  // namespace
 
 const char* to_string(Phase p) {
@@ -418,7 +423,7 @@ void Driver::on_mission_done(MissionCompletion c, TimePoint now) {
                 for (std::size_t i = 1; i < c.items.size(); ++i) {
                     mission_.push_back(decode_item(c.items[i]));
                 }
-                RequestDone d{op.id, op.kind, r, {}, mission_, std::nullopt, {}, std::nullopt};
+                RequestDone d{op.id, op.kind, r, {}, mission_, std::nullopt, {}, std::nullopt, std::nullopt};
                 emit(std::move(d));
                 return;
             }
@@ -427,7 +432,9 @@ void Driver::on_mission_done(MissionCompletion c, TimePoint now) {
         }
         update_speed(now);  // the item being driven to may have a new speed
     }
-    done(op.id, op.kind, r, c.detail);
+    // How this board runs a Stop is known once one was written to it (a 2.x board refuses the first).
+    const bool known = stop_as_jump_ || has_stop(op.items);
+    done(op.id, op.kind, r, c.detail, known ? std::optional<bool>(stop_as_jump_) : std::nullopt);
 }
 
 // A board that does not store NAV_LOITER_UNLIM (APM:Rover 2.x: MAV_MISSION_UNSUPPORTED) gets Stop items as
@@ -435,9 +442,7 @@ void Driver::on_mission_done(MissionCompletion c, TimePoint now) {
 bool Driver::retry_with_stops_as_jumps(const PendingOp& op, const MissionCompletion& c, TimePoint now) {
     constexpr std::uint8_t kMissionUnsupported = 3;
     const bool writes = op.kind == RequestKind::UploadMission || op.kind == RequestKind::WriteItems;
-    const bool has_stop = std::any_of(op.items.begin(), op.items.end(),
-                                      [](const MissionItem& m) { return m.kind == MissionItem::Kind::Stop; });
-    if (!writes || !has_stop || stop_as_jump_ || c.result != MissionResult::Denied ||
+    if (!writes || !has_stop(op.items) || stop_as_jump_ || c.result != MissionResult::Denied ||
         c.refusal != kMissionUnsupported) {
         return false;
     }
@@ -490,7 +495,8 @@ void Driver::on_param_done(ParamCompletion c, TimePoint now) {
     if (it == param_ops_.end()) {
         return;
     }
-    RequestDone d{it->second.id, it->second.kind, c.result, c.detail, {}, std::nullopt, {}, std::nullopt};
+    RequestDone d{it->second.id, it->second.kind, c.result, c.detail, {}, std::nullopt, {},
+                  std::nullopt,  std::nullopt};
     if (c.value) {
         d.param_value = *c.value;
     }
@@ -512,12 +518,14 @@ void Driver::cancel_everything(const std::string& why, TimePoint now) {
     override_active_ = false;
 }
 
-void Driver::done(std::uint32_t id, RequestKind kind, RequestResult result, std::string detail) {
+void Driver::done(std::uint32_t id, RequestKind kind, RequestResult result, std::string detail,
+                  std::optional<bool> stop_ends_mission) {
     RequestDone d;
     d.id = id;
     d.kind = kind;
     d.result = result;
     d.detail = std::move(detail);
+    d.stop_ends_mission = stop_ends_mission;
     emit(std::move(d));
 }
 

@@ -169,7 +169,8 @@ class Driver {
     bool retry_with_stops_as_jumps(const PendingOp& op, const MissionCompletion& c, TimePoint now);
     void on_param_done(ParamCompletion c, TimePoint now);
     void cancel_everything(const std::string& why, TimePoint now);
-    void done(std::uint32_t id, RequestKind kind, RequestResult result, std::string detail = {});
+    void done(std::uint32_t id, RequestKind kind, RequestResult result, std::string detail = {},
+              std::optional<bool> stop_ends_mission = std::nullopt);
     std::uint32_t reject_if_not_ready(RequestKind kind);
     void send_mode(std::uint32_t mode);
     void send_due_modes();

@@ -123,7 +123,8 @@ struct SimRig {
             now() + limit);
         return found ? *found
                      : RequestDone{
-                           id, RequestKind::SetState, RequestResult::Cancelled, "no result", {}, {}, {}, {}};
+                           id, RequestKind::SetState, RequestResult::Cancelled, "no result", {}, {}, {}, {},
+                           {}};
     }
     /// The port opens: the board sees DTR (and reboots when it is an APM on USB).
     bool open_and_wait_ready() {

@@ -94,10 +94,15 @@ struct Rig {
     RequestDone wait_result(std::uint32_t id, Duration limit = seconds(60)) {
         harness.run_until([&] { return result_of(id).has_value(); }, now() + limit);
         auto r = result_of(id);
-        return r ? *r
-                 : RequestDone{
-                       id, RequestKind::SetState, RequestResult::Cancelled, "no result in time", {}, {}, {},
-                       {}};
+        return r ? *r : RequestDone{id,
+                                    RequestKind::SetState,
+                                    RequestResult::Cancelled,
+                                    "no result in time",
+                                    {},
+                                    {},
+                                    {},
+                                    {},
+                                    {}};
     }
     void bring_up() {
         open_with_reset();
@@ -885,6 +890,7 @@ TEST(Driver, ABoardWithoutLoiterUnlimGetsStopsAsJumpsPastTheEnd) {
     const auto r = rig.wait_result(rig.driver.upload_mission(plan(6), rig.now()));  // slot 6 is a Stop
     ASSERT_EQ(r.result, RequestResult::Ok) << r.detail;
     EXPECT_TRUE(rig.driver.stops_as_jumps());
+    EXPECT_EQ(r.stop_ends_mission, std::optional<bool>(true)) << "the flight plan manager is told";
     EXPECT_EQ(rig.rover.mission()[6].command, 177) << "MAV_CMD_DO_JUMP";
     EXPECT_EQ(rig.rover.mission()[6].param1, 255.0f) << "past the end of any mission the board holds";
     EXPECT_EQ(rig.driver.mission()[5].kind, MissionItem::Kind::Stop)
@@ -897,6 +903,22 @@ TEST(Driver, ABoardWithoutLoiterUnlimGetsStopsAsJumpsPastTheEnd) {
     rig.rover.reach(5, rig.now());
     rig.harness.run_for(seconds(2));
     EXPECT_EQ(rig.rover.mode(), testing::kAuto) << "no HOLD from the driver";
+}
+
+// The flight plan manager learns from a write's result how the board runs a Stop, once one was written: a
+// board with NAV_LOITER_UNLIM loiters there in AUTO. Before that the result says nothing either way.
+TEST(Driver, AWriteResultSaysHowTheBoardRunsAStopOnceOneWasWritten) {
+    Rig rig(pixhawk_config(), FakeRover::Options{});
+    rig.bring_up();
+    auto places = plan(6);
+    places.back().kind = MissionItem::Kind::Waypoint;
+    const auto first = rig.wait_result(rig.driver.upload_mission(places, rig.now()));
+    ASSERT_EQ(first.result, RequestResult::Ok) << first.detail;
+    EXPECT_EQ(first.stop_ends_mission, std::nullopt) << "no Stop written yet";
+    const auto with_stop = rig.wait_result(rig.driver.write_items(6, {plan(6).back()}, rig.now()));
+    ASSERT_EQ(with_stop.result, RequestResult::Ok) << with_stop.detail;
+    EXPECT_EQ(with_stop.stop_ends_mission, std::optional<bool>(false));
+    EXPECT_FALSE(rig.driver.stops_as_jumps());
 }
 
 TEST(Driver, HoldReportedAsUninitByA2xBoardIsNoReboot) {

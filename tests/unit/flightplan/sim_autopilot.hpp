@@ -386,8 +386,13 @@ class Harness {
             const RequestResult res = refuse ? RequestResult::Refused
                                       : fail ? RequestResult::Timeout
                                              : ap.apply(*r);
-            // The driver reports a confirmed mode change before the request's result.
+            // The driver reports a confirmed mode change before the request's result, and with a write's
+            // result how the board runs a Stop: a 2.x board (legacy) as the end of its mission.
             report_modes();
+            if (std::holds_alternative<autopilot::WriteMissionItems>(r->op) ||
+                std::holds_alternative<autopilot::UploadMission>(r->op)) {
+                feeder.set_stop_ends_mission(ap.legacy);
+            }
             feeder.on_request_result(r->id, res, now, refuse ? "MAV_MISSION_UNSUPPORTED_FRAME" : "");
             drain();
         }

@@ -316,6 +316,43 @@ TEST(FlightplanFeeder, TheBoardsOwnHoldMidPlanIsUndoneAndThePlanGoesOnInOrder) {
     EXPECT_EQ(h.feeder.progress().interruptions, 1u);
 }
 
+// A failsafe while the vehicle waits at the frontier: on a board that stays in AUTO on a Stop, that HOLD is
+// not the barrier's (a 2.x board's own stop there is), so it is said like any other and undone once the head
+// is written.
+TEST(FlightplanFeeder, TheBoardsOwnHoldWhileWaitingAtTheFrontierIsSaidAndUndone) {
+    Harness h;
+    h.feeder.replace_plan(test::synthetic(50), h.now);
+    for (int i = 0; i < 10; ++i) {
+        h.step();
+    }
+    h.impairments().requests_per_step = 0;  // the feeder falls behind: the vehicle parks on the barrier
+    for (int i = 0; i < 8; ++i) {
+        h.step();
+    }
+    ASSERT_TRUE(h.feeder.progress().held_at_frontier);
+    ASSERT_TRUE(h.ap.in_auto()) << "parked on the barrier in AUTO";
+    h.ap.board_holds();
+    h.step();
+    ASSERT_EQ(h.count(FeederEvent::Kind::Interrupted), 1u);
+    const auto said = std::find_if(h.events.begin(), h.events.end(), [](const FeederEvent& e) {
+        return e.kind == FeederEvent::Kind::Interrupted;
+    });
+    EXPECT_NE(said->detail.find("HOLD by itself"), std::string::npos) << said->detail;
+    // Undone once the head and its barrier are written (two writes, a set-current, AUTO).
+    h.impairments().requests_per_step = 2;
+    int back = 0;
+    while (!h.ap.in_auto() && back < 5) {
+        h.step();
+        ++back;
+    }
+    EXPECT_LE(back, 6) << "the plan must continue by itself after the board's own HOLD";
+    EXPECT_EQ(h.count(FeederEvent::Kind::Continued), 1u);
+    ASSERT_LT(h.run_until_done(200), 200);
+    EXPECT_EQ(h.reached, iota(0, 50));
+    expect_visited(h, 41.0, 0, 50);
+    EXPECT_EQ(h.feeder.progress().interruptions, 1u);
+}
+
 TEST(FlightplanFeeder, AReachedReportThatCrossesTheBoardsOwnHoldStillCounts) {
     Harness h;
     h.feeder.replace_plan(test::synthetic(40), h.now);
