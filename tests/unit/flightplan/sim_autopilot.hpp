@@ -428,6 +428,16 @@ class Harness {
         drain();
     }
 
+    /// Steps until the vehicle is in AUTO (or the limit); returns the steps taken.
+    int run_until_auto(int limit) {
+        int steps = 0;
+        while (!ap.in_auto() && steps < limit) {
+            step();
+            ++steps;
+        }
+        return steps;
+    }
+
     /// Steps until the plan is done (or the limit); returns the steps taken.
     int run_until_done(int limit) {
         for (int i = 0; i < limit; ++i) {

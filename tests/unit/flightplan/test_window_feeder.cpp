@@ -301,12 +301,7 @@ TEST(FlightplanFeeder, TheBoardsOwnHoldMidPlanIsUndoneAndThePlanGoesOnInOrder) {
     EXPECT_NE(h.feeder.progress().interruption.find("HOLD by itself"), std::string::npos)
         << h.feeder.progress().interruption;
     // Within a few steps (the daemon's second each) the vehicle is back in AUTO at the same target.
-    int back = 0;
-    while (!h.ap.in_auto() && back < 5) {
-        h.step();
-        ++back;
-    }
-    EXPECT_LT(back, 5) << "the plan must continue by itself after the board's own HOLD";
+    EXPECT_LT(h.run_until_auto(5), 5) << "the plan must continue by itself after the board's own HOLD";
     EXPECT_EQ(h.count(FeederEvent::Kind::Continued), 1u);
     EXPECT_EQ(h.feeder.progress().state, PlanState::Running);
     (void)target_before;
@@ -340,12 +335,7 @@ TEST(FlightplanFeeder, TheBoardsOwnHoldWhileWaitingAtTheFrontierIsSaidAndUndone)
     EXPECT_NE(said->detail.find("HOLD by itself"), std::string::npos) << said->detail;
     // Undone once the head and its barrier are written (two writes, a set-current, AUTO).
     h.impairments().requests_per_step = 2;
-    int back = 0;
-    while (!h.ap.in_auto() && back < 5) {
-        h.step();
-        ++back;
-    }
-    EXPECT_LE(back, 6) << "the plan must continue by itself after the board's own HOLD";
+    EXPECT_LT(h.run_until_auto(8), 8) << "the plan must continue by itself after the board's own HOLD";
     EXPECT_EQ(h.count(FeederEvent::Kind::Continued), 1u);
     ASSERT_LT(h.run_until_done(200), 200);
     EXPECT_EQ(h.reached, iota(0, 50));
