@@ -109,6 +109,11 @@ nlohmann::json speeds_json(const RoverSim& sim, std::uint64_t from, std::uint64_
 nlohmann::json stats_json(const RoverSim& sim) {
     const SimCounters& c = sim.counters();
     const MissionServerStats& m = sim.mission_stats();
+    auto long_gaps = nlohmann::json::array();
+    for (const HeartbeatGap& g : sim.long_heartbeat_gaps()) {
+        long_gaps.push_back({{"t", seconds_since(sim.started(), g.at)},
+                             {"s", std::chrono::duration<double>(g.length).count()}});
+    }
     return {{"bytes_in", c.bytes_in},
             {"bytes_out", c.bytes_out},
             {"bytes_lost", c.bytes_lost},
@@ -121,6 +126,8 @@ nlohmann::json stats_json(const RoverSim& sim) {
             {"heartbeats_stalled", c.heartbeats_stalled},
             {"auto_restarts", c.auto_restarts},
             {"arm_refused", c.arm_refused},
+            {"heartbeat_gap_max_s", std::chrono::duration<double>(c.heartbeat_gap_max).count()},
+            {"long_heartbeat_gaps", long_gaps},
             {"uploads_completed", m.uploads_completed},
             {"uploads_cancelled", m.uploads_cancelled},
             {"mission_rerequests", m.rerequests},
@@ -321,7 +328,8 @@ std::string apply_control(RoverSim& sim, std::string_view command, TimePoint now
             return "ok commands: state, modes [N], reached [FROM [COUNT]], speeds [FROM [COUNT]], stats, "
                    "rcpilot MODE, mode MODE, reboot [S], unplug, replug, hbstall S, loss P [BURST], corrupt "
                    "P, "
-                   "ignore-mission on|off, freeze on|off, battery full, slow MS, param NAME [VALUE], arm [force], "
+                   "ignore-mission on|off, freeze on|off, battery full, slow MS, param NAME [VALUE], arm "
+                   "[force], "
                    "disarm, "
                    "gps lose|fix, fail-check REASON...|off";
         }

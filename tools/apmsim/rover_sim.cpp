@@ -261,7 +261,11 @@ void RoverSim::handle_timeout(TimePoint now) {
         enter_phase(phase_ == BootPhase::Silent ? BootPhase::Calibrating : BootPhase::Ready, now);
     }
     if (next_heartbeat_ <= now) {
+        const auto sent = counters_.heartbeats_sent;
         send_heartbeat(now);
+        if (counters_.heartbeats_sent != sent) {
+            note_heartbeat_sent(now);
+        }
         arming_update(now);  // AP_Arming::update() runs at 1 Hz too
         next_heartbeat_ = std::max(next_heartbeat_ + seconds(1), now);
     }
@@ -275,6 +279,22 @@ void RoverSim::handle_timeout(TimePoint now) {
     legacy_server_.handle_timeout(now);
     note_speed("param", now);  // a parameter written directly (params())
     out_.release(now);
+}
+
+// Whatever silenced the board, its peer saw the silence: a stall fault, a reboot, or (at a speedup) the
+// simulator itself not running, which a wake at the end of it shows as one long gap.
+void RoverSim::note_heartbeat_sent(TimePoint now) {
+    if (last_heartbeat_sent_ != kNever) {
+        const Duration gap = now - last_heartbeat_sent_;
+        counters_.heartbeat_gap_max = std::max(counters_.heartbeat_gap_max, gap);
+        if (gap > kLongHeartbeatGap) {
+            if (long_heartbeat_gaps_.size() == kMaxHeartbeatGaps) {
+                long_heartbeat_gaps_.pop_front();
+            }
+            long_heartbeat_gaps_.push_back({now, gap});
+        }
+    }
+    last_heartbeat_sent_ = now;
 }
 
 TimePoint RoverSim::poll_timeout() const {

@@ -170,6 +170,14 @@ struct SimCounters {
     std::uint64_t heartbeats_stalled = 0;
     std::uint64_t auto_restarts = 0;  // "Auto mission changed, restarted command" (the change detector)
     std::uint64_t arm_refused = 0;    // arming attempts that failed their checks
+    Duration heartbeat_gap_max{0};    // the longest time between two heartbeats sent, in board time
+};
+
+/// A silence of the board: its heartbeats stopped for longer than RoverSim::kLongHeartbeatGap (a stall
+/// fault, a reboot, or the simulator itself not running). Ended at `at`.
+struct HeartbeatGap {
+    TimePoint at;
+    Duration length;
 };
 
 class RoverSim {
@@ -179,6 +187,9 @@ class RoverSim {
     static constexpr std::size_t kMaxReachedLog = 4096;
     static constexpr std::size_t kMaxSpeedLog = 4096;
     static constexpr std::size_t kMaxLegSamples = std::size_t{1} << 20;  // speed samples kept for one leg
+    /// A heartbeat gap this long (the board beats at 1 Hz) is a silence, kept in long_heartbeat_gaps().
+    static constexpr Duration kLongHeartbeatGap = seconds(5);
+    static constexpr std::size_t kMaxHeartbeatGaps = 64;  // the latest kept
 
     RoverSim(RoverSimConfig config, TimePoint now);
 
@@ -241,6 +252,8 @@ class RoverSim {
         return rover2_mission() ? legacy_server_.stats() : server_.stats();
     }
     const SimCounters& counters() const { return counters_; }
+    /// The board's silences, the latest kMaxHeartbeatGaps, oldest first.
+    const std::deque<HeartbeatGap>& long_heartbeat_gaps() const { return long_heartbeat_gaps_; }
     const RoverSimConfig& config() const { return config_; }
     TimePoint started() const { return started_; }
 
@@ -308,6 +321,7 @@ class RoverSim {
     void take_leg_stats(ReachedEvent& event);
     // rover_sim_telemetry.cpp
     void send_heartbeat(TimePoint now);
+    void note_heartbeat_sent(TimePoint now);
     void send_stream_message(std::uint32_t msgid, TimePoint now);
     void send_mission_current();
     void send_home_position();
@@ -365,6 +379,8 @@ class RoverSim {
     std::uint32_t boots_ = 0;
     TimePoint reboot_at_ = kNever;
     TimePoint next_heartbeat_ = kNever;
+    TimePoint last_heartbeat_sent_ = kNever;
+    std::deque<HeartbeatGap> long_heartbeat_gaps_;
     TimePoint hb_stall_until_{};
     TimePoint last_step_{};
     bool frozen_ = false;

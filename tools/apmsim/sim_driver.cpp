@@ -10,6 +10,13 @@ namespace {
 
 // Waking more often than this costs more than it shows: the core catches up whole physics steps.
 constexpr Duration kMinWake = std::chrono::milliseconds(1);
+// A wake this late means the simulator itself was not running (stopped, or starved of CPU): the board it
+// models fell silent meanwhile, and a peer's link watch may rightly have said so. Logged, so that a link
+// loss seen by the peer can be told from one the peer made up.
+constexpr Duration kLateWakeLogged = std::chrono::milliseconds(500);
+// Bytes queued beside the pty's own buffer (itself some 64 KiB): more than a parameter list's burst and a
+// whole kernel buffer behind means the peer is not reading (or is starved), and what it hears is that old.
+constexpr std::size_t kBacklogLogged = 64 * 1024;
 
 }  // namespace
 
@@ -130,6 +137,11 @@ void SimDriver::pump() {
     auto bytes = sim_->poll_transmit();
     if (!bytes.empty() && pty_->is_open() && pty_->peer_connected()) {
         pty_->write(baud_mismatch() ? noise(bytes.size()) : std::move(bytes));
+        const std::size_t queued = pty_->queued_bytes();
+        if (queued > kBacklogLogged && !backlog_logged_) {
+            log(std::to_string(queued) + " bytes queued that the port did not take: the peer is not reading");
+        }
+        backlog_logged_ = queued > kBacklogLogged || (backlog_logged_ && queued > 0);
     }
     log_new_events();
     arm();
@@ -149,6 +161,11 @@ void SimDriver::arm() {
     timer_.async_wait([this](const boost::system::error_code& ec) {
         if (ec == boost::asio::error::operation_aborted) {
             return;  // re-armed earlier, or stopping
+        }
+        if (const Duration late = SteadyClock::now() - armed_; late > kLateWakeLogged) {
+            log("woke " +
+                std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(late).count()) +
+                " ms late: the simulator was not running, and the board sent nothing meanwhile");
         }
         armed_ = kNever;
         pump();

@@ -63,6 +63,7 @@ class SimDriver {
     bool stopped_ = false;
     std::mt19937 noise_rng_;
     unsigned mismatch_logged_ = 0;  // the peer rate last reported as wrong (0: none)
+    bool backlog_logged_ = false;   // the peer's unread backlog was reported, and has not cleared since
 };
 
 }  // namespace airseg::apmsim

@@ -121,6 +121,7 @@ void Driver::on_reset_pulsed(TimePoint now) {
 // --- plumbing ----------------------------------------------------------------------------------------------
 
 void Driver::handle_bytes(std::span<const std::uint8_t> bytes, TimePoint now) {
+    link_.on_bytes(bytes.size(), now);
     parser_.push(bytes, [&](const mav::Frame& f) {
         if (!f.checksum_verified) {
             return;
@@ -163,7 +164,7 @@ void Driver::handle_timeout(TimePoint now, bool input_waiting) {
 
     const LinkWatch::Due due = link_.handle_timeout(now, input_waiting);
     if (due.lost) {
-        link_lost(*due.lost, now);
+        link_lost(*due.lost, due.lost_detail, now);
     }
     if (due.reboot && watching_for_reboots()) {
         reboot_detected(*due.reboot, now);

@@ -199,7 +199,7 @@ class Driver {
     void reboot_detected(const std::string& evidence, TimePoint now);
     /// Reboots are looked for once the autopilot has booted (not while a boot is waited for).
     bool watching_for_reboots() const { return phase_ != Phase::WaitBoot && phase_ != Phase::Closed; }
-    void link_lost(Duration silent, TimePoint now);
+    void link_lost(Duration silent, const std::string& detail, TimePoint now);
     void tap_incoming(const mavlink::Frame& f);
     void on_mission_current(std::uint16_t seq, TimePoint now);
     void report_current(std::uint16_t seq);

@@ -328,9 +328,9 @@ void Driver::reboot_detected(const std::string& evidence, TimePoint now) {
     enter(Phase::WaitBoot, now);
 }
 
-void Driver::link_lost(Duration silent, TimePoint now) {
+void Driver::link_lost(Duration silent, const std::string& detail, TimePoint now) {
     const auto silent_s = std::chrono::duration<double>(silent).count();
-    emit(LinkDown{"no heartbeat for " + std::to_string(static_cast<int>(silent_s)) + " s"});
+    emit(LinkDown{"no heartbeat for " + std::to_string(static_cast<int>(silent_s)) + " s (" + detail + ")"});
     // Transfers in progress are left to their own timeouts: a few lost heartbeats on a noisy radio must not
     // throw away a long upload that is still making progress.
     update_state(now, false);

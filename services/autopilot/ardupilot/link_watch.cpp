@@ -58,6 +58,22 @@ void LinkWatch::on_frame() {
     // and then, but hardly ever with the right system id as well.
     heard_frame_ = true;
     baud_deadline_ = kNever;
+    ++frames_since_heartbeat_;
+}
+
+void LinkWatch::on_bytes(std::size_t n, TimePoint now) {
+    bytes_since_heartbeat_ += n;
+    last_bytes_at_ = now;
+}
+
+std::string LinkWatch::silence_text(TimePoint now) const {
+    if (bytes_since_heartbeat_ == 0) {
+        return "nothing read from the port since the last one";
+    }
+    return std::to_string(bytes_since_heartbeat_) + " bytes read since the last one, " +
+           std::to_string(frames_since_heartbeat_) +
+           " of the autopilot's frames among them, the last bytes " + seconds_text(now - last_bytes_at_) +
+           " s ago";
 }
 
 LinkWatch::HeartbeatSeen LinkWatch::on_heartbeat(TimePoint now, bool booting, bool watching,
@@ -76,6 +92,8 @@ LinkWatch::HeartbeatSeen LinkWatch::on_heartbeat(TimePoint now, bool booting, bo
                               now);
     }
     last_heartbeat_ = now;
+    bytes_since_heartbeat_ = 0;
+    frames_since_heartbeat_ = 0;
     quiet_since_ = now;
     heartbeat_due_ = now + config_.heartbeat_timeout;
     overdue_since_.reset();
@@ -145,6 +163,7 @@ LinkWatch::Due LinkWatch::handle_timeout(TimePoint now, bool input_waiting) {
             up_ = false;
             ++link_losses_;
             due.lost = now - last_heartbeat_;
+            due.lost_detail = silence_text(now);
             heartbeat_due_ = kNever;
             overdue_since_.reset();
         }

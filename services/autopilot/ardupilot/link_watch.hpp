@@ -59,6 +59,7 @@ class LinkWatch {
     /// What handle_timeout() found due.
     struct Due {
         std::optional<Duration> lost;       // the link went down after this long without a heartbeat
+        std::string lost_detail;            // with `lost`: what the port carried meanwhile (silence_text)
         std::optional<unsigned> baud;       // reconfigure the port to this rate
         std::optional<unsigned> pulse;      // unresponsive: ask for reset pulse number N
         bool pulses_exhausted = false;      // unresponsive, and the pulse budget is spent
@@ -78,6 +79,12 @@ class LinkWatch {
     void on_reset_pulsed(TimePoint now);
     /// A valid frame from the autopilot's system id: ends baud probing.
     void on_frame();
+    /// Bytes read from the port (before parsing), for what a link-down verdict says the port carried.
+    void on_bytes(std::size_t n, TimePoint now);
+    /// What the port carried since the last heartbeat: nothing (a silent board, or a cut line), or bytes and
+    /// the autopilot's frames without a heartbeat among them (a board that stopped beating, or a line that
+    /// garbles), with how long ago the last bytes came (a reader that stopped reading).
+    std::string silence_text(TimePoint now) const;
     /// `booting`: the heartbeat says the autopilot is starting up; `watching`: reboots are looked for (not
     /// while a boot is being waited for); `boot_mode_after`, when not empty: the heartbeat's mode is the one
     /// the firmware holds only while it boots (Rover's INITIALISING), and the last heartbeat's was this one.
@@ -121,6 +128,9 @@ class LinkWatch {
     bool port_open_ = false;
     bool up_ = false;
     TimePoint last_heartbeat_{};
+    std::size_t bytes_since_heartbeat_ = 0;
+    std::size_t frames_since_heartbeat_ = 0;
+    TimePoint last_bytes_at_{};
     TimePoint heartbeat_due_ = kNever;        // the next look at an overdue heartbeat
     std::optional<TimePoint> overdue_since_;  // the first look that found it overdue
     TimePoint quiet_since_{};                 // reference for the unresponsive timer

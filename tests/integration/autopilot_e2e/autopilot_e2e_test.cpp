@@ -50,12 +50,24 @@ struct Answer {
 
 class AutopilotE2e : public ::testing::Test {
   protected:
+    static constexpr int kSpeedup = 10;  // board seconds per real second
+    /// The board's silences as long as the daemon's autopilot.heartbeat_timeout (3 s, real time) or longer,
+    /// by the simulator's record: a stall fault, a reboot, or the simulator itself not running. Each may end
+    /// the link, rightly; nothing else may.
+    int board_silences() {
+        int n = 0;
+        for (const auto& gap : control_->json("stats").value("long_heartbeat_gaps", Json::array())) {
+            n += gap.value("s", 0.0) / kSpeedup >= 3.0 ? 1 : 0;
+        }
+        return n;
+    }
     void SetUp() override {
         sim_ = std::make_unique<Subprocess>(
             with(std::vector<std::string>{binary("tools/apmsim/airseg-apmsim"), "--link",
                                           dir_.file("ttyACM0"), "--control", dir_.file("ctl"), "--home",
                                           std::to_string(kHomeLat) + "," + std::to_string(kHomeLon),
-                                          "--speedup", "10", "--boot-delay", "0.5", "--calib-time", "0.5"},
+                                          "--speedup", std::to_string(kSpeedup), "--boot-delay", "0.5",
+                                          "--calib-time", "0.5"},
                  extra_sim_args_),
             std::map<std::string, std::string>{}, dir_.path());
         ASSERT_TRUE(wait_until([&] { return exists(dir_.file("ttyACM0")) && exists(dir_.file("ctl")); },
@@ -366,7 +378,14 @@ TEST_F(GcsEndpointE2e, ParameterListsFromAnotherStationBringBannersButNoReboot) 
                            << after.value("ground_stations", Json()).dump();
     EXPECT_EQ(after["reboots"], 0) << after.dump() << daemon_->err();
     EXPECT_EQ(after["syncs"], 1) << "the parameters and the mission were read once";
-    EXPECT_EQ(after["link_losses"], 0) << "the daemon's log says when the link was lost:\n" << daemon_->err();
+    // A loaded machine can keep the simulator from running for seconds (30 board seconds and more at x10):
+    // its board then really was silent for the daemon's heartbeat timeout, and a loss is the daemon right.
+    const int silences = board_silences();
+    EXPECT_LE(after["link_losses"].get<int>(), silences)
+        << "the daemon's log says when the link was lost:\n"
+        << daemon_->err() << "the board's log:\n"
+        << sim_->err()
+        << "the board's silences: " << control_->json("stats").value("long_heartbeat_gaps", Json());
     EXPECT_EQ(after["ready_s"], at_ready["ready_s"]);
     EXPECT_EQ(daemon_->err().find("rebooted"), std::string::npos) << daemon_->err();
     // The endpoint's counters in status: the station's heartbeat and 20 requests passed on, nothing damaged,
@@ -385,9 +404,11 @@ TEST_F(GcsEndpointE2e, ParameterListsFromAnotherStationBringBannersButNoReboot) 
     EXPECT_EQ(rebooted["reboots"], 1) << rebooted.dump();
     EXPECT_EQ(rebooted["syncs"], 2) << rebooted.dump();
     std::cout << "[ figures ] " << banners << " parameter lists with their banner over " << board_minutes
-              << " board minutes: " << after["reboots"] << " reboots, " << after["syncs"]
-              << " syncs; ready_s " << at_ready["ready_s"] << "; a real reboot: " << rebooted["reboots"]
-              << " reboot, " << rebooted["syncs"] << " syncs; the endpoint: " << stations.dump() << "\n";
+              << " board minutes: " << after["reboots"] << " reboots, " << after["syncs"] << " syncs; "
+              << after["link_losses"] << " link losses over " << silences
+              << " silences of the board; ready_s " << at_ready["ready_s"]
+              << "; a real reboot: " << rebooted["reboots"] << " reboot, " << rebooted["syncs"]
+              << " syncs; the endpoint: " << stations.dump() << "\n";
 }
 
 TEST_F(GcsEndpointE2e, AGroundStationsMissionBecomesThePlanAndAnotherIsRefusedWhileItRuns) {

@@ -382,14 +382,27 @@ TEST(DriverWithApmSim, TenSecondHeartbeatStallIsDetectedAndRecovered) {
     SimRig rig(Board::Apm2);
     ASSERT_TRUE(rig.open_and_wait_ready());
     const TimePoint stall = rig.now();
+    EXPECT_TRUE(rig.sim.long_heartbeat_gaps().empty());
+    EXPECT_LE(rig.sim.counters().heartbeat_gap_max, seconds(1) + milliseconds(20));
     rig.sim.stall_heartbeats(seconds(10), rig.now());
     ASSERT_TRUE(rig.run_until_event<LinkDown>(1, seconds(10)));
     EXPECT_LE(rig.now() - stall, seconds(4));
+    // The board streams on without beating: the verdict says the port carried its frames.
+    const std::string reason = rig.all<LinkDown>()[0].reason;
+    EXPECT_TRUE(reason.starts_with("no heartbeat for 3 s (")) << reason;
+    EXPECT_NE(reason.find(" of the autopilot's frames among them, the last bytes 0."), std::string::npos)
+        << reason;
     ASSERT_TRUE(rig.run_until_event<LinkUp>(2, seconds(15)));
     EXPECT_GE(rig.now() - stall, seconds(9));
     EXPECT_TRUE(rig.driver.ready());
     EXPECT_EQ(rig.driver.status().reboots, 0u);
     EXPECT_EQ(rig.driver.status().state, VehicleState::Directed);
+    // The simulator keeps the silence it made: one gap of the stall's length, the longest.
+    ASSERT_EQ(rig.sim.long_heartbeat_gaps().size(), 1u);
+    const apmsim::HeartbeatGap gap = rig.sim.long_heartbeat_gaps().front();
+    EXPECT_GE(gap.length, seconds(10));
+    EXPECT_LE(gap.length, seconds(11));
+    EXPECT_EQ(rig.sim.counters().heartbeat_gap_max, gap.length);
 }
 
 TEST(DriverWithApmSim, RcOverrideDrivesAndIsReleasedWhenTheJoystickStops) {

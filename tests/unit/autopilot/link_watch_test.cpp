@@ -54,6 +54,36 @@ TEST(LinkWatch, LinkGoesDownAfterHeartbeatTimeoutAndTheReadGrace) {
     EXPECT_FALSE(beat(w, hb + seconds(6)));
 }
 
+// The verdict says what the port carried without a heartbeat: nothing (a silent board or a cut line), or the
+// autopilot's frames (a board that stopped beating) and when the last bytes came (a reader that stopped).
+TEST(LinkWatch, AVerdictSaysWhatThePortCarriedSinceTheLastHeartbeat) {
+    LinkWatch w(quiet_open());
+    w.on_port_open(kOpen);
+    w.on_bytes(17, kOpen);
+    w.on_frame();
+    beat(w, kOpen);
+    auto due = w.handle_timeout(kOpen + seconds(3));
+    due = w.handle_timeout(kOpen + seconds(3) + LinkWatch::kReadGrace);
+    ASSERT_TRUE(due.lost);
+    EXPECT_EQ(due.lost_detail, "nothing read from the port since the last one");
+
+    beat(w, kOpen + seconds(4));
+    for (int i = 0; i < 5; ++i) {
+        w.on_bytes(40, kOpen + seconds(4) + milliseconds(100 * i));
+        w.on_frame();
+    }
+    w.on_bytes(3, kOpen + seconds(5));  // noise: no frame
+    due = w.handle_timeout(kOpen + seconds(7));
+    due = w.handle_timeout(kOpen + seconds(7) + LinkWatch::kReadGrace);
+    ASSERT_TRUE(due.lost);
+    EXPECT_EQ(due.lost_detail,
+              "203 bytes read since the last one, 5 of the autopilot's frames among them, the last bytes 2.2 "
+              "s ago");
+    EXPECT_EQ(w.silence_text(kOpen + seconds(8)),
+              "203 bytes read since the last one, 5 of the autopilot's "
+              "frames among them, the last bytes 3.0 s ago");
+}
+
 TEST(LinkWatch, HeartbeatsInTimeKeepTheLinkUp) {
     LinkWatch w(quiet_open());
     w.on_port_open(kOpen);
