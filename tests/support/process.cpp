@@ -151,8 +151,39 @@ bool Subprocess::running() {
 }
 
 std::optional<int> Subprocess::wait_exit(std::chrono::milliseconds timeout) {
-    wait_until([this] { return !running(); }, timeout, std::chrono::milliseconds(5));
+    if (!wait_until([this] { return !running(); }, timeout, std::chrono::milliseconds(5))) {
+        stuck_ =
+            "still running " + std::to_string(timeout.count()) + " ms into a wait for its exit:\n" + where();
+    }
     return exit_code_;
+}
+
+std::string Subprocess::where() {
+    if (!running()) {
+        return {};
+    }
+    std::string text;
+    const std::filesystem::path tasks = "/proc/" + std::to_string(pid_) + "/task";
+    std::error_code ec;
+    for (const auto& task : std::filesystem::directory_iterator(tasks, ec)) {
+        // stat: "tid (comm) state ..."; the name may hold spaces and parentheses, the state follows the last.
+        const std::string stat = read_file((task.path() / "stat").string());
+        const auto close = stat.rfind(')');
+        const std::string state =
+            close != std::string::npos && close + 2 < stat.size() ? stat.substr(close + 2, 1) : "?";
+        const auto open = stat.find('(');
+        const std::string name = open != std::string::npos && close != std::string::npos
+                                     ? stat.substr(open + 1, close - open - 1)
+                                     : "";
+        text += "  thread " + task.path().filename().string() + " (" + name + "): state " + state +
+                ", waits in " + read_file((task.path() / "wchan").string()) + "\n";
+        std::istringstream stack(read_file((task.path() / "stack").string()));
+        int frames = 0;
+        for (std::string line; std::getline(stack, line) && frames < 12; ++frames) {
+            text += "    " + line + "\n";
+        }
+    }
+    return text;
 }
 
 std::string Subprocess::out() const {

@@ -68,15 +68,22 @@ class Subprocess {
 
     pid_t pid() const { return pid_; }
     void signal(int signo) const;
-    /// Waits for exit; returns the exit code (128+signal when killed), or nullopt on timeout.
+    /// Waits for exit; returns the exit code (128+signal when killed), or nullopt on timeout (and then
+    /// records where the process was: stuck()).
     std::optional<int> wait_exit(std::chrono::milliseconds timeout);
     bool running();
     std::string out() const;
     std::string err() const;
+    /// Where each thread of the running process is now: its state, the kernel function it waits in, and its
+    /// kernel stack where /proc shows it (root). Empty once the process has exited.
+    std::string where();
+    /// where() as it was when a wait_exit() last timed out; empty when none did.
+    const std::string& stuck() const { return stuck_; }
 
   private:
     pid_t pid_ = -1;
     std::optional<int> exit_code_;
+    std::string stuck_;
     std::string out_path_;
     std::string err_path_;
 };

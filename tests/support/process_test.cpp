@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <csignal>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,6 +28,21 @@ TEST(Subprocess, ManyStartedAtOnceEachKeepTheirOwnOutput) {
         EXPECT_EQ(children[i]->out(), "out-" + std::to_string(i) + "\n");
         EXPECT_EQ(children[i]->err(), "err-" + std::to_string(i) + "\n");
     }
+}
+
+// A child that does not exit in time is described where it waits, so that a slow exit can be told from a
+// hung one in the failure message; one that has exited is not.
+TEST(Subprocess, AWaitThatTimesOutSaysWhereTheProcessWas) {
+    TempDir dir;
+    Subprocess child({"/bin/sleep", "30"}, {}, dir.path());
+    EXPECT_EQ(child.stuck(), "");
+    EXPECT_EQ(child.wait_exit(std::chrono::milliseconds(200)), std::nullopt);
+    EXPECT_TRUE(child.stuck().starts_with("still running 200 ms into a wait for its exit:\n  thread "))
+        << child.stuck();
+    EXPECT_NE(child.stuck().find(": state S, waits in "), std::string::npos) << child.stuck();
+    child.signal(SIGTERM);
+    ASSERT_TRUE(child.wait_exit(std::chrono::seconds(30)));
+    EXPECT_EQ(child.where(), "");
 }
 
 }  // namespace

@@ -151,7 +151,7 @@ void SystemBench::start_daemon() {
 void SystemBench::stop_daemon() {
     ASSERT_TRUE(daemon_);
     daemon_->signal(SIGTERM);
-    EXPECT_EQ(daemon_->wait_exit(std::chrono::seconds(20)), 0) << daemon_->err();
+    EXPECT_EQ(daemon_->wait_exit(std::chrono::seconds(20)), 0) << daemon_->err() << daemon_->stuck();
 }
 
 void SystemBench::kill_daemon() {

@@ -90,7 +90,7 @@ class AutopilotE2e : public ::testing::Test {
     void TearDown() override {
         if (daemon_ && daemon_->running()) {
             daemon_->signal(SIGTERM);
-            EXPECT_EQ(daemon_->wait_exit(10s), 0) << daemon_->err();
+            EXPECT_EQ(daemon_->wait_exit(10s), 0) << daemon_->err() << daemon_->stuck();
         }
     }
 
