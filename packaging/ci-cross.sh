@@ -27,7 +27,9 @@
 # The ARM builds start in the order of their suites' length, longest first: armel, armhf, arm64.
 # The builds no suite waits for (the arm64 packages, the amd64 packages and their rebuild) compile at SCHED_IDLE
 # (AIRSEG_CROSS_IDLE=0: at nice 19 only): they take only the CPU that nothing else wants, which is the end of the
-# run, where the last suite's simulated-rover chains leave most of the machine idle.
+# run, where the last suite's simulated-rover chains leave most of the machine idle. They come one after the
+# other, amd64 first: its install test and the virtual machine's boot then run beside arm64's compile and the
+# last suite, not after everything else with half the machine idle.
 # The suites take AIRSEG_TEST_LOCK (default: one of this stage's own): one suite's CPU-bound part at a time,
 # their simulated-rover chains side by side (tools/run-ctest.sh).
 # With --prepare, only step 1: CI runs it in the background while it compiles the sanitizer build, so
@@ -44,7 +46,7 @@ for a in "$@"; do
   case "$a" in
     --prepare) prepare_only=1 ;;
     amd64|armhf|armel|arm64) arches+=("$a") ;;
-    -h|--help) sed -n '2,32p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,/^set -euo/{/^#/p}' "$0"; exit 0 ;;
     *) die "unknown argument '$a' (expected --prepare, amd64, armhf, armel, arm64)" ;;
   esac
 done
@@ -111,6 +113,14 @@ build_arm() {
     AIRSEG_EXTRA_CMAKE_ARGS="-DAIRSEG_TEST_HANG_INJECTION=ON -DAIRSEG_TEST_OPTIMIZATION=-O1 -DAIRSEG_TEST_UNITY_BATCH_SIZE=0${bench:+ $bench}" \
       "$AIRSEG_ROOT/packaging/build-debs.sh" --no-debug-info "$arch"
   else
+    # The two builds nothing waits for come one after the other, amd64's first: its install test and the
+    # virtual machine's boot (a core for two minutes, then half the machine idle) follow it, and run beside
+    # this build and the last suite instead of after everything else.
+    if [ -n "$amd64_built" ]; then
+      step "$arch waits for the amd64 packages ($amd64_built)"
+      while [ ! -e "$amd64_built" ]; do sleep 2; done
+      step "$arch: building"
+    fi
     at_idle_priority "$AIRSEG_ROOT/packaging/build-debs.sh" --no-check --no-debug-info "$arch"
   fi
 }
@@ -137,6 +147,7 @@ amd64_packages() {
   ccache_stage_begin cross-amd64
   at_idle_priority "$AIRSEG_ROOT/packaging/build-debs.sh" --no-check --no-debug-info amd64
   record_stage "cross: amd64 packages, built and checked" "$((SECONDS - start))" "" cross-amd64
+  [ -z "$amd64_built" ] || touch "$amd64_built"
   line="amd64: $((SECONDS - start)) s wall; packages checked; ccache $(ccache_stage_rate cross-amd64)"
   if [ "${AIRSEG_CI_SKIP_INSTALL_TEST:-0}" != 1 ]; then
     # The virtual machine's boot (a core for minutes, with a time limit) waits for the end of the suite this
@@ -204,6 +215,13 @@ done
 arm_arches=("${ordered[@]}")
 overlap=${AIRSEG_CROSS_OVERLAP:-1}
 [ ${#arm_arches[@]} -gt 0 ] || overlap=0
+# Side by side with amd64, the ARM builds without a suite start once the amd64 packages are built (build_arm),
+# whether that build passed or not (its failure fails the stage at the end).
+amd64_built=""
+if [ "$with_amd64" = 1 ] && [ "$overlap" = 1 ]; then
+  amd64_built=$AIRSEG_CI_LOGS/cross-amd64.built
+  rm -f "$amd64_built"
+fi
 if [ "$with_amd64" = 1 ] && [ "$overlap" = 0 ]; then
   amd64_packages
 fi
@@ -257,6 +275,7 @@ if [ "$overlap" = 1 ]; then
       code=0
       renice -n 19 -p "$BASHPID" >/dev/null
       amd64_packages >"$AIRSEG_CI_LOGS/cross-amd64.log" 2>&1 || code=$?
+      touch "$amd64_built"
       exit "$code"
     ) &
     amd64_pid=$!
