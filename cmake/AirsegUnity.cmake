@@ -11,7 +11,8 @@
 # lines, found through the top of the tree on the target's include path. The batch files are the same bytes
 # in every clone, and __FILE__ and compiler messages name a source by that path as the include path reaches it
 # (`../services/...` from a build directory in the tree).
-# A target with one C++ source compiles it as it is. C sources are not batched.
+# A target with one C++ source compiles it as it is. C sources are not batched, nor are sources whose
+# SKIP_UNITY_BUILD_INCLUSION is set (a file whose own flags must not reach its batch-mates).
 
 # airseg_unity_targets(DIR OUT): every buildsystem target of DIR and the directories below it.
 function(airseg_unity_targets dir out)
@@ -61,6 +62,12 @@ function(airseg_unity_target target)
       continue()
     endif()
     cmake_path(ABSOLUTE_PATH source BASE_DIRECTORY ${source_dir} NORMALIZE OUTPUT_VARIABLE path)
+    # By its absolute path: a relative one would be read from the top directory, where this runs.
+    get_source_file_property(skip ${path} DIRECTORY ${source_dir} SKIP_UNITY_BUILD_INCLUSION)
+    if(skip)
+      list(APPEND kept ${source})
+      continue()
+    endif()
     cmake_path(IS_PREFIX PROJECT_SOURCE_DIR ${path} NORMALIZE below_top)
     if(NOT below_top)
       message(FATAL_ERROR "airseg unity build: ${target}'s source ${path} is not below ${PROJECT_SOURCE_DIR}")

@@ -13,6 +13,7 @@
 
 #include "base/file_text.hpp"
 #include "ground/map/http.hpp"
+#include "ground/map/map_web_source.hpp"
 #include "ground/map/plan_export.hpp"
 #include "ground/map/request_guard.hpp"
 #include "ground/map/request_reader.hpp"
@@ -174,7 +175,7 @@ std::string map_web_dir(const std::string& configured) {
     if (std::filesystem::exists(std::filesystem::path(AIRSEG_MAP_WEB_INSTALLED) / "index.html", ec)) {
         return AIRSEG_MAP_WEB_INSTALLED;
     }
-    return AIRSEG_MAP_WEB_SOURCE;
+    return map_web_source_dir();
 }
 
 class Session;
