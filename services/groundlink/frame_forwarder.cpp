@@ -54,8 +54,10 @@ void FrameForwarder::offer(const autopilot::ForwardedFrame& frame, [[maybe_unuse
         return;
     }
     Slot& slot = slots_[frame.id];
+    ++slot.stats.offered;
     if (slot.pending) {
         ++stats_.replaced;
+        ++slot.stats.replaced;
     }
     slot.bytes = frame.bytes;
     slot.pending = true;
@@ -66,6 +68,7 @@ void FrameForwarder::link_down() {
     for (auto& [id, slot] : slots_) {
         if (slot.pending) {
             ++stats_.stale;
+            ++slot.stats.stale;
             slot.pending = false;
             slot.bytes.clear();
         }
@@ -87,6 +90,9 @@ FrameForwarderStats FrameForwarder::stats() const {
     FrameForwarderStats s = stats_;
     s.reliable_queued = reliable_.size();
     s.reliable_queued_bytes = reliable_bytes_;
+    for (const auto& [id, slot] : slots_) {
+        s.freshest_by_id.emplace(id, slot.stats);
+    }
     return s;
 }
 
@@ -151,6 +157,11 @@ std::optional<FrameForwarder::Out> FrameForwarder::poll(TimePoint now) {
     // On schedule, the id keeps its grid (a frame arriving a little late does not slow the id down); after
     // a pause or a wait for the budget it starts afresh from now, so it earns no burst.
     s.next_allowed = now - s.next_allowed < s.interval ? s.next_allowed + s.interval : now + s.interval;
+    ++s.stats.forwarded;
+    if (s.last_forwarded != TimePoint{}) {
+        s.stats.longest_gap = std::max(s.stats.longest_gap, now - s.last_forwarded);
+    }
+    s.last_forwarded = now;
     return take(Out{Delivery::Freshest, slot->first, std::move(s.bytes)});
 }
 

@@ -52,6 +52,16 @@ struct FrameForwarderConfig {
     [[nodiscard]] std::vector<std::string> validate() const;
 };
 
+/// One freshest message id's counts: whether its rate fell short at the ground because the forwarder held it
+/// back (a long gap here) or because it was lost after it.
+struct FreshestIdStats {
+    std::uint64_t offered = 0;
+    std::uint64_t forwarded = 0;
+    std::uint64_t replaced = 0;
+    std::uint64_t stale = 0;
+    Duration longest_gap{};  // between two frames of the id handed out, since the first
+};
+
 struct FrameForwarderStats {
     std::uint64_t offered = 0;
     std::uint64_t forwarded = 0;  // frames handed out by poll()
@@ -62,6 +72,8 @@ struct FrameForwarderStats {
     std::uint64_t stale = 0;     // freshest frames waiting when the link went down, dropped by link_down()
     std::size_t reliable_queued = 0;        // reliable frames waiting now
     std::size_t reliable_queued_bytes = 0;  // ... their bytes
+    /// Per freshest id offered (bounded by the dialect: only verified frames of known ids are offered).
+    std::map<std::uint32_t, FreshestIdStats> freshest_by_id;
 };
 
 class FrameForwarder {
@@ -96,6 +108,8 @@ class FrameForwarder {
         bool pending = false;
         TimePoint next_allowed{};  // the id's rate limit: the earliest moment its next frame may go
         Duration interval{};
+        TimePoint last_forwarded{};  // TimePoint{} until the first
+        FreshestIdStats stats;
     };
     void refill(TimePoint now);
     [[nodiscard]] double rate_of(std::uint32_t id) const;

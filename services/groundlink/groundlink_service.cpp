@@ -649,6 +649,16 @@ void GroundlinkService::publish_status() {
                                     {"reliable_queued_bytes", fwd.reliable_queued_bytes},
                                     {"from_ground", fwd_counters[1]},
                                     {"from_ground_refused", fwd_counters[2]}};
+            auto& by_id = g["mavlink_forward"]["freshest_by_id"] = nlohmann::json::object();
+            for (const auto& [id, c] : fwd.freshest_by_id) {
+                by_id[std::to_string(id)] = {
+                    {"offered", c.offered},
+                    {"forwarded", c.forwarded},
+                    {"replaced", c.replaced},
+                    {"stale", c.stale},
+                    {"longest_gap_s",
+                     std::round(std::chrono::duration<double>(c.longest_gap).count() * 100) / 100}};
+            }
             g["tx"] = {{"safe", class_json(s.tx_safe)}, {"fast", class_json(s.tx_fast)}};
             g["rx"] = {{"safe", class_json(s.rx_safe)}, {"fast", class_json(s.rx_fast)}};
             auto& paths = g["paths"] = nlohmann::json::array();

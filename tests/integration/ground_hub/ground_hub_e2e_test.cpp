@@ -287,8 +287,9 @@ TEST_F(GroundHubE2e, AGroundStationGetsTheAutopilotsMavlinkThroughTheHub) {
     ASSERT_TRUE(summary.is_object()) << gcs.out << gcs.err << "\nhub:\n" << hub->err();
     EXPECT_TRUE(summary["ok"].get<bool>()) << summary.dump(2);
     // The vehicle's forwarder as the station ended: a freshest frame goes at most at its rate and within the
-    // byte budget, and a newer one replaces it meanwhile ("replaced"); with a rate short of 0.9 Hz, these say
-    // whether frames were replaced on the vehicle or late on the way.
+    // byte budget, and a newer one replaces it meanwhile ("replaced"); with a rate short of 0.9 Hz, the
+    // counts of each id (freshest_by_id: "0" the heartbeat, "33" the position; how many went out and the
+    // longest gap between two) say whether the vehicle held them back or they were lost after it.
     const auto vehicle_status = Json::parse(ctl({"status"}).out, nullptr, false);
     const Json forwarder =
         vehicle_status.is_object()

@@ -111,6 +111,45 @@ TEST(FrameForwarder, RateLimitsEachIdAndSendsTheNewestFrame) {
     }
 }
 
+// Each freshest id's own counts say whether its rate at the ground fell short in the forwarder (held back: a
+// long gap) or after it: with the budget free, an id's longest gap is its interval; with a budget too small
+// for what waits (a parameter download taking its turns), it is longer. Replaced frames are counted per id.
+TEST(FrameForwarder, EachFreshestIdCountsItsOwnFramesAndItsLongestGap) {
+    auto run = [](double budget, bool download) {
+        FrameForwarderConfig c;
+        c.enabled = true;
+        c.rate_hz = {{33, 1.0}};
+        c.budget_bytes_per_s = budget;
+        Rig rig(c);
+        rig.add(33, Delivery::Freshest, 36, 5.0);  // GLOBAL_POSITION_INT at 5 Hz, forwarded at 1
+        rig.add(0, Delivery::Freshest, 17, 1.0);   // HEARTBEAT at 1 Hz
+        if (download) {
+            rig.add(22, Delivery::Reliable, 37, 20.0);  // PARAM_VALUE, 740 bytes/s offered
+        }
+        rig.run(seconds(20));
+        return std::pair{rig.fwd.stats(), rig.count(33)};
+    };
+    const auto [free, sent_free] = run(1728, false);
+    const auto& position = free.freshest_by_id.at(33);
+    EXPECT_EQ(position.offered, 100u);
+    EXPECT_EQ(position.forwarded, sent_free);
+    EXPECT_NEAR(static_cast<double>(position.forwarded), 20.0, 1.0);
+    EXPECT_EQ(position.offered, position.forwarded + position.replaced + position.stale + 1)  // one waiting
+        << "forwarded " << position.forwarded << ", replaced " << position.replaced;
+    EXPECT_LE(position.longest_gap, milliseconds(1001));
+    EXPECT_EQ(free.freshest_by_id.at(0).replaced, 0u);
+    EXPECT_EQ(free.freshest_by_id.count(22), 0u) << "reliable frames are not freshest ones";
+    std::uint64_t replaced = 0;
+    for (const auto& [id, c] : free.freshest_by_id) {
+        replaced += c.replaced;
+    }
+    EXPECT_EQ(replaced, free.replaced);
+
+    const auto [starved, sent_starved] = run(40, true);
+    EXPECT_LT(sent_starved, sent_free);
+    EXPECT_GT(starved.freshest_by_id.at(33).longest_gap, milliseconds(1500));
+}
+
 TEST(FrameForwarder, ReliableFramesAllArriveInOrderBetweenTelemetry) {
     FrameForwarderConfig c;
     c.enabled = true;
