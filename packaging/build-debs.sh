@@ -19,6 +19,8 @@
 # fails the build (no case is rerun unless tests/ci-rerun.txt names it with its cause; each rerun is printed).
 # AIRSEG_EXTRA_CMAKE_ARGS: more cmake options (CI: -DAIRSEG_TEST_HANG_INJECTION=ON, so that the
 # stuck-service test runs on ARM too; packages to ship leave the test-only hook out).
+# AIRSEG_GCC_FLAGS: more compiler flags that leave the objects as they are (CI: GCC's garbage collector
+# parameters, tools/build-and-test.sh).
 # AIRSEG_TEST_JOBS: test cases run at once (default: AIRSEG_JOBS, the build's parallel level).
 # --upgrade-build: build the same source again, as version V+upgradetest1 (a changelog entry on top) with one
 # comment line more in the shipped airseg.yaml, into dist/upgrade-test/, for packaging/test-install.sh's
@@ -90,7 +92,9 @@ build_one() {
   opts="parallel=${AIRSEG_JOBS:-2} terse"
   [ "$check" = 1 ] || opts="$opts nocheck"
   local -a env=()
-  [ "$debug_info" = 1 ] || { opts="$opts noautodbgsym"; env+=(DEB_CFLAGS_APPEND=-g0 DEB_CXXFLAGS_APPEND=-g0); }
+  local gcc_flags=${AIRSEG_GCC_FLAGS:-}
+  [ "$debug_info" = 1 ] || { opts="$opts noautodbgsym"; gcc_flags="-g0${gcc_flags:+ $gcc_flags}"; }
+  [ -z "$gcc_flags" ] || env+=(DEB_CFLAGS_APPEND="$gcc_flags" DEB_CXXFLAGS_APPEND="$gcc_flags")
 
   if [ "$arch" = amd64 ]; then
     ensure_packages "${AIRSEG_DEV_PACKAGES[@]}"
@@ -119,8 +123,8 @@ build_one() {
     echo "# shipped by $pkg_version" >>"$src/config/airseg.yaml"
   fi
   # CMake reads the compiler flags only when it creates a build directory: one kept from a build
-  # with other options (tests, debug information) is started afresh.
-  local obj="$src/obj-$(arch_triplet "$arch")" key="check=$check debug_info=$debug_info${AIRSEG_EXTRA_CMAKE_ARGS:+ $AIRSEG_EXTRA_CMAKE_ARGS}"
+  # with other options (tests, debug information, compiler flags) is started afresh.
+  local obj="$src/obj-$(arch_triplet "$arch")" key="check=$check debug_info=$debug_info${AIRSEG_EXTRA_CMAKE_ARGS:+ $AIRSEG_EXTRA_CMAKE_ARGS}${gcc_flags:+ flags=$gcc_flags}"
   if [ -d "$obj" ] && [ "$(cat "$obj/.airseg-build-options" 2>/dev/null)" != "$key" ]; then
     rm -rf "$obj"
   fi

@@ -51,6 +51,12 @@ test_jobs=${AIRSEG_TEST_JOBS:-$((4 * jobs))}
 export AIRSEG_TEST_JOBS=$test_jobs
 total=$SECONDS
 
+# GCC's garbage collector runs first when its heap reaches 1 GiB (by default here 128 MiB, an eighth of the
+# memory up to that): the same objects for about 5 % less CPU (an armhf batch of test code 16.3 -> 14.9 CPU-s,
+# one of shipped code 14.6 -> 14.0), each compile at about 1.1 GB at most. The TSan build and the package
+# builds (packaging/build-debs.sh) add it; clang's sanitizer build has no such parameter.
+export AIRSEG_GCC_FLAGS=${AIRSEG_GCC_FLAGS-"--param=ggc-min-heapsize=1048576"}
+
 # The CI builds map the tree's path to . in their objects (AIRSEG_RELATIVE_PATHS), so that a clone elsewhere
 # shares their cache entries.
 launcher=(-DAIRSEG_RELATIVE_PATHS=ON)
@@ -200,7 +206,7 @@ mapfile -t tsan_targets < <(grep '^[a-z]' tests/concurrency-tests.txt)
 tsan_build() {
   ccache_stage_begin tsan-build
   cmake -S . -B build-tsan -G Ninja "${launcher[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" -DAIRSEG_BUILD_BENCH=OFF -DAIRSEG_SANITIZE=thread \
+    "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1${AIRSEG_GCC_FLAGS:+ $AIRSEG_GCC_FLAGS}" -DAIRSEG_BUILD_BENCH=OFF -DAIRSEG_SANITIZE=thread \
     -DAIRSEG_TEST_UNITY_BATCH_SIZE=0
   cmake --build build-tsan -j"$jobs" --target "${tsan_targets[@]}"
 }
