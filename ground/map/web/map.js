@@ -48,6 +48,7 @@
   const stateTrack = new URLSearchParams(location.search).get('state') === 'track';
   let positionAt = null;    // when the last position was new, by this page's clock (ms)
   let positionAge = null;   // seconds, once older than kStaleSeconds
+  let snapshotOver = false; // ?for=S: the stream has ended and the picture is kept
   const kStaleSeconds = 3;
   const kMostLabels = 300;  // more numbered waypoints than this: only the next target is labelled
 
@@ -82,7 +83,8 @@
       numbered: route.length,
       next_waypoint: nextIndex,
       progress: progressText,
-      position_age_s: positionAge
+      position_age_s: positionAge,
+      snapshot_over: snapshotOver
     };
   }
   // Mirrored into the page so that a headless browser's DOM dump shows what is drawn.
@@ -481,6 +483,8 @@
   events.onerror = () => {
     if (follow) {
       events.close();
+      snapshotOver = true;
+      publish();
       return;
     }
     setLink({ link: 'down', note: 'no connection to the hub', down_since: linkState && linkState.down_since,

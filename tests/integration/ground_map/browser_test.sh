@@ -15,15 +15,19 @@ start_fixture() {
   launch_fixture --seconds "$@"
 }
 
-# The page's event stream holds the browser's virtual time until the fixture ends it, so the fixture
-# runs a few seconds (the vehicle moves 10 times a second) and the browser then dumps what it drew.
-run_browser() {
-  headless_browser --window-size=1200,800 --virtual-time-budget=15000 "$@"
+# The fixture runs a few seconds (the vehicle moves 10 times a second) and then ends the page's event
+# stream; the page keeps its picture (?for=60: a snapshot, longer than the fixture) and says its snapshot is
+# over, and the browser then dumps what it drew ($1, the rest: more conditions, then headless_page.py's
+# options).
+snapshot() {
+  local page=$1 more=$2
+  shift 2
+  capture_page --size 1200,800 --url "$page" --until "airsegMap.state().snapshot_over$more" "$@"
 }
 
 # The vehicle's first samples come before a GPS fix (0,0, flagged as no position), as on every bench.
 start_fixture 4 --fixless-first 5
-run_browser --dump-dom "$url" >"$work/dom.html" || {
+snapshot "${url}?for=60" "" --dom "$work/dom.html" || {
   echo "FAIL: chromium failed:" >&2
   tail -20 "$work/browser.log" >&2
   exit 1
@@ -111,7 +115,7 @@ PY
 
 # The debug view (?debug=1, the page's checkbox) lists every event in the vehicle's own words.
 start_fixture 4
-run_browser --dump-dom "${url}?debug=1" >"$work/dom-debug.html" || {
+snapshot "${url}?debug=1&for=60" "" --dom "$work/dom-debug.html" || {
   echo "FAIL: chromium failed:" >&2
   tail -20 "$work/browser.log" >&2
   exit 1
@@ -124,7 +128,7 @@ check "debug view: a reworded event shows the vehicle's words" \
 # A radio outage after 10 samples: the link box says since when and greys its last figures; the vehicle's
 # position says how old it is, and its marker greys.
 start_fixture 5 --outage-after 10
-run_browser --dump-dom "$url" >"$work/dom-outage.html" || {
+snapshot "${url}?for=60" " && airsegMap.state().position_age_s >= 3" --dom "$work/dom-outage.html" || {
   echo "FAIL: chromium failed:" >&2
   tail -20 "$work/browser.log" >&2
   exit 1
@@ -154,7 +158,7 @@ PY
 
 # The fix lost after 10 samples: the vehicle stays where it was last known, greyed, and says "no fix".
 start_fixture 4 --lose-fix-after 10
-run_browser --dump-dom "$url" >"$work/dom-nofix.html" || {
+snapshot "${url}?for=60" "" --dom "$work/dom-nofix.html" || {
   echo "FAIL: chromium failed:" >&2
   tail -20 "$work/browser.log" >&2
   exit 1
@@ -198,7 +202,8 @@ for _ in $(seq 100); do
   sleep 0.1
 done
 [ -n "$attacker_url" ] || { echo "FAIL: the attacker's page server did not start" >&2; cat "$work/attacker.log" >&2; exit 1; }
-run_browser --dump-dom "$attacker_url" >"$work/attack.html" || true
+capture_page --url "$attacker_url" --until "document.getElementById('result').textContent !== 'pending'" \
+  --dom "$work/attack.html" || true
 echo "attacker page: $(grep -o '<pre id="result">[^<]*' "$work/attack.html" | sed 's/.*>//')"
 for _ in $(seq 100); do
   grep -q "map: refused a command" "$fixture_out" && break
@@ -209,7 +214,7 @@ check "the cross-origin command was refused and logged" \
 check "the vehicle got no command" "$(grep -q 'vehicle got the command' "$fixture_out" && echo no || echo yes)"
 
 start_fixture 4
-run_browser --screenshot="$work/map.png" "$url" >/dev/null || true
+snapshot "${url}?for=60" "" --screenshot "$work/map.png" || true
 if [ ! -s "$work/map.png" ]; then
   echo "FAIL: no screenshot written" >&2
   tail -20 "$work/browser.log" >&2

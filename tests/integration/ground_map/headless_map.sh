@@ -1,3 +1,4 @@
+# shellcheck shell=bash
 # Sourced by browser_test.sh and moments_test.sh (set `fixture`, airseg-map-fixture's path, first): the
 # headless browser, the fixture serving the map, and a work directory that goes with the test however the test
 # ends (the fixtures it started are stopped then too).
@@ -37,8 +38,9 @@ launch_fixture() {
   exit 1
 }
 
-# Headless chromium with options "$@" on a profile of its own; its messages go to $work/browser.log.
-headless_browser() {
-  timeout 120 "$browser" --headless --no-sandbox --disable-gpu --disable-dev-shm-usage --no-first-run \
-    --user-data-dir="$work/profile.$RANDOM" "$@" 2>>"$work/browser.log"
+# The page at --url in headless chromium once --until holds (headless_page.py: options "$@"); on a profile of
+# its own, its messages to $work/browser.log. Each step has a deadline and a failing one is named.
+capture_page() {
+  python3 "$(dirname "${BASH_SOURCE[0]}")/headless_page.py" --browser "$browser" \
+    --profile "$work/profile.$RANDOM" --log "$work/browser.log" "$@"
 }

@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # The map page at three moments of a survey (airseg-map-fixture --moment): leaving the start, mid-scan, and
-# in a radio outage. For each, headless chromium dumps what the page drew and the test checks it: the plan's
+# in a radio outage. For each, headless chromium (headless_page.py) dumps what the page drew once the moment's
+# snapshot is over, and the test checks it: the plan's
 # progress ("waypoint k of 14", the element, distance left), its 14 waypoints numbered with the next target
 # highlighted, every track point the page draws inside the plan's area (and none in the no-fly zone), and in
-# the outage the link box "down since" and the position's age. Then it takes the moment's screenshot and
-# checks it is a PNG of the window's size.
+# the outage the link box "down since" and the position's age. The same browser pictures the moment, and the
+# test checks the picture is a PNG of the window's size.
 #
 #   moments_test.sh PATH/TO/airseg-map-fixture
 #
@@ -27,26 +28,23 @@ start_fixture() {
   launch_fixture --web-dir "$web_dir" --seconds "$@"
 }
 
-# The page's event stream holds the browser's virtual time until it ends (the page's ?for=S: a snapshot,
-# the page keeps its picture and does not say the hub is gone); then the page's clock runs $budget ms more
-# and the browser dumps (or pictures) what it drew. A held moment gets little (its position stays fresh, the
-# page greys a position 3 s old), the outage enough for its position's age.
-run_browser() {
-  headless_browser --hide-scrollbars --window-size=$width,$height --virtual-time-budget="$budget" "$@"
-}
-
 fail=0
 
 # One moment: $1 its name, $2 the fixture's seconds, $3 the waypoint (1-based) the vehicle heads for,
-# $4 the element's words in the progress.
+# $4 the element's words in the progress. The page follows the vehicle for $2 seconds (?for=S: a snapshot,
+# the page keeps its picture and does not say the hub is gone); once its stream has ended the browser dumps
+# what the page drew and pictures it, in one go. A held moment is taken at once (its position still fresh:
+# the page greys a position 3 s old), the outage once its position says its age.
 moment() {
   local name=$1 seconds=$2 next=$3 element=$4
   echo "== moment: $name"
-  budget=$([ "$name" = outage ] && echo 8000 || echo 1000)
+  local until='airsegMap.state().snapshot_over'
+  [ "$name" = outage ] && until="$until && airsegMap.state().position_age_s >= 3"
   # The fixture outlives the snapshot (the test ends it).
   start_fixture 120 --moment "$name"
-  local dom=$work/dom-$name.html
-  if ! run_browser --dump-dom "${url}?for=$seconds&state=track" >"$dom"; then
+  local dom=$work/dom-$name.html png=$work/map-$name.png
+  if ! capture_page --size "$width,$height" --url "${url}?for=$seconds&state=track" --until "$until" \
+    --dom "$dom" --screenshot "$png"; then
     echo "FAIL: chromium failed ($name):" >&2
     tail -20 "$work/browser.log" >&2
     fail=1
@@ -116,11 +114,6 @@ for what, ok in checks:
 sys.exit(0 if all(ok for _, ok in checks) else 1)
 PY
 
-  # The same moment again, pictured.
-  start_fixture 120 --moment "$name"
-  local png=$work/map-$name.png
-  run_browser --screenshot="$png" "${url}?for=$seconds" >/dev/null || true
-  kill "$fixture_pid" 2>/dev/null || true
   if [ ! -s "$png" ]; then
     echo "FAIL: $name: no screenshot written" >&2
     tail -20 "$work/browser.log" >&2
