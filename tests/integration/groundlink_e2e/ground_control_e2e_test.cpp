@@ -159,7 +159,12 @@ class GroundControlE2e : public ::testing::Test {
 TEST_F(GroundControlE2e, StatusAndPushedTelemetryOverTheRadio) {
     start_link();
     start_sim();
-    start_daemon();
+    // This case counts the pushed samples at the requested rate, so the vehicle's samples have a floor of
+    // 2 Hz however weak the link is judged: under qemu-arm beside the rest of the suite the daemon's own
+    // delays are seen as loss (a run measured 25 %), the weak-link factor halves every 2 s of it, and 6 s of
+    // watching at half the rate had no sample to spare. The lowering and recovery have their own tests
+    // (TelemetryScheduler.LowersUnderAWeakLink…).
+    start_daemon({"--set", "groundlink.telemetry.min_hz=2"});
     Json doc;
     ASSERT_TRUE(wait_until(
         [&] {
@@ -174,13 +179,11 @@ TEST_F(GroundControlE2e, StatusAndPushedTelemetryOverTheRadio) {
     EXPECT_NEAR(doc["autopilot"]["position"]["lat"].get<double>(), kHomeLat, 1e-3);
     EXPECT_EQ(doc["groundlink"]["link"], "up");
     EXPECT_GE(doc["groundlink"]["frames_received"].get<int>(), 1);
-    // The rates: as requested, times the link's factor (halved while the link is judged weak: under qemu-arm
-    // beside the rest of the suite the daemon's own delays are seen as loss, and the rates go down).
+    // The rates: as requested, whatever the link's factor (the floor, see above, is above both).
     const auto& telemetry = doc["groundlink"]["telemetry"];
     EXPECT_EQ(telemetry["requested_hz"]["vehicle"], 2.0) << telemetry.dump();
-    EXPECT_NEAR(telemetry["effective_hz"]["vehicle"].get<double>(), 2.0 * telemetry["factor"].get<double>(),
-                0.001)
-        << telemetry.dump();
+    EXPECT_NEAR(telemetry["effective_hz"]["vehicle"].get<double>(), 2.0, 0.001) << telemetry.dump();
+    EXPECT_NEAR(telemetry["effective_hz"]["link_stats"].get<double>(), 1.0, 0.001) << telemetry.dump();
 
     // watch over the radio: the pushed samples, not the status document.
     auto watch = ctl({"watch", "--duration", "6000"});
@@ -190,6 +193,7 @@ TEST_F(GroundControlE2e, StatusAndPushedTelemetryOverTheRadio) {
     // One view per interval (500 ms), whatever comes over the link: a bounded output.
     EXPECT_LE(lines.size(), 13u) << watch.out.substr(0, 3000);
     const auto& last = lines.back();
+    // 2 Hz for 6 s: 12 samples; a sample lost on the half-duplex radio is not sent again (the freshest goes).
     EXPECT_GE(last["samples"].get<int>(), 6) << last.dump();
     EXPECT_NEAR(last["vehicle"]["lat"].get<double>(), kHomeLat, 1e-3) << last.dump();
     EXPECT_TRUE(last["vehicle"]["state"].is_string());
@@ -200,8 +204,8 @@ TEST_F(GroundControlE2e, StatusAndPushedTelemetryOverTheRadio) {
     ASSERT_EQ(rates.exit_code, 0) << rates.err;
     const auto changed = Json::parse(rates.out);
     EXPECT_EQ(changed["requested_hz"]["vehicle"], 5.0) << changed.dump();
-    EXPECT_NEAR(changed["effective_hz"]["vehicle"].get<double>(), 5.0 * changed["factor"].get<double>(),
-                0.001)
+    EXPECT_NEAR(changed["effective_hz"]["vehicle"].get<double>(),
+                std::max(2.0, 5.0 * changed["factor"].get<double>()), 0.001)
         << changed.dump();
     auto params = ctl({"param", "get", "WP_RADIUS"});
     EXPECT_EQ(params.exit_code, 0) << params.err;
