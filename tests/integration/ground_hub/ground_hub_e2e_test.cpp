@@ -306,7 +306,10 @@ TEST_F(GroundHubE2e, AGroundStationGetsTheAutopilotsMavlinkThroughTheHub) {
     EXPECT_EQ(summary["mode"]["ack"], 0) << summary.dump();
     EXPECT_TRUE(summary["mode"]["seen"].get<bool>()) << summary.dump();
 
-    // airseg's own Fast telemetry (2 Hz) kept its rate while the ground station downloaded.
+    // airseg's own Fast telemetry (2 Hz) kept its rate while the ground station downloaded. The watcher
+    // counts the samples of its last 5 s, 0.2 Hz a sample: a healthy link reads 1.8 or 2.0 by where the
+    // last line falls between two samples (1.8 in both runs of the case alone on amd64), one sample late
+    // under qemu reads 1.6, and a rate the vehicle lowered (halved by a link judged weak) reads 1.2 or less.
     watcher.signal(SIGTERM);
     ASSERT_TRUE(watcher.wait_exit(kGenerous));
     const auto lines = json_lines(watcher.out());
@@ -315,7 +318,7 @@ TEST_F(GroundHubE2e, AGroundStationGetsTheAutopilotsMavlinkThroughTheHub) {
     // judged weak, by loss or by samples replaced before they could go) or the samples were lost after it.
     auto status = ctl({"status"});
     const auto groundlink = Json::parse(status.out, nullptr, false).value("groundlink", Json::object());
-    EXPECT_GE(lines.back()["sample_rate"].get<double>(), 1.8)
+    EXPECT_GE(lines.back()["sample_rate"].get<double>(), 1.5)
         << lines.back().dump()
         << "\nthe vehicle's telemetry: " << groundlink.value("telemetry", Json()).dump();
     // And the vehicle counted both directions.
