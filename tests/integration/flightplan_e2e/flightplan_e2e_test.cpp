@@ -716,7 +716,10 @@ TEST_P(FlightplanE2e, ALawnmowerIsDrivenInOrderWithoutAHoldAtThePlansSpeedWithin
               << 100.0 * (actual - plain.driving_s) / plain.driving_s << " % over plain\n";
     EXPECT_EQ(plain.restarts, 0u);
     EXPECT_NEAR(actual, plain.driving_s, 0.05 * plain.driving_s);
-    EXPECT_EQ(restarts, 0) << "window writes inside the board's change-detector look-ahead";
+    // A write inside the look-ahead is either a feeder late by the window's travel (2.6 s here) or one that
+    // caught up at the frontier while the vehicle drove to a barrier: the plan's counts tell which.
+    EXPECT_EQ(restarts, 0) << "window writes inside the board's change-detector look-ahead; the plan: "
+                           << show().dump();
     EXPECT_EQ(ap.value("speed", Json()), Json(kSpeed)) << ap.dump();
 }
 
@@ -923,7 +926,10 @@ TEST_P(FlightplanSurveyE2e,
               << 100.0 * (actual - plain.driving_s) / plain.driving_s << " % over plain\n";
     EXPECT_EQ(plain.restarts, 0u);
     EXPECT_NEAR(actual, plain.driving_s, 0.05 * plain.driving_s);
-    EXPECT_EQ(restarts, 0) << "window writes inside the board's change-detector look-ahead";
+    // A write inside the look-ahead is either a feeder late by the window's travel (2.6 s here) or one that
+    // caught up at the frontier while the vehicle drove to a barrier: the plan's counts tell which.
+    EXPECT_EQ(restarts, 0) << "window writes inside the board's change-detector look-ahead; the plan: "
+                           << show().dump();
 }
 
 // Current Rover boots disarmed (ARMING_REQUIRE 1): the daemon arms it when the plan starts, never forcing,
