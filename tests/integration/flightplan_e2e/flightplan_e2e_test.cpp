@@ -926,8 +926,8 @@ TEST_P(FlightplanSurveyE2e,
               << 100.0 * (actual - plain.driving_s) / plain.driving_s << " % over plain\n";
     EXPECT_EQ(plain.restarts, 0u);
     EXPECT_NEAR(actual, plain.driving_s, 0.05 * plain.driving_s);
-    // A write inside the look-ahead is either a feeder late by the window's travel (2.6 s here) or one that
-    // caught up at the frontier while the vehicle drove to a barrier: the plan's counts tell which.
+    // A write inside the look-ahead is either a feeder late by the window's travel or one that caught up
+    // at the frontier while the vehicle drove to a barrier: the plan's counts tell which.
     EXPECT_EQ(restarts, 0) << "window writes inside the board's change-detector look-ahead; the plan: "
                            << show().dump();
 }

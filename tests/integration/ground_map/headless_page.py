@@ -33,7 +33,7 @@ class Browser:
         to_browser_r, to_browser_w = os.pipe()
         from_browser_r, from_browser_w = os.pipe()
         # posix_spawn's dup2 onto 3 and 4 must not land on one of the pipes themselves.
-        ends = [fcntl_dup_above(fd, 10) for fd in (to_browser_r, from_browser_w)]
+        ends = [fcntl.fcntl(fd, fcntl.F_DUPFD_CLOEXEC, 10) for fd in (to_browser_r, from_browser_w)]
         args = [path, '--headless', '--no-sandbox', '--disable-gpu', '--disable-dev-shm-usage', '--no-first-run',
                 '--hide-scrollbars', '--remote-debugging-pipe', '--window-size=%d,%d' % (width, height),
                 '--user-data-dir=' + profile, 'about:blank']
@@ -99,10 +99,6 @@ class Browser:
             pass
         if self.pid is not None:
             os.waitpid(self.pid, 0)
-
-
-def fcntl_dup_above(fd, lowest):
-    return fcntl.fcntl(fd, fcntl.F_DUPFD_CLOEXEC, lowest)
 
 
 def wait(readable, writable, deadline, step):
