@@ -188,7 +188,7 @@ void GroundlinkService::make_driver() {
                                      ctx_.wakes);
     last_rx_bytes_ = 0;
     delivery_.reset();
-    last_fast_messages_ = last_fast_replaced_ = 0;
+    own_fast_sent_ = own_fast_replaced_ = 0;
 }
 
 void GroundlinkService::attach_writers() {
@@ -462,17 +462,16 @@ void GroundlinkService::do_stats() {
 
 void GroundlinkService::feed_scheduler(TimePoint now) {
     const auto& s = driver_->stats();
-    const auto fast = s.tx_fast.messages - last_fast_messages_;
-    const auto replaced = s.tx_fast.replaced + s.tx_fast.drops - last_fast_replaced_;
     LinkQuality q;
     q.up = driver_->link_up();
     // What the ground says it received is the direct measure; the transport's Safe loss estimate stands in
     // until the ground has reported enough (a ground end that does not report, or a slow rate).
     q.loss = delivery_.loss().value_or(s.frame_loss);
-    q.replaced_share = fast > 0 ? static_cast<double>(replaced) / static_cast<double>(fast) : 0.0;
+    q.replaced_share = own_fast_sent_ > 0
+                           ? static_cast<double>(own_fast_replaced_) / static_cast<double>(own_fast_sent_)
+                           : 0.0;
     q.link_rate_bytes_per_s = transport_.carried_rate_bytes_per_s();
-    last_fast_messages_ = s.tx_fast.messages;
-    last_fast_replaced_ = s.tx_fast.replaced + s.tx_fast.drops;
+    own_fast_sent_ = own_fast_replaced_ = 0;
     scheduler_.update_link(q, now);
     arm_telemetry();
 }
@@ -490,8 +489,8 @@ void GroundlinkService::on_telemetry_timer() {
                 continue;  // nobody listens: a sample queued now would only be stale when the link comes back
             }
             if (*kind == TelemetryKind::Vehicle && vehicle_) {
-                driver_->send_fast(protocol::kPriorityTelemetry, protocol::kTopicTelemetry,
-                                   protocol::encode(make_sample(*vehicle_, plan_)));
+                send_own_fast(protocol::kPriorityTelemetry, protocol::kTopicTelemetry,
+                              protocol::encode(make_sample(*vehicle_, plan_)));
                 ++samples_sent_;
                 delivery_.on_pushed(now);
             } else if (*kind == TelemetryKind::LinkStats) {
@@ -515,8 +514,17 @@ void GroundlinkService::send_link_stats(TimePoint now) {
     report.goodput_bps = static_cast<std::uint32_t>(goodput_bps_);
     report.retransmissions = static_cast<std::uint32_t>(s.tx_safe.retransmissions);
     report.mac_failures = static_cast<std::uint32_t>(s.mac_failures);
-    driver_->send_fast(protocol::kPriorityStatus, protocol::kTopicLinkStats, protocol::encode(report));
+    send_own_fast(protocol::kPriorityStatus, protocol::kTopicLinkStats, protocol::encode(report));
     delivery_.on_pushed(now);
+}
+
+void GroundlinkService::send_own_fast(std::uint8_t priority, std::uint16_t topic,
+                                      std::span<const std::uint8_t> bytes) {
+    const auto r = driver_->send_fast(priority, topic, bytes);
+    ++own_fast_sent_;
+    if (r == SendResult::Replaced) {
+        ++own_fast_replaced_;
+    }
 }
 
 void GroundlinkService::update_health() {

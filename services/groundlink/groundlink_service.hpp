@@ -3,6 +3,7 @@
 // on top, commands from the ground through the shared dispatcher, and link statistics in the status document.
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -88,6 +89,8 @@ class GroundlinkService : public Service {
     void arm_telemetry();
     void on_telemetry_timer();
     void send_link_stats(TimePoint now);
+    /// One of airseg's own telemetry messages to the transport, counted for the scheduler.
+    void send_own_fast(std::uint8_t priority, std::uint16_t topic, std::span<const std::uint8_t> bytes);
     void update_health();
     void publish_status();
     /// What the telemetry rates report is made of, copied so it can be rendered later on another strand.
@@ -124,8 +127,12 @@ class GroundlinkService : public Service {
     SlackTimer stats_timer_;
     std::string fatal_;  // a configuration problem found at start (bad key file): the link stays down
     std::uint64_t last_rx_bytes_ = 0;
-    std::uint64_t last_fast_messages_ = 0;
-    std::uint64_t last_fast_replaced_ = 0;
+    /// airseg's own pushed telemetry (samples, link statistics) since the scheduler was last fed: how many
+    /// went to the transport, and how many replaced one of theirs still unsent (the link did not carry the
+    /// rate). The forwarder's Fast frames are not counted: a ground station's frames of one id replace each
+    /// other by design, under their own budget and below telemetry's priority.
+    std::uint64_t own_fast_sent_ = 0;
+    std::uint64_t own_fast_replaced_ = 0;
     std::uint64_t samples_sent_ = 0;
     std::uint64_t events_sent_ = 0;
     std::uint64_t events_dropped_ = 0;
