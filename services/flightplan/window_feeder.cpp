@@ -56,7 +56,8 @@ std::optional<std::string> FeederConfig::validate() const {
 WindowFeeder::WindowFeeder(FeederConfig config)
     : config_(config),
       confirmed_(config.window + 1u + kWrapSlots),
-      written_over_stop_(config.window + 1u + kWrapSlots, false) {}
+      written_over_stop_(config.window + 1u + kWrapSlots, false),
+      sent_(config.window + 1u + kWrapSlots) {}
 
 std::vector<MissionItem> WindowFeeder::slot_items(std::uint16_t slot, const MissionItem& item) const {
     if (slot != wrap_slot()) {
@@ -549,6 +550,15 @@ void WindowFeeder::on_reached(std::uint16_t slot, TimePoint now) {
     // By the ring's invariant every slot the vehicle can reach from its target holds the entry the window
     // put there or a barrier, so a report of an entry's confirmed slot is that entry reached, whether or not
     // a set-current is still due (the vehicle may have driven on into the window by itself).
+    const Entry& head = queue_[0];
+    if (stop_kind_told_ && stop_ends_mission_ && slot == head.slot && !head.stop && holds_stop(slot) &&
+        sent_[slot] == head.item()) {
+        // This board runs a Stop as a jump past its mission's end, which it never reports reached: the slot
+        // holds the head's entry, from a write whose answer was given up on (the daemon was stopped while
+        // the answer waited in its port) or is still to be read. Taken for the barrier, the arrival would
+        // be a wait at the frontier, and the vehicle would be pointed at the slot it had reached again.
+        confirmed_[slot] = head.item();
+    }
     const std::size_t limit = std::min<std::size_t>(queue_.size(), config_.lost_reached_tolerance + 1);
     for (std::size_t p = 0; p < limit; ++p) {
         const Entry& e = queue_[p];
@@ -811,6 +821,7 @@ void WindowFeeder::on_autopilot_rebooted(TimePoint now) {
     left_frontier(now);
     mission_ok_ = false;
     std::fill(confirmed_.begin(), confirmed_.end(), std::nullopt);
+    std::fill(sent_.begin(), sent_.end(), std::nullopt);
     ap_target_.reset();
     mode_ = Mode::Unknown;
     outstanding_.reset();
@@ -876,6 +887,7 @@ void WindowFeeder::request_succeeded(const FeederRequest& request, TimePoint now
     if (const auto* up = std::get_if<autopilot::UploadMission>(&request.op)) {
         std::fill(confirmed_.begin(), confirmed_.end(), std::nullopt);
         std::fill(written_over_stop_.begin(), written_over_stop_.end(), false);
+        std::fill(sent_.begin(), sent_.end(), std::nullopt);
         for (std::size_t i = 0; i < up->items.size() && i + 1 < confirmed_.size(); ++i) {
             confirmed_[i + 1] = up->items[i];
         }
@@ -969,6 +981,9 @@ std::optional<FeederRequest> WindowFeeder::write(std::uint16_t slot, const Missi
     autopilot::WriteMissionItems w;
     w.first_slot = slot;
     w.items = slot_items(slot, item);
+    for (std::size_t i = 0; i < w.items.size() && slot + i < sent_.size(); ++i) {
+        sent_[slot + i] = w.items[i];
+    }
     return issue(std::move(w), now);
 }
 

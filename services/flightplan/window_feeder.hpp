@@ -105,7 +105,10 @@ class WindowFeeder {
     /// How the board runs a Stop, as its last mission write said: as the end of its mission, holding there
     /// in HOLD (APM:Rover 2.x), or staying in AUTO (current Rover). Until told, a HOLD where a 2.x board
     /// would hold by itself is taken for that board's.
-    void set_stop_ends_mission(bool ends) { stop_ends_mission_ = ends; }
+    void set_stop_ends_mission(bool ends) {
+        stop_ends_mission_ = ends;
+        stop_kind_told_ = true;
+    }
     void handle_timeout(TimePoint now);
 
     std::optional<FeederRequest> poll_request(TimePoint now);
@@ -221,6 +224,9 @@ class WindowFeeder {
     // Slots where an entry replaced a barrier while the entry before it was not yet seen reached: a board
     // that got there first drives (or waits at) its copy of the Stop, whatever the slot holds now.
     std::vector<bool> written_over_stop_;
+    // By slot: the items of the last write sent there, answered or not. A daemon stopped for seconds gives
+    // up on answers still waiting in its port, so the board may hold these where confirmed_ says otherwise.
+    std::vector<std::optional<autopilot::MissionItem>> sent_;
     std::optional<std::uint16_t> ap_target_;  // the slot the autopilot is believed to head for
     bool need_set_current_ = false;
     std::optional<std::uint16_t> old_target_;  // after a fresh start: the target the vehicle had, kept apart
@@ -244,6 +250,7 @@ class WindowFeeder {
     std::deque<Waypoint> holds_;  // holds to run, front first (the one being held while holding_)
     bool holding_ = false;
     bool stop_ends_mission_ = true;        // set_stop_ends_mission()
+    bool stop_kind_told_ = false;          // ... was called
     std::optional<TimePoint> hold_until_;  // empty while holding: until released
     std::optional<Waypoint> hold_wp_;
 

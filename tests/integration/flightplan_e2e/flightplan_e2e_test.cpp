@@ -754,12 +754,16 @@ TEST_P(FlightplanE2e, APlanLoadedAfterAFinishedOneAndAParkingCommandDrivesWithou
 }
 
 TEST_P(FlightplanE2e, TheBoardFallingIntoHoldMidPlanIsSeenSaidAndUndoneWithinFiveSeconds) {
-    const auto file = write_plan("route.yaml", line_plan("route", kHomeLat, kHomeLon + 0.0001, 0, 40, 10));
+    // Legs of 40 m, 200 ms of real time each at this speedup: under qemu the feeder keeps ahead of the
+    // vehicle, which must be on a leg when the HOLD comes. Waiting at the frontier, a 2.x board holds by
+    // itself (the barrier ends its mission), and a HOLD forced then is that one: nothing to say.
+    const auto file = write_plan("route.yaml", line_plan("route", kHomeLat, kHomeLon + 0.0001, 0, 40, 40));
     const auto expected = expected_positions(file);
     start_daemon(20);
     const auto first = reached_total(*control_);
     ASSERT_EQ(ctl({"plan", "load", file}).exit_code, 0);
     ASSERT_TRUE(wait_until([&] { return show().value("waypoints_reached", 0) >= 8; }, kGenerous, kPoll));
+    const auto frontier_stops_before = show().value("frontier_stops", 0);
     const double forced_at = sim_time();
     const auto forced = control_->ask(kForceHold);
     ASSERT_TRUE(forced && forced->rfind("ok", 0) == 0) << forced.value_or("no answer");
@@ -779,7 +783,9 @@ TEST_P(FlightplanE2e, TheBoardFallingIntoHoldMidPlanIsSeenSaidAndUndoneWithinFiv
     std::cout << "[ figures ] " << GetParam() << ": back in AUTO " << seconds_since(held_since)
               << " s after the HOLD\n";
     const auto plan = show();
-    ASSERT_TRUE(plan["interruption"].is_string()) << plan.dump();
+    ASSERT_TRUE(plan["interruption"].is_string())
+        << "stops at the frontier before the HOLD " << frontier_stops_before << " (a HOLD during one is the "
+        << "board's own on 2.x); the plan: " << plan.dump();
     EXPECT_NE(plan["interruption"].get<std::string>().find("HOLD"), std::string::npos) << plan.dump();
     ASSERT_TRUE(wait_until([&] { return show().value("state", "") == "done"; }, 60s, kPoll)) << show().dump();
     const auto reached = board_log(first);

@@ -2,6 +2,7 @@
 // pause and holds, all in simulated time.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <map>
@@ -32,6 +33,39 @@ void expect_visited(const Harness& h, double base_lat, std::uint64_t from, std::
             << "waypoint " << i;
     }
 }
+
+/// A board driven by hand, one place at a time: the vehicle reaches at most one place per step, so it
+/// outruns the feeder, which falls behind to the frontier.
+struct OutrunningBoard {
+    std::map<std::uint16_t, autopilot::MissionItem> items;
+    std::uint16_t target = 1;
+
+    /// Takes an answered upload or set-current; a write is the caller's.
+    void take(const FeederRequest& r) {
+        if (const auto* up = std::get_if<autopilot::UploadMission>(&r.op)) {
+            for (std::size_t k = 0; k < up->items.size(); ++k) {
+                items[static_cast<std::uint16_t>(k + 1)] = up->items[k];
+            }
+        } else if (const auto* sc = std::get_if<autopilot::SetMissionCurrent>(&r.op)) {
+            target = sc->slot;
+        }
+    }
+    /// Drives to the target if it holds a waypoint (a barrier, or nothing, holds the vehicle there) and
+    /// reports it reached and the next target, through the wrap's jump.
+    void drive_one(WindowFeeder& f, TimePoint now) {
+        const auto at = items.find(target);
+        if (at == items.end() || at->second.kind != autopilot::MissionItem::Kind::Waypoint) {
+            return;
+        }
+        f.on_reached(target, now);
+        target = static_cast<std::uint16_t>(target + 1);
+        if (const auto next = items.find(target);
+            next != items.end() && next->second.kind == autopilot::MissionItem::Kind::JumpTo) {
+            target = next->second.jump_slot;
+        }
+        f.on_current(target, now);
+    }
+};
 
 TEST(FlightplanFeeder, ConfigRejectsWindowBelowThree) {
     FeederConfig c;
@@ -732,8 +766,9 @@ TEST(FlightplanFeeder, AnArrivalAtTheWrapBeforeItsWriteIsAnsweredIsTheEntryOnceT
     WindowFeeder f(FeederConfig{});  // window 5: ring slots 2..5, the wrap 6..8
     TimePoint now{};
     f.replace_plan(test::synthetic(40), now);
-    std::map<std::uint16_t, MissionItem> board;
-    std::uint16_t target = 1;
+    OutrunningBoard b;
+    auto& board = b.items;
+    auto& target = b.target;
     std::vector<FeederEvent::Kind> kinds;
     int starved = 0;
     const auto drain = [&] {
@@ -742,36 +777,17 @@ TEST(FlightplanFeeder, AnArrivalAtTheWrapBeforeItsWriteIsAnsweredIsTheEntryOnceT
             starved += e->kind == FeederEvent::Kind::WindowStarved ? 1 : 0;
         }
     };
-    // The vehicle reaches at most one place per request answered: it outruns the feeder, which falls behind.
-    const auto drive_one = [&] {
-        const auto at = board.find(target);
-        if (at == board.end() || at->second.kind != MissionItem::Kind::Waypoint) {
-            return;  // a barrier (or nothing): it waits there
-        }
-        f.on_reached(target, now);
-        target = static_cast<std::uint16_t>(target + 1);
-        if (const auto next = board.find(target);
-            next != board.end() && next->second.kind == MissionItem::Kind::JumpTo) {
-            target = next->second.jump_slot;
-        }
-        f.on_current(target, now);
-    };
     bool met = false;
     for (int i = 0; i < 400 && !met; ++i) {
         now += milliseconds(100);
         const auto r = f.poll_request(now);
         if (!r) {
-            drive_one();
+            b.drive_one(f, now);
             drain();
             continue;
         }
-        if (const auto* up = std::get_if<autopilot::UploadMission>(&r->op)) {
-            for (std::size_t k = 0; k < up->items.size(); ++k) {
-                board[static_cast<std::uint16_t>(k + 1)] = up->items[k];
-            }
-        } else if (const auto* sc = std::get_if<autopilot::SetMissionCurrent>(&r->op)) {
-            target = sc->slot;
-        } else if (const auto* w = std::get_if<autopilot::WriteMissionItems>(&r->op)) {
+        b.take(*r);
+        if (const auto* w = std::get_if<autopilot::WriteMissionItems>(&r->op)) {
             const bool at_the_wrap = w->first_slot == 6 && w->items.size() == 3 && target == 6 &&
                                      board[6].kind == MissionItem::Kind::Stop;
             board[w->first_slot] = w->items[0];
@@ -795,7 +811,7 @@ TEST(FlightplanFeeder, AnArrivalAtTheWrapBeforeItsWriteIsAnsweredIsTheEntryOnceT
         f.on_request_result(r->id, autopilot::RequestResult::Ok, now);
         drain();
         if (!met) {
-            drive_one();
+            b.drive_one(f, now);
             drain();
         }
     }
@@ -814,6 +830,95 @@ TEST(FlightplanFeeder, AnArrivalAtTheWrapBeforeItsWriteIsAnsweredIsTheEntryOnceT
         }
         if (const auto* sc = std::get_if<autopilot::SetMissionCurrent>(&r->op)) {
             EXPECT_NE(sc->slot, 6) << "pointed back at the slot it reached";
+        }
+        f.on_request_result(r->id, autopilot::RequestResult::Ok, now);
+    }
+}
+
+// A 2.x board runs a Stop as a jump past its mission's end and never reports reaching one. The daemon,
+// stopped for seconds, gave up on the answer to the head's write (it waited in the port); the board had
+// stored the entry, and the vehicle reached it and stopped at the next barrier. Its report of the head's slot
+// is the entry reached, not an arrival at the barrier the slot held: no wait at the frontier is counted
+// there, and the vehicle is never pointed back at the slot it reached (it drove that waypoint twice, in
+// place).
+TEST(FlightplanFeeder, AReportOfTheHeadsSlotWhoseWriteWasGivenUpOnIsTheEntryOnABoardWhoseStopIsAJump) {
+    using autopilot::MissionItem;
+    const FeederConfig config{};  // window 5: ring slots 2..5, the wrap 6..8
+    WindowFeeder f(config);
+    f.set_stop_ends_mission(true);
+    TimePoint now{};
+    f.replace_plan(test::synthetic(40), now);
+    OutrunningBoard b;
+    auto& board = b.items;
+    auto& target = b.target;
+    std::vector<FeederEvent> events;
+    const auto drain = [&] {
+        while (auto e = f.poll_event()) {
+            events.push_back(*e);
+        }
+    };
+    std::optional<std::uint16_t> lost_slot;
+    std::size_t reached_before = 0;
+    for (int i = 0; i < 400 && !lost_slot; ++i) {
+        now += milliseconds(100);
+        const auto r = f.poll_request(now);
+        if (!r) {
+            b.drive_one(f, now);
+            drain();
+            continue;
+        }
+        b.take(*r);
+        if (const auto* w = std::get_if<autopilot::WriteMissionItems>(&r->op)) {
+            const bool over_the_target = w->first_slot == target && w->first_slot < 6 &&
+                                         w->items.size() == 1 &&
+                                         w->items[0].kind == MissionItem::Kind::Waypoint &&
+                                         board[target].kind == MissionItem::Kind::Stop;
+            board[w->first_slot] = w->items[0];
+            if (over_the_target) {
+                // The board stores the entry and answers; the daemon is stopped, and when it runs again it
+                // gives up on the answer before reading it.
+                lost_slot = w->first_slot;
+                drain();
+                reached_before = static_cast<std::size_t>(std::count_if(
+                    events.begin(), events.end(),
+                    [](const FeederEvent& e) { return e.kind == FeederEvent::Kind::WaypointReached; }));
+                now += config.request_timeout + seconds(1);
+                f.handle_timeout(now);
+                now += seconds(1);
+                f.handle_timeout(now);
+                drain();
+                // Then it reads what the board said meanwhile: the entry reached, and nothing of use after it
+                // (the barrier beyond is a jump past the end; the board holds there).
+                f.on_reached(*lost_slot, now);
+                target = static_cast<std::uint16_t>(*lost_slot + 1);
+                drain();
+                continue;
+            }
+            for (std::size_t k = 1; k < w->items.size(); ++k) {
+                board[static_cast<std::uint16_t>(w->first_slot + k)] = w->items[k];
+            }
+        }
+        f.on_request_result(r->id, autopilot::RequestResult::Ok, now);
+        drain();
+        b.drive_one(f, now);
+        drain();
+    }
+    ASSERT_TRUE(lost_slot)
+        << "the scenario needs the head written over its barrier as the vehicle heads there";
+    const std::size_t reached_after =
+        static_cast<std::size_t>(std::count_if(events.begin(), events.end(), [](const FeederEvent& e) {
+            return e.kind == FeederEvent::Kind::WaypointReached;
+        }));
+    EXPECT_EQ(reached_after, reached_before + 1) << "the entry in the lost write's slot, reached";
+    // What follows (every request answered): the vehicle is never pointed back at the slot it reached.
+    for (int i = 0; i < 50; ++i) {
+        now += milliseconds(100);
+        const auto r = f.poll_request(now);
+        if (!r) {
+            break;
+        }
+        if (const auto* sc = std::get_if<autopilot::SetMissionCurrent>(&r->op)) {
+            EXPECT_NE(sc->slot, *lost_slot) << "pointed back at the slot it reached";
         }
         f.on_request_result(r->id, autopilot::RequestResult::Ok, now);
     }
