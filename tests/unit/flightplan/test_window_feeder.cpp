@@ -50,6 +50,20 @@ struct OutrunningBoard {
             target = sc->slot;
         }
     }
+    /// 100 ms on: the feeder's next request, taken (a write is the caller's); without one the vehicle drives
+    /// one place and `drain` reads the feeder's events.
+    template <class Drain>
+    std::optional<FeederRequest> step(WindowFeeder& f, TimePoint& now, Drain&& drain) {
+        now += milliseconds(100);
+        auto r = f.poll_request(now);
+        if (!r) {
+            drive_one(f, now);
+            drain();
+            return std::nullopt;
+        }
+        take(*r);
+        return r;
+    }
     /// Drives to the target if it holds a waypoint (a barrier, or nothing, holds the vehicle there) and
     /// reports it reached and the next target, through the wrap's jump.
     void drive_one(WindowFeeder& f, TimePoint now) {
@@ -779,14 +793,10 @@ TEST(FlightplanFeeder, AnArrivalAtTheWrapBeforeItsWriteIsAnsweredIsTheEntryOnceT
     };
     bool met = false;
     for (int i = 0; i < 400 && !met; ++i) {
-        now += milliseconds(100);
-        const auto r = f.poll_request(now);
+        const auto r = b.step(f, now, drain);
         if (!r) {
-            b.drive_one(f, now);
-            drain();
             continue;
         }
-        b.take(*r);
         if (const auto* w = std::get_if<autopilot::WriteMissionItems>(&r->op)) {
             const bool at_the_wrap = w->first_slot == 6 && w->items.size() == 3 && target == 6 &&
                                      board[6].kind == MissionItem::Kind::Stop;
@@ -860,14 +870,10 @@ TEST(FlightplanFeeder, AReportOfTheHeadsSlotWhoseWriteWasGivenUpOnIsTheEntryOnAB
     std::optional<std::uint16_t> lost_slot;
     std::size_t reached_before = 0;
     for (int i = 0; i < 400 && !lost_slot; ++i) {
-        now += milliseconds(100);
-        const auto r = f.poll_request(now);
+        const auto r = b.step(f, now, drain);
         if (!r) {
-            b.drive_one(f, now);
-            drain();
             continue;
         }
-        b.take(*r);
         if (const auto* w = std::get_if<autopilot::WriteMissionItems>(&r->op)) {
             const bool over_the_target = w->first_slot == target && w->first_slot < 6 &&
                                          w->items.size() == 1 &&
